@@ -1,0 +1,23 @@
+#pragma once
+// The subcommands of the drapegen program. Each registers its options on the app and returns a runner that
+// returns the process exit code.
+
+#include <CLI/CLI.hpp>
+#include <functional>
+
+namespace drapegen::cli {
+
+using Runner = std::function<int()>;
+
+/// Exit codes shared by all subcommands.
+enum ExitCode : int {
+  kExitOk = 0,
+  kExitUsage = 1,        // bad input: one line on stderr says why
+  kExitNotConverged = 2, // the computation ran but did not reach its goal (the outcome says why)
+  kExitIo = 3,           // an output could not be written
+};
+
+Runner add_simulate_command(CLI::App& app);
+Runner add_cantilever_command(CLI::App& app);
+
+}  // namespace drapegen::cli

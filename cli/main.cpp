@@ -1,0 +1,28 @@
+// drapegen: synthetic drape data for bending-parameter estimation. One program, one subcommand per job.
+#include <iostream>
+#include <map>
+
+#include "commands.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"drapegen - cloth drape simulation for learning fabric bending stiffness"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "drapegen 0.1.0");
+  std::map<CLI::App*, drapegen::cli::Runner> runners;
+  auto add = [&](const char* name, const char* description, auto factory) {
+    CLI::App* sub = app.add_subcommand(name, description);
+    runners[sub] = factory(*sub);
+  };
+  add("simulate", "Simulate one drape on the drape tester and print its summary", drapegen::cli::add_simulate_command);
+  add("cantilever", "Simulate a clamped strip hanging under its own weight (physical validation)",
+      drapegen::cli::add_cantilever_command);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  for (const auto& [sub, run] : runners) {
+    if (sub->parsed()) return run();
+  }
+  return drapegen::cli::kExitUsage;
+}

@@ -1,0 +1,192 @@
+// drapegen simulate: one drape on the drape tester.
+#include <cmath>
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <random>
+
+#include <fmt/format.h>
+
+#include "commands.hpp"
+#include "drapegen/sim/drape.hpp"
+#include "drapegen/sim/ply.hpp"
+#include "parse.hpp"
+
+namespace drapegen::cli {
+namespace {
+
+struct SimulateOptions {
+  std::string alpha;
+  std::string beta = "0";
+  double density = 300.0;
+  int resolution = 100;
+  std::string init = "flat";
+  double rotation_deg = 0.0;
+  std::string drift = "0";
+  std::uint64_t seed = 0;
+  std::string out;
+  bool json = false;
+  std::string model = "dihedral";
+  std::string anisotropy = "curvature";
+  double sigma = 200.0;
+  std::string band = "0.99,1.01";
+  bool structured = false;
+  int max_iterations = 400;
+  double tolerance = 1e-3;
+  bool verbose = false;
+};
+
+/// "--drift MM": a distance in a direction drawn from the seed; "--drift DX,DY": an offset. Millimetres.
+sim::Expected<Eigen::Vector2d> parse_drift(const std::string& text, std::uint64_t seed) {
+  const auto comma = text.find(',');
+  try {
+    std::size_t used = 0;
+    if (comma == std::string::npos) {
+      const double mm = std::stod(text, &used);
+      if (used != text.size() || !std::isfinite(mm) || mm < 0.0) throw std::invalid_argument("");
+      std::mt19937_64 rng(seed ^ 0x9e3779b97f4a7c15ULL);
+      const double angle = std::uniform_real_distribution<double>(0.0, 2.0 * M_PI)(rng);
+      return Eigen::Vector2d(Eigen::Vector2d(std::cos(angle), std::sin(angle)) * (mm * 1e-3));
+    }
+    std::size_t used_y = 0;
+    const std::string xs = text.substr(0, comma), ys = text.substr(comma + 1);
+    const double dx = std::stod(xs, &used), dy = std::stod(ys, &used_y);
+    if (used != xs.size() || used_y != ys.size() || !std::isfinite(dx) || !std::isfinite(dy)) {
+      throw std::invalid_argument("");
+    }
+    return Eigen::Vector2d(dx * 1e-3, dy * 1e-3);
+  } catch (const std::exception&) {
+    return sim::Error{"--drift: expected MM (>= 0) or DX,DY in millimetres, got '" + text + "'"};
+  }
+}
+
+int fail(const std::string& message, int code = kExitUsage) {
+  std::cerr << "drapegen simulate: error: " << message << "\n";
+  return code;
+}
+
+int run_simulate(const SimulateOptions& o) {
+  const auto alpha = parse_directional(o.alpha, "--alpha");
+  if (!alpha) return fail(alpha.error().message);
+  const auto beta = parse_directional(o.beta, "--beta");
+  if (!beta) return fail(beta.error().message);
+  if (!(o.density > 0.0) || !std::isfinite(o.density)) return fail("--density must be positive (g/m^2)");
+  if (o.resolution < 3) return fail("--resolution must be at least 3");
+  auto initial = sim::parse_initial_state(o.init);
+  if (!initial) return fail(initial.error().message);
+  const auto drift = parse_drift(o.drift, o.seed);
+  if (!drift) return fail(drift.error().message);
+  if (!std::isfinite(o.rotation_deg)) return fail("--rotation must be finite");
+
+  sim::DrapeConfig config;
+  config.fabric = sim::fabric_from_paper_units(*alpha, *beta, o.density);
+  if (o.model == "quadratic") {
+    config.bending_model = sim::BendingModel::kQuadratic;
+    // The quadratic model's gamma equals alpha / 3 for identical small-angle behaviour (paper Section 4.2.1).
+    config.fabric.gamma = {config.fabric.alpha.warp / 3, config.fabric.alpha.bias / 3, config.fabric.alpha.weft / 3};
+  }
+  config.anisotropy = o.anisotropy == "edge" ? sim::AnisotropyRule::kEdge : sim::AnisotropyRule::kCurvature;
+  config.membrane.stiffness = o.sigma;
+  {
+    const auto comma = o.band.find(',');
+    try {
+      if (comma == std::string::npos) throw std::invalid_argument("");
+      config.membrane.band_low = std::stod(o.band.substr(0, comma));
+      config.membrane.band_high = std::stod(o.band.substr(comma + 1));
+    } catch (const std::exception&) {
+      return fail("--band: expected LOW,HIGH, e.g. 0.99,1.01");
+    }
+    if (!(config.membrane.band_low > 0.0 && config.membrane.band_low <= 1.0 && config.membrane.band_high >= 1.0 &&
+          std::isfinite(config.membrane.band_high))) {
+      return fail("--band: need 0 < LOW <= 1 <= HIGH");
+    }
+  }
+  if (!(o.sigma > 0.0) || !std::isfinite(o.sigma)) return fail("--sigma must be positive (kg/s^2)");
+  config.specimen.vertices_x = config.specimen.vertices_y = o.resolution;
+  config.specimen.seed = o.seed;
+  if (o.structured) {
+    config.specimen.jitter = 0.0;
+    config.specimen.random_diagonals = false;
+  }
+  initial->seed = o.seed;
+  initial->rotation = o.rotation_deg * M_PI / 180.0;
+  initial->drift = *drift;
+  config.initial = *initial;
+  config.solver.max_iterations = o.max_iterations;
+  config.solver.tolerance = o.tolerance;
+  if (sim::Status s = sim::validate(config.fabric, config.bending_model); !s) return fail(s.error().message);
+
+  // Refuse an unwritable output before spending the simulation on it.
+  if (!o.out.empty()) {
+    if (sim::Status s = check_writable(o.out); !s) return fail(s.error().message, kExitIo);
+  }
+  std::function<void(const sim::IterationInfo&)> progress;
+  if (o.verbose) {
+    progress = [](const sim::IterationInfo& i) {
+      std::cerr << fmt::format("iter {:4d}  energy {:.9e}  residual {:.3e}  step {:.3g}  shift {:.1e}\n", i.iteration,
+                               i.energy, i.residual, i.step_length, i.regularization);
+    };
+  }
+  const auto result = sim::simulate_drape(config, progress);
+  if (!result) return fail(result.error().message);
+  if (!o.out.empty()) {
+    if (sim::Status s = sim::write_ply(o.out, result->mesh); !s) return fail(s.error().message, kExitIo);
+  }
+  nlohmann::json summary = sim::to_json(*result);
+  summary["alpha"] = {alpha->warp, alpha->bias, alpha->weft};
+  summary["beta"] = {beta->warp, beta->bias, beta->weft};
+  summary["density_g_per_m2"] = o.density;
+  summary["init"] = o.init;
+  summary["seed"] = o.seed;
+  if (!o.out.empty()) summary["mesh"] = o.out;
+  if (o.json) {
+    std::cout << summary.dump(2) << "\n";
+  } else {
+    const auto& r = result->report;
+    std::cout << fmt::format(
+        "drape: {} in {} iterations, {:.2f} s (factorisation {:.2f} s), residual {:.2e}\n"
+        "  drape coefficient {:.3f}, folds {}, self-intersections {}, lowest point {:.1f} mm\n",
+        sim::to_string(r.outcome), r.iterations, r.seconds, r.factorization_seconds, r.residual,
+        result->measures.drape_coefficient, result->measures.folds, result->measures.self_intersections,
+        result->measures.lowest_point * 1e3);
+    if (!r.message.empty()) std::cout << "  " << r.message << "\n";
+    if (!o.out.empty()) std::cout << "  mesh written to " << o.out << "\n";
+  }
+  return result->report.outcome == sim::SolveOutcome::kConverged ? kExitOk : kExitNotConverged;
+}
+
+}  // namespace
+
+Runner add_simulate_command(CLI::App& app) {
+  auto o = std::make_shared<SimulateOptions>();
+  app.add_option("--alpha", o->alpha, "Linear bending moduli W,B,F (warp, bias, weft), g*mm^2/s^2")->required();
+  app.add_option("--beta", o->beta, "Quadratic bending moduli W,B,F, g*mm^3/s^2 (usually negative)")
+      ->capture_default_str();
+  app.add_option("--density", o->density, "Areal density, g/m^2")->capture_default_str();
+  app.add_option("--resolution", o->resolution, "Vertices per side of the 300 mm specimen")->capture_default_str();
+  app.add_option("--init", o->init, "Initial state: flat, sine, fold or mesh:FILE.ply")->capture_default_str();
+  app.add_option("--rotation", o->rotation_deg, "Specimen rotation about the platform axis, degrees")
+      ->capture_default_str();
+  app.add_option("--drift", o->drift, "Specimen centre off the axis: MM (seeded direction) or DX,DY, millimetres")
+      ->capture_default_str();
+  app.add_option("--seed", o->seed, "Seed of the triangulation perturbation and the initial state")
+      ->capture_default_str();
+  app.add_option("--out", o->out, "Write the draped mesh to this PLY file");
+  app.add_flag("--json", o->json, "Print the summary as JSON");
+  app.add_option("--model", o->model, "Bending model: dihedral (paper Eq. 1-3) or quadratic (Eq. 4, gamma = alpha/3)")
+      ->check(CLI::IsMember({"dihedral", "quadratic"}))
+      ->capture_default_str();
+  app.add_option("--anisotropy", o->anisotropy, "Bending direction rule: curvature (paper) or edge (naive)")
+      ->check(CLI::IsMember({"curvature", "edge"}))
+      ->capture_default_str();
+  app.add_option("--sigma", o->sigma, "In-plane stiffness, kg/s^2")->capture_default_str();
+  app.add_option("--band", o->band, "Stretch band LOW,HIGH absorbed by the adaptive reference (1,1: none)")
+      ->capture_default_str();
+  app.add_flag("--structured", o->structured, "Use a regular grid instead of the perturbed triangulation");
+  app.add_option("--max-iterations", o->max_iterations, "Newton iteration limit")->capture_default_str();
+  app.add_option("--tolerance", o->tolerance, "Residual force over the largest vertex weight")->capture_default_str();
+  app.add_flag("-v,--verbose", o->verbose, "Print every Newton iteration on stderr");
+  return [o] { return run_simulate(*o); };
+}
+
+}  // namespace drapegen::cli

@@ -1,0 +1,108 @@
+#pragma once
+// Bending energies: the paper's nonlinear dihedral-angle model (Eq. 1-3) and the quadratic model (Eq. 4), both
+// anisotropic by Eq. 8 with a bending direction per hinge (curvature-based or edge-based rule, Section 4.4).
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "drapegen/sim/anisotropy.hpp"
+#include "drapegen/sim/energy.hpp"
+#include "drapegen/sim/mesh.hpp"
+
+namespace drapegen::sim {
+
+/// The torque law tau(kappa) = alpha * kappa + beta * kappa^2 per unit hinge length (alpha in N*m, beta in N*m^2).
+///
+/// Softening (beta < 0) makes the torque peak at kappa_peak = alpha / (2|beta|) and fall beyond it, which would be a
+/// negative stiffness (alpha + 2 beta kappa <= 0) and a torque that changes sign. The model holds the torque at its
+/// peak beyond kappa_peak instead: a plateau, like a yield moment. The energy stays C1 and convex in theta.
+struct TorqueLaw {
+  double alpha = 0.0;
+  double beta = 0.0;
+
+  /// Curvature where the plateau starts (infinity if beta >= 0).
+  [[nodiscard]] double peak_curvature() const;
+  [[nodiscard]] double torque(double kappa) const;     // kappa >= 0
+  [[nodiscard]] double stiffness(double kappa) const;  // d torque / d kappa, >= 0
+  /// Integral of the torque from 0 to kappa (energy per unit hinge length per unit of the curvature scale).
+  [[nodiscard]] double work(double kappa) const;
+};
+
+/// Rest geometry shared by hinge-based models.
+struct HingeRest {
+  double edge_length = 0.0;   // e
+  double height_sum = 0.0;    // H0 + H1 (rest heights of the two wings over the edge)
+};
+
+[[nodiscard]] std::vector<HingeRest> hinge_rest_geometry(const ClothMesh& mesh, const Topology& topology);
+
+/// Per-direction bending moduli of the nonlinear dihedral model (SI units).
+struct DihedralModuli {
+  DirectionalValues alpha;  // N*m
+  DirectionalValues beta;   // N*m^2
+  [[nodiscard]] bool isotropic() const;
+};
+
+/// E_h = e * integral_0^|theta| tau(c xi) dxi with c = 2 / (H0 + H1), i.e. kappa = 2 theta / (H0 + H1) (Eq. 3).
+class DihedralBending final : public EnergyTerm {
+ public:
+  DihedralBending(const ClothMesh& mesh, const Topology& topology, const DihedralModuli& moduli, AnisotropyRule rule);
+
+  [[nodiscard]] std::string_view name() const override { return "bending"; }
+  [[nodiscard]] int arity() const override { return 4; }
+  [[nodiscard]] int element_count() const override { return static_cast<int>(hinges_.size()); }
+  void element_vertices(int element, int* out) const override;
+
+  /// Recomputes each hinge's bending direction (curvature rule) and its torque law by Eq. 8.
+  void begin_iteration(const Eigen::Matrix3Xd& x) override;
+  [[nodiscard]] double energy(const Eigen::Matrix3Xd& x) const override;
+  double evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd* gradient, HessianSink* hessian) const override;
+
+  /// Use the Gauss-Newton Hessian (drop tau * d^2 theta) in projected mode instead of an eigen-projection of the
+  /// full element Hessian. Cheaper per iteration; PSD by construction since the torque law is monotone.
+  void set_gauss_newton(bool on) { gauss_newton_ = on; }
+  [[nodiscard]] const std::vector<TorqueLaw>& laws() const { return laws_; }
+  [[nodiscard]] const Eigen::VectorXd& bending_angles() const { return phi_; }
+
+ private:
+  void assign_laws();
+
+  const ClothMesh* mesh_;
+  const Topology* topology_;
+  std::vector<Hinge> hinges_;
+  std::vector<HingeRest> rest_;
+  std::vector<TorqueLaw> laws_;
+  Eigen::VectorXd phi_;
+  DihedralModuli moduli_;
+  AnisotropyRule rule_;
+  bool gauss_newton_ = false;
+};
+
+/// Bergou et al. 2006 (paper Eq. 4): E_h = 3 gamma / ((H0 + H1) e) * |K x|^2 with the hinge's cotangent weights K.
+/// Equal to the linear dihedral model for small angles when gamma = alpha / 3.
+class QuadraticBending final : public EnergyTerm {
+ public:
+  QuadraticBending(const ClothMesh& mesh, const Topology& topology, const DirectionalValues& gamma,
+                   AnisotropyRule rule);
+
+  [[nodiscard]] std::string_view name() const override { return "bending"; }
+  [[nodiscard]] int arity() const override { return 4; }
+  [[nodiscard]] int element_count() const override { return static_cast<int>(hinges_.size()); }
+  void element_vertices(int element, int* out) const override;
+  void begin_iteration(const Eigen::Matrix3Xd& x) override;
+  [[nodiscard]] double energy(const Eigen::Matrix3Xd& x) const override;
+  double evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd* gradient, HessianSink* hessian) const override;
+
+ private:
+  const ClothMesh* mesh_;
+  const Topology* topology_;
+  std::vector<Hinge> hinges_;
+  std::vector<Eigen::Vector4d> weights_;  // cotangent weights per hinge vertex
+  std::vector<double> scale_;             // 3 / ((H0 + H1) e)
+  std::vector<double> gamma_;
+  Eigen::VectorXd phi_;
+  DirectionalValues gamma_dir_;
+  AnisotropyRule rule_;
+};
+
+}  // namespace drapegen::sim

@@ -1,0 +1,62 @@
+#pragma once
+// The drape test (paper Section 5.2.1): a specimen on the platform, adhesive where it starts on the top, solved to
+// quasistatic equilibrium; the result with its measures.
+
+#include <functional>
+#include <nlohmann/json_fwd.hpp>
+
+#include "drapegen/sim/expected.hpp"
+#include "drapegen/sim/fabric.hpp"
+#include "drapegen/sim/gravity.hpp"
+#include "drapegen/sim/initial_state.hpp"
+#include "drapegen/sim/membrane.hpp"
+#include "drapegen/sim/newton_solver.hpp"
+#include "drapegen/sim/platform.hpp"
+#include "drapegen/sim/specimen.hpp"
+
+namespace drapegen::sim {
+
+struct DrapeConfig {
+  FabricParameters fabric;
+  BendingModel bending_model = BendingModel::kNonlinearDihedral;
+  AnisotropyRule anisotropy = AnisotropyRule::kCurvature;
+  MembraneParameters membrane;
+  PlatformSpec platform;
+  /// 300 x 300 mm, 100 x 100 vertices, perturbed triangulation.
+  SpecimenSpec specimen{0.3, 0.3, 100, 100, 0.2, true, 0, 0.0};
+  InitialStateSpec initial;
+  SolverOptions solver;
+  double gravity = kStandardGravity;
+  /// Hold the vertices that start on the platform top (static friction, Section 5.2.1).
+  bool adhesion = true;
+  /// Bending Hessian without the tau * d^2(theta) term (cheaper); otherwise the element Hessian is eigen-projected.
+  bool gauss_newton_bending = false;
+};
+
+struct DrapeMeasures {
+  double drape_coefficient = 0.0;   // Cusick
+  int folds = 0;                    // nodes of the hem
+  int self_intersections = 0;       // intersecting pairs of non-adjacent triangles
+  double max_penetration = 0.0;     // m, deepest vertex inside the platform's contact offset
+  double lowest_point = 0.0;        // m, z of the lowest vertex
+};
+
+struct DrapeResult {
+  ClothMesh mesh;
+  SolveReport report;
+  DrapeMeasures measures;
+  int fixed_vertices = 0;
+};
+
+/// Builds and solves the drape. Errors: invalid parameters or an unreadable initial mesh. A solve that does not
+/// converge still returns a result: check report.outcome.
+[[nodiscard]] Expected<DrapeResult> simulate_drape(const DrapeConfig& config,
+                                                   const std::function<void(const IterationInfo&)>& progress = {});
+
+/// Measures of a draped mesh on the given platform.
+[[nodiscard]] DrapeMeasures measure_drape(const ClothMesh& mesh, const PlatformSpec& platform);
+
+/// The JSON summary: outcome, iterations, seconds, residual, energy, drape coefficient, folds, self-intersections.
+[[nodiscard]] nlohmann::json to_json(const DrapeResult& result);
+
+}  // namespace drapegen::sim

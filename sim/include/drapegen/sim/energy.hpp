@@ -1,0 +1,47 @@
+#pragma once
+// The interface every potential energy of the quasistatic problem implements.
+
+#include <Eigen/Core>
+#include <string_view>
+
+namespace drapegen::sim {
+
+/// How an element Hessian is formed.
+enum class HessianMode {
+  kExact,      // the true second derivative (used by derivative checks)
+  kProjected,  // projected to positive semi-definite per element (what Newton uses)
+};
+
+/// Receives one dense element Hessian at a time, (3 * arity) x (3 * arity), column-major, vertex-major DOF order.
+class HessianSink {
+ public:
+  virtual ~HessianSink() = default;
+  [[nodiscard]] virtual HessianMode mode() const = 0;
+  virtual void add(int element, const double* hessian) = 0;
+};
+
+/// A sum of per-element energies over vertex stencils of fixed arity. Positions are 3 x N in metres, energies in J.
+class EnergyTerm {
+ public:
+  virtual ~EnergyTerm() = default;
+
+  [[nodiscard]] virtual std::string_view name() const = 0;
+  /// Vertices per element (1: per-vertex terms, 3: triangles, 4: hinges).
+  [[nodiscard]] virtual int arity() const = 0;
+  [[nodiscard]] virtual int element_count() const = 0;
+  /// Writes the element's `arity()` vertex indices to `out`.
+  virtual void element_vertices(int element, int* out) const = 0;
+  /// Whether the term has a non-zero Hessian at all (gravity does not).
+  [[nodiscard]] virtual bool has_hessian() const { return true; }
+
+  /// Updates quantities lagged by one Newton iteration (adaptive reference state, anisotropy directions).
+  /// The energy is a fixed function of x between two calls.
+  virtual void begin_iteration(const Eigen::Matrix3Xd& /*x*/) {}
+
+  [[nodiscard]] virtual double energy(const Eigen::Matrix3Xd& x) const = 0;
+  /// Returns the energy, adds the gradient into `gradient` (3 x N) when non-null and hands every element Hessian
+  /// to `hessian` when non-null.
+  virtual double evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd* gradient, HessianSink* hessian) const = 0;
+};
+
+}  // namespace drapegen::sim

@@ -1,0 +1,35 @@
+#pragma once
+// Initial states of a drape (paper Fig. 16): flat, random sine waves, a fold along a random direction, or a given
+// mesh (e.g. another sample's drape), each rotated about the platform axis and shifted by a drift.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <string>
+
+#include "drapegen/sim/expected.hpp"
+#include "drapegen/sim/mesh.hpp"
+
+namespace drapegen::sim {
+
+enum class InitialShape { kFlat, kSine, kFold, kMesh };
+
+struct InitialStateSpec {
+  InitialShape shape = InitialShape::kFlat;
+  std::uint64_t seed = 0;       // draws the waves or the fold line
+  double rotation = 0.0;        // radians about the platform axis
+  Eigen::Vector2d drift = Eigen::Vector2d::Zero();  // m, specimen centre relative to the axis
+  std::string mesh_path;        // kMesh: a PLY file
+  double lift = 0.001;          // m, height of the flat part above the top (the contact offset)
+  double platform_radius = 0.05;
+};
+
+/// Parses "flat", "sine", "fold" or "mesh:FILE".
+[[nodiscard]] Expected<InitialStateSpec> parse_initial_state(const std::string& text);
+
+/// Places `mesh` (a flat specimen from make_specimen) in its initial state. The part of the specimen over the
+/// platform top stays flat on it, so it can be held by the adhesive boundary condition. For kMesh the file's
+/// positions replace the mesh's (its rest coordinates and triangles must match the specimen's vertex count; a file
+/// with rest coordinates replaces the whole mesh).
+[[nodiscard]] Status apply_initial_state(const InitialStateSpec& spec, ClothMesh& mesh);
+
+}  // namespace drapegen::sim

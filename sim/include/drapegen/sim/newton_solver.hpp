@@ -1,0 +1,78 @@
+#pragma once
+// Newton-Raphson on the total potential energy: projected Hessians, CHOLMOD, line search and a regularised fallback.
+
+#include <Eigen/Core>
+#include <functional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "drapegen/sim/energy.hpp"
+
+namespace drapegen::sim {
+
+enum class SolveOutcome {
+  kConverged,            // residual below tolerance
+  kIterationLimit,       // max_iterations reached first
+  kStalled,              // no step lowered the energy, even with the strongest regularisation
+  kDiverged,             // non-finite energy, gradient or step
+  kFactorizationFailed,  // CHOLMOD failed for a reason other than indefiniteness
+};
+[[nodiscard]] std::string_view to_string(SolveOutcome outcome);
+
+struct SolverOptions {
+  int max_iterations = 400;
+  /// Converged when the largest unbalanced force on a free vertex is below tolerance * the largest vertex weight.
+  double tolerance = 1e-3;
+  double armijo = 1e-4;
+  int max_line_search = 30;
+  /// Largest vertex displacement of one step, m (keeps penalty contact from being stepped through).
+  double max_step = 0.01;
+  /// Diagonal shift, relative to the mean diagonal, at which the solver gives up (kStalled).
+  double max_regularization = 1e6;
+  /// Below this residual, try the exact (unprojected) Hessian first: near a stable equilibrium it is positive
+  /// definite and restores quadratic convergence; where CHOLMOD finds it indefinite, the projected one is used.
+  double exact_hessian_below = 1.0;
+  /// Below this residual, quantities lagged by one iteration (anisotropy directions) are frozen, so the last
+  /// iterations solve one fixed energy and converge quadratically instead of chasing the lag.
+  double freeze_lagged_below = 0.05;
+};
+
+struct SolveReport {
+  SolveOutcome outcome = SolveOutcome::kIterationLimit;
+  int iterations = 0;
+  double seconds = 0.0;
+  double assembly_seconds = 0.0;
+  double factorization_seconds = 0.0;
+  double residual = 0.0;          // relative, as in SolverOptions::tolerance
+  double energy = 0.0;            // J
+  int regularized_iterations = 0;  // iterations that needed a diagonal shift
+  int exact_hessian_iterations = 0;  // iterations that stepped with the unprojected Hessian
+  int line_search_failures = 0;
+  std::string message;
+};
+
+struct IterationInfo {
+  int iteration;
+  double energy;
+  double residual;
+  double step_length;
+  double regularization;
+};
+
+/// Minimises sum of `terms` over the vertices not in `fixed`, starting from and writing to `x`.
+/// `reference_force` is the force scale of the residual test (the largest vertex weight, N).
+class NewtonSolver {
+ public:
+  explicit NewtonSolver(SolverOptions options = {}) : options_(options) {}
+  void set_progress(std::function<void(const IterationInfo&)> callback) { progress_ = std::move(callback); }
+
+  SolveReport solve(const std::vector<EnergyTerm*>& terms, const std::vector<bool>& fixed, double reference_force,
+                    Eigen::Matrix3Xd& x) const;
+
+ private:
+  SolverOptions options_;
+  std::function<void(const IterationInfo&)> progress_;
+};
+
+}  // namespace drapegen::sim

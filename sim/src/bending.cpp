@@ -1,0 +1,235 @@
+#include "drapegen/sim/bending.hpp"
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "drapegen/sim/dihedral.hpp"
+#include "drapegen/sim/psd_projection.hpp"
+
+namespace drapegen::sim {
+
+double TorqueLaw::peak_curvature() const {
+  return beta < 0.0 ? alpha / (-2.0 * beta) : std::numeric_limits<double>::infinity();
+}
+
+double TorqueLaw::torque(double kappa) const {
+  const double k = std::min(kappa, peak_curvature());
+  return alpha * k + beta * k * k;
+}
+
+double TorqueLaw::stiffness(double kappa) const {
+  return kappa < peak_curvature() ? alpha + 2.0 * beta * kappa : 0.0;
+}
+
+double TorqueLaw::work(double kappa) const {
+  const double peak = peak_curvature();
+  const double k = std::min(kappa, peak);
+  double w = 0.5 * alpha * k * k + beta * k * k * k / 3.0;
+  if (kappa > peak) w += torque(peak) * (kappa - peak);
+  return w;
+}
+
+std::vector<HingeRest> hinge_rest_geometry(const ClothMesh& mesh, const Topology& topology) {
+  std::vector<HingeRest> rest;
+  rest.reserve(topology.hinges.size());
+  auto cross2 = [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); };
+  for (const Hinge& h : topology.hinges) {
+    const Eigen::Vector2d e = mesh.rest.col(h.v1) - mesh.rest.col(h.v0);
+    const double len = e.norm();
+    const double ha = std::abs(cross2(e, mesh.rest.col(h.v2) - mesh.rest.col(h.v0))) / len;
+    const double hb = std::abs(cross2(e, mesh.rest.col(h.v3) - mesh.rest.col(h.v0))) / len;
+    if (!(len > 0.0 && ha > 0.0 && hb > 0.0)) throw std::invalid_argument("bending: degenerate rest hinge");
+    rest.push_back(HingeRest{len, ha + hb});
+  }
+  return rest;
+}
+
+bool DihedralModuli::isotropic() const {
+  return alpha.warp == alpha.bias && alpha.bias == alpha.weft && beta.warp == beta.bias && beta.bias == beta.weft;
+}
+
+namespace {
+
+void validate_directional(const DirectionalValues& v, const char* what, bool positive) {
+  for (double x : {v.warp, v.bias, v.weft}) {
+    if (!std::isfinite(x) || (positive && !(x > 0.0))) {
+      throw std::invalid_argument(std::string("bending: ") + what + (positive ? " must be positive and finite"
+                                                                                : " must be finite"));
+    }
+  }
+}
+
+/// Eq. 8 can extrapolate a modulus below zero between sample directions for extreme anisotropy; keep a floor.
+double floored(double value, const DirectionalValues& v) {
+  const double floor = 1e-3 * std::min({v.warp, v.bias, v.weft});
+  return std::max(value, floor);
+}
+
+}  // namespace
+
+DihedralBending::DihedralBending(const ClothMesh& mesh, const Topology& topology, const DihedralModuli& moduli,
+                                 AnisotropyRule rule)
+    : mesh_(&mesh), topology_(&topology), hinges_(topology.hinges), rest_(hinge_rest_geometry(mesh, topology)),
+      moduli_(moduli), rule_(rule) {
+  validate_directional(moduli.alpha, "alpha", true);
+  validate_directional(moduli.beta, "beta", false);
+  phi_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(hinges_.size()));
+  if (!moduli_.isotropic()) hinge_bending_angles(mesh, topology, AnisotropyRule::kEdge, phi_);
+  assign_laws();
+}
+
+void DihedralBending::element_vertices(int element, int* out) const {
+  const Hinge& h = hinges_[element];
+  out[0] = h.v0;
+  out[1] = h.v1;
+  out[2] = h.v2;
+  out[3] = h.v3;
+}
+
+void DihedralBending::assign_laws() {
+  laws_.resize(hinges_.size());
+  for (std::size_t i = 0; i < hinges_.size(); ++i) {
+    if (moduli_.isotropic()) {
+      laws_[i] = TorqueLaw{moduli_.alpha.warp, moduli_.beta.warp};
+    } else {
+      laws_[i] = TorqueLaw{floored(interpolate_directional(moduli_.alpha, phi_[i]), moduli_.alpha),
+                           interpolate_directional(moduli_.beta, phi_[i])};
+    }
+  }
+}
+
+void DihedralBending::begin_iteration(const Eigen::Matrix3Xd& x) {
+  if (moduli_.isotropic() || rule_ == AnisotropyRule::kEdge) return;
+  ClothMesh current = *mesh_;  // the anisotropy rule reads positions from a mesh
+  current.positions = x;
+  hinge_bending_angles(current, *topology_, rule_, phi_);
+  assign_laws();
+}
+
+double DihedralBending::energy(const Eigen::Matrix3Xd& x) const {
+  double total = 0.0;
+  for (std::size_t i = 0; i < hinges_.size(); ++i) {
+    const Hinge& h = hinges_[i];
+    const double theta = dihedral_angle(x.col(h.v0), x.col(h.v1), x.col(h.v2), x.col(h.v3));
+    const double c = 2.0 / rest_[i].height_sum;
+    total += rest_[i].edge_length / c * laws_[i].work(c * std::abs(theta));
+  }
+  return total;
+}
+
+double DihedralBending::evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd* gradient,
+                                 HessianSink* hessian) const {
+  double total = 0.0;
+  Vector12d g;
+  Matrix12d h2;
+  Matrix12d element;
+  const bool exact_second = hessian != nullptr && (hessian->mode() == HessianMode::kExact || !gauss_newton_);
+  for (std::size_t i = 0; i < hinges_.size(); ++i) {
+    const Hinge& h = hinges_[i];
+    const double c = 2.0 / rest_[i].height_sum;
+    const double e = rest_[i].edge_length;
+    const double theta = exact_second
+                             ? dihedral_angle_hessian(x.col(h.v0), x.col(h.v1), x.col(h.v2), x.col(h.v3), g, h2)
+                             : dihedral_angle_gradient(x.col(h.v0), x.col(h.v1), x.col(h.v2), x.col(h.v3), g);
+    const double kappa = c * std::abs(theta);
+    const TorqueLaw& law = laws_[i];
+    total += e / c * law.work(kappa);
+    const double de = std::copysign(e * law.torque(kappa), theta);  // dE / dtheta
+    const double d2e = e * c * law.stiffness(kappa);                 // d^2E / dtheta^2
+    if (gradient != nullptr) {
+      for (int v = 0; v < 4; ++v) gradient->col((&h.v0)[v]) += de * g.segment<3>(3 * v);
+    }
+    if (hessian == nullptr) continue;
+    element.noalias() = d2e * g * g.transpose();
+    if (exact_second) {
+      element.noalias() += de * h2;
+      if (hessian->mode() == HessianMode::kProjected) project_to_psd<12>(element);
+    }
+    hessian->add(static_cast<int>(i), element.data());
+  }
+  return total;
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+
+QuadraticBending::QuadraticBending(const ClothMesh& mesh, const Topology& topology, const DirectionalValues& gamma,
+                                   AnisotropyRule rule)
+    : mesh_(&mesh), topology_(&topology), hinges_(topology.hinges), gamma_dir_(gamma), rule_(rule) {
+  validate_directional(gamma, "gamma", true);
+  const std::vector<HingeRest> rest = hinge_rest_geometry(mesh, topology);
+  weights_.reserve(hinges_.size());
+  scale_.reserve(hinges_.size());
+  for (std::size_t i = 0; i < hinges_.size(); ++i) {
+    const Hinge& h = hinges_[i];
+    const Eigen::Vector2d x0 = mesh.rest.col(h.v0), x1 = mesh.rest.col(h.v1);
+    const Eigen::Vector2d e = x1 - x0;
+    const double len2 = e.squaredNorm();
+    const double a2 = (mesh.rest.col(h.v2) - x0).dot(e) / len2;
+    const double a3 = (mesh.rest.col(h.v3) - x0).dot(e) / len2;
+    auto height = [&](int v) {
+      const Eigen::Vector2d d = mesh.rest.col(v) - x0;
+      return std::abs(e.x() * d.y() - e.y() * d.x()) / std::sqrt(len2);
+    };
+    // |e| / h equals cot + cot of the wing's two angles at the edge (Bergou's cotangent weights).
+    const double wa = std::sqrt(len2) / height(h.v2), wb = std::sqrt(len2) / height(h.v3);
+    weights_.emplace_back(-((1.0 - a2) * wa + (1.0 - a3) * wb), -(a2 * wa + a3 * wb), wa, wb);
+    scale_.push_back(3.0 / (rest[i].height_sum * rest[i].edge_length));
+  }
+  phi_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(hinges_.size()));
+  hinge_bending_angles(mesh, topology, AnisotropyRule::kEdge, phi_);
+  gamma_.resize(hinges_.size());
+  for (std::size_t i = 0; i < hinges_.size(); ++i) gamma_[i] = floored(interpolate_directional(gamma, phi_[i]), gamma);
+}
+
+void QuadraticBending::element_vertices(int element, int* out) const {
+  const Hinge& h = hinges_[element];
+  out[0] = h.v0;
+  out[1] = h.v1;
+  out[2] = h.v2;
+  out[3] = h.v3;
+}
+
+void QuadraticBending::begin_iteration(const Eigen::Matrix3Xd& x) {
+  const bool isotropic = gamma_dir_.warp == gamma_dir_.bias && gamma_dir_.bias == gamma_dir_.weft;
+  if (isotropic || rule_ == AnisotropyRule::kEdge) return;
+  ClothMesh current = *mesh_;
+  current.positions = x;
+  hinge_bending_angles(current, *topology_, rule_, phi_);
+  for (std::size_t i = 0; i < hinges_.size(); ++i) {
+    gamma_[i] = floored(interpolate_directional(gamma_dir_, phi_[i]), gamma_dir_);
+  }
+}
+
+double QuadraticBending::energy(const Eigen::Matrix3Xd& x) const { return evaluate(x, nullptr, nullptr); }
+
+double QuadraticBending::evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd* gradient,
+                                  HessianSink* hessian) const {
+  double total = 0.0;
+  Matrix12d element;
+  for (std::size_t i = 0; i < hinges_.size(); ++i) {
+    const Hinge& h = hinges_[i];
+    const int v[4] = {h.v0, h.v1, h.v2, h.v3};
+    const Eigen::Vector4d& w = weights_[i];
+    Eigen::Vector3d kx = Eigen::Vector3d::Zero();
+    for (int a = 0; a < 4; ++a) kx += w[a] * x.col(v[a]);
+    const double k = gamma_[i] * scale_[i];
+    total += k * kx.squaredNorm();
+    if (gradient != nullptr) {
+      for (int a = 0; a < 4; ++a) gradient->col(v[a]) += 2.0 * k * w[a] * kx;
+    }
+    if (hessian != nullptr) {
+      element.setZero();
+      for (int a = 0; a < 4; ++a) {
+        for (int b = 0; b < 4; ++b) element.block<3, 3>(3 * a, 3 * b).diagonal().setConstant(2.0 * k * w[a] * w[b]);
+      }
+      hessian->add(static_cast<int>(i), element.data());
+    }
+  }
+  return total;
+}
+
+}  // namespace drapegen::sim

@@ -1,0 +1,100 @@
+#include "drapegen/sim/drape.hpp"
+
+#include <memory>
+#include <nlohmann/json.hpp>
+
+#include "drapegen/sim/bending.hpp"
+#include "drapegen/sim/gravity.hpp"
+#include "drapegen/sim/measures.hpp"
+
+namespace drapegen::sim {
+namespace {
+
+std::unique_ptr<EnergyTerm> make_bending(const ClothMesh& mesh, const Topology& topology, const FabricParameters& fabric,
+                                         BendingModel model, AnisotropyRule rule, bool gauss_newton) {
+  if (model == BendingModel::kQuadratic) return std::make_unique<QuadraticBending>(mesh, topology, fabric.gamma, rule);
+  auto bending = std::make_unique<DihedralBending>(mesh, topology, DihedralModuli{fabric.alpha, fabric.beta}, rule);
+  bending->set_gauss_newton(gauss_newton);
+  return bending;
+}
+
+}  // namespace
+
+Expected<DrapeResult> simulate_drape(const DrapeConfig& config,
+                                     const std::function<void(const IterationInfo&)>& progress) {
+  if (Status s = validate(config.fabric, config.bending_model); !s) return s.error();
+  DrapeResult result;
+  try {
+    result.mesh = make_specimen(config.specimen);
+  } catch (const std::invalid_argument& e) {
+    return Error{e.what()};
+  }
+  InitialStateSpec initial = config.initial;
+  initial.platform_radius = config.platform.radius;
+  initial.lift = config.platform.contact_offset;
+  if (Status s = apply_initial_state(initial, result.mesh); !s) return s.error();
+  ClothMesh& mesh = result.mesh;
+  try {
+    const Topology topology = build_topology(mesh);
+    CorotationalMembrane membrane(mesh, config.membrane);
+    std::unique_ptr<EnergyTerm> bending =
+        make_bending(mesh, topology, config.fabric, config.bending_model, config.anisotropy,
+                     config.gauss_newton_bending);
+    Gravity gravity(mesh, config.fabric.density, config.gravity);
+    PlatformContact contact(mesh, config.platform);
+
+    std::vector<bool> fixed(mesh.vertex_count(), false);
+    if (config.adhesion) {
+      for (int v : contact.vertices_on_top(mesh.positions, 5e-4)) fixed[v] = true;
+    }
+    result.fixed_vertices = static_cast<int>(std::count(fixed.begin(), fixed.end(), true));
+
+    NewtonSolver solver(config.solver);
+    if (progress) solver.set_progress(progress);
+    std::vector<EnergyTerm*> terms{&membrane, bending.get(), &gravity, &contact};
+    Eigen::Matrix3Xd x = mesh.positions;
+    result.report = solver.solve(terms, fixed, gravity.vertex_weights().maxCoeff(), x);
+    mesh.positions = x;
+  } catch (const std::invalid_argument& e) {
+    return Error{e.what()};
+  }
+  result.measures = measure_drape(mesh, config.platform);
+  return result;
+}
+
+DrapeMeasures measure_drape(const ClothMesh& mesh, const PlatformSpec& platform) {
+  DrapeMeasures m;
+  m.drape_coefficient = drape_coefficient(mesh, platform.radius);
+  m.folds = count_folds(hem_profile(mesh));
+  m.self_intersections = count_self_intersections(mesh);
+  m.max_penetration = PlatformContact(mesh, platform).max_penetration(mesh.positions);
+  m.lowest_point = mesh.positions.row(2).minCoeff();
+  return m;
+}
+
+nlohmann::json to_json(const DrapeResult& result) {
+  const SolveReport& r = result.report;
+  return nlohmann::json{
+      {"outcome", std::string(to_string(r.outcome))},
+      {"message", r.message},
+      {"iterations", r.iterations},
+      {"seconds", r.seconds},
+      {"assembly_seconds", r.assembly_seconds},
+      {"factorization_seconds", r.factorization_seconds},
+      {"residual", r.residual},
+      {"energy", r.energy},
+      {"regularized_iterations", r.regularized_iterations},
+      {"exact_hessian_iterations", r.exact_hessian_iterations},
+      {"line_search_failures", r.line_search_failures},
+      {"vertices", result.mesh.vertex_count()},
+      {"triangles", result.mesh.triangle_count()},
+      {"fixed_vertices", result.fixed_vertices},
+      {"drape_coefficient", result.measures.drape_coefficient},
+      {"folds", result.measures.folds},
+      {"self_intersections", result.measures.self_intersections},
+      {"max_penetration_m", result.measures.max_penetration},
+      {"lowest_point_m", result.measures.lowest_point},
+  };
+}
+
+}  // namespace drapegen::sim

@@ -1,0 +1,185 @@
+#include "drapegen/sim/newton_solver.hpp"
+
+#include <chrono>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "drapegen/sim/hessian_assembler.hpp"
+#include "drapegen/sim/logging.hpp"
+#include "drapegen/sim/sparse_cholesky.hpp"
+
+namespace drapegen::sim {
+
+std::string_view to_string(SolveOutcome outcome) {
+  switch (outcome) {
+    case SolveOutcome::kConverged: return "converged";
+    case SolveOutcome::kIterationLimit: return "iteration_limit";
+    case SolveOutcome::kStalled: return "stalled";
+    case SolveOutcome::kDiverged: return "diverged";
+    case SolveOutcome::kFactorizationFailed: return "factorization_failed";
+  }
+  return "unknown";
+}
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+double total_energy(const std::vector<EnergyTerm*>& terms, const Eigen::Matrix3Xd& x) {
+  double e = 0.0;
+  for (const EnergyTerm* t : terms) e += t->energy(x);
+  return e;
+}
+
+}  // namespace
+
+SolveReport NewtonSolver::solve(const std::vector<EnergyTerm*>& terms, const std::vector<bool>& fixed,
+                                double reference_force, Eigen::Matrix3Xd& x) const {
+  const auto start = Clock::now();
+  SolveReport report;
+  const int nv = static_cast<int>(x.cols());
+  std::vector<const EnergyTerm*> const_terms(terms.begin(), terms.end());
+  HessianAssembler assembler(nv, fixed, const_terms);
+  SparseCholesky cholesky;
+  const int n = assembler.dof_count();
+  Eigen::Matrix3Xd gradient(3, nv);
+  Eigen::VectorXd g(n), step(n);
+  Eigen::Matrix3Xd trial(3, nv);
+  double lambda = 0.0;  // diagonal shift relative to the mean diagonal
+
+  auto gather = [&](const Eigen::Matrix3Xd& full, Eigen::VectorXd& reduced) {
+    for (int v = 0; v < nv; ++v) {
+      const int f = assembler.free_index(v);
+      if (f >= 0) reduced.segment<3>(3 * f) = full.col(v);
+    }
+  };
+  auto residual_of = [&](const Eigen::VectorXd& reduced) {
+    double worst = 0.0;
+    for (int f = 0; f < n / 3; ++f) worst = std::max(worst, reduced.segment<3>(3 * f).norm());
+    return worst / reference_force;
+  };
+
+  if (n == 0) {
+    report.outcome = SolveOutcome::kConverged;
+    report.message = "no free vertices";
+    return report;
+  }
+
+  int exact_cooldown = 0;
+  bool frozen = false;     // lagged quantities no longer updated  // iterations to wait before trying the exact Hessian again
+  for (int it = 0; it < options_.max_iterations; ++it) {
+    report.iterations = it;
+    frozen = frozen || (it > 0 && report.residual < options_.freeze_lagged_below);
+    if (!frozen) {
+      for (EnergyTerm* t : terms) t->begin_iteration(x);
+    }
+    bool exact = it > 0 && report.residual < options_.exact_hessian_below && exact_cooldown == 0;
+    exact_cooldown = std::max(0, exact_cooldown - 1);
+    auto t0 = Clock::now();
+    gradient.setZero();
+    double energy = assembler.assemble(x, exact ? HessianMode::kExact : HessianMode::kProjected, gradient);
+    report.assembly_seconds += since(t0);
+    gather(gradient, g);
+    report.energy = energy;
+    report.residual = residual_of(g);
+    if (!std::isfinite(energy) || !g.allFinite()) {
+      report.outcome = SolveOutcome::kDiverged;
+      report.message = fmt::format("non-finite energy or gradient at iteration {}", it);
+      break;
+    }
+    if (report.residual <= options_.tolerance) {
+      report.outcome = SolveOutcome::kConverged;
+      break;
+    }
+
+    // Find a descent step, shifting the diagonal until the factorisation succeeds and the line search passes.
+    double mean_diagonal = 0.0;
+    for (int p : assembler.diagonal_positions()) mean_diagonal += assembler.values()[p];
+    mean_diagonal = std::max(mean_diagonal / n, 1e-300);
+    bool accepted = false;
+    double step_length = 0.0;
+    while (!accepted) {
+      t0 = Clock::now();
+      const FactorStatus status = cholesky.factorize(assembler, lambda * mean_diagonal);
+      report.factorization_seconds += since(t0);
+      if (exact && status != FactorStatus::kOk) {  // indefinite: fall back to the projected Hessian
+        exact = false;
+        exact_cooldown = 5;
+        t0 = Clock::now();
+        gradient.setZero();
+        energy = assembler.assemble(x, HessianMode::kProjected, gradient);
+        report.assembly_seconds += since(t0);
+        continue;
+      }
+      if (status == FactorStatus::kFailed) {
+        report.outcome = SolveOutcome::kFactorizationFailed;
+        report.message = fmt::format("CHOLMOD failed at iteration {} (shift {:.3g})", it, lambda);
+        report.seconds = since(start);
+        return report;
+      }
+      if (status == FactorStatus::kOk && cholesky.solve(-g, step)) {
+        // Limit the largest vertex displacement.
+        double largest = 0.0;
+        for (int f = 0; f < n / 3; ++f) largest = std::max(largest, step.segment<3>(3 * f).norm());
+        double t = largest > options_.max_step ? options_.max_step / largest : 1.0;
+        const double slope = g.dot(step);
+        // A direction almost orthogonal to the gradient comes from an ill-conditioned matrix: treat it as failed.
+        if (slope < -1e-8 * g.norm() * step.norm()) {
+          for (int ls = 0; ls < options_.max_line_search; ++ls, t *= 0.5) {
+            trial = x;
+            for (int v = 0; v < nv; ++v) {
+              const int f = assembler.free_index(v);
+              if (f >= 0) trial.col(v) += t * step.segment<3>(3 * f);
+            }
+            const double e_trial = total_energy(terms, trial);
+            // Near convergence the energy change drops below round-off: accept a step whose predicted decrease
+            // is at the level of machine precision.
+            const bool round_off = report.residual < 10.0 * options_.tolerance &&
+                                   -slope * t < 1e-13 * std::abs(energy);
+            if (std::isfinite(e_trial) && (e_trial <= energy + options_.armijo * t * slope || round_off)) {
+              accepted = true;
+              step_length = t;
+              x.swap(trial);
+              break;
+            }
+          }
+        }
+        if (!accepted) ++report.line_search_failures;
+      }
+      if (!accepted && exact) {  // the exact Hessian gave no usable step: back to the projected one
+        exact = false;
+        exact_cooldown = 5;
+        gradient.setZero();
+        energy = assembler.assemble(x, HessianMode::kProjected, gradient);
+        continue;
+      }
+      if (!accepted) {
+        lambda = lambda == 0.0 ? 1e-6 : lambda * 10.0;
+        if (lambda > options_.max_regularization) {
+          report.outcome = SolveOutcome::kStalled;
+          report.message = fmt::format("no descent step at iteration {} (residual {:.3g})", it, report.residual);
+          report.seconds = since(start);
+          return report;
+        }
+      }
+    }
+    if (lambda > 0.0) ++report.regularized_iterations;
+    if (exact) ++report.exact_hessian_iterations;
+    if (progress_) progress_(IterationInfo{it, energy, report.residual, step_length, lambda});
+    lambda = lambda < 1e-5 ? 0.0 : lambda * 0.1;
+    report.iterations = it + 1;
+  }
+  if (report.outcome != SolveOutcome::kConverged && report.outcome != SolveOutcome::kDiverged &&
+      report.iterations >= options_.max_iterations) {
+    report.outcome = SolveOutcome::kIterationLimit;
+    report.message = fmt::format("residual {:.3g} after {} iterations", report.residual, report.iterations);
+  }
+  report.seconds = since(start);
+  logger()->debug("newton: {} after {} iterations, residual {:.3g}", to_string(report.outcome), report.iterations,
+                  report.residual);
+  return report;
+}
+
+}  // namespace drapegen::sim

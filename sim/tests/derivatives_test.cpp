@@ -1,0 +1,206 @@
+// Finite-difference checks of every energy's gradient and exact Hessian, and PSD-ness of the projected Hessian.
+#include <gtest/gtest.h>
+
+#include <Eigen/Eigenvalues>
+#include <cmath>
+#include <memory>
+#include <random>
+
+#include "drapegen/sim/bending.hpp"
+#include "drapegen/sim/dihedral.hpp"
+#include "drapegen/sim/gravity.hpp"
+#include "drapegen/sim/membrane.hpp"
+#include "drapegen/sim/platform.hpp"
+#include "drapegen/sim/specimen.hpp"
+
+namespace drapegen::sim {
+namespace {
+
+class DenseSink final : public HessianSink {
+ public:
+  DenseSink(const EnergyTerm& term, int vertex_count, HessianMode mode)
+      : term_(term), mode_(mode), h_(Eigen::MatrixXd::Zero(3 * vertex_count, 3 * vertex_count)) {}
+  [[nodiscard]] HessianMode mode() const override { return mode_; }
+  void add(int element, const double* local) override {
+    const int n = term_.arity();
+    std::vector<int> v(n);
+    term_.element_vertices(element, v.data());
+    const Eigen::Map<const Eigen::MatrixXd> m(local, 3 * n, 3 * n);
+    for (int a = 0; a < n; ++a)
+      for (int b = 0; b < n; ++b) h_.block<3, 3>(3 * v[a], 3 * v[b]) += m.block<3, 3>(3 * a, 3 * b);
+  }
+  [[nodiscard]] const Eigen::MatrixXd& matrix() const { return h_; }
+
+ private:
+  const EnergyTerm& term_;
+  HessianMode mode_;
+  Eigen::MatrixXd h_;
+};
+
+Eigen::VectorXd flat(const Eigen::Matrix3Xd& x) { return Eigen::Map<const Eigen::VectorXd>(x.data(), x.size()); }
+
+/// Compares the analytic gradient with central differences of the energy, and the exact Hessian with central
+/// differences of the gradient. Returns the Hessian for further checks.
+Eigen::MatrixXd check_derivatives(const EnergyTerm& term, const Eigen::Matrix3Xd& x, double h, double tol) {
+  const int nv = static_cast<int>(x.cols());
+  Eigen::Matrix3Xd grad = Eigen::Matrix3Xd::Zero(3, nv);
+  DenseSink sink(term, nv, HessianMode::kExact);
+  const double e = term.evaluate(x, &grad, &sink);
+  EXPECT_NEAR(e, term.energy(x), 1e-12 * std::max(1.0, std::abs(e)));
+  const Eigen::VectorXd g = flat(grad);
+  Eigen::VectorXd g_fd(g.size());
+  Eigen::MatrixXd h_fd(g.size(), g.size());
+  for (int i = 0; i < g.size(); ++i) {
+    Eigen::Matrix3Xd xp = x, xm = x;
+    xp.data()[i] += h;
+    xm.data()[i] -= h;
+    g_fd[i] = (term.energy(xp) - term.energy(xm)) / (2 * h);
+    Eigen::Matrix3Xd gp = Eigen::Matrix3Xd::Zero(3, nv), gm = Eigen::Matrix3Xd::Zero(3, nv);
+    term.evaluate(xp, &gp, nullptr);
+    term.evaluate(xm, &gm, nullptr);
+    h_fd.col(i) = (flat(gp) - flat(gm)) / (2 * h);
+  }
+  EXPECT_GT(g.norm(), 0.0) << term.name() << ": the configuration should be loaded";
+  EXPECT_LE((g - g_fd).norm(), tol * g.norm()) << term.name() << " gradient";
+  const Eigen::MatrixXd& hess = sink.matrix();
+  EXPECT_GT(hess.norm(), 0.0);
+  EXPECT_LE((hess - h_fd).norm(), tol * hess.norm()) << term.name() << " Hessian";
+  EXPECT_LE((hess - hess.transpose()).norm(), 1e-12 * hess.norm());
+  return hess;
+}
+
+void expect_projected_psd(const EnergyTerm& term, const Eigen::Matrix3Xd& x) {
+  const int nv = static_cast<int>(x.cols());
+  DenseSink sink(term, nv, HessianMode::kProjected);
+  term.evaluate(x, nullptr, &sink);
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(sink.matrix());
+  EXPECT_GE(eig.eigenvalues().minCoeff(), -1e-9 * std::max(1.0, eig.eigenvalues().maxCoeff())) << term.name();
+}
+
+ClothMesh crumpled_mesh(std::uint64_t seed, double amplitude) {
+  SpecimenSpec spec{0.02, 0.02, 5, 5, 0.25, true, seed, 0.3};
+  ClothMesh mesh = make_specimen(spec);
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> noise(0.0, amplitude);
+  for (int v = 0; v < mesh.vertex_count(); ++v) {
+    const Eigen::Vector2d r = mesh.rest.col(v);
+    mesh.positions.col(v) = Eigen::Vector3d(r.x() * 1.02, r.y() * 0.97, 30.0 * r.x() * r.x() - 20.0 * r.x() * r.y());
+    for (int c = 0; c < 3; ++c) mesh.positions(c, v) += noise(rng);
+  }
+  return mesh;
+}
+
+TEST(Derivatives, MembraneStretchBandIsC1) {
+  CorotationalMembrane membrane(crumpled_mesh(1, 0.0), MembraneParameters{200.0, 0.99, 1.01, 0.01});
+  for (double s : {0.95, 0.99, 0.995, 1.0, 1.007, 1.01, 1.05}) {
+    const double h = 1e-7;
+    const auto g = membrane.stretch_energy(s);
+    EXPECT_NEAR(g.first, (membrane.stretch_energy(s + h).value - membrane.stretch_energy(s - h).value) / (2 * h), 1e-7);
+  }
+  EXPECT_DOUBLE_EQ(membrane.stretch_energy(1.0).value, 0.0);
+  EXPECT_DOUBLE_EQ(membrane.stretch_energy(1.005).second, 0.02);  // eps * 2 inside the band
+  EXPECT_DOUBLE_EQ(membrane.stretch_energy(1.02).second, 2.0);
+}
+
+TEST(Derivatives, MembraneWithStretchBand) {
+  // Stretches of 1.02 and 0.97 plus noise: principal stretches inside and outside the band.
+  const ClothMesh mesh = crumpled_mesh(1, 3e-4);
+  CorotationalMembrane membrane(mesh, MembraneParameters{200.0, 0.99, 1.01});
+  EXPECT_GT(membrane.energy(mesh.positions), 0.0);
+  check_derivatives(membrane, mesh.positions, 1e-7, 1e-5);
+  expect_projected_psd(membrane, mesh.positions);
+}
+
+TEST(Derivatives, MembraneUnderCompressionHasIndefiniteExactHessian) {
+  ClothMesh mesh = crumpled_mesh(3, 0.0);
+  mesh.positions.topRows<2>() = 0.8 * mesh.rest;  // strong compression: twist and out-of-plane modes go negative
+  mesh.positions.row(2).setZero();
+  mesh.positions(2, 12) = 1e-4;
+  CorotationalMembrane membrane(mesh, MembraneParameters{200.0, 1.0, 1.0});
+  const Eigen::MatrixXd h = check_derivatives(membrane, mesh.positions, 1e-8, 1e-5);
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(h);
+  EXPECT_LT(eig.eigenvalues().minCoeff(), 0.0);
+  expect_projected_psd(membrane, mesh.positions);
+}
+
+TEST(Derivatives, DihedralAngleMatchesGeometry) {
+  // A hinge folded by a known angle: wing x2 rotated about the edge (x axis) by -phi (lifted), x3 flat.
+  const double phi = 0.7;
+  const Eigen::Vector3d x0(0, 0, 0), x1(1, 0, 0), x2(0.3, std::cos(phi), std::sin(phi)), x3(0.6, -1.0, 0.0);
+  EXPECT_NEAR(dihedral_angle(x0, x1, x2, x3), -phi, 1e-12);
+  EXPECT_NEAR(dihedral_angle(x0, x1, Eigen::Vector3d(0.3, 1, 0), x3), 0.0, 1e-15);
+}
+
+TEST(Derivatives, NonlinearDihedralBendingSofteningAndStiffening) {
+  const ClothMesh mesh = crumpled_mesh(4, 4e-4);
+  const Topology topo = build_topology(mesh);
+  // Soft enough that some hinges sit on the torque plateau (kappa > alpha / 2|beta|) and some below.
+  for (double beta : {-3e-7, 3e-9}) {
+    DihedralModuli moduli{{1e-5, 1.5e-5, 2e-5}, {beta, 0.5 * beta, 0.8 * beta}};
+    DihedralBending bending(mesh, topo, moduli, AnisotropyRule::kCurvature);
+    bending.begin_iteration(mesh.positions);
+    if (beta < 0) {  // the configuration must exercise both branches of the torque law
+      const std::vector<HingeRest> rest = hinge_rest_geometry(mesh, topo);
+      int plateau = 0, rising = 0;
+      for (std::size_t i = 0; i < topo.hinges.size(); ++i) {
+        const Hinge& h = topo.hinges[i];
+        const double kappa = 2.0 / rest[i].height_sum *
+                             std::abs(dihedral_angle(mesh.positions.col(h.v0), mesh.positions.col(h.v1),
+                                                     mesh.positions.col(h.v2), mesh.positions.col(h.v3)));
+        (kappa > bending.laws()[i].peak_curvature() ? plateau : rising)++;
+      }
+      EXPECT_GT(plateau, 0);
+      EXPECT_GT(rising, 0);
+    }
+    check_derivatives(bending, mesh.positions, 1e-8, 1e-5);
+    expect_projected_psd(bending, mesh.positions);
+  }
+}
+
+TEST(Derivatives, QuadraticBending) {
+  const ClothMesh mesh = crumpled_mesh(5, 4e-4);
+  const Topology topo = build_topology(mesh);
+  QuadraticBending bending(mesh, topo, DirectionalValues{3e-6, 4e-6, 5e-6}, AnisotropyRule::kEdge);
+  check_derivatives(bending, mesh.positions, 1e-7, 1e-5);
+  expect_projected_psd(bending, mesh.positions);
+}
+
+TEST(Derivatives, PlatformContactOnTopRimAndWall) {
+  ClothMesh mesh = make_specimen(SpecimenSpec{0.02, 0.02, 4, 4, 0.0, false, 0, 0.0});
+  PlatformSpec spec;
+  // Place vertices around the rim of the platform: on the top, over the rounded rim and against the wall, all
+  // slightly inside the contact offset.
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int v = 0; v < mesh.vertex_count(); ++v) {
+    const double azimuth = 2.0 * M_PI * u(rng);
+    const double along = -0.004 + 0.008 * u(rng);  // from top (z>0 side) over the rim to the wall
+    Eigen::Vector3d p;
+    if (along < 0) {
+      p = Eigen::Vector3d((spec.radius + along) * std::cos(azimuth), (spec.radius + along) * std::sin(azimuth),
+                          0.0007);
+    } else {
+      const double a = along / 0.004 * M_PI / 2;  // over the fillet
+      const double rr = spec.radius - spec.fillet + (spec.fillet + 0.0007) * std::sin(a);
+      p = Eigen::Vector3d(rr * std::cos(azimuth), rr * std::sin(azimuth),
+                          -spec.fillet + (spec.fillet + 0.0007) * std::cos(a) - 0.002 * u(rng));
+    }
+    mesh.positions.col(v) = p;
+  }
+  PlatformContact contact(mesh, spec);
+  EXPECT_GT(contact.max_penetration(mesh.positions), 0.0);
+  check_derivatives(contact, mesh.positions, 1e-9, 1e-5);
+  expect_projected_psd(contact, mesh.positions);
+}
+
+TEST(Derivatives, GravityGradientIsWeight) {
+  const ClothMesh mesh = crumpled_mesh(6, 1e-4);
+  Gravity gravity(mesh, 0.3);
+  Eigen::Matrix3Xd g = Eigen::Matrix3Xd::Zero(3, mesh.vertex_count());
+  gravity.evaluate(mesh.positions, &g, nullptr);
+  EXPECT_NEAR(g.row(2).sum(), 0.3 * kStandardGravity * 0.02 * 0.02, 1e-15);
+  EXPECT_EQ(g.topRows<2>().norm(), 0.0);
+}
+
+}  // namespace
+}  // namespace drapegen::sim
