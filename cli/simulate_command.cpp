@@ -106,7 +106,7 @@ int run_simulate(const SimulateOptions& o) {
   config.specimen.seed = o.seed;
   if (o.structured) {
     config.specimen.jitter = 0.0;
-    config.specimen.random_diagonals = false;
+    config.specimen.triangulation = sim::Triangulation::kAlternating;
   }
   initial->seed = o.seed;
   initial->rotation = o.rotation_deg * M_PI / 180.0;

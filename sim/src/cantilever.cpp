@@ -1,5 +1,6 @@
 #include "drapegen/sim/cantilever.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 
@@ -15,24 +16,25 @@ Expected<CantileverResult> simulate_cantilever(const CantileverSpec& spec) {
   if (!(spec.length > 0.0) || !(spec.width > 0.0) || !std::isfinite(spec.length) || !std::isfinite(spec.width)) {
     return Error{"cantilever length and width must be positive and finite"};
   }
-  if (spec.segments < 2 || spec.width_vertices < 2) return Error{"cantilever needs >= 2 segments and width vertices"};
+  if (spec.segments < 2) return Error{"cantilever needs at least 2 segments"};
 
   const double h = spec.length / spec.segments;
-  SpecimenSpec s{spec.length + h, spec.width, spec.segments + 2, spec.width_vertices, spec.jitter, spec.jitter > 0.0,
-                 spec.seed, spec.cut_angle};
+  const double row_spacing = spec.triangulation == Triangulation::kEquilateral ? h * std::sqrt(3.0) / 2.0 : h;
+  const int rows = std::max(2, static_cast<int>(std::lround(spec.width / row_spacing)) + 1);
+  SpecimenSpec s{spec.length + h, spec.width, spec.segments + 2, rows, spec.jitter, spec.triangulation, spec.seed,
+                 spec.cut_angle};
   ClothMesh mesh;
   try {
     mesh = make_specimen(s);
   } catch (const std::invalid_argument& e) {
     return Error{e.what()};
   }
-  // Clamp column at x = 0 and one behind it; the free strip runs to x = L.
-  const double shift = -0.5 * (spec.length + h) + h;
-  for (int v = 0; v < mesh.vertex_count(); ++v) mesh.rest(0, v) -= shift;
+  // Shift so that the clamp line is x = 0 and the free strip runs to x = L.
+  mesh.rest.row(0).array() += 0.5 * (spec.length + h) - h;
   mesh.positions.topRows<2>() = mesh.rest;
   mesh.positions.row(2).setZero();
   std::vector<bool> fixed(mesh.vertex_count(), false);
-  for (int v = 0; v < mesh.vertex_count(); ++v) fixed[v] = v % (spec.segments + 2) <= 1;
+  for (int v = 0; v < mesh.vertex_count(); ++v) fixed[v] = mesh.rest(0, v) <= 1e-9 * spec.length;
 
   CantileverResult result;
   const double alpha_cut = interpolate_directional(
@@ -71,14 +73,15 @@ Expected<CantileverResult> simulate_cantilever(const CantileverSpec& spec) {
   } catch (const std::invalid_argument& e) {
     return Error{e.what()};
   }
-  // Centre line: mean position of every column of vertices from the clamp to the tip.
-  const int nx = spec.segments + 2;
-  for (int i = 1; i < nx; ++i) {
-    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-    for (int j = 0; j < spec.width_vertices; ++j) mean += mesh.positions.col(j * nx + i);
-    mean /= spec.width_vertices;
-    result.curve.emplace_back(mean.x(), mean.z());
+  // Centre line: the lattice row nearest y = 0 (jitter moves vertices by at most 0.3 spacings), clamp to tip.
+  const double dy = spec.width / (rows - 1);
+  const double centre_y = -0.5 * spec.width + std::round(0.5 * (rows - 1)) * dy;
+  std::vector<int> row;
+  for (int v = 0; v < mesh.vertex_count(); ++v) {
+    if (std::abs(mesh.rest(1, v) - centre_y) < 0.4 * dy && mesh.rest(0, v) >= -1e-9 * spec.length) row.push_back(v);
   }
+  std::sort(row.begin(), row.end(), [&](int a, int b) { return mesh.rest(0, a) < mesh.rest(0, b); });
+  for (int v : row) result.curve.emplace_back(mesh.positions(0, v), mesh.positions(2, v));
   const Eigen::Vector2d tip = result.curve.back();
   result.height_over_width = tip.x() > 1e-12 ? -tip.y() / tip.x() : std::numeric_limits<double>::infinity();
   return result;

@@ -54,7 +54,7 @@ double quantile(std::vector<double> values, double q) {
 ClothMesh specimen(bool irregular, double material_angle = 0.0) {
   SpecimenSpec spec;
   spec.jitter = irregular ? 0.3 : 0.0;
-  spec.random_diagonals = irregular;
+  spec.triangulation = irregular ? Triangulation::kRandom : Triangulation::kAlternating;
   spec.seed = 11;
   spec.material_angle = material_angle;
   return make_specimen(spec);

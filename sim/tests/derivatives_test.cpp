@@ -78,7 +78,7 @@ void expect_projected_psd(const EnergyTerm& term, const Eigen::Matrix3Xd& x) {
 }
 
 ClothMesh crumpled_mesh(std::uint64_t seed, double amplitude) {
-  SpecimenSpec spec{0.02, 0.02, 5, 5, 0.25, true, seed, 0.3};
+  SpecimenSpec spec{0.02, 0.02, 5, 5, 0.25, Triangulation::kRandom, seed, 0.3};
   ClothMesh mesh = make_specimen(spec);
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> noise(0.0, amplitude);
@@ -166,7 +166,7 @@ TEST(Derivatives, QuadraticBending) {
 }
 
 TEST(Derivatives, PlatformContactOnTopRimAndWall) {
-  ClothMesh mesh = make_specimen(SpecimenSpec{0.02, 0.02, 4, 4, 0.0, false, 0, 0.0});
+  ClothMesh mesh = make_specimen(SpecimenSpec{0.02, 0.02, 4, 4, 0.0, Triangulation::kAlternating, 0, 0.0});
   PlatformSpec spec;
   // Place vertices around the rim of the platform: on the top, over the rounded rim and against the wall, all
   // slightly inside the contact offset.

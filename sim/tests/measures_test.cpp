@@ -19,7 +19,7 @@ constexpr double kPi = std::numbers::pi;
 
 ClothMesh square_specimen(int vertices, double jitter = 0.0, bool random_diagonals = false) {
   return make_specimen(SpecimenSpec{.size_x = 0.3, .size_y = 0.3, .vertices_x = vertices, .vertices_y = vertices,
-                                    .jitter = jitter, .random_diagonals = random_diagonals, .seed = 3});
+                                    .jitter = jitter, .triangulation = random_diagonals ? Triangulation::kRandom : Triangulation::kAlternating, .seed = 3});
 }
 
 /// The specimen draped analytically: flat on the platform for r <= R, then straight down a cone whose generators
@@ -309,11 +309,14 @@ TEST(Measures, LargeMeshIsFast) {
   const double area_ms = milliseconds([&] { area = projected_area(mesh); });
   EXPECT_EQ(crossings, 0);
   EXPECT_NEAR(area, 0.09, 0.005 * 0.09);
-  // Generous bounds (debug and sanitizer builds); a quadratic pair search would take seconds.
-  EXPECT_LT(intersect_ms, 1000.0);
-  EXPECT_LT(area_ms, 1000.0);
   RecordProperty("count_self_intersections_ms", std::to_string(intersect_ms));
   RecordProperty("projected_area_ms", std::to_string(area_ms));
+#if defined(__OPTIMIZE__)
+  // About 10 ms each when optimised; generous for loaded machines and sanitizers. A quadratic pair search (1.9e8
+  // pairs) would take seconds. Unoptimised Eigen is 50-100 times slower, so no bound there.
+  EXPECT_LT(intersect_ms, 400.0);
+  EXPECT_LT(area_ms, 400.0);
+#endif
 }
 
 }  // namespace

@@ -32,7 +32,7 @@ bool file_exists(const std::string& path) { return std::ifstream(path).good(); }
 /// A small irregular specimen whose positions differ from its rest coordinates.
 ClothMesh sample_mesh() {
   ClothMesh mesh = make_specimen(SpecimenSpec{.size_x = 0.3, .size_y = 0.2, .vertices_x = 7, .vertices_y = 5,
-                                              .jitter = 0.3, .random_diagonals = true, .seed = 7,
+                                              .jitter = 0.3, .triangulation = Triangulation::kRandom, .seed = 7,
                                               .material_angle = 0.1 + 1.0 / 3.0});
   for (int i = 0; i < mesh.vertex_count(); ++i) {
     mesh.positions(2, i) = -0.05 * std::sin(17.0 * i) / 3.0;

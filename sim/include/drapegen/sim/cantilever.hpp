@@ -8,6 +8,7 @@
 #include "drapegen/sim/expected.hpp"
 #include "drapegen/sim/fabric.hpp"
 #include "drapegen/sim/newton_solver.hpp"
+#include "drapegen/sim/specimen.hpp"
 
 namespace drapegen::sim {
 
@@ -20,7 +21,9 @@ struct CantileverSpec {
   /// Warp direction relative to the strip's long axis, radians (a strip cut at angle phi, Fig. 13).
   double cut_angle = 0.0;
   int segments = 40;        // elements along the length
-  int width_vertices = 5;
+  /// Nearly equilateral triangles by default: every edge then has its wing tips symmetric about it, which the
+  /// dihedral model needs to be consistent (on right-triangle grids a free strip is ~20% too soft; docs/PHYSICS.md).
+  Triangulation triangulation = Triangulation::kEquilateral;
   double jitter = 0.0;      // triangulation perturbation (fraction of the spacing)
   std::uint64_t seed = 0;
   double membrane_stiffness = 200.0;
@@ -35,8 +38,9 @@ struct CantileverResult {
   SolveReport report;
 };
 
-/// Simulates the strip. The clamp holds the two first columns of vertices (a horizontal tangent). Loads are applied
-/// in a few increments of gravity so that very soft strips (Gamma up to ~1e3) are reached robustly.
+/// Simulates the strip: `segments` spacings along its length, rows of nearly equilateral triangles across it. The
+/// clamp holds every vertex at x <= 0 (two lattice columns: a horizontal tangent). Soft strips (Gamma > 50) are
+/// loaded in a few increments of gravity. The curve is the lattice row nearest the centre line, clamp to tip.
 [[nodiscard]] Expected<CantileverResult> simulate_cantilever(const CantileverSpec& spec);
 
 }  // namespace drapegen::sim

@@ -23,7 +23,7 @@ struct DrapeConfig {
   MembraneParameters membrane;
   PlatformSpec platform;
   /// 300 x 300 mm, 100 x 100 vertices, perturbed triangulation.
-  SpecimenSpec specimen{0.3, 0.3, 100, 100, 0.2, true, 0, 0.0};
+  SpecimenSpec specimen{0.3, 0.3, 100, 100, 0.2, Triangulation::kRandom, 0, 0.0};
   InitialStateSpec initial;
   SolverOptions solver;
   double gravity = kStandardGravity;

@@ -7,22 +7,30 @@
 
 namespace drapegen::sim {
 
+/// How the specimen is triangulated.
+enum class Triangulation {
+  kAlternating,  // grid quads split by alternating diagonals ("union jack")
+  kRandom,       // grid quads split by random diagonals (the paper's perturbed triangulation, with jitter)
+  kEquilateral,  // rows of (nearly) equilateral triangles, odd rows offset by half a spacing; straight borders
+};
+
 struct SpecimenSpec {
   double size_x = 0.3;  // metres, along the rest x axis
   double size_y = 0.3;  // metres, along the rest y axis
   int vertices_x = 100;
   int vertices_y = 100;
-  /// Interior vertices move by up to this fraction of the grid spacing (uniform in a square). 0 keeps the grid.
+  /// Interior vertices move by up to this fraction of the spacing (uniform in a square), at most 0.3 (beyond it
+  /// rest triangles can flip). 0 keeps the lattice.
   double jitter = 0.0;
-  /// Choose each quad's diagonal at random; false gives alternating diagonals (a symmetric "union jack" grid).
-  bool random_diagonals = false;
+  Triangulation triangulation = Triangulation::kAlternating;
   std::uint64_t seed = 0;
   /// Warp direction relative to the rest x axis, radians.
   double material_angle = 0.0;
 };
 
 /// A flat specimen centred on the origin in the plane z = 0 (positions equal the rest coordinates).
-/// Vertex (i, j) has index j * vertices_x + i. Throws std::invalid_argument on fewer than 2 vertices per side,
+/// Grid triangulations: vertex (i, j) has index j * vertices_x + i. kEquilateral: `vertices_y` rows, even rows with
+/// `vertices_x` vertices, odd rows with one more (their end vertices sit on the borders), row by row. Throws std::invalid_argument on fewer than 2 vertices per side,
 /// non-positive sizes or a jitter outside [0, 0.45].
 [[nodiscard]] ClothMesh make_specimen(const SpecimenSpec& spec);
 
