@@ -9,6 +9,7 @@
 
 #include "commands.hpp"
 #include "drapegen/sim/drape.hpp"
+#include "drapegen/sim/logging.hpp"
 #include "drapegen/sim/ply.hpp"
 #include "parse.hpp"
 
@@ -122,6 +123,7 @@ int run_simulate(const SimulateOptions& o) {
   }
   std::function<void(const sim::IterationInfo&)> progress;
   if (o.verbose) {
+    sim::logger()->set_level(spdlog::level::debug);
     progress = [](const sim::IterationInfo& i) {
       std::cerr << fmt::format("iter {:4d}  energy {:.9e}  residual {:.3e}  step {:.3g}  shift {:.1e}\n", i.iteration,
                                i.energy, i.residual, i.step_length, i.regularization);

@@ -90,24 +90,31 @@ void DihedralBending::element_vertices(int element, int* out) const {
   out[3] = h.v3;
 }
 
-void DihedralBending::assign_laws() {
+double DihedralBending::assign_laws() {
   laws_.resize(hinges_.size());
+  double change = 0.0;
   for (std::size_t i = 0; i < hinges_.size(); ++i) {
-    if (moduli_.isotropic()) {
-      laws_[i] = TorqueLaw{moduli_.alpha.warp, moduli_.beta.warp};
-    } else {
-      laws_[i] = TorqueLaw{floored(interpolate_directional(moduli_.alpha, phi_[i]), moduli_.alpha),
-                           interpolate_directional(moduli_.beta, phi_[i])};
+    TorqueLaw law{moduli_.alpha.warp, moduli_.beta.warp};
+    if (!moduli_.isotropic()) {
+      law = TorqueLaw{floored(interpolate_directional(moduli_.alpha, phi_[i]), moduli_.alpha),
+                      interpolate_directional(moduli_.beta, phi_[i])};
     }
+    const TorqueLaw& old = laws_[i];
+    if (old.alpha > 0.0) {
+      change = std::max({change, std::abs(law.alpha - old.alpha) / old.alpha,
+                         std::abs(law.beta - old.beta) / std::max(std::abs(old.beta), 1e-300)});
+    }
+    laws_[i] = law;
   }
+  return change;
 }
 
-void DihedralBending::begin_iteration(const Eigen::Matrix3Xd& x) {
-  if (moduli_.isotropic() || rule_ == AnisotropyRule::kEdge) return;
+double DihedralBending::update_lagged(const Eigen::Matrix3Xd& x) {
+  if (moduli_.isotropic() || rule_ == AnisotropyRule::kEdge) return 0.0;
   ClothMesh current = *mesh_;  // the anisotropy rule reads positions from a mesh
   current.positions = x;
   hinge_bending_angles(current, *topology_, rule_, phi_);
-  assign_laws();
+  return assign_laws();
 }
 
 double DihedralBending::energy(const Eigen::Matrix3Xd& x) const {
@@ -193,15 +200,19 @@ void QuadraticBending::element_vertices(int element, int* out) const {
   out[3] = h.v3;
 }
 
-void QuadraticBending::begin_iteration(const Eigen::Matrix3Xd& x) {
+double QuadraticBending::update_lagged(const Eigen::Matrix3Xd& x) {
   const bool isotropic = gamma_dir_.warp == gamma_dir_.bias && gamma_dir_.bias == gamma_dir_.weft;
-  if (isotropic || rule_ == AnisotropyRule::kEdge) return;
+  if (isotropic || rule_ == AnisotropyRule::kEdge) return 0.0;
   ClothMesh current = *mesh_;
   current.positions = x;
   hinge_bending_angles(current, *topology_, rule_, phi_);
+  double change = 0.0;
   for (std::size_t i = 0; i < hinges_.size(); ++i) {
-    gamma_[i] = floored(interpolate_directional(gamma_dir_, phi_[i]), gamma_dir_);
+    const double gamma = floored(interpolate_directional(gamma_dir_, phi_[i]), gamma_dir_);
+    change = std::max(change, std::abs(gamma - gamma_[i]) / gamma_[i]);
+    gamma_[i] = gamma;
   }
+  return change;
 }
 
 double QuadraticBending::energy(const Eigen::Matrix3Xd& x) const { return evaluate(x, nullptr, nullptr); }

@@ -6,6 +6,7 @@
 #include "drapegen/sim/bending.hpp"
 #include "drapegen/sim/gravity.hpp"
 #include "drapegen/sim/measures.hpp"
+#include "drapegen/sim/mesh_transfer.hpp"
 
 namespace drapegen::sim {
 namespace {
@@ -53,6 +54,25 @@ Expected<DrapeResult> simulate_drape(const DrapeConfig& config,
     if (progress) solver.set_progress(progress);
     std::vector<EnergyTerm*> terms{&membrane, bending.get(), &gravity, &contact};
     Eigen::Matrix3Xd x = mesh.positions;
+    const int coarse = config.coarse_start_resolution;
+    if (coarse >= 3 && initial.shape != InitialShape::kMesh && config.specimen.vertices_x >= 2 * coarse &&
+        config.specimen.vertices_y >= 2 * coarse) {
+      // A cascade: each level starts from the drape of one at half its resolution, down to `coarse`.
+      DrapeConfig coarse_config = config;
+      coarse_config.specimen.vertices_x = std::max(coarse, config.specimen.vertices_x / 2);
+      coarse_config.specimen.vertices_y = std::max(coarse, config.specimen.vertices_y / 2);
+      coarse_config.solver.tolerance = std::max(config.solver.tolerance, 1e-2);
+      const Expected<DrapeResult> start = simulate_drape(coarse_config);
+      if (start) {
+        result.coarse_report = start->report;
+        result.coarse_report.iterations += start->coarse_report.iterations;
+        result.coarse_report.seconds += start->coarse_report.seconds;
+        const Eigen::Matrix3Xd guess = transfer_positions(start->mesh, mesh.rest);
+        for (int v = 0; v < mesh.vertex_count(); ++v) {
+          if (!fixed[v]) x.col(v) = guess.col(v);
+        }
+      }
+    }
     result.report = solver.solve(terms, fixed, gravity.vertex_weights().maxCoeff(), x);
     mesh.positions = x;
   } catch (const std::invalid_argument& e) {
@@ -78,13 +98,17 @@ nlohmann::json to_json(const DrapeResult& result) {
       {"outcome", std::string(to_string(r.outcome))},
       {"message", r.message},
       {"iterations", r.iterations},
-      {"seconds", r.seconds},
+      {"seconds", r.seconds + result.coarse_report.seconds},
+      {"coarse_iterations", result.coarse_report.iterations},
+      {"coarse_seconds", result.coarse_report.seconds},
       {"assembly_seconds", r.assembly_seconds},
       {"factorization_seconds", r.factorization_seconds},
       {"residual", r.residual},
       {"energy", r.energy},
       {"regularized_iterations", r.regularized_iterations},
       {"exact_hessian_iterations", r.exact_hessian_iterations},
+      {"lagged_updates", r.lagged_updates},
+      {"lagged_change", r.lagged_change},
       {"line_search_failures", r.line_search_failures},
       {"vertices", result.mesh.vertex_count()},
       {"triangles", result.mesh.triangle_count()},

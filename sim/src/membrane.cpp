@@ -93,16 +93,32 @@ Eigen::Matrix<double, 3, 2> CorotationalMembrane::deformation_gradient(const Eig
   return ds * rest_inverse_[t];
 }
 
+namespace {
+
+/// One side of the band energy, for a stretch excess u >= 0 over a band half-width b: stiffness ratio eps inside the
+/// band, rising linearly to 1 over a width w beyond it (so the second derivative is continuous), 1 after that.
+CorotationalMembrane::StretchEnergy band_side(double u, double b, double eps) {
+  if (b <= 0.0) return {u * u, 2.0 * u, 2.0};
+  const double w = 0.5 * b;
+  if (u <= b) return {eps * u * u, 2.0 * eps * u, 2.0 * eps};
+  if (u <= b + w) {
+    const double t = u - b;
+    return {eps * b * b + 2.0 * eps * b * t + eps * t * t + (1.0 - eps) * t * t * t / (3.0 * w),
+            2.0 * eps * (b + t) + (1.0 - eps) * t * t / w, 2.0 * eps + 2.0 * (1.0 - eps) * t / w};
+  }
+  const double t = u - b - w;
+  const double g1 = 2.0 * eps * (b + w) + (1.0 - eps) * w;
+  const double g0 = eps * (b + w) * (b + w) + (1.0 - eps) * w * w / 3.0;
+  return {g0 + g1 * t + t * t, g1 + 2.0 * t, 2.0};
+}
+
+}  // namespace
+
 CorotationalMembrane::StretchEnergy CorotationalMembrane::stretch_energy(double s) const {
-  // Piecewise quadratic, C1: eps * (s - 1)^2 inside [low, high], continued by (s - edge)^2 outside.
   const double eps = params_.band_stiffness_ratio;
-  const double edge = std::clamp(s, params_.band_low, params_.band_high);
-  const double inside = edge - 1.0, outside = s - edge;
-  StretchEnergy g;
-  g.value = eps * inside * inside + 2.0 * eps * inside * outside + outside * outside;
-  g.first = 2.0 * eps * inside + 2.0 * outside;
-  g.second = (s > params_.band_low && s < params_.band_high) ? 2.0 * eps : 2.0;
-  return g;
+  if (s >= 1.0) return band_side(s - 1.0, params_.band_high - 1.0, eps);
+  const StretchEnergy g = band_side(1.0 - s, 1.0 - params_.band_low, eps);
+  return {g.value, -g.first, g.second};
 }
 
 double CorotationalMembrane::energy(const Eigen::Matrix3Xd& x) const {

@@ -67,13 +67,19 @@ SolveReport NewtonSolver::solve(const std::vector<EnergyTerm*>& terms, const std
     return report;
   }
 
-  int exact_cooldown = 0;
-  bool frozen = false;     // lagged quantities no longer updated  // iterations to wait before trying the exact Hessian again
+  int exact_cooldown = 0;  // iterations to wait before trying the exact Hessian again
+  bool frozen = false;     // state-dependent parameters no longer updated
+  int outer_updates = 0;
   for (int it = 0; it < options_.max_iterations; ++it) {
     report.iterations = it;
-    frozen = frozen || (it > 0 && report.residual < options_.freeze_lagged_below);
-    if (!frozen) {
-      for (EnergyTerm* t : terms) t->begin_iteration(x);
+    const bool outer = it > 0 && report.residual < options_.lagged_outer_below;
+    if (!frozen && (it == 0 || outer || report.residual > options_.lagged_every_above)) {
+      double change = 0.0;
+      for (EnergyTerm* t : terms) change = std::max(change, t->update_lagged(x));
+      ++report.lagged_updates;
+      outer_updates += outer ? 1 : 0;
+      report.lagged_change = change;
+      frozen = it > 0 && (change < options_.lagged_tolerance || outer_updates >= options_.max_lagged_outer_updates);
     }
     bool exact = it > 0 && report.residual < options_.exact_hessian_below && exact_cooldown == 0;
     exact_cooldown = std::max(0, exact_cooldown - 1);
@@ -89,7 +95,7 @@ SolveReport NewtonSolver::solve(const std::vector<EnergyTerm*>& terms, const std
       report.message = fmt::format("non-finite energy or gradient at iteration {}", it);
       break;
     }
-    if (report.residual <= options_.tolerance) {
+    if (report.residual <= options_.tolerance && frozen) {
       report.outcome = SolveOutcome::kConverged;
       break;
     }

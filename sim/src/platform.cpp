@@ -41,6 +41,7 @@ PlatformContact::PlatformContact(const ClothMesh& mesh, const PlatformSpec& spec
     throw std::invalid_argument("platform: radius, height and stiffness must be positive, 0 <= fillet < radius");
   }
   stiffness_ = rest_vertex_areas(mesh) * spec.contact_stiffness;
+  scale_ = std::max(spec.contact_offset, 1e-4);
 }
 
 double PlatformContact::energy(const Eigen::Matrix3Xd& x) const { return evaluate(x, nullptr, nullptr); }
@@ -62,11 +63,14 @@ double PlatformContact::evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd* gr
     const double gap = d.distance - spec_.contact_offset;
     Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
     if (gap < 0.0) {
-      const double k = stiffness_[i];
-      total += 0.5 * k * gap * gap;
-      if (gradient != nullptr) gradient->col(i) += k * gap * d.gradient;
-      h = k * d.gradient * d.gradient.transpose();
-      if (exact) h += k * gap * d.hessian;  // negative semi-definite: dropped by the projection
+      // Cubic penalty k p^3 / (3 t) in the penetration p = -gap, t = contact_offset: its Hessian is continuous where
+      // contact starts, so Newton does not chatter as vertices slide on and off the wall.
+      const double k = stiffness_[i] / scale_;
+      const double p = -gap;
+      total += k * p * p * p / 3.0;
+      if (gradient != nullptr) gradient->col(i) -= k * p * p * d.gradient;
+      h = 2.0 * k * p * d.gradient * d.gradient.transpose();
+      if (exact) h -= k * p * p * d.hessian;  // negative semi-definite: dropped by the projection
     }
     if (hessian != nullptr) hessian->add(i, h.data());
   }

@@ -90,12 +90,14 @@ ClothMesh crumpled_mesh(std::uint64_t seed, double amplitude) {
   return mesh;
 }
 
-TEST(Derivatives, MembraneStretchBandIsC1) {
+TEST(Derivatives, MembraneStretchBandIsC2) {
   CorotationalMembrane membrane(crumpled_mesh(1, 0.0), MembraneParameters{200.0, 0.99, 1.01, 0.01});
-  for (double s : {0.95, 0.99, 0.995, 1.0, 1.007, 1.01, 1.05}) {
+  for (double s : {0.95, 0.985, 0.99, 0.995, 1.0, 1.007, 1.01, 1.012, 1.015, 1.05}) {
     const double h = 1e-7;
     const auto g = membrane.stretch_energy(s);
     EXPECT_NEAR(g.first, (membrane.stretch_energy(s + h).value - membrane.stretch_energy(s - h).value) / (2 * h), 1e-7);
+    // g is C2; its third derivative jumps at the band edges, which limits central differences to ~1e-5 there.
+    EXPECT_NEAR(g.second, (membrane.stretch_energy(s + h).first - membrane.stretch_energy(s - h).first) / (2 * h), 1e-4);
   }
   EXPECT_DOUBLE_EQ(membrane.stretch_energy(1.0).value, 0.0);
   EXPECT_DOUBLE_EQ(membrane.stretch_energy(1.005).second, 0.02);  // eps * 2 inside the band
@@ -138,7 +140,7 @@ TEST(Derivatives, NonlinearDihedralBendingSofteningAndStiffening) {
   for (double beta : {-3e-7, 3e-9}) {
     DihedralModuli moduli{{1e-5, 1.5e-5, 2e-5}, {beta, 0.5 * beta, 0.8 * beta}};
     DihedralBending bending(mesh, topo, moduli, AnisotropyRule::kCurvature);
-    bending.begin_iteration(mesh.positions);
+    bending.update_lagged(mesh.positions);
     if (beta < 0) {  // the configuration must exercise both branches of the torque law
       const std::vector<HingeRest> rest = hinge_rest_geometry(mesh, topo);
       int plateau = 0, rising = 0;

@@ -54,7 +54,7 @@ class DihedralBending final : public EnergyTerm {
   void element_vertices(int element, int* out) const override;
 
   /// Recomputes each hinge's bending direction (curvature rule) and its torque law by Eq. 8.
-  void begin_iteration(const Eigen::Matrix3Xd& x) override;
+  double update_lagged(const Eigen::Matrix3Xd& x) override;
   [[nodiscard]] double energy(const Eigen::Matrix3Xd& x) const override;
   double evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd* gradient, HessianSink* hessian) const override;
 
@@ -65,7 +65,8 @@ class DihedralBending final : public EnergyTerm {
   [[nodiscard]] const Eigen::VectorXd& bending_angles() const { return phi_; }
 
  private:
-  void assign_laws();
+  /// Sets every hinge's torque law from its bending angle; returns the largest relative change of alpha or beta.
+  double assign_laws();
 
   const ClothMesh* mesh_;
   const Topology* topology_;
@@ -89,7 +90,7 @@ class QuadraticBending final : public EnergyTerm {
   [[nodiscard]] int arity() const override { return 4; }
   [[nodiscard]] int element_count() const override { return static_cast<int>(hinges_.size()); }
   void element_vertices(int element, int* out) const override;
-  void begin_iteration(const Eigen::Matrix3Xd& x) override;
+  double update_lagged(const Eigen::Matrix3Xd& x) override;
   [[nodiscard]] double energy(const Eigen::Matrix3Xd& x) const override;
   double evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd* gradient, HessianSink* hessian) const override;
 

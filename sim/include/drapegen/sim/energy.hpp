@@ -34,9 +34,10 @@ class EnergyTerm {
   /// Whether the term has a non-zero Hessian at all (gravity does not).
   [[nodiscard]] virtual bool has_hessian() const { return true; }
 
-  /// Updates quantities lagged by one Newton iteration (adaptive reference state, anisotropy directions).
-  /// The energy is a fixed function of x between two calls.
-  virtual void begin_iteration(const Eigen::Matrix3Xd& /*x*/) {}
+  /// Updates quantities that depend on the state but are held fixed while the energy is minimised (the bending
+  /// directions of the curvature-based anisotropy). Returns the largest relative change of any element's parameters
+  /// (0 for terms without such quantities). The energy is a fixed function of x between two calls.
+  virtual double update_lagged(const Eigen::Matrix3Xd& /*x*/) { return 0.0; }
 
   [[nodiscard]] virtual double energy(const Eigen::Matrix3Xd& x) const = 0;
   /// Returns the energy, adds the gradient into `gradient` (3 x N) when non-null and hands every element Hessian

@@ -27,7 +27,8 @@ struct MembraneParameters {
 /// the state that minimises the band ("dead zone") energy below; this class solves that energy directly, so Newton
 /// sees the true problem instead of a lagged one:
 ///
-///   psi(F) = A * sum_i g(s_i),  g(s) = sigma * (s - clamp(s, low, high))^2 + eps * sigma * (clamped part)^2,
+///   psi(F) = A * sum_i g(s_i),  g'' = 2 sigma * eps inside [low, high], 2 sigma beyond, with a linear ramp between
+///   over half a band width (so that g is C2 and Newton's quadratic model has no jump where a stretch leaves the band),
 ///
 /// with s_i the singular values of the deformation gradient F (3x2) of the rest triangle. Without a band this is the
 /// corotational energy sigma * A * |F - R|^2. A small stiffness eps * sigma inside the band keeps in-plane modes from

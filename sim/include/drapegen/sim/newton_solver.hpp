@@ -33,9 +33,15 @@ struct SolverOptions {
   /// Below this residual, try the exact (unprojected) Hessian first: near a stable equilibrium it is positive
   /// definite and restores quadratic convergence; where CHOLMOD finds it indefinite, the projected one is used.
   double exact_hessian_below = 1.0;
-  /// Below this residual, quantities lagged by one iteration (anisotropy directions) are frozen, so the last
-  /// iterations solve one fixed energy and converge quadratically instead of chasing the lag.
-  double freeze_lagged_below = 0.05;
+  /// State-dependent parameters (anisotropy directions, EnergyTerm::update_lagged) are updated at every iteration
+  /// while the residual is above `lagged_every_above`; below it, only once the residual has dropped under
+  /// `lagged_outer_below` for the current parameters (an outer fixed-point loop), until the parameters change by
+  /// less than `lagged_tolerance` (relative); then they stay fixed and Newton converges on one energy.
+  double lagged_every_above = 10.0;
+  double lagged_outer_below = 0.3;
+  double lagged_tolerance = 1e-3;
+  /// Outer updates after which the parameters are fixed anyway (directions in nearly flat regions can cycle).
+  int max_lagged_outer_updates = 6;
 };
 
 struct SolveReport {
@@ -48,6 +54,8 @@ struct SolveReport {
   double energy = 0.0;            // J
   int regularized_iterations = 0;  // iterations that needed a diagonal shift
   int exact_hessian_iterations = 0;  // iterations that stepped with the unprojected Hessian
+  int lagged_updates = 0;            // updates of state-dependent parameters
+  double lagged_change = 0.0;        // relative change at the last update
   int line_search_failures = 0;
   std::string message;
 };

@@ -1,0 +1,112 @@
+// Timing benchmark of the quasistatic drape (docs/BENCHMARKS.md): fabrics from ../shared/data/fabrics618.csv
+// spanning soft to stiff, every initial-state type, one core. Prints one line per drape and a summary.
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "drapegen/sim/drape.hpp"
+
+namespace {
+
+struct Fabric {
+  double density;  // kg/m^2
+  drapegen::sim::DirectionalValues alpha, beta;  // paper units, normalised to 300 g/m^2
+};
+
+std::vector<Fabric> read_fabrics(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error("cannot read " + path);
+  std::string line;
+  std::getline(in, line);  // header: density, linear warp, weft, diag, nonlinear warp, weft, diag
+  std::vector<Fabric> out;
+  while (std::getline(in, line)) {
+    std::stringstream ss(line);
+    std::vector<double> v;
+    for (std::string cell; std::getline(ss, cell, ',');) v.push_back(std::stod(cell));
+    if (v.size() != 7) continue;
+    const double s = drapegen::sim::kStandardDensity / v[0];  // k / rho at the standard density
+    out.push_back({v[0], {v[1] * s, v[3] * s, v[2] * s}, {v[4] * s, v[6] * s, v[5] * s}});
+  }
+  return out;
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"drape timing benchmark"};
+  std::string data = "../shared/data/fabrics618.csv";
+  int resolution = 100, fabrics = 5;
+  std::vector<std::string> inits{"flat", "sine", "fold"};
+  bool json = false;
+  app.add_option("--data", data, "fabrics618.csv")->capture_default_str();
+  app.add_option("--resolution", resolution, "vertices per side")->capture_default_str();
+  app.add_option("--fabrics", fabrics, "fabrics at evenly spaced quantiles of mean alpha")->capture_default_str();
+  app.add_option("--inits", inits, "initial states")->capture_default_str();
+  app.add_flag("--json", json, "one JSON object per drape");
+  CLI11_PARSE(app, argc, argv);
+
+  std::vector<Fabric> all = read_fabrics(data);
+  std::sort(all.begin(), all.end(), [](const Fabric& a, const Fabric& b) {
+    return a.alpha.warp + a.alpha.bias + a.alpha.weft < b.alpha.warp + b.alpha.bias + b.alpha.weft;
+  });
+  std::vector<double> seconds, iterations, factor_share;
+  int converged = 0, total = 0;
+  for (int f = 0; f < fabrics; ++f) {
+    const std::size_t index = fabrics == 1 ? all.size() / 2 : (all.size() - 1) * f / (fabrics - 1);
+    const Fabric& fabric = all[index];
+    for (const std::string& init : inits) {
+      drapegen::sim::DrapeConfig config;
+      config.fabric = drapegen::sim::fabric_from_paper_units(fabric.alpha, fabric.beta, 300.0);
+      config.specimen.vertices_x = config.specimen.vertices_y = resolution;
+      config.specimen.seed = 100 + f;
+      auto initial = drapegen::sim::parse_initial_state(init);
+      config.initial = *initial;
+      config.initial.seed = 7 + f;
+      const auto result = drapegen::sim::simulate_drape(config);
+      if (!result) {
+        std::cerr << "error: " << result.error().message << "\n";
+        return 1;
+      }
+      const auto& r = result->report;
+      ++total;
+      converged += r.outcome == drapegen::sim::SolveOutcome::kConverged;
+      seconds.push_back(r.seconds);
+      iterations.push_back(r.iterations);
+      factor_share.push_back(r.factorization_seconds / r.seconds);
+      if (json) {
+        nlohmann::json j = drapegen::sim::to_json(*result);
+        j["fabric_index"] = index;
+        j["init"] = init;
+        std::cout << j.dump() << "\n";
+      } else {
+        std::cout << fmt::format(
+            "fabric {:3d} alpha {:7.0f},{:7.0f},{:7.0f} beta {:8.0f},{:8.0f},{:8.0f} {:5s}: {:15s} {:4d} it "
+            "{:6.2f} s (factor {:4.1f}%, assembly {:4.1f}%) DC {:.3f} folds {}\n",
+            index, fabric.alpha.warp, fabric.alpha.bias, fabric.alpha.weft, fabric.beta.warp, fabric.beta.bias,
+            fabric.beta.weft, init, drapegen::sim::to_string(r.outcome), r.iterations, r.seconds,
+            100 * r.factorization_seconds / r.seconds, 100 * r.assembly_seconds / r.seconds,
+            result->measures.drape_coefficient, result->measures.folds);
+      }
+      std::cout.flush();
+    }
+  }
+  std::cout << fmt::format(
+      "summary: {}x{} vertices, {} drapes, {} converged; seconds median {:.2f} max {:.2f}; iterations median {:.0f} "
+      "max {:.0f}; factorisation share median {:.0f}%\n",
+      resolution, resolution, total, converged, median(seconds), *std::max_element(seconds.begin(), seconds.end()),
+      median(iterations), *std::max_element(iterations.begin(), iterations.end()), 100 * median(factor_share));
+  return converged == total ? 0 : 2;
+}

@@ -1,0 +1,268 @@
+// Physics acceptance tests of the drape simulator (Feng et al. 2022) on coarse meshes: k/rho invariance (Section
+// 5.1.2, Fig. 14), rotation invariance about the platform axis, in-plane stiffness and locking (Section 4.1, Figs.
+// 5-7, 9), mesh dependence of anisotropic bending (Section 4.4, Fig. 12) and the initial states (Fig. 16).
+// bench/drape_physics.cpp runs the same checks on finer meshes (docs/BENCHMARKS.md).
+//
+// A drape that starts flat passes through buckling bifurcations (the hem chooses where to fold), so its final
+// state is one of many nearby local minima, selected by details of the Newton path: a 1% change of k and rho (with
+// sigma fixed) or a different random triangulation moves folds by millimetres and the drape coefficient by up to
+// ~10% at these resolutions. The bounds below are therefore asserted only where the simulator must be exact (a
+// problem that is a scaled or rotated copy of another) or where the effect is far above that noise; the rest is
+// printed for the record.
+#include "drapegen/sim/drape.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "drapegen/sim/measures.hpp"
+
+namespace drapegen::sim {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+constexpr double kMm = 1e3;  // m -> mm
+
+/// The median fabric of the paper's data set (paper units: alpha g*mm^2/s^2, beta g*mm^3/s^2).
+constexpr DirectionalValues kMedianAlpha{13923, 11455, 8821};
+constexpr DirectionalValues kMedianBeta{-35390, -29660, -22042};
+
+DirectionalValues scaled(const DirectionalValues& v, double s) { return {v.warp * s, v.bias * s, v.weft * s}; }
+
+/// A 300 mm specimen of n x n vertices with the median fabric: the paper's perturbed triangulation, or a structured
+/// "union jack" grid (symmetric under 90-degree rotations when n is odd).
+DrapeConfig config(int n, bool structured) {
+  DrapeConfig c;
+  c.fabric = fabric_from_paper_units(kMedianAlpha, kMedianBeta, 300.0);
+  c.specimen = SpecimenSpec{0.3, 0.3, n, n, structured ? 0.0 : 0.2,
+                            structured ? Triangulation::kAlternating : Triangulation::kRandom, 0, 0.0};
+  return c;
+}
+
+/// Solves and checks that the solve converged.
+DrapeResult drape(const DrapeConfig& c, const std::string& label) {
+  Expected<DrapeResult> r = simulate_drape(c);
+  if (!r) {
+    ADD_FAILURE() << label << ": " << r.error().message;
+    return {};
+  }
+  const SolveReport& s = r->report;
+  EXPECT_EQ(s.outcome, SolveOutcome::kConverged) << label << ": residual " << s.residual << " after " << s.iterations
+                                                 << " iterations";
+  std::printf("[ drape    ] %-34s %3d it %5.1f s  DC %.4f  folds %d  self-intersections %d\n", label.c_str(),
+              s.iterations, s.seconds, r->measures.drape_coefficient, r->measures.folds,
+              r->measures.self_intersections);
+  return std::move(r).value();
+}
+
+double max_distance_mm(const Eigen::Matrix3Xd& a, const Eigen::Matrix3Xd& b) {
+  return a.cols() == b.cols() && a.cols() > 0 ? (a - b).colwise().norm().maxCoeff() * kMm : 1e9;
+}
+double mean_distance_mm(const Eigen::Matrix3Xd& a, const Eigen::Matrix3Xd& b) {
+  return a.cols() == b.cols() && a.cols() > 0 ? (a - b).colwise().norm().mean() * kMm : 1e9;
+}
+
+// (a) Section 5.1.2, Fig. 14. Scaling alpha, beta and rho by s scales bending and gravity by s; the paper argues that
+// the stretching force may be scaled arbitrarily "as long as it remains sufficiently large", so x depends on k/rho
+// only. Scaling sigma and the contact penalty along makes the total energy s times the original: the drape must be
+// identical, whatever path the solver takes (this checks that no tolerance, step limit or regularisation of the
+// simulator has an absolute scale). With sigma fixed, k/rho invariance holds only as far as in-plane compliance is
+// negligible, and small differences select other local minima: the drape coefficient is compared, loosely.
+TEST(DrapePhysics, DrapeDependsOnBendingOverDensity) {
+  const DrapeConfig base = config(25, false);
+  const DrapeResult r0 = drape(base, "k/rho: median fabric");
+  const double dc0 = r0.measures.drape_coefficient;
+  for (const double s : {3.0, 0.5}) {
+    DrapeConfig c = base;
+    c.fabric.alpha = scaled(base.fabric.alpha, s);
+    c.fabric.beta = scaled(base.fabric.beta, s);
+    c.fabric.density *= s;
+    DrapeConfig all = c;
+    all.membrane.stiffness *= s;
+    all.platform.contact_stiffness *= s;
+    const DrapeResult exact = drape(all, "k/rho: k, rho, sigma, contact x" + std::to_string(s).substr(0, 3));
+    const double d_exact = max_distance_mm(exact.mesh.positions, r0.mesh.positions);
+    std::printf("[ k/rho    ] x%.1f with sigma and contact scaled: max vertex distance %.2e mm\n", s, d_exact);
+    EXPECT_LT(d_exact, 0.1) << "x" << s;
+    EXPECT_NEAR(exact.measures.drape_coefficient, dc0, 1e-6);
+
+    const DrapeResult fixed_sigma = drape(c, "k/rho: k, rho x" + std::to_string(s).substr(0, 3) + ", sigma fixed");
+    const double dc = fixed_sigma.measures.drape_coefficient;
+    std::printf("[ k/rho    ] x%.1f, sigma fixed: max vertex distance %.2f mm, mean %.2f mm, DC %.4f vs %.4f\n", s,
+                max_distance_mm(fixed_sigma.mesh.positions, r0.mesh.positions),
+                mean_distance_mm(fixed_sigma.mesh.positions, r0.mesh.positions), dc, dc0);
+    // Observed: 25 x 25 max 8.2 / 4.6 mm, mean 1.5 / 0.7 mm, |dDC| 0.0007 / 0.0009 (x3 / x0.5); 30 x 30 max 23 /
+    // 34 mm, |dDC| up to 0.018. Even x1.01 moves folds by ~6 mm from a flat start, while continuing from the base
+    // drape moves it by 0.06-0.15 mm: the distance measures which local minimum the path finds, not k/rho.
+    EXPECT_NEAR(dc, dc0, 0.03) << "x" << s;
+  }
+}
+
+// (b) The platform is a cylinder about the z axis and gravity points along it: rotating the specimen about the axis
+// must rotate the drape, vertex by vertex. On an odd union jack grid the mesh itself is symmetric under a rotation by
+// 90 degrees that maps vertex (i, j) to (n-1-j, i), so an isotropic drape must have that symmetry too (the solver must
+// not break it), and swapping warp and weft of an anisotropic fabric must give the drape rotated by 90 degrees.
+// (Newton keeps an exact symmetry, so a symmetric drape can also be a saddle: with warp = 4 x weft on a 31 x 31 grid,
+// a restart from 1 micrometre of noise moves 12 mm to a lower energy. At 25 x 25 both drapes here are stable;
+// bench/drape_physics.cpp checks that.)
+TEST(DrapePhysics, RotationAboutTheAxisRotatesTheDrape) {
+  constexpr int n = 25;
+  DrapeConfig base = config(n, true);
+  base.fabric = fabric_from_paper_units({11455, 11455, 11455}, {-29660, -29660, -29660}, 300.0);
+  const DrapeResult r0 = drape(base, "rotation: isotropic, 0 deg");
+  DrapeConfig turned = base;
+  turned.initial.rotation = kPi / 2.0;
+  const DrapeResult r90 = drape(turned, "rotation: isotropic, 90 deg");
+  const Eigen::Matrix3d q = Eigen::AngleAxisd(kPi / 2.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const double d_rotated = max_distance_mm(r90.mesh.positions, q * r0.mesh.positions);
+  EXPECT_LT(d_rotated, 0.1);
+  EXPECT_NEAR(r90.measures.drape_coefficient, r0.measures.drape_coefficient, 1e-3);
+
+  // Vertex (i, j) of the drape rotated by 90 degrees lands on vertex (n-1-j, i).
+  auto symmetry_defect = [&](const Eigen::Matrix3Xd& a, const Eigen::Matrix3Xd& b) {
+    if (a.cols() != n * n) return 1e9;  // a failed drape
+    Eigen::Matrix3Xd permuted(3, a.cols());
+    for (int j = 0; j < n; ++j) {
+      for (int i = 0; i < n; ++i) permuted.col(i * n + (n - 1 - j)) = q * a.col(j * n + i);
+    }
+    return max_distance_mm(permuted, b);
+  };
+  const double d_symmetry = symmetry_defect(r0.mesh.positions, r0.mesh.positions);
+  std::printf("[ rotation ] 90 deg: max distance to the rotated drape %.2e mm; D4 symmetry defect %.2e mm\n",
+              d_rotated, d_symmetry);
+  EXPECT_LT(d_symmetry, 0.1);
+
+  DrapeConfig warp_stiff = base;
+  warp_stiff.fabric = fabric_from_paper_units({20000, 12500, 5000}, {-50000, -31250, -12500}, 300.0);
+  DrapeConfig weft_stiff = warp_stiff;
+  std::swap(weft_stiff.fabric.alpha.warp, weft_stiff.fabric.alpha.weft);
+  std::swap(weft_stiff.fabric.beta.warp, weft_stiff.fabric.beta.weft);
+  const DrapeResult a = drape(warp_stiff, "rotation: warp 4 x weft");
+  const DrapeResult b = drape(weft_stiff, "rotation: weft 4 x warp");
+  const double d_swap = symmetry_defect(a.mesh.positions, b.mesh.positions);
+  std::printf("[ rotation ] warp/weft swapped vs drape rotated by 90 deg: max distance %.2e mm\n", d_swap);
+  EXPECT_LT(d_swap, 0.1);
+}
+
+// (c) Section 4.1: sigma barely changes the drape once it is large enough (Figs. 5-7), and a stiff sigma = 5000 does
+// not lock thanks to the stretch band [0.99, 1.01] (Fig. 9). Without the band, sigma = 5000 locks: the specimen
+// cannot form folds and stands out like a stiff skirt.
+TEST(DrapePhysics, InPlaneStiffnessBarelyMattersAndDoesNotLock) {
+  const DrapeConfig base = config(25, false);
+  auto with = [&](double sigma, bool band) {
+    DrapeConfig c = base;
+    c.membrane.stiffness = sigma;
+    if (!band) c.membrane.band_low = c.membrane.band_high = 1.0;
+    return drape(c, "sigma " + std::to_string(static_cast<int>(sigma)) + (band ? ", band" : ", no band"));
+  };
+  const DrapeResult s200 = with(200, true), s1000 = with(1000, true), s5000 = with(5000, true);
+  const DrapeResult locked = with(5000, false);
+  const double dc200 = s200.measures.drape_coefficient, dc1000 = s1000.measures.drape_coefficient;
+  const double dc5000 = s5000.measures.drape_coefficient, dc_locked = locked.measures.drape_coefficient;
+  const double mean1000 = mean_distance_mm(s1000.mesh.positions, s200.mesh.positions);
+  std::printf("[ sigma    ] DC: 200 %.4f, 1000 %.4f, 5000 %.4f; no band 5000 %.4f\n", dc200, dc1000, dc5000, dc_locked);
+  std::printf("[ sigma    ] vertex distance to sigma 200: 1000 mean %.2f max %.2f mm; 5000 mean %.2f mm; "
+              "5000 without band mean %.2f mm\n",
+              mean1000, max_distance_mm(s1000.mesh.positions, s200.mesh.positions),
+              mean_distance_mm(s5000.mesh.positions, s200.mesh.positions),
+              mean_distance_mm(locked.mesh.positions, s200.mesh.positions));
+  // Fold positions move by millimetres between nearby local minima (see the top of the file); the mean distance of
+  // a 150 mm overhang changing its fold pattern would be >= 10 mm.
+  EXPECT_LT(mean1000, 6.0);
+  EXPECT_NEAR(dc1000, dc200, 0.05 * dc200);
+  EXPECT_NEAR(dc5000, dc200, 0.05 * dc200);
+  // Locking without the band: far stiffer than any bending change here (DC roughly doubles or more).
+  EXPECT_GT(dc_locked, dc200 + 0.1);
+}
+
+/// Hem radius around the rest x axis (azimuths 0 and 180 degrees, +-15 degrees) over that around the rest y axis.
+double hem_elongation(const ClothMesh& mesh) {
+  const std::vector<double> p = hem_profile(mesh, 360);
+  double x = 0.0, y = 0.0;
+  for (int d = 0; d < 360; ++d) {
+    if (std::min(d % 180, 180 - d % 180) <= 15) x += p[static_cast<std::size_t>(d)];
+    if (std::abs(d % 180 - 90) <= 15) y += p[static_cast<std::size_t>(d)];
+  }
+  return x / y;
+}
+
+// (d) Section 4.4, Fig. 12: strongly anisotropic bending (alpha and beta warp = 4 x weft).
+//
+// The paper's comparison - drape coefficients on a structured and a perturbed mesh within 2% under the curvature
+// rule, further apart under the edge rule - is printed but not asserted: at these resolutions the drape coefficient
+// of *isotropic* bending already differs by 3-30% between the two triangulations (5-15% at 30 x 30, ~3% at 60 x 60;
+// bench/drape_physics.cpp), and the perturbed mesh (a grid with random diagonals) has hinges along warp, weft and
+// the bias like the structured one, so the edge rule errs little on it (0.4% at 25 x 25, 16% at 30 x 30: noise).
+//
+// What is asserted is where the edge rule must fail: on the equilateral mesh (edges at 0, 60 and 120 degrees) no
+// hinge bends along the warp when the warp is the rest x axis, and none along the weft when the material is turned
+// by 90 degrees. The anisotropy of the hem - warp over weft hem radius, averaged over the material at 0 and 90
+// degrees so that the mesh's own x/y bias cancels - is then weaker under the edge rule than under the curvature
+// rule (observed at 24-41 vertices per side: curvature 0.78-0.89, edge 0.84-0.94, the edge rule always higher, by
+// 0.04-0.14).
+TEST(DrapePhysics, CurvatureRuleKeepsTheAnisotropyOnAnyMesh) {
+  const FabricParameters fabric =
+      fabric_from_paper_units({20000, 12500, 5000}, {-50000, -31250, -12500}, 300.0);
+  for (const AnisotropyRule rule : {AnisotropyRule::kCurvature, AnisotropyRule::kEdge}) {
+    const bool edge = rule == AnisotropyRule::kEdge;
+    double dc[2];
+    for (const bool structured : {true, false}) {
+      DrapeConfig c = config(25, structured);
+      c.fabric = fabric;
+      c.anisotropy = rule;
+      dc[structured] = drape(c, std::string(edge ? "edge" : "curvature") + " rule, " +
+                                    (structured ? "structured" : "perturbed"))
+                           .measures.drape_coefficient;
+    }
+    std::printf("[ fig 12   ] %s rule: DC structured %.4f, perturbed %.4f, relative difference %.1f%% "
+                "(paper: < 2%% for the curvature rule; not asserted, see above)\n",
+                edge ? "edge" : "curvature", dc[1], dc[0], 100 * std::abs(dc[1] - dc[0]) / (0.5 * (dc[0] + dc[1])));
+  }
+
+  double ratio[2];
+  for (const AnisotropyRule rule : {AnisotropyRule::kCurvature, AnisotropyRule::kEdge}) {
+    const bool edge = rule == AnisotropyRule::kEdge;
+    double elongation[2];
+    for (const bool turned : {false, true}) {
+      DrapeConfig c = config(25, true);
+      c.specimen.triangulation = Triangulation::kEquilateral;
+      c.specimen.material_angle = turned ? kPi / 2.0 : 0.0;
+      c.fabric = fabric;
+      c.anisotropy = rule;
+      elongation[turned] = hem_elongation(
+          drape(c, std::string(edge ? "edge" : "curvature") + " rule, equilateral, warp " + (turned ? "y" : "x"))
+              .mesh);
+    }
+    ratio[edge] = std::sqrt(elongation[0] / elongation[1]);
+  }
+  std::printf("[ fig 12   ] equilateral mesh, hem radius warp/weft: curvature rule %.4f, edge rule %.4f\n", ratio[0],
+              ratio[1]);
+  EXPECT_LT(ratio[0], 0.95);      // the anisotropy shows (isotropic bending: 1)
+  EXPECT_GT(ratio[1], ratio[0]);  // the edge rule loses part of it
+}
+
+// (e) Fig. 16: flat, sine and fold starts all reach an equilibrium for the median fabric. They may settle in
+// different local minima (other fold patterns), so only convergence and sanity are asserted.
+TEST(DrapePhysics, EveryInitialStateConverges) {
+  for (const InitialShape shape : {InitialShape::kFlat, InitialShape::kSine, InitialShape::kFold}) {
+    const std::string name = shape == InitialShape::kFlat ? "flat" : shape == InitialShape::kSine ? "sine" : "fold";
+    DrapeConfig c = config(25, false);
+    c.initial.shape = shape;
+    c.initial.seed = 3;
+    const DrapeResult r = drape(c, "initial state " + name);
+    EXPECT_GT(r.measures.drape_coefficient, 0.0) << name;
+    EXPECT_LT(r.measures.drape_coefficient, 0.5) << name;
+    EXPECT_GE(r.measures.folds, 3) << name;
+    EXPECT_LT(r.measures.max_penetration, 1e-3) << name;
+  }
+}
+
+}  // namespace
+}  // namespace drapegen::sim
