@@ -1,0 +1,375 @@
+// Physics acceptance checks of the drape simulator at production-like resolutions (docs/BENCHMARKS.md): the same
+// checks as sim/tests/drape_test.cpp on finer meshes, printed as a table (check, quantity, value, bound).
+//
+//   a  k/rho invariance (paper Section 5.1.2, Fig. 14): alpha, beta and density scaled together
+//   b  rotation invariance: a structured isotropic specimen rotated by 90 degrees about the platform axis
+//   c  in-plane stiffness sigma and locking (Section 4.1, Figs. 5-7, 9), with and without the stretch band
+//   d  mesh dependence of anisotropic bending (Section 4.4, Fig. 12): curvature vs edge rule
+//   e  initial states flat, sine and fold (Fig. 16)
+//
+// Usage: drapegen_drape_physics [--resolution N]... [--checks abcde] [--tolerance T]
+// Each drape's solve is logged on stderr; the table goes to stdout. Exit code 0 when every bounded row passes.
+#include <fmt/format.h>
+
+#include <Eigen/Geometry>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+#include <numbers>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "drapegen/sim/drape.hpp"
+#include "drapegen/sim/measures.hpp"
+#include "drapegen/sim/ply.hpp"
+
+namespace {
+
+using namespace drapegen::sim;
+
+/// The median fabric of the paper's data (paper units: alpha g*mm^2/s^2, beta g*mm^3/s^2), 300 g/m^2.
+const DirectionalValues kMedianAlpha{13923, 11455, 8821};
+const DirectionalValues kMedianBeta{-35390, -29660, -22042};
+
+DirectionalValues scaled(const DirectionalValues& v, double s) { return {v.warp * s, v.bias * s, v.weft * s}; }
+
+struct Options {
+  std::vector<int> resolutions;
+  std::string checks = "abcde";
+  double tolerance = 1e-3;  // the solver's default; the exact checks do not depend on it
+};
+
+DrapeConfig base_config(int n, Triangulation triangulation, double jitter, const Options& options) {
+  DrapeConfig c;
+  c.fabric = fabric_from_paper_units(kMedianAlpha, kMedianBeta, 300.0);
+  c.specimen = SpecimenSpec{0.3, 0.3, n, n, jitter, triangulation, 0, 0.0};
+  c.solver.tolerance = options.tolerance;
+  return c;
+}
+
+struct Run {
+  DrapeResult result;
+  double seconds = 0.0;
+  bool converged = false;
+};
+
+Run run(const std::string& label, const DrapeConfig& config) {
+  const auto start = std::chrono::steady_clock::now();
+  Expected<DrapeResult> r = simulate_drape(config);
+  Run out;
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (!r) {
+    std::cerr << "error in " << label << ": " << r.error().message << "\n";
+    std::exit(1);
+  }
+  out.result = std::move(r).value();
+  const SolveReport& s = out.result.report;
+  out.converged = s.outcome == SolveOutcome::kConverged;
+  std::cerr << fmt::format("  {:<44s} {:>4d}x{:<4d} {:<16s} {:4d} it  residual {:8.2e}  {:6.1f} s  DC {:.4f}  "
+                           "folds {}  self-intersections {}  energy {:.6e} J\n",
+                           label, config.specimen.vertices_x, config.specimen.vertices_y, to_string(s.outcome),
+                           s.iterations, s.residual, out.seconds, out.result.measures.drape_coefficient,
+                           out.result.measures.folds, out.result.measures.self_intersections, s.energy);
+  return out;
+}
+
+double max_distance(const Eigen::Matrix3Xd& a, const Eigen::Matrix3Xd& b) { return (a - b).colwise().norm().maxCoeff(); }
+double mean_distance(const Eigen::Matrix3Xd& a, const Eigen::Matrix3Xd& b) { return (a - b).colwise().norm().mean(); }
+
+/// The output table. A row without a bound is informative.
+class Table {
+ public:
+  void row(int n, const std::string& check, const std::string& quantity, double value, const std::string& bound = "",
+           bool pass = true) {
+    rows_.push_back(fmt::format("| {:>3d} | {:<2s}| {:<66s}| {:>11.4g} | {:<16s}| {:<4s} |", n, check, quantity, value,
+                                bound, bound.empty() ? "" : (pass ? "ok" : "FAIL")));
+    failures_ += pass ? 0 : 1;
+  }
+  void print() const {
+    std::cout << fmt::format("| {:>3s} | {:<2s}| {:<66s}| {:>11s} | {:<16s}| {:<4s} |\n", "N", "", "quantity", "value",
+                             "bound", "");
+    std::cout << "|----:|---|" << std::string(67, '-') << "|" << std::string(12, '-') << ":|" << std::string(17, '-')
+              << "|------|\n";
+    for (const std::string& r : rows_) std::cout << r << "\n";
+  }
+  [[nodiscard]] int failures() const { return failures_; }
+
+ private:
+  std::vector<std::string> rows_;
+  int failures_ = 0;
+};
+
+constexpr double kMm = 1e3;  // m -> mm
+
+void check_converged(Table& t, int n, const std::string& check, const std::string& label, const Run& r) {
+  t.row(n, check, label + ": converged (1 = yes)", r.converged ? 1.0 : 0.0, "= 1", r.converged);
+}
+
+// a: alpha, beta, density x s. With sigma (and the contact penalty) fixed the in-plane stiffness relative to the
+// weight changes by 1/s, so the drape is invariant only as far as the stretch is negligible (the paper's argument);
+// scaling every force (sigma and contact too) scales the total energy, an exact invariance.
+void check_k_over_rho(Table& t, int n, const Options& o) {
+  const DrapeConfig base = base_config(n, Triangulation::kRandom, 0.2, o);
+  const Run r0 = run("a: median fabric", base);
+  check_converged(t, n, "a", "base", r0);
+  for (double s : {3.0, 0.5}) {
+    DrapeConfig c = base;
+    c.fabric.alpha = scaled(base.fabric.alpha, s);
+    c.fabric.beta = scaled(base.fabric.beta, s);
+    c.fabric.density *= s;
+    const Run r = run(fmt::format("a: k, rho x {}", s), c);
+    check_converged(t, n, "a", fmt::format("k, rho x {}", s), r);
+    const double d = max_distance(r.result.mesh.positions, r0.result.mesh.positions) * kMm;
+    t.row(n, "a", fmt::format("k, rho x {} (sigma fixed): max vertex distance, mm", s), d, "< 0.1", d < 0.1);
+    t.row(n, "a", fmt::format("k, rho x {} (sigma fixed): mean vertex distance, mm", s),
+          mean_distance(r.result.mesh.positions, r0.result.mesh.positions) * kMm);
+    t.row(n, "a", fmt::format("k, rho x {} (sigma fixed): |dDC|", s),
+          std::abs(r.result.measures.drape_coefficient - r0.result.measures.drape_coefficient));
+    c.membrane.stiffness *= s;
+    c.platform.contact_stiffness *= s;
+    const Run e = run(fmt::format("a: k, rho, sigma, contact x {}", s), c);
+    const double de = max_distance(e.result.mesh.positions, r0.result.mesh.positions) * kMm;
+    t.row(n, "a", fmt::format("k, rho, sigma, contact x {}: max distance, mm", s), de, "< 0.01", de < 0.01);
+  }
+}
+
+/// Vertex (i, j) of an n x n grid drape rotated by 90 degrees about the axis lands on vertex (n-1-j, i); the largest
+/// distance between that image of `a` and `b` (an odd union jack grid is symmetric under this map).
+double grid_rotation_defect(int n, const Eigen::Matrix3Xd& a, const Eigen::Matrix3Xd& b) {
+  const Eigen::Matrix3d q = Eigen::AngleAxisd(std::numbers::pi / 2.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  Eigen::Matrix3Xd image(3, a.cols());
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i < n; ++i) image.col(i * n + (n - 1 - j)) = q * a.col(j * n + i);
+  }
+  return max_distance(image, b);
+}
+
+/// Restarts `config` from its drape `r` with every hanging vertex moved by Gaussian noise of `amplitude` metres: a
+/// stable equilibrium comes back, an unstable one (a saddle kept by symmetry) leaves.
+Run restart_perturbed(const std::string& label, DrapeConfig config, const DrapeResult& r, double amplitude) {
+  ClothMesh mesh = r.mesh;
+  std::mt19937_64 rng(1);
+  std::normal_distribution<double> noise(0.0, amplitude);
+  for (int v = 0; v < mesh.vertex_count(); ++v) {
+    if (mesh.positions(2, v) < -0.003) {
+      for (int k = 0; k < 3; ++k) mesh.positions(k, v) += noise(rng);
+    }
+  }
+  const std::string path = (std::filesystem::temp_directory_path() / "drapegen_drape_physics_restart.ply").string();
+  if (Status s = write_ply(path, mesh); !s) {
+    std::cerr << "error: " << s.error().message << "\n";
+    std::exit(1);
+  }
+  config.initial = InitialStateSpec{};
+  config.initial.shape = InitialShape::kMesh;
+  config.initial.mesh_path = path;
+  Run out = run(label, config);
+  std::filesystem::remove(path);
+  return out;
+}
+
+// b: the cylinder is axisymmetric, so the drape of a specimen rotated about the axis is the rotated drape. On an odd
+// union jack grid the mesh is itself symmetric under 90-degree rotations: the isotropic drape must be too, and
+// swapping warp and weft must rotate the drape by 90 degrees. Symmetric solutions may be saddles that Newton keeps
+// by symmetry: a restart from a 1 micrometre perturbation tells.
+void check_rotation(Table& t, int n, const Options& o) {
+  if (n % 2 == 0) ++n;  // odd: symmetric grid
+  DrapeConfig base = base_config(n, Triangulation::kAlternating, 0.0, o);
+  base.fabric = fabric_from_paper_units({11455, 11455, 11455}, {-29660, -29660, -29660}, 300.0);
+  const Run r0 = run("b: isotropic, structured", base);
+  check_converged(t, n, "b", "rotation 0", r0);
+  for (double degrees : {90.0, 45.0}) {
+    DrapeConfig c = base;
+    c.initial.rotation = degrees * std::numbers::pi / 180.0;
+    const Run r = run(fmt::format("b: rotated {} deg", degrees), c);
+    check_converged(t, n, "b", fmt::format("rotation {}", degrees), r);
+    const Eigen::Matrix3d rot = Eigen::AngleAxisd(c.initial.rotation, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    const double d = max_distance(r.result.mesh.positions, rot * r0.result.mesh.positions) * kMm;
+    t.row(n, "b", fmt::format("rotation {}: max distance to rotated drape, mm", degrees), d, "< 0.1", d < 0.1);
+    t.row(n, "b", fmt::format("rotation {}: |dDC|", degrees),
+          std::abs(r.result.measures.drape_coefficient - r0.result.measures.drape_coefficient));
+  }
+  const double sym = grid_rotation_defect(n, r0.result.mesh.positions, r0.result.mesh.positions) * kMm;
+  t.row(n, "b", "isotropic: 90-degree symmetry defect of the drape, mm", sym, "< 0.1", sym < 0.1);
+
+  DrapeConfig warp = base;
+  warp.fabric = fabric_from_paper_units({20000, 12500, 5000}, {-50000, -31250, -12500}, 300.0);
+  DrapeConfig weft = warp;
+  std::swap(weft.fabric.alpha.warp, weft.fabric.alpha.weft);
+  std::swap(weft.fabric.beta.warp, weft.fabric.beta.weft);
+  const Run a = run("b: warp 4 x weft", warp), b = run("b: weft 4 x warp", weft);
+  const double swap = grid_rotation_defect(n, a.result.mesh.positions, b.result.mesh.positions) * kMm;
+  t.row(n, "b", "warp/weft swapped vs drape rotated 90 deg: max distance, mm", swap, "< 0.1", swap < 0.1);
+
+  for (const Run* r : {&r0, &a}) {
+    const bool iso = r == &r0;
+    const Run p = restart_perturbed(fmt::format("b: {} restarted, 1 um noise", iso ? "isotropic" : "warp 4 x weft"),
+                                    iso ? base : warp, r->result, 1e-6);
+    t.row(n, "b", fmt::format("{}: restart from 1 um noise moves it by (max), mm", iso ? "isotropic" : "warp 4x"),
+          max_distance(p.result.mesh.positions, r->result.mesh.positions) * kMm);
+    t.row(n, "b", fmt::format("{}: energy change of that restart, J", iso ? "isotropic" : "warp 4x"),
+          p.result.report.energy - r->result.report.energy);
+  }
+}
+
+// c: sigma barely matters once large enough (Figs. 5-7), and no locking at sigma = 5000 thanks to the band (Fig. 9).
+void check_sigma(Table& t, int n, const Options& o) {
+  const DrapeConfig base = base_config(n, Triangulation::kRandom, 0.2, o);
+  auto with = [&](double sigma, bool band) {
+    DrapeConfig c = base;
+    c.membrane.stiffness = sigma;
+    if (!band) c.membrane.band_low = c.membrane.band_high = 1.0;
+    const Run r = run(fmt::format("c: sigma {} band {}", sigma, band ? "on" : "off"), c);
+    check_converged(t, n, "c", fmt::format("sigma {} band {}", sigma, band ? "on" : "off"), r);
+    return r;
+  };
+  const Run s200 = with(200, true), s1000 = with(1000, true), s5000 = with(5000, true);
+  const Run n200 = with(200, false), n1000 = with(1000, false), n5000 = with(5000, false);
+  const double dc200 = s200.result.measures.drape_coefficient;
+  auto rel = [&](const Run& r) { return std::abs(r.result.measures.drape_coefficient - dc200) / dc200; };
+  const Eigen::Matrix3Xd& x200 = s200.result.mesh.positions;
+  t.row(n, "c", "band on: DC sigma 200", dc200);
+  t.row(n, "c", "band on: DC sigma 1000", s1000.result.measures.drape_coefficient);
+  t.row(n, "c", "band on: DC sigma 5000", s5000.result.measures.drape_coefficient);
+  const double mean1000 = mean_distance(s1000.result.mesh.positions, x200) * kMm;
+  t.row(n, "c", "band on: sigma 1000 vs 200 mean vertex distance, mm", mean1000, "< 2", mean1000 < 2.0);
+  t.row(n, "c", "band on: sigma 1000 vs 200 max vertex distance, mm",
+        max_distance(s1000.result.mesh.positions, x200) * kMm);
+  t.row(n, "c", "band on: sigma 5000 vs 200 mean vertex distance, mm",
+        mean_distance(s5000.result.mesh.positions, x200) * kMm);
+  t.row(n, "c", "band on: sigma 5000 vs 200 |dDC|/DC", rel(s5000), "< 0.05", rel(s5000) < 0.05);
+  t.row(n, "c", "band off: DC sigma 200", n200.result.measures.drape_coefficient);
+  t.row(n, "c", "band off: DC sigma 1000", n1000.result.measures.drape_coefficient);
+  t.row(n, "c", "band off: DC sigma 5000", n5000.result.measures.drape_coefficient);
+  t.row(n, "c", "band off: sigma 200 vs band-on 200 mean distance, mm",
+        mean_distance(n200.result.mesh.positions, x200) * kMm);
+  t.row(n, "c", "band off: sigma 5000 vs band-on 200 mean distance, mm",
+        mean_distance(n5000.result.mesh.positions, x200) * kMm);
+  t.row(n, "c", "band off: sigma 5000 vs band-on 200 |dDC|/DC", rel(n5000));
+}
+
+/// Hem radius around the rest x axis (azimuths 0 and 180 degrees, +-15 degrees) over that around the rest y axis.
+double hem_elongation(const ClothMesh& mesh) {
+  const std::vector<double> p = hem_profile(mesh, 360);
+  double x = 0.0, y = 0.0;
+  for (int d = 0; d < 360; ++d) {
+    if (std::min(d % 180, 180 - d % 180) <= 15) x += p[d];
+    if (std::abs(d % 180 - 90) <= 15) y += p[d];
+  }
+  return x / y;
+}
+
+// d: strongly anisotropic bending (alpha and beta warp = 4 x weft) on a structured and a perturbed mesh (the paper's
+// Fig. 12 comparison, by drape coefficient), with isotropic bending on the same meshes as the noise floor. The edge
+// rule only errs where hinges are not aligned with warp and weft: on the equilateral mesh (edges at 0, 60, 120
+// degrees) no hinge bends along the warp when it is the rest x axis. There, the anisotropy of the hem (warp over
+// weft hem radius, averaged over the material at 0 and 90 degrees to the mesh so that the mesh's own bias cancels)
+// is compared between the rules.
+void check_mesh_dependence(Table& t, int n, const Options& o) {
+  const FabricParameters aniso = fabric_from_paper_units({20000, 12500, 5000}, {-50000, -31250, -12500}, 300.0);
+  const FabricParameters iso = fabric_from_paper_units({11180, 11180, 11180}, {-27950, -27950, -27950}, 300.0);
+  double difference[3] = {0.0, 0.0, 0.0};
+  const char* names[3] = {"isotropic", "curvature rule", "edge rule"};
+  for (int k = 0; k < 3; ++k) {
+    double dc[2];
+    for (int perturbed = 0; perturbed < 2; ++perturbed) {
+      DrapeConfig c = perturbed ? base_config(n, Triangulation::kRandom, 0.2, o)
+                                : base_config(n, Triangulation::kAlternating, 0.0, o);
+      c.fabric = k == 0 ? iso : aniso;
+      c.anisotropy = k == 2 ? AnisotropyRule::kEdge : AnisotropyRule::kCurvature;
+      const std::string label = fmt::format("{}, {} mesh", names[k], perturbed ? "perturbed" : "structured");
+      const Run r = run("d: " + label, c);
+      check_converged(t, n, "d", label, r);
+      dc[perturbed] = r.result.measures.drape_coefficient;
+      t.row(n, "d", fmt::format("{}: DC {} mesh", names[k], perturbed ? "perturbed" : "structured"), dc[perturbed]);
+    }
+    difference[k] = std::abs(dc[0] - dc[1]) / (0.5 * (dc[0] + dc[1]));
+  }
+  t.row(n, "d", "isotropic: |dDC| / mean DC, structured vs perturbed", difference[0]);
+  t.row(n, "d", "curvature rule: |dDC| / mean DC, structured vs perturbed", difference[1], "< 0.02",
+        difference[1] < 0.02);
+  t.row(n, "d", "edge rule: |dDC| / mean DC, structured vs perturbed", difference[2], "> curvature",
+        difference[2] > difference[1]);
+
+  double ratio[2];
+  for (int edge = 0; edge < 2; ++edge) {
+    double elongation[2];
+    for (int turned = 0; turned < 2; ++turned) {
+      DrapeConfig c = base_config(n, Triangulation::kEquilateral, 0.0, o);
+      c.fabric = aniso;
+      c.anisotropy = edge ? AnisotropyRule::kEdge : AnisotropyRule::kCurvature;
+      c.specimen.material_angle = turned ? std::numbers::pi / 2.0 : 0.0;
+      const std::string label =
+          fmt::format("{}, equilateral mesh, warp at {} deg", edge ? "edge rule" : "curvature rule", turned ? 90 : 0);
+      const Run r = run("d: " + label, c);
+      check_converged(t, n, "d", label, r);
+      elongation[turned] = hem_elongation(r.result.mesh);
+    }
+    ratio[edge] = std::sqrt(elongation[0] / elongation[1]);  // warp / weft hem radius
+    t.row(n, "d", fmt::format("{}: equilateral mesh hem radius warp/weft", edge ? "edge rule" : "curvature rule"),
+          ratio[edge]);
+  }
+  t.row(n, "d", "edge rule: anisotropy lost on equilateral mesh (ratio diff)", ratio[1] - ratio[0], "> 0",
+        ratio[1] > ratio[0]);
+}
+
+// e: every initial state converges for the median fabric (possibly to different local minima).
+void check_initial_states(Table& t, int n, const Options& o) {
+  for (InitialShape shape : {InitialShape::kFlat, InitialShape::kSine, InitialShape::kFold}) {
+    const char* name = shape == InitialShape::kFlat ? "flat" : shape == InitialShape::kSine ? "sine" : "fold";
+    DrapeConfig c = base_config(n, Triangulation::kRandom, 0.2, o);
+    c.solver.tolerance = 1e-3;  // the default
+    c.initial.shape = shape;
+    c.initial.seed = 3;
+    const Run r = run(fmt::format("e: initial {}", name), c);
+    check_converged(t, n, "e", fmt::format("initial {}", name), r);
+    t.row(n, "e", fmt::format("initial {}: DC", name), r.result.measures.drape_coefficient);
+    t.row(n, "e", fmt::format("initial {}: folds", name), r.result.measures.folds);
+    t.row(n, "e", fmt::format("initial {}: iterations", name), r.result.report.iterations);
+    t.row(n, "e", fmt::format("initial {}: self-intersections", name), r.result.measures.self_intersections, "= 0",
+          r.result.measures.self_intersections == 0);
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options options;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if ((arg == "--resolution" || arg == "-r") && i + 1 < argc) {
+      options.resolutions.push_back(std::atoi(argv[++i]));
+    } else if (arg == "--checks" && i + 1 < argc) {
+      options.checks = argv[++i];
+    } else if (arg == "--tolerance" && i + 1 < argc) {
+      options.tolerance = std::atof(argv[++i]);
+    } else {
+      std::cerr << "usage: drapegen_drape_physics [--resolution N]... [--checks abcde] [--tolerance T]\n";
+      return arg == "--help" || arg == "-h" ? 0 : 1;
+    }
+  }
+  if (options.resolutions.empty()) options.resolutions = {60};
+  Table table;
+  const auto start = std::chrono::steady_clock::now();
+  for (int n : options.resolutions) {
+    if (n < 5) {
+      std::cerr << "resolution must be at least 5\n";
+      return 1;
+    }
+    const bool want[5] = {options.checks.find('a') != std::string::npos, options.checks.find('b') != std::string::npos,
+                          options.checks.find('c') != std::string::npos, options.checks.find('d') != std::string::npos,
+                          options.checks.find('e') != std::string::npos};
+    if (want[0]) check_k_over_rho(table, n, options);
+    if (want[1]) check_rotation(table, n, options);
+    if (want[2]) check_sigma(table, n, options);
+    if (want[3]) check_mesh_dependence(table, n, options);
+    if (want[4]) check_initial_states(table, n, options);
+  }
+  table.print();
+  std::cout << fmt::format("{} failed rows, {:.0f} s total\n", table.failures(),
+                           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  return table.failures() == 0 ? 0 : 2;
+}
