@@ -108,6 +108,7 @@ nlohmann::json to_json(const DrapeResult& result) {
       {"regularized_iterations", r.regularized_iterations},
       {"exact_hessian_iterations", r.exact_hessian_iterations},
       {"lagged_updates", r.lagged_updates},
+      {"reused_factorizations", r.reused_factorizations},
       {"lagged_change", r.lagged_change},
       {"line_search_failures", r.line_search_failures},
       {"vertices", result.mesh.vertex_count()},

@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 #include <fmt/format.h>
 
@@ -70,6 +71,9 @@ SolveReport NewtonSolver::solve(const std::vector<EnergyTerm*>& terms, const std
   int exact_cooldown = 0;  // iterations to wait before trying the exact Hessian again
   bool frozen = false;     // state-dependent parameters no longer updated
   int outer_updates = 0;
+  bool have_factor = false, last_step_full = false;
+  int reuse_count = 0;
+  double previous_residual = std::numeric_limits<double>::infinity();
   for (int it = 0; it < options_.max_iterations; ++it) {
     report.iterations = it;
     const bool outer = it > 0 && report.residual < options_.lagged_outer_below;
@@ -106,10 +110,22 @@ SolveReport NewtonSolver::solve(const std::vector<EnergyTerm*>& terms, const std
     mean_diagonal = std::max(mean_diagonal / n, 1e-300);
     bool accepted = false;
     double step_length = 0.0;
+    // Keep the last factorisation while it still gives full steps that cut the residual well: a chord step costs
+    // two triangular solves instead of a factorisation.
+    bool reuse = have_factor && lambda == 0.0 && !exact && reuse_count < options_.max_factor_reuse &&
+                 last_step_full && report.residual < 0.5 * previous_residual;
     while (!accepted) {
-      t0 = Clock::now();
-      const FactorStatus status = cholesky.factorize(assembler, lambda * mean_diagonal);
-      report.factorization_seconds += since(t0);
+      FactorStatus status = FactorStatus::kOk;
+      if (reuse) {
+        ++reuse_count;
+        ++report.reused_factorizations;
+      } else {
+        t0 = Clock::now();
+        status = cholesky.factorize(assembler, lambda * mean_diagonal);
+        report.factorization_seconds += since(t0);
+        have_factor = status == FactorStatus::kOk;
+        reuse_count = 0;
+      }
       if (exact && status != FactorStatus::kOk) {  // indefinite: fall back to the projected Hessian
         exact = false;
         exact_cooldown = 5;
@@ -154,6 +170,10 @@ SolveReport NewtonSolver::solve(const std::vector<EnergyTerm*>& terms, const std
         }
         if (!accepted) ++report.line_search_failures;
       }
+      if (!accepted && reuse) {  // the old factorisation is too stale: factorise afresh
+        reuse = false;
+        continue;
+      }
       if (!accepted && exact) {  // the exact Hessian gave no usable step: back to the projected one
         exact = false;
         exact_cooldown = 5;
@@ -171,6 +191,8 @@ SolveReport NewtonSolver::solve(const std::vector<EnergyTerm*>& terms, const std
         }
       }
     }
+    last_step_full = step_length == 1.0;
+    previous_residual = report.residual;
     if (lambda > 0.0) ++report.regularized_iterations;
     if (exact) ++report.exact_hessian_iterations;
     if (progress_) progress_(IterationInfo{it, energy, report.residual, step_length, lambda});

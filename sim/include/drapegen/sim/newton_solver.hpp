@@ -40,6 +40,9 @@ struct SolverOptions {
   double lagged_every_above = 10.0;
   double lagged_outer_below = 0.3;
   double lagged_tolerance = 1e-3;
+  /// Consecutive iterations that may reuse the last factorisation (chord steps) while it gives full steps that at
+  /// least halve the residual; 0 factorises at every iteration.
+  int max_factor_reuse = 3;
   /// Outer updates after which the parameters are fixed anyway (directions in nearly flat regions can cycle).
   int max_lagged_outer_updates = 6;
 };
@@ -55,6 +58,7 @@ struct SolveReport {
   int regularized_iterations = 0;  // iterations that needed a diagonal shift
   int exact_hessian_iterations = 0;  // iterations that stepped with the unprojected Hessian
   int lagged_updates = 0;            // updates of state-dependent parameters
+  int reused_factorizations = 0;     // iterations that stepped with an earlier factorisation
   double lagged_change = 0.0;        // relative change at the last update
   int line_search_failures = 0;
   std::string message;
