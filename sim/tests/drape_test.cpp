@@ -108,7 +108,7 @@ TEST(DrapePhysics, DrapeDependsOnBendingOverDensity) {
 // (b) The platform is a cylinder about the z axis and gravity points along it: rotating the specimen about the axis
 // must rotate the drape, vertex by vertex. On an odd union jack grid the mesh itself is symmetric under a rotation by
 // 90 degrees that maps vertex (i, j) to (n-1-j, i), so an isotropic drape must have that symmetry too (the solver must
-// not break it), and swapping warp and weft of an anisotropic fabric must give the drape rotated by 90 degrees.
+// not break it), and swapping warp and weft of an anisotropic fabric must give the drape mirrored in x = y.
 // (Newton keeps an exact symmetry, so a symmetric drape can also be a saddle: with warp = 4 x weft on a 31 x 31 grid,
 // a restart from 1 micrometre of noise moves 12 mm to a lower energy. At 25 x 25 both drapes here are stable;
 // bench/drape_physics.cpp checks that.)
@@ -146,14 +146,32 @@ TEST(DrapePhysics, RotationAboutTheAxisRotatesTheDrape) {
   std::swap(weft_stiff.fabric.beta.warp, weft_stiff.fabric.beta.weft);
   const DrapeResult a = drape(warp_stiff, "rotation: warp 4 x weft");
   const DrapeResult b = drape(weft_stiff, "rotation: weft 4 x warp");
-  const double d_swap = symmetry_defect(a.mesh.positions, b.mesh.positions);
-  std::printf("[ rotation ] warp/weft swapped vs drape rotated by 90 deg: max distance %.2e mm\n", d_swap);
+  // Mirroring in the plane x = y maps the grid onto itself (vertex (i, j) to (j, i)) and swaps warp and weft.
+  Eigen::Matrix3Xd mirrored(3, a.mesh.positions.cols());
+  if (a.mesh.positions.cols() == n * n) {
+    for (int j = 0; j < n; ++j) {
+      for (int i = 0; i < n; ++i) {
+        const Eigen::Vector3d p = a.mesh.positions.col(j * n + i);
+        mirrored.col(i * n + j) = Eigen::Vector3d(p.y(), p.x(), p.z());
+      }
+    }
+  }
+  const double d_swap = max_distance_mm(mirrored, b.mesh.positions);
+  const double d_swap_rotated = symmetry_defect(a.mesh.positions, b.mesh.positions);
+  std::printf("[ rotation ] warp/weft swapped vs drape mirrored in x = y: max distance %.2e mm (vs rotated by 90 "
+              "deg: %.2e mm)\n",
+              d_swap, d_swap_rotated);
   EXPECT_LT(d_swap, 0.1);
+  // The two images agree while the anisotropic drape keeps its mirror symmetries, as it does at 25 x 25 (at 61 x 61
+  // it breaks them, to a fold pattern 34 mm away from its mirror image, so only the x = y mirror is exact there).
+  EXPECT_LT(d_swap_rotated, 0.1);
 }
 
 // (c) Section 4.1: sigma barely changes the drape once it is large enough (Figs. 5-7), and a stiff sigma = 5000 does
 // not lock thanks to the stretch band [0.99, 1.01] (Fig. 9). Without the band, sigma = 5000 locks: the specimen
-// cannot form folds and stands out like a stiff skirt.
+// cannot form folds and stands out like a stiff skirt. (At 25 x 25 sigma 5000 with the band is within 0.5% of sigma
+// 200; on finer meshes some locking remains: +1.5% to +7.5% at 60 x 60 over three triangulations, see
+// bench/drape_physics.cpp.)
 TEST(DrapePhysics, InPlaneStiffnessBarelyMattersAndDoesNotLock) {
   const DrapeConfig base = config(25, false);
   auto with = [&](double sigma, bool band) {
@@ -173,9 +191,10 @@ TEST(DrapePhysics, InPlaneStiffnessBarelyMattersAndDoesNotLock) {
               mean1000, max_distance_mm(s1000.mesh.positions, s200.mesh.positions),
               mean_distance_mm(s5000.mesh.positions, s200.mesh.positions),
               mean_distance_mm(locked.mesh.positions, s200.mesh.positions));
-  // Fold positions move by millimetres between nearby local minima (see the top of the file); the mean distance of
-  // a 150 mm overhang changing its fold pattern would be >= 10 mm.
-  EXPECT_LT(mean1000, 6.0);
+  // Fold positions move by millimetres between nearby local minima (see the top of the file), so the paper's "little
+  // change" is bounded at 5 mm mean (observed 0.8 mm at 25 x 25, 1.3 mm at 60 x 60, up to 4 mm at 30 x 30 with an
+  // earlier solver); a different model gives more (no band at sigma 200: 7.5 mm; sigma 5000 without band: 31 mm).
+  EXPECT_LT(mean1000, 5.0);
   EXPECT_NEAR(dc1000, dc200, 0.05 * dc200);
   EXPECT_NEAR(dc5000, dc200, 0.05 * dc200);
   // Locking without the band: far stiffer than any bending change here (DC roughly doubles or more).
@@ -205,8 +224,8 @@ double hem_elongation(const ClothMesh& mesh) {
 // hinge bends along the warp when the warp is the rest x axis, and none along the weft when the material is turned
 // by 90 degrees. The anisotropy of the hem - warp over weft hem radius, averaged over the material at 0 and 90
 // degrees so that the mesh's own x/y bias cancels - is then weaker under the edge rule than under the curvature
-// rule (observed at 24-41 vertices per side: curvature 0.78-0.89, edge 0.84-0.94, the edge rule always higher, by
-// 0.04-0.14).
+// rule (observed at 24-41 vertices per side: curvature 0.75-0.89, edge 0.84-0.95, the edge rule always higher, by
+// 0.04-0.20; 60 x 60: 0.86 vs 0.92).
 TEST(DrapePhysics, CurvatureRuleKeepsTheAnisotropyOnAnyMesh) {
   const FabricParameters fabric =
       fabric_from_paper_units({20000, 12500, 5000}, {-50000, -31250, -12500}, 300.0);
