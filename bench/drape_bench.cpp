@@ -51,6 +51,10 @@ int main(int argc, char** argv) {
   int resolution = 100, fabrics = 5;
   std::vector<std::string> inits{"flat", "sine", "fold"};
   bool json = false;
+  int factor_reuse = drapegen::sim::SolverOptions{}.max_factor_reuse;
+  int coarse = drapegen::sim::DrapeConfig{}.coarse_start_resolution;
+  app.add_option("--factor-reuse", factor_reuse, "SolverOptions::max_factor_reuse")->capture_default_str();
+  app.add_option("--coarse", coarse, "DrapeConfig::coarse_start_resolution (0: off)")->capture_default_str();
   app.add_option("--data", data, "fabrics618.csv")->capture_default_str();
   app.add_option("--resolution", resolution, "vertices per side")->capture_default_str();
   app.add_option("--fabrics", fabrics, "fabrics at evenly spaced quantiles of mean alpha")->capture_default_str();
@@ -72,6 +76,8 @@ int main(int argc, char** argv) {
       config.fabric = drapegen::sim::fabric_from_paper_units(fabric.alpha, fabric.beta, 300.0);
       config.specimen.vertices_x = config.specimen.vertices_y = resolution;
       config.specimen.seed = 100 + f;
+      config.solver.max_factor_reuse = factor_reuse;
+      config.coarse_start_resolution = coarse;
       auto initial = drapegen::sim::parse_initial_state(init);
       config.initial = *initial;
       config.initial.seed = 7 + f;

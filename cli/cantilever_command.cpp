@@ -19,7 +19,7 @@ struct CantileverOptions {
   double alpha = 0.0;
   double beta = 0.0;
   double density = 300.0;
-  double width = 0.02;
+  double width = 0.0;  // 0: twice the length
   int segments = 40;
   bool json = false;
 };
@@ -34,12 +34,12 @@ int run_cantilever(const CantileverOptions& o) {
   if (!(o.alpha > 0.0) || !std::isfinite(o.alpha)) return fail("--alpha must be positive (g*mm^2/s^2)");
   if (!std::isfinite(o.beta)) return fail("--beta must be finite (g*mm^3/s^2)");
   if (!(o.density > 0.0) || !std::isfinite(o.density)) return fail("--density must be positive (g/m^2)");
-  if (!(o.width > 0.0) || !std::isfinite(o.width)) return fail("--width must be positive (m)");
+  if (!(o.width >= 0.0) || !std::isfinite(o.width)) return fail("--width must be positive (m), or 0 for 2 x length");
   if (o.segments < 4) return fail("--segments must be at least 4");
 
   sim::CantileverSpec spec;
   spec.length = o.length;
-  spec.width = o.width;
+  spec.width = o.width > 0.0 ? o.width : 2.0 * o.length;
   spec.segments = o.segments;
   spec.fabric = sim::fabric_from_paper_units({o.alpha, o.alpha, o.alpha}, {o.beta, o.beta, o.beta}, o.density);
   const auto result = sim::simulate_cantilever(spec);
@@ -81,7 +81,9 @@ Runner add_cantilever_command(CLI::App& app) {
   app.add_option("--alpha", o->alpha, "Linear bending modulus, g*mm^2/s^2")->required();
   app.add_option("--beta", o->beta, "Quadratic bending modulus, g*mm^3/s^2")->capture_default_str();
   app.add_option("--density", o->density, "Areal density, g/m^2")->capture_default_str();
-  app.add_option("--width", o->width, "Strip width, m")->capture_default_str();
+  app.add_option("--width", o->width,
+                 "Strip width, m (default 0: twice the length; the hinge model curls narrow strips across and makes "
+                 "them up to ~8% softer, see docs/PHYSICS.md)");
   app.add_option("--segments", o->segments, "Elements along the length")->capture_default_str();
   app.add_flag("--json", o->json, "Print JSON: gamma, height_over_width, deflection curve, elastica reference, fit");
   return [o] { return run_cantilever(*o); };

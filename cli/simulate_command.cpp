@@ -78,6 +78,8 @@ int run_simulate(const SimulateOptions& o) {
   const auto drift = parse_drift(o.drift, o.seed);
   if (!drift) return fail(drift.error().message);
   if (!std::isfinite(o.rotation_deg)) return fail("--rotation must be finite");
+  if (!(o.tolerance > 0.0) || !std::isfinite(o.tolerance)) return fail("--tolerance must be positive");
+  if (o.max_iterations < 1) return fail("--max-iterations must be at least 1");
 
   sim::DrapeConfig config;
   config.fabric = sim::fabric_from_paper_units(*alpha, *beta, o.density);

@@ -73,6 +73,7 @@ SolveReport NewtonSolver::solve(const std::vector<EnergyTerm*>& terms, const std
   int outer_updates = 0;
   bool have_factor = false, last_step_full = false;
   int reuse_count = 0;
+  int creeping = 0;  // consecutive iterations whose step moved no vertex measurably
   double previous_residual = std::numeric_limits<double>::infinity();
   for (int it = 0; it < options_.max_iterations; ++it) {
     report.iterations = it;
@@ -190,6 +191,17 @@ SolveReport NewtonSolver::solve(const std::vector<EnergyTerm*>& terms, const std
           return report;
         }
       }
+    }
+    // Steps that no longer move anything mean the line search is creeping at round-off: stop and say so.
+    double moved = 0.0;
+    for (int f = 0; f < n / 3; ++f) moved = std::max(moved, step_length * step.segment<3>(3 * f).norm());
+    creeping = moved < 1e-12 ? creeping + 1 : 0;
+    if (creeping >= 5) {
+      report.outcome = SolveOutcome::kStalled;
+      report.message = fmt::format("steps below 1e-12 m for 5 iterations at residual {:.3g}", report.residual);
+      report.iterations = it + 1;
+      report.seconds = since(start);
+      return report;
     }
     last_step_full = step_length == 1.0;
     previous_residual = report.residual;

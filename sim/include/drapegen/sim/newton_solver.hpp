@@ -14,7 +14,7 @@ namespace drapegen::sim {
 enum class SolveOutcome {
   kConverged,            // residual below tolerance
   kIterationLimit,       // max_iterations reached first
-  kStalled,              // no step lowered the energy, even with the strongest regularisation
+  kStalled,              // no step lowered the energy (even with the strongest regularisation), or steps stopped moving
   kDiverged,             // non-finite energy, gradient or step
   kFactorizationFailed,  // CHOLMOD failed for a reason other than indefiniteness
 };

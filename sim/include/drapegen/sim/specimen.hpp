@@ -30,8 +30,8 @@ struct SpecimenSpec {
 
 /// A flat specimen centred on the origin in the plane z = 0 (positions equal the rest coordinates).
 /// Grid triangulations: vertex (i, j) has index j * vertices_x + i. kEquilateral: `vertices_y` rows, even rows with
-/// `vertices_x` vertices, odd rows with one more (their end vertices sit on the borders), row by row. Throws std::invalid_argument on fewer than 2 vertices per side,
-/// non-positive sizes or a jitter outside [0, 0.45].
+/// `vertices_x` vertices, odd rows with one more (their end vertices sit on the borders), row by row.
+/// Throws std::invalid_argument on fewer than 2 vertices per side, non-positive sizes or a jitter outside [0, 0.3].
 [[nodiscard]] ClothMesh make_specimen(const SpecimenSpec& spec);
 
 }  // namespace drapegen::sim
