@@ -147,10 +147,11 @@ int run_simulate(const SimulateOptions& o) {
     std::cout << summary.dump(2) << "\n";
   } else {
     const auto& r = result->report;
+    const auto& c = result->coarse_report;
     std::cout << fmt::format(
-        "drape: {} in {} iterations, {:.2f} s (factorisation {:.2f} s), residual {:.2e}\n"
+        "drape: {} in {} iterations (+{} on coarser levels), {:.2f} s (coarser levels {:.2f} s), residual {:.2e}\n"
         "  drape coefficient {:.3f}, folds {}, self-intersections {}, lowest point {:.1f} mm\n",
-        sim::to_string(r.outcome), r.iterations, r.seconds, r.factorization_seconds, r.residual,
+        sim::to_string(r.outcome), r.iterations, c.iterations, r.seconds + c.seconds, c.seconds, r.residual,
         result->measures.drape_coefficient, result->measures.folds, result->measures.self_intersections,
         result->measures.lowest_point * 1e3);
     if (!r.message.empty()) std::cout << "  " << r.message << "\n";
