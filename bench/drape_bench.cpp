@@ -54,6 +54,10 @@ int main(int argc, char** argv) {
   int factor_reuse = drapegen::sim::SolverOptions{}.max_factor_reuse;
   int coarse = drapegen::sim::DrapeConfig{}.coarse_start_resolution;
   app.add_option("--factor-reuse", factor_reuse, "SolverOptions::max_factor_reuse")->capture_default_str();
+  double exact_below = drapegen::sim::SolverOptions{}.exact_hessian_below;
+  int max_iterations = drapegen::sim::SolverOptions{}.max_iterations;
+  app.add_option("--exact-below", exact_below, "SolverOptions::exact_hessian_below")->capture_default_str();
+  app.add_option("--max-iterations", max_iterations, "SolverOptions::max_iterations")->capture_default_str();
   app.add_option("--coarse", coarse, "DrapeConfig::coarse_start_resolution (0: off)")->capture_default_str();
   app.add_option("--data", data, "fabrics618.csv")->capture_default_str();
   app.add_option("--resolution", resolution, "vertices per side")->capture_default_str();
@@ -77,6 +81,8 @@ int main(int argc, char** argv) {
       config.specimen.vertices_x = config.specimen.vertices_y = resolution;
       config.specimen.seed = 100 + f;
       config.solver.max_factor_reuse = factor_reuse;
+      config.solver.exact_hessian_below = exact_below;
+      config.solver.max_iterations = max_iterations;
       config.coarse_start_resolution = coarse;
       auto initial = drapegen::sim::parse_initial_state(init);
       config.initial = *initial;

@@ -35,7 +35,9 @@ int run_cantilever(const CantileverOptions& o) {
   if (!std::isfinite(o.beta)) return fail("--beta must be finite (g*mm^3/s^2)");
   if (!(o.density > 0.0) || !std::isfinite(o.density)) return fail("--density must be positive (g/m^2)");
   if (!(o.width >= 0.0) || !std::isfinite(o.width)) return fail("--width must be positive (m), or 0 for 2 x length");
-  if (o.segments < 4) return fail("--segments must be at least 4");
+  if (o.segments < 4 || o.segments > 2000) return fail("--segments must be between 4 and 2000");
+  if (o.width > 20.0 * o.length) return fail("--width must be at most 20 x --length");
+  if (!(o.density >= 1.0 && o.density <= 1e5)) return fail("--density must be between 1 and 100000 g/m^2");
 
   sim::CantileverSpec spec;
   spec.length = o.length;

@@ -1,6 +1,7 @@
 // drapegen: synthetic drape data for bending-parameter estimation. One program, one subcommand per job.
 #include <iostream>
 #include <map>
+#include <new>
 
 #include "commands.hpp"
 
@@ -22,7 +23,15 @@ int main(int argc, char** argv) {
     return app.exit(e);
   }
   for (const auto& [sub, run] : runners) {
-    if (sub->parsed()) return run();
+    if (!sub->parsed()) continue;
+    try {
+      return run();
+    } catch (const std::bad_alloc&) {
+      std::cerr << "drapegen " << sub->get_name() << ": error: out of memory (try a smaller --resolution)\n";
+    } catch (const std::exception& e) {
+      std::cerr << "drapegen " << sub->get_name() << ": error: " << e.what() << "\n";
+    }
+    return drapegen::cli::kExitUsage;
   }
   return drapegen::cli::kExitUsage;
 }

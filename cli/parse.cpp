@@ -4,7 +4,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
+#include <cstdlib>
+#include <unistd.h>
 #include <sstream>
 #include <vector>
 
@@ -35,10 +36,11 @@ sim::Expected<sim::DirectionalValues> parse_directional(const std::string& text,
 }
 
 sim::Status check_writable(const std::string& path) {
-  const std::string probe = path + ".probe";
-  std::ofstream out(probe, std::ios::binary);
-  if (!out) return sim::Error{"cannot write '" + path + "': " + std::strerror(errno)};
-  out.close();
+  // A unique probe beside the target (never touches an existing file), removed again.
+  std::string probe = path + ".probe-XXXXXX";
+  const int fd = ::mkstemp(probe.data());
+  if (fd < 0) return sim::Error{"cannot write '" + path + "': " + std::strerror(errno)};
+  ::close(fd);
   std::remove(probe.c_str());
   return {};
 }

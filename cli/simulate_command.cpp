@@ -71,8 +71,8 @@ int run_simulate(const SimulateOptions& o) {
   if (!alpha) return fail(alpha.error().message);
   const auto beta = parse_directional(o.beta, "--beta");
   if (!beta) return fail(beta.error().message);
-  if (!(o.density > 0.0) || !std::isfinite(o.density)) return fail("--density must be positive (g/m^2)");
-  if (o.resolution < 3) return fail("--resolution must be at least 3");
+  if (!(o.density >= 1.0 && o.density <= 1e5)) return fail("--density must be between 1 and 100000 g/m^2");
+  if (o.resolution < 3 || o.resolution > 1000) return fail("--resolution must be between 3 and 1000");
   auto initial = sim::parse_initial_state(o.init);
   if (!initial) return fail(initial.error().message);
   const auto drift = parse_drift(o.drift, o.seed);
@@ -92,13 +92,13 @@ int run_simulate(const SimulateOptions& o) {
   config.membrane.stiffness = o.sigma;
   {
     const auto comma = o.band.find(',');
-    try {
-      if (comma == std::string::npos) throw std::invalid_argument("");
-      config.membrane.band_low = std::stod(o.band.substr(0, comma));
-      config.membrane.band_high = std::stod(o.band.substr(comma + 1));
-    } catch (const std::exception&) {
-      return fail("--band: expected LOW,HIGH, e.g. 0.99,1.01");
-    }
+    if (comma == std::string::npos) return fail("--band: expected LOW,HIGH, e.g. 0.99,1.01");
+    // One number each: the strict parser of W,B,F values accepts a single value.
+    const auto low = parse_directional(o.band.substr(0, comma), "--band");
+    const auto high = parse_directional(o.band.substr(comma + 1), "--band");
+    if (!low || !high) return fail("--band: expected LOW,HIGH, e.g. 0.99,1.01");
+    config.membrane.band_low = low->warp;
+    config.membrane.band_high = high->warp;
     if (!(config.membrane.band_low > 0.0 && config.membrane.band_low <= 1.0 && config.membrane.band_high >= 1.0 &&
           std::isfinite(config.membrane.band_high))) {
       return fail("--band: need 0 < LOW <= 1 <= HIGH");

@@ -101,8 +101,10 @@ double DihedralBending::assign_laws() {
     }
     const TorqueLaw& old = laws_[i];
     if (old.alpha > 0.0) {
+      // beta relative to its effect at the hinge's own curvature scale 1/(H0+H1), compared with alpha.
+      const double beta_scale = std::max(std::abs(old.beta), old.alpha * rest_[i].height_sum);
       change = std::max({change, std::abs(law.alpha - old.alpha) / old.alpha,
-                         std::abs(law.beta - old.beta) / std::max(std::abs(old.beta), 1e-300)});
+                         std::abs(law.beta - old.beta) / beta_scale});
     }
     laws_[i] = law;
   }

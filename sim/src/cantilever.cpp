@@ -142,6 +142,12 @@ Expected<CantileverResult> simulate_cantilever(const CantileverSpec& spec) {
       result.report.seconds += r.seconds;
       result.report.assembly_seconds += r.assembly_seconds;
       result.report.factorization_seconds += r.factorization_seconds;
+      result.report.lagged_updates += r.lagged_updates;
+      result.report.reused_factorizations += r.reused_factorizations;
+      result.report.exact_hessian_iterations += r.exact_hessian_iterations;
+      result.report.regularized_iterations += r.regularized_iterations;
+      result.report.line_search_failures += r.line_search_failures;
+      result.report.lagged_change = r.lagged_change;
       result.report.regularized_iterations += r.regularized_iterations;
       result.report.exact_hessian_iterations += r.exact_hessian_iterations;
       result.report.line_search_failures += r.line_search_failures;

@@ -49,6 +49,10 @@ Expected<DrapeResult> simulate_drape(const DrapeConfig& config,
       for (int v : contact.vertices_on_top(mesh.positions, 5e-4)) fixed[v] = true;
     }
     result.fixed_vertices = static_cast<int>(std::count(fixed.begin(), fixed.end(), true));
+    if (config.adhesion && result.fixed_vertices == 0) {
+      return Error{"no vertex of the initial state rests on the platform top (drift too large, or the initial mesh "
+                   "is not on the platform)"};
+    }
 
     NewtonSolver solver(config.solver);
     if (progress) solver.set_progress(progress);
@@ -75,10 +79,10 @@ Expected<DrapeResult> simulate_drape(const DrapeConfig& config,
     }
     result.report = solver.solve(terms, fixed, gravity.vertex_weights().maxCoeff(), x);
     mesh.positions = x;
+    result.measures = measure_drape(mesh, config.platform);
   } catch (const std::invalid_argument& e) {
     return Error{e.what()};
   }
-  result.measures = measure_drape(mesh, config.platform);
   return result;
 }
 

@@ -95,6 +95,12 @@ Status apply_initial_state(const InitialStateSpec& spec, ClothMesh& mesh) {
       return Error{"initial mesh '" + spec.mesh_path + "' has " + std::to_string(loaded->vertex_count()) +
                    " vertices; the specimen has " + std::to_string(mesh.vertex_count())};
     }
+    const double area = rest_triangle_areas(mesh).sum(), loaded_area = rest_triangle_areas(*loaded).sum();
+    if (loaded->triangle_count() != mesh.triangle_count() || !(std::abs(loaded_area - area) <= 0.01 * area) ||
+        rest_triangle_areas(*loaded).minCoeff() <= 0.0) {
+      return Error{"initial mesh '" + spec.mesh_path + "' is not this specimen: it needs the same triangle count, "
+                   "rest coordinates (u, v) of the same area and counter-clockwise rest triangles"};
+    }
     mesh = std::move(loaded).value();
   } else {
     mesh.positions.topRows<2>() = mesh.rest;

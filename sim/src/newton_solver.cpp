@@ -62,6 +62,11 @@ SolveReport NewtonSolver::solve(const std::vector<EnergyTerm*>& terms, const std
     return worst / reference_force;
   };
 
+  if (!(reference_force > 0.0) || !std::isfinite(reference_force)) {
+    report.outcome = SolveOutcome::kDiverged;
+    report.message = "the reference force of the residual test must be positive and finite";
+    return report;
+  }
   if (n == 0) {
     report.outcome = SolveOutcome::kConverged;
     report.message = "no free vertices";
@@ -210,6 +215,15 @@ SolveReport NewtonSolver::solve(const std::vector<EnergyTerm*>& terms, const std
     if (progress_) progress_(IterationInfo{it, energy, report.residual, step_length, lambda});
     lambda = lambda < 1e-5 ? 0.0 : lambda * 0.1;
     report.iterations = it + 1;
+  }
+  if (report.outcome != SolveOutcome::kConverged && report.outcome != SolveOutcome::kDiverged &&
+      report.iterations >= options_.max_iterations) {
+    // Report the state that is returned, not the one before the last step.
+    gradient.setZero();
+    report.energy = assembler.assemble(x, HessianMode::kProjected, gradient);
+    gather(gradient, g);
+    report.residual = residual_of(g);
+    if (report.residual <= options_.tolerance && frozen) report.outcome = SolveOutcome::kConverged;
   }
   if (report.outcome != SolveOutcome::kConverged && report.outcome != SolveOutcome::kDiverged &&
       report.iterations >= options_.max_iterations) {

@@ -27,9 +27,10 @@ struct InitialStateSpec {
 [[nodiscard]] Expected<InitialStateSpec> parse_initial_state(const std::string& text);
 
 /// Places `mesh` (a flat specimen from make_specimen) in its initial state. The part of the specimen over the
-/// platform top stays flat on it, so it can be held by the adhesive boundary condition. For kMesh the file's
-/// positions replace the mesh's (its rest coordinates and triangles must match the specimen's vertex count; a file
-/// with rest coordinates replaces the whole mesh).
+/// platform top stays flat on it, so it can be held by the adhesive boundary condition. For kMesh the file replaces
+/// the whole mesh (positions, rest coordinates, triangles): it must have the specimen's vertex and triangle counts
+/// and rest coordinates (u, v) of the same total area (within 1%) with counter-clockwise triangles, as the PLY
+/// files this library writes do.
 [[nodiscard]] Status apply_initial_state(const InitialStateSpec& spec, ClothMesh& mesh);
 
 }  // namespace drapegen::sim

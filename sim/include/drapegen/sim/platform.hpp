@@ -14,8 +14,8 @@ struct PlatformSpec {
   double height = 0.25;       // m (longer than a 300 mm specimen's corner overhang of ~162 mm)
   double fillet = 0.002;      // m, radius of the rounded rim
   double contact_offset = 0.001;  // m, the cloth rests this far from the surface (its half thickness)
-  /// Penalty stiffness per unit vertex area, N/m^3: k_i = stiffness * A_i is the contact stiffness at a
-  /// penetration of one contact offset (the penalty is cubic, see PlatformContact).
+  /// Penalty coefficient per unit vertex area, N/m^3: k_i = stiffness * A_i in the cubic penalty of
+  /// PlatformContact (its stiffness at a penetration p is 2 k_i p / t).
   double contact_stiffness = 2e7;
 };
 
@@ -27,8 +27,8 @@ struct PlatformDistance {
 };
 [[nodiscard]] PlatformDistance platform_distance(const PlatformSpec& spec, const Eigen::Vector3d& p);
 
-/// E = sum_i k_i / (3 t) * max(0, t - d(x_i))^3 over the vertices, t = contact offset (C2: no Hessian jump where a
-/// vertex touches).
+/// E = sum_i k_i / (3 t) * max(0, offset - d(x_i))^3 over the vertices, t = max(contact offset, 0.1 mm) (C2: no
+/// Hessian jump where a vertex touches).
 class PlatformContact final : public EnergyTerm {
  public:
   PlatformContact(const ClothMesh& mesh, const PlatformSpec& spec);
