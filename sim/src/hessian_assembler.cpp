@@ -122,16 +122,4 @@ double HessianAssembler::assemble(const Eigen::Matrix3Xd& x, HessianMode mode, E
   return energy;
 }
 
-Eigen::MatrixXd HessianAssembler::to_dense() const {
-  const int n = dof_count();
-  Eigen::MatrixXd dense = Eigen::MatrixXd::Zero(n, n);
-  for (int c = 0; c < n; ++c) {
-    for (int p = colptr_[c]; p < colptr_[c + 1]; ++p) {
-      dense(rowind_[p], c) = values_[p];
-      dense(c, rowind_[p]) = values_[p];
-    }
-  }
-  return dense;
-}
-
 }  // namespace drapegen::sim

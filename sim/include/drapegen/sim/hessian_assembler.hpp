@@ -30,9 +30,6 @@ class HessianAssembler {
   /// full 3 x N gradient into `gradient`).
   double assemble(const Eigen::Matrix3Xd& x, HessianMode mode, Eigen::Matrix3Xd& gradient);
 
-  /// Dense copy of the full symmetric matrix (tests).
-  [[nodiscard]] Eigen::MatrixXd to_dense() const;
-
  private:
   class Sink;
   struct TermMap {
