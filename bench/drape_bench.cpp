@@ -2,6 +2,7 @@
 // spanning soft to stiff, every initial-state type, one core. Prints one line per drape and a summary.
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <functional>
 #include <cmath>
 #include <fstream>
 #include <iostream>
@@ -51,9 +52,14 @@ int main(int argc, char** argv) {
   int resolution = 100, fabrics = 5;
   std::vector<std::string> inits{"flat", "sine", "fold"};
   bool json = false;
-  int factor_reuse = drapegen::sim::SolverOptions{}.max_factor_reuse;
+  int pcg_iterations = drapegen::sim::SolverOptions{}.max_pcg_iterations;
+  double pcg_tolerance = drapegen::sim::SolverOptions{}.pcg_tolerance;
   int coarse = drapegen::sim::DrapeConfig{}.coarse_start_resolution;
-  app.add_option("--factor-reuse", factor_reuse, "SolverOptions::max_factor_reuse")->capture_default_str();
+  app.add_option("--pcg-iterations", pcg_iterations, "SolverOptions::max_pcg_iterations (0: factorise every step)")
+      ->capture_default_str();
+  app.add_option("--pcg-tolerance", pcg_tolerance, "SolverOptions::pcg_tolerance")->capture_default_str();
+  double outer_below = drapegen::sim::SolverOptions{}.lagged_outer_below;
+  app.add_option("--outer-below", outer_below, "SolverOptions::lagged_outer_below")->capture_default_str();
   double exact_below = drapegen::sim::SolverOptions{}.exact_hessian_below;
   int max_iterations = drapegen::sim::SolverOptions{}.max_iterations;
   app.add_option("--exact-below", exact_below, "SolverOptions::exact_hessian_below")->capture_default_str();
@@ -64,6 +70,8 @@ int main(int argc, char** argv) {
   app.add_option("--fabrics", fabrics, "fabrics at evenly spaced quantiles of mean alpha")->capture_default_str();
   app.add_option("--inits", inits, "initial states")->capture_default_str();
   app.add_flag("--json", json, "one JSON object per drape");
+  bool verbose = false;
+  app.add_flag("--verbose", verbose, "print every Newton iteration on stderr");
   CLI11_PARSE(app, argc, argv);
 
   std::vector<Fabric> all = read_fabrics(data);
@@ -80,14 +88,23 @@ int main(int argc, char** argv) {
       config.fabric = drapegen::sim::fabric_from_paper_units(fabric.alpha, fabric.beta, 300.0);
       config.specimen.vertices_x = config.specimen.vertices_y = resolution;
       config.specimen.seed = 100 + f;
-      config.solver.max_factor_reuse = factor_reuse;
+      config.solver.max_pcg_iterations = pcg_iterations;
+      config.solver.pcg_tolerance = pcg_tolerance;
+      config.solver.lagged_outer_below = outer_below;
       config.solver.exact_hessian_below = exact_below;
       config.solver.max_iterations = max_iterations;
       config.coarse_start_resolution = coarse;
       auto initial = drapegen::sim::parse_initial_state(init);
       config.initial = *initial;
       config.initial.seed = 7 + f;
-      const auto result = drapegen::sim::simulate_drape(config);
+      std::function<void(const drapegen::sim::IterationInfo&)> progress;
+      if (verbose) {
+        progress = [](const drapegen::sim::IterationInfo& i) {
+          std::cerr << fmt::format("iter {:4d} energy {:.9e} residual {:.3e} step {:.3g} shift {:.1e}\n", i.iteration,
+                                   i.energy, i.residual, i.step_length, i.regularization);
+        };
+      }
+      const auto result = drapegen::sim::simulate_drape(config, progress);
       if (!result) {
         std::cerr << "error: " << result.error().message << "\n";
         return 1;
@@ -108,10 +125,12 @@ int main(int argc, char** argv) {
       } else {
         std::cout << fmt::format(
             "fabric {:3d} alpha {:7.0f},{:7.0f},{:7.0f} beta {:8.0f},{:8.0f},{:8.0f} {:5s}: {:15s} {:4d} it "
-            "(+{:3d} coarse) {:6.2f} s (coarse {:4.2f} s, factorisation {:4.1f}%) DC {:.3f} folds {}\n",
+            "(+{:3d} coarse) {:6.2f} s (coarse {:4.2f} s, factorisation {:4.1f}%, {} of {} steps by PCG, {} CG it) "
+            "DC {:.3f} folds {}\n",
             index, fabric.alpha.warp, fabric.alpha.bias, fabric.alpha.weft, fabric.beta.warp, fabric.beta.bias,
             fabric.beta.weft, init, drapegen::sim::to_string(r.outcome), r.iterations, c.iterations, wall,
-            c.seconds, 100 * factor_share.back(),
+            c.seconds, 100 * factor_share.back(), r.reused_factorizations + c.reused_factorizations,
+            r.iterations + c.iterations, r.pcg_iterations + c.pcg_iterations,
             result->measures.drape_coefficient, result->measures.folds);
       }
       std::cout.flush();

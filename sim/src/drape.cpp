@@ -35,13 +35,14 @@ Expected<DrapeResult> simulate_drape(const DrapeConfig& config,
   initial.lift = config.platform.contact_offset;
   if (Status s = apply_initial_state(initial, result.mesh); !s) return s.error();
   ClothMesh& mesh = result.mesh;
+  const FabricParameters fabric = normalized(config.fabric);  // the drape depends on k / rho only
   try {
     const Topology topology = build_topology(mesh);
     CorotationalMembrane membrane(mesh, config.membrane);
     std::unique_ptr<EnergyTerm> bending =
-        make_bending(mesh, topology, config.fabric, config.bending_model, config.anisotropy,
+        make_bending(mesh, topology, fabric, config.bending_model, config.anisotropy,
                      config.gauss_newton_bending);
-    Gravity gravity(mesh, config.fabric.density, config.gravity);
+    Gravity gravity(mesh, fabric.density, config.gravity);
     PlatformContact contact(mesh, config.platform);
 
     std::vector<bool> fixed(mesh.vertex_count(), false);
@@ -69,8 +70,7 @@ Expected<DrapeResult> simulate_drape(const DrapeConfig& config,
       const Expected<DrapeResult> start = simulate_drape(coarse_config);
       if (start) {
         result.coarse_report = start->report;
-        result.coarse_report.iterations += start->coarse_report.iterations;
-        result.coarse_report.seconds += start->coarse_report.seconds;
+        result.coarse_report.add_work(start->coarse_report);
         const Eigen::Matrix3Xd guess = transfer_positions(start->mesh, mesh.rest);
         for (int v = 0; v < mesh.vertex_count(); ++v) {
           if (!fixed[v]) x.col(v) = guess.col(v);
@@ -113,6 +113,7 @@ nlohmann::json to_json(const DrapeResult& result) {
       {"exact_hessian_iterations", r.exact_hessian_iterations},
       {"lagged_updates", r.lagged_updates},
       {"reused_factorizations", r.reused_factorizations},
+      {"pcg_iterations", r.pcg_iterations},
       {"lagged_change", r.lagged_change},
       {"line_search_failures", r.line_search_failures},
       {"vertices", result.mesh.vertex_count()},

@@ -13,6 +13,12 @@ FabricParameters fabric_from_paper_units(const DirectionalValues& alpha_paper, c
   return f;
 }
 
+FabricParameters normalized(const FabricParameters& fabric) {
+  const double s = kStandardDensity / fabric.density;
+  auto scale = [s](const DirectionalValues& v) { return DirectionalValues{v.warp * s, v.bias * s, v.weft * s}; };
+  return FabricParameters{scale(fabric.alpha), scale(fabric.beta), scale(fabric.gamma), kStandardDensity};
+}
+
 Status validate(const FabricParameters& fabric, BendingModel model) {
   auto all = [](const DirectionalValues& v, auto pred) { return pred(v.warp) && pred(v.bias) && pred(v.weft); };
   auto positive = [](double x) { return std::isfinite(x) && x > 0.0; };

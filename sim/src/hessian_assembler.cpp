@@ -122,4 +122,21 @@ double HessianAssembler::assemble(const Eigen::Matrix3Xd& x, HessianMode mode, E
   return energy;
 }
 
+void HessianAssembler::multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y, double shift) const {
+  const int n = dof_count();
+  y = shift * x;
+  for (int j = 0; j < n; ++j) {
+    const double xj = x[j];
+    double yj = 0.0;
+    // The first stored entry of every column is its diagonal.
+    yj += values_[colptr_[j]] * xj;
+    for (int p = colptr_[j] + 1; p < colptr_[j + 1]; ++p) {
+      const int i = rowind_[p];
+      y[i] += values_[p] * xj;
+      yj += values_[p] * x[i];
+    }
+    y[j] += yj;
+  }
+}
+
 }  // namespace drapegen::sim

@@ -23,6 +23,20 @@ std::string_view to_string(SolveOutcome outcome) {
   return "unknown";
 }
 
+void SolveReport::add_work(const SolveReport& other) {
+  iterations += other.iterations;
+  seconds += other.seconds;
+  assembly_seconds += other.assembly_seconds;
+  factorization_seconds += other.factorization_seconds;
+  pcg_seconds += other.pcg_seconds;
+  regularized_iterations += other.regularized_iterations;
+  exact_hessian_iterations += other.exact_hessian_iterations;
+  lagged_updates += other.lagged_updates;
+  reused_factorizations += other.reused_factorizations;
+  pcg_iterations += other.pcg_iterations;
+  line_search_failures += other.line_search_failures;
+}
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -32,6 +46,37 @@ double total_energy(const std::vector<EnergyTerm*>& terms, const Eigen::Matrix3X
   double e = 0.0;
   for (const EnergyTerm* t : terms) e += t->energy(x);
   return e;
+}
+
+/// Preconditioned conjugate gradients on (A + shift I) step = -g, preconditioned by a factorisation of an earlier
+/// matrix. Succeeds when the residual drops below `tolerance` * |g| within `max_iterations`; fails on negative
+/// curvature or a failed solve. `iterations` counts the matrix products.
+bool preconditioned_cg(const HessianAssembler& a, double shift, SparseCholesky& preconditioner,
+                       const Eigen::VectorXd& g, double tolerance, int max_iterations, Eigen::VectorXd& step,
+                       int& iterations) {
+  const int n = static_cast<int>(g.size());
+  Eigen::VectorXd r = -g, z(n), p(n), ap(n);
+  step.setZero(n);
+  iterations = 0;
+  if (!preconditioner.solve(r, z)) return false;
+  p = z;
+  double rz = r.dot(z);
+  const double goal = tolerance * g.norm();
+  while (iterations < max_iterations) {
+    a.multiply(p, ap, shift);
+    ++iterations;
+    const double pap = p.dot(ap);
+    if (!(pap > 0.0)) return false;
+    const double step_size = rz / pap;
+    step += step_size * p;
+    r -= step_size * ap;
+    if (r.norm() <= goal) return step.allFinite();
+    if (!preconditioner.solve(r, z)) return false;
+    const double rz_next = r.dot(z);
+    p = z + (rz_next / rz) * p;
+    rz = rz_next;
+  }
+  return false;
 }
 
 }  // namespace
@@ -76,14 +121,13 @@ SolveReport NewtonSolver::solve(const std::vector<EnergyTerm*>& terms, const std
   int exact_cooldown = 0;  // iterations to wait before trying the exact Hessian again
   bool frozen = false;     // state-dependent parameters no longer updated
   int outer_updates = 0;
-  bool have_factor = false, last_step_full = false;
-  int reuse_count = 0;
+  bool have_factor = false;
   int creeping = 0;  // consecutive iterations whose step moved no vertex measurably
-  double previous_residual = std::numeric_limits<double>::infinity();
   for (int it = 0; it < options_.max_iterations; ++it) {
     report.iterations = it;
     const bool outer = it > 0 && report.residual < options_.lagged_outer_below;
-    if (!frozen && (it == 0 || outer || report.residual > options_.lagged_every_above)) {
+    const bool early = it < options_.lagged_every_iterations && report.residual > options_.lagged_every_above;
+    if (!frozen && (it == 0 || outer || early)) {
       double change = 0.0;
       for (EnergyTerm* t : terms) change = std::max(change, t->update_lagged(x));
       ++report.lagged_updates;
@@ -116,21 +160,33 @@ SolveReport NewtonSolver::solve(const std::vector<EnergyTerm*>& terms, const std
     mean_diagonal = std::max(mean_diagonal / n, 1e-300);
     bool accepted = false;
     double step_length = 0.0;
-    // Keep the last factorisation while it still gives full steps that cut the residual well: a chord step costs
-    // two triangular solves instead of a factorisation.
-    bool reuse = have_factor && lambda == 0.0 && !exact && reuse_count < options_.max_factor_reuse &&
-                 last_step_full && report.residual < 0.5 * previous_residual;
+    // Inexact Newton: while an earlier factorisation still preconditions the current Hessian well, conjugate
+    // gradients replace the factorisation (a product and two triangular solves per iteration instead of a
+    // factorisation).
+    bool reuse = have_factor && lambda == 0.0 && options_.max_pcg_iterations > 0;
+    bool solved = false;
     while (!accepted) {
       FactorStatus status = FactorStatus::kOk;
+      solved = false;
       if (reuse) {
-        ++reuse_count;
+        int cg_iterations = 0;
+        t0 = Clock::now();
+        // The forcing term shrinks with the residual, for superlinear convergence near the solution.
+        const double forcing = std::min(options_.pcg_tolerance, report.residual);
+        solved = preconditioned_cg(assembler, 0.0, cholesky, g, forcing, options_.max_pcg_iterations, step,
+                                   cg_iterations);
+        report.pcg_seconds += since(t0);
+        report.pcg_iterations += cg_iterations;
+        if (!solved) {
+          reuse = false;
+          continue;
+        }
         ++report.reused_factorizations;
       } else {
         t0 = Clock::now();
         status = cholesky.factorize(assembler, lambda * mean_diagonal);
         report.factorization_seconds += since(t0);
         have_factor = status == FactorStatus::kOk;
-        reuse_count = 0;
       }
       if (exact && status != FactorStatus::kOk) {  // indefinite: fall back to the projected Hessian
         exact = false;
@@ -147,7 +203,7 @@ SolveReport NewtonSolver::solve(const std::vector<EnergyTerm*>& terms, const std
         report.seconds = since(start);
         return report;
       }
-      if (status == FactorStatus::kOk && cholesky.solve(-g, step)) {
+      if (status == FactorStatus::kOk && (solved || cholesky.solve(-g, step))) {
         // Limit the largest vertex displacement.
         double largest = 0.0;
         for (int f = 0; f < n / 3; ++f) largest = std::max(largest, step.segment<3>(3 * f).norm());
@@ -208,8 +264,6 @@ SolveReport NewtonSolver::solve(const std::vector<EnergyTerm*>& terms, const std
       report.seconds = since(start);
       return report;
     }
-    last_step_full = step_length == 1.0;
-    previous_residual = report.residual;
     if (lambda > 0.0) ++report.regularized_iterations;
     if (exact) ++report.exact_hessian_iterations;
     if (progress_) progress_(IterationInfo{it, energy, report.residual, step_length, lambda});

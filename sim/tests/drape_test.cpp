@@ -10,12 +10,14 @@
 // problem that is a scaled or rotated copy of another) or where the effect is far above that noise; the rest is
 // printed for the record.
 #include "drapegen/sim/drape.hpp"
+#include "drapegen/sim/ply.hpp"
 
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <cstdio>
 #include <numbers>
 #include <string>
@@ -71,38 +73,52 @@ double mean_distance_mm(const Eigen::Matrix3Xd& a, const Eigen::Matrix3Xd& b) {
 
 // (a) Section 5.1.2, Fig. 14. Scaling alpha, beta and rho by s scales bending and gravity by s; the paper argues that
 // the stretching force may be scaled arbitrarily "as long as it remains sufficiently large", so x depends on k/rho
-// only. Scaling sigma and the contact penalty along makes the total energy s times the original: the drape must be
-// identical, whatever path the solver takes (this checks that no tolerance, step limit or regularisation of the
-// simulator has an absolute scale). With sigma fixed, k/rho invariance holds only as far as in-plane compliance is
-// negligible, and small differences select other local minima: the drape coefficient is compared, loosely.
+// only, and it normalises every fabric to the standard density. The simulator does the same (normalized()): sigma
+// and the contact penalty are stiffnesses at the standard density. So (1) a fabric with k and rho scaled together
+// must drape like the original from the same start (the normalised moduli differ in the last bit, so the inexact
+// solver path differs at round-off level); (2) the physical claim behind it: with sigma and the contact penalty
+// held in absolute units instead (equivalently, both divided by s at the standard density), the equilibrium moves
+// little. Observed at 25 x 25: max 8.2 / 4.6 mm, mean 1.45 / 0.67 mm, |dDC| 0.0007 / 0.0009 for s = 3 / 0.5: the
+// coarse mesh compresses beyond the 1% band in its folds, where sigma acts (bench/drape_physics.cpp, check a, at
+// finer meshes). (2) continues from the base drape: from a flat start, tiny differences can select another of the
+// drape's many local minima, which measures the path, not k/rho.
 TEST(DrapePhysics, DrapeDependsOnBendingOverDensity) {
   const DrapeConfig base = config(25, false);
   const DrapeResult r0 = drape(base, "k/rho: median fabric");
-  const double dc0 = r0.measures.drape_coefficient;
+  const std::string path = (std::filesystem::temp_directory_path() / "drapegen_k_over_rho_base.ply").string();
+  ASSERT_TRUE(write_ply(path, r0.mesh));
   for (const double s : {3.0, 0.5}) {
     DrapeConfig c = base;
     c.fabric.alpha = scaled(base.fabric.alpha, s);
     c.fabric.beta = scaled(base.fabric.beta, s);
     c.fabric.density *= s;
-    DrapeConfig all = c;
-    all.membrane.stiffness *= s;
-    all.platform.contact_stiffness *= s;
-    const DrapeResult exact = drape(all, "k/rho: k, rho, sigma, contact x" + std::to_string(s).substr(0, 3));
-    const double d_exact = max_distance_mm(exact.mesh.positions, r0.mesh.positions);
-    std::printf("[ k/rho    ] x%.1f with sigma and contact scaled: max vertex distance %.2e mm\n", s, d_exact);
-    EXPECT_LT(d_exact, 0.1) << "x" << s;
-    EXPECT_NEAR(exact.measures.drape_coefficient, dc0, 1e-6);
+    const DrapeResult same = drape(c, "k/rho: k, rho x" + std::to_string(s).substr(0, 3));
+    const double d_same = max_distance_mm(same.mesh.positions, r0.mesh.positions);
+    std::printf("[ k/rho    ] x%.1f: max vertex distance %.2e mm\n", s, d_same);
+    EXPECT_LT(d_same, 0.1) << "x" << s;
+    EXPECT_NEAR(same.measures.drape_coefficient, r0.measures.drape_coefficient, 1e-4);
 
-    const DrapeResult fixed_sigma = drape(c, "k/rho: k, rho x" + std::to_string(s).substr(0, 3) + ", sigma fixed");
-    const double dc = fixed_sigma.measures.drape_coefficient;
-    std::printf("[ k/rho    ] x%.1f, sigma fixed: max vertex distance %.2f mm, mean %.2f mm, DC %.4f vs %.4f\n", s,
-                max_distance_mm(fixed_sigma.mesh.positions, r0.mesh.positions),
-                mean_distance_mm(fixed_sigma.mesh.positions, r0.mesh.positions), dc, dc0);
-    // Observed: 25 x 25 max 8.2 / 4.6 mm, mean 1.5 / 0.7 mm, |dDC| 0.0007 / 0.0009 (x3 / x0.5); 30 x 30 max 23 /
-    // 34 mm, |dDC| up to 0.018. Even x1.01 moves folds by ~6 mm from a flat start, while continuing from the base
-    // drape moves it by 0.06-0.15 mm: the distance measures which local minimum the path finds, not k/rho.
-    EXPECT_NEAR(dc, dc0, 0.03) << "x" << s;
+    // The control restarts the base fabric from its own drape: the curvature rule recomputes the bending directions
+    // from that drape, so even the control moves a little; the claim concerns the difference.
+    DrapeConfig control = base;
+    control.initial = InitialStateSpec{};
+    control.initial.shape = InitialShape::kMesh;
+    control.initial.mesh_path = path;
+    DrapeConfig absolute = control;
+    absolute.membrane.stiffness /= s;
+    absolute.platform.contact_stiffness /= s;
+    const DrapeResult restarted = drape(control, "k/rho: restart from the base drape");
+    const DrapeResult moved = drape(absolute, "k/rho: same, sigma and contact in absolute units");
+    const double d_max = max_distance_mm(moved.mesh.positions, restarted.mesh.positions);
+    const double d_mean = mean_distance_mm(moved.mesh.positions, restarted.mesh.positions);
+    const double d_dc = std::abs(moved.measures.drape_coefficient - restarted.measures.drape_coefficient);
+    std::printf("[ k/rho    ] x%.1f, sigma and contact absolute: max vertex distance %.3f mm, mean %.3f mm, |dDC| "
+                "%.4f (control moved %.3f mm)\n",
+                s, d_max, d_mean, d_dc, max_distance_mm(restarted.mesh.positions, r0.mesh.positions));
+    EXPECT_LT(d_mean, 2.0) << "x" << s;
+    EXPECT_LT(d_dc, 0.005) << "x" << s;
   }
+  std::filesystem::remove(path);
 }
 
 // (b) The platform is a cylinder about the z axis and gravity points along it: rotating the specimen about the axis
@@ -116,6 +132,7 @@ TEST(DrapePhysics, RotationAboutTheAxisRotatesTheDrape) {
   constexpr int n = 25;
   DrapeConfig base = config(n, true);
   base.fabric = fabric_from_paper_units({11455, 11455, 11455}, {-29660, -29660, -29660}, 300.0);
+  base.solver.max_pcg_iterations = 0;  // exact Newton steps keep the symmetry of the path (see k/rho above)
   const DrapeResult r0 = drape(base, "rotation: isotropic, 0 deg");
   DrapeConfig turned = base;
   turned.initial.rotation = kPi / 2.0;

@@ -27,6 +27,11 @@ struct FabricParameters {
 [[nodiscard]] FabricParameters fabric_from_paper_units(const DirectionalValues& alpha_paper,
                                                        const DirectionalValues& beta_paper, double density_g_per_m2);
 
+/// The same fabric at the standard density: moduli times kStandardDensity / density (Section 5.1.2). The drape
+/// simulator works in these normalised units, and every other stiffness of the simulator (the in-plane stiffness
+/// sigma, the contact penalty) is given for the standard density: a drape therefore depends on k / rho only.
+[[nodiscard]] FabricParameters normalized(const FabricParameters& fabric);
+
 /// Checks that every modulus is finite, alpha (and gamma for the quadratic model) positive and density positive.
 [[nodiscard]] Status validate(const FabricParameters& fabric, BendingModel model);
 

@@ -26,6 +26,9 @@ class HessianAssembler {
   /// Index of the diagonal entry of every DOF in `values()`.
   [[nodiscard]] const std::vector<int>& diagonal_positions() const { return diagonal_; }
 
+  /// y = (A + shift * I) x with the symmetric matrix A whose lower triangle is stored.
+  void multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y, double shift = 0.0) const;
+
   /// Clears the values and assembles the Hessians of all terms at x (also returns the total energy and adds the
   /// full 3 x N gradient into `gradient`).
   double assemble(const Eigen::Matrix3Xd& x, HessianMode mode, Eigen::Matrix3Xd& gradient);

@@ -38,11 +38,17 @@ struct SolverOptions {
   /// `lagged_outer_below` for the current parameters (an outer fixed-point loop), until the parameters change by
   /// less than `lagged_tolerance` (relative); then they stay fixed and Newton converges on one energy.
   double lagged_every_above = 10.0;
-  double lagged_outer_below = 0.3;
+  /// ... but only in the first `lagged_every_iterations` iterations: a parameter field that keeps changing (strong
+  /// anisotropy where principal directions are ill-defined) would otherwise make Newton chase a moving energy.
+  int lagged_every_iterations = 30;
+  double lagged_outer_below = 3.0;
   double lagged_tolerance = 1e-3;
-  /// Consecutive iterations that may reuse the last factorisation (chord steps) while it gives full steps that at
-  /// least halve the residual; 0 factorises at every iteration.
-  int max_factor_reuse = 3;
+  /// Inexact Newton with a stale preconditioner: the step solves the current Hessian by conjugate gradients,
+  /// preconditioned by the last factorisation, to min(`pcg_tolerance`, residual) relative to |g|; when that takes
+  /// more than `max_pcg_iterations` (or meets negative curvature) the Hessian is factorised afresh. 0 factorises at
+  /// every iteration.
+  int max_pcg_iterations = 20;
+  double pcg_tolerance = 0.1;
   /// Outer updates after which the parameters are fixed anyway (directions in nearly flat regions can cycle).
   int max_lagged_outer_updates = 6;
 };
@@ -58,10 +64,15 @@ struct SolveReport {
   int regularized_iterations = 0;  // iterations that needed a diagonal shift
   int exact_hessian_iterations = 0;  // iterations that stepped with the unprojected Hessian
   int lagged_updates = 0;            // updates of state-dependent parameters
-  int reused_factorizations = 0;     // iterations that stepped with an earlier factorisation
+  int reused_factorizations = 0;     // iterations that stepped with an earlier factorisation (by PCG)
+  int pcg_iterations = 0;            // conjugate-gradient iterations in those steps
+  double pcg_seconds = 0.0;
   double lagged_change = 0.0;        // relative change at the last update
   int line_search_failures = 0;
   std::string message;
+
+  /// Adds the work counters (iterations, times, counts) of another solve, for reports that span several solves.
+  void add_work(const SolveReport& other);
 };
 
 struct IterationInfo {
