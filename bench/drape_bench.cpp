@@ -125,11 +125,12 @@ int main(int argc, char** argv) {
       } else {
         std::cout << fmt::format(
             "fabric {:3d} alpha {:7.0f},{:7.0f},{:7.0f} beta {:8.0f},{:8.0f},{:8.0f} {:5s}: {:15s} {:4d} it "
-            "(+{:3d} coarse) {:6.2f} s (coarse {:4.2f} s, factorisation {:4.1f}%, {} of {} steps by PCG, {} CG it) "
-            "DC {:.3f} folds {}\n",
+            "(+{:3d} coarse) {:6.2f} s (coarse {:4.2f} s, factorisation {:4.1f}%, PCG {:4.1f}%, assembly {:4.1f}%, "
+            "{} of {} steps by PCG, {} CG it) DC {:.3f} folds {}\n",
             index, fabric.alpha.warp, fabric.alpha.bias, fabric.alpha.weft, fabric.beta.warp, fabric.beta.bias,
             fabric.beta.weft, init, drapegen::sim::to_string(r.outcome), r.iterations, c.iterations, wall,
-            c.seconds, 100 * factor_share.back(), r.reused_factorizations + c.reused_factorizations,
+            c.seconds, 100 * factor_share.back(), 100 * (r.pcg_seconds + c.pcg_seconds) / wall,
+            100 * (r.assembly_seconds + c.assembly_seconds) / wall, r.reused_factorizations + c.reused_factorizations,
             r.iterations + c.iterations, r.pcg_iterations + c.pcg_iterations,
             result->measures.drape_coefficient, result->measures.folds);
       }
