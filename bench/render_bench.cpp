@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cmath>
 #include <ctime>
+#include <time.h>
 #include <string>
 #include <vector>
 
@@ -24,7 +25,12 @@ namespace sim = drapegen::sim;
 namespace {
 
 double now() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
-double cpu_now() { return static_cast<double>(std::clock()) / CLOCKS_PER_SEC; }
+/// CPU seconds of this process (all threads): on a shared machine, the honest measure of one core's work.
+double cpu_now() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
 
 template <class T>
 T unwrap(sim::Expected<T> e) {
@@ -54,29 +60,29 @@ void timing(DepthRenderer& renderer, const TriangleMesh& cloth, int data_points,
     point.noise = request.noise.describe();
     for (int v = 0; v < static_cast<int>(setup.views.size()); ++v) {
       const auto& view = setup.views[v];
-      double t = now();
+      double t = cpu_now();
       DepthImage clean = unwrap(renderer.render(view.camera, view.model));
-      t_render += now() - t;
-      t = now();
+      t_render += cpu_now() - t;
+      t = cpu_now();
       ViewRecord r;
       r.depth = request.noise.apply(clean, setup.noise_seed(v));
-      t_noise += now() - t;
+      t_noise += cpu_now() - t;
       r.camera.intrinsics = view.camera.intrinsics;
       r.camera.world_to_camera = view.mesh_to_camera();
       r.noise_seed = setup.noise_seed(v);
       r.table_angle = view.table_angle;
       point.views.push_back(std::move(r));
     }
-    const double t = now();
+    const double t = cpu_now();
     bytes += unwrap(writer.encode(point)).size();
-    t_encode += now() - t;
+    t_encode += cpu_now() - t;
   }
   const double wall = now() - wall0, cpu = cpu_now() - cpu0;
   const int views = data_points * request.rig.views;
   fmt::print("timing: {} data points x {} views, {} triangles (cloth + cylinder), storage {} {}\n", data_points,
              request.rig.views, tester_scene(cloth, request.rig).triangle_count(),
              storage.pixel == ExrStorage::Pixel::kHalf ? "half" : "float", storage.compression);
-  fmt::print("  render {:.3f} ms/view, noise {:.3f} ms/view, EXR encode {:.3f} ms/view\n", 1e3 * t_render / views,
+  fmt::print("  CPU time: render {:.3f} ms/view, noise {:.3f} ms/view, EXR encode {:.3f} ms/view\n", 1e3 * t_render / views,
              1e3 * t_noise / views, 1e3 * t_encode / views);
   fmt::print("  total {:.3f} ms/view wall, {:.3f} ms/view CPU (all threads) -> {:.0f} views/s per core\n",
              1e3 * wall / views, 1e3 * cpu / views, views / std::max(wall, cpu));

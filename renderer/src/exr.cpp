@@ -18,6 +18,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fmt/format.h>
+#include <algorithm>
 #include <map>
 
 namespace drapegen::renderer {
@@ -65,19 +66,22 @@ class MemoryIStream final : public Imf::IStream {
   std::uint64_t position_ = 0;
 };
 
+/// Short on purpose (every byte of the header is a quarter byte per view); docs/RENDERER.md spells it out.
+constexpr const char* kUnits = "Z: camera z, m, 0 = none; K: px, OpenCV; meshToCamera: m, x' = M x; angles: rad";
+
 std::string channel_name(int view) { return fmt::format("view{}.Z", view); }
 
-Imath::M44d to_m44(const Eigen::Isometry3d& T) {
-  Imath::M44d m;
+Imath::M44f to_m44(const Eigen::Isometry3d& T) {
+  Imath::M44f m;
   for (int i = 0; i < 4; ++i)
-    for (int j = 0; j < 4; ++j) m[i][j] = T.matrix()(i, j);
+    for (int j = 0; j < 4; ++j) m[i][j] = static_cast<float>(T.matrix()(i, j));
   return m;
 }
 
-Imath::M33d to_m33(const Eigen::Matrix3d& K) {
-  Imath::M33d m;
+Imath::M33f to_m33(const Eigen::Matrix3d& K) {
+  Imath::M33f m;
   for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) m[i][j] = K(i, j);
+    for (int j = 0; j < 3; ++j) m[i][j] = static_cast<float>(K(i, j));
   return m;
 }
 
@@ -128,8 +132,8 @@ sim::Expected<DataPointRecord> decode(Imf::IStream& stream) {
       }
     }
     const std::string prefix = fmt::format("view{}.", v);
-    const auto* K = find<Imf::M33dAttribute>(h, prefix + "K");
-    const auto* T = find<Imf::M44dAttribute>(h, prefix + "meshToCamera");
+    const auto* K = find<Imf::M33fAttribute>(h, prefix + "K");
+    const auto* T = find<Imf::M44fAttribute>(h, prefix + "meshToCamera");
     if (K == nullptr || T == nullptr) return sim::Error{fmt::format("missing camera of view {}", v)};
     r.camera.intrinsics.width = W;
     r.camera.intrinsics.height = H;
@@ -174,18 +178,31 @@ sim::Expected<std::vector<char>> ExrWriter::encode(const DataPointRecord& point)
       return sim::Error{"views differ in size"};
     }
   }
+  // The data window is the bounding box of the pixels with a return in any view (OpenEXR readers fill the rest of
+  // the display window with 0, which is what no return means here).
+  int x0 = W, y0 = H, x1 = -1, y1 = -1;
+  for (const auto& v : point.views) {
+    for (int y = 0; y < H; ++y) {
+      for (int x = 0; x < W; ++x) {
+        if (v.depth.at(x, y) > 0.0f) {
+          x0 = std::min(x0, x);
+          x1 = std::max(x1, x);
+          y0 = std::min(y0, y);
+          y1 = std::max(y1, y);
+        }
+      }
+    }
+  }
+  if (x1 < 0) x0 = y0 = x1 = y1 = 0;  // nothing anywhere: one pixel of 0
+  const int dw = x1 - x0 + 1, dh = y1 - y0 + 1;
   try {
-    Imf::Header header(W, H);
+    Imf::Header header(Imath::Box2i({0, 0}, {W - 1, H - 1}), Imath::Box2i({x0, y0}, {x1, y1}));
     header.compression() = compressions().at(storage_.compression);
     header.zipCompressionLevel() = storage_.zip_level;
     const bool half = storage_.pixel == ExrStorage::Pixel::kHalf;
     const int views = static_cast<int>(point.views.size());
     for (int v = 0; v < views; ++v) header.channels().insert(channel_name(v), Imf::Channel(half ? Imf::HALF : Imf::FLOAT));
-    header.insert("drapegen.units", Imf::StringAttribute(
-                                        "viewN.Z: camera-space z (optical axis) in metres, 0 = no return; "
-                                        "viewN.K: pixels (u = column, v = row, centre of top-left pixel = 0,0); "
-                                        "viewN.meshToCamera: metres, maps drape-frame points (column vectors) to "
-                                        "camera axes x right, y down, z forward; angles in radians"));
+    header.insert("drapegen.units", Imf::StringAttribute(kUnits));
     header.insert("drapegen.views", Imf::IntAttribute(views));
     header.insert("drapegen.index", Imf::IntAttribute(point.index));
     header.insert("drapegen.orientation", Imf::DoubleAttribute(point.orientation));
@@ -198,42 +215,47 @@ sim::Expected<std::vector<char>> ExrWriter::encode(const DataPointRecord& point)
     for (int v = 0; v < views; ++v) {
       const ViewRecord& r = point.views[v];
       const std::string prefix = fmt::format("view{}.", v);
-      header.insert(prefix + "K", Imf::M33dAttribute(to_m33(r.camera.intrinsics.K)));
-      header.insert(prefix + "meshToCamera", Imf::M44dAttribute(to_m44(r.camera.world_to_camera)));
+      header.insert(prefix + "K", Imf::M33fAttribute(to_m33(r.camera.intrinsics.K)));
+      header.insert(prefix + "meshToCamera", Imf::M44fAttribute(to_m44(r.camera.world_to_camera)));
       header.insert(prefix + "tableAngle", Imf::DoubleAttribute(r.table_angle));
       header.insert(prefix + "noiseSeed", Imf::StringAttribute(std::to_string(r.noise_seed)));
     }
 
-    const std::size_t n = static_cast<std::size_t>(W) * H;
+    const std::size_t n = static_cast<std::size_t>(dw) * dh;
     std::vector<Imath::half> halves(half ? n * views : 0);
     std::vector<float> floats(half ? 0 : n * views);
     const double q = storage_.quantum;
     Imf::FrameBuffer fb;
+    // Slices address pixel (x, y) of the data window at base + x * xStride + y * yStride.
+    const std::ptrdiff_t origin = static_cast<std::ptrdiff_t>(y0) * dw + x0;
     for (int v = 0; v < views; ++v) {
-      const auto& depth = point.views[v].depth.depth;
-      for (std::size_t i = 0; i < n; ++i) {
-        float z = depth[i];
-        if (!(z > 0.0f) || !std::isfinite(z)) z = 0.0f;
-        if (q > 0.0 && z > 0.0f) z = static_cast<float>(q * std::round(z / q));
-        if (half) {
-          halves[v * n + i] = Imath::half(z);
-        } else {
-          floats[v * n + i] = z;
+      const DepthImage& depth = point.views[v].depth;
+      for (int y = 0; y < dh; ++y) {
+        for (int x = 0; x < dw; ++x) {
+          float z = depth.at(x0 + x, y0 + y);
+          if (!(z > 0.0f) || !std::isfinite(z)) z = 0.0f;
+          if (q > 0.0 && z > 0.0f) z = static_cast<float>(q * std::round(z / q));
+          const std::size_t i = v * n + static_cast<std::size_t>(y) * dw + x;
+          if (half) {
+            halves[i] = Imath::half(z);
+          } else {
+            floats[i] = z;
+          }
         }
       }
       if (half) {
-        fb.insert(channel_name(v), Imf::Slice(Imf::HALF, reinterpret_cast<char*>(halves.data() + v * n),
-                                              sizeof(Imath::half), sizeof(Imath::half) * W));
+        fb.insert(channel_name(v), Imf::Slice(Imf::HALF, reinterpret_cast<char*>(halves.data() + v * n - origin),
+                                              sizeof(Imath::half), sizeof(Imath::half) * dw));
       } else {
-        fb.insert(channel_name(v),
-                  Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(floats.data() + v * n), sizeof(float), sizeof(float) * W));
+        fb.insert(channel_name(v), Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(floats.data() + v * n - origin),
+                                              sizeof(float), sizeof(float) * dw));
       }
     }
     MemoryOStream stream;
     {
       Imf::OutputFile file(stream, header, 0);
       file.setFrameBuffer(fb);
-      file.writePixels(H);
+      file.writePixels(dh);
     }
     return std::move(stream.data);
   } catch (const std::exception& e) {

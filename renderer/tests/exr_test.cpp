@@ -61,8 +61,12 @@ void expect_same_metadata(const DataPointRecord& a, const DataPointRecord& b) {
   EXPECT_EQ(a.source, b.source);
   ASSERT_EQ(a.views.size(), b.views.size());
   for (std::size_t v = 0; v < a.views.size(); ++v) {
-    EXPECT_EQ(a.views[v].camera.intrinsics.K, b.views[v].camera.intrinsics.K);
-    EXPECT_EQ(a.views[v].camera.world_to_camera.matrix(), b.views[v].camera.world_to_camera.matrix());
+    // Stored as 32-bit floats: 1e-7 relative, 0.1 um on a 1 m translation.
+    EXPECT_TRUE(a.views[v].camera.intrinsics.K.isApprox(b.views[v].camera.intrinsics.K, 1e-7));
+    EXPECT_LT((a.views[v].camera.world_to_camera.matrix() - b.views[v].camera.world_to_camera.matrix())
+                  .cwiseAbs()
+                  .maxCoeff(),
+              1e-6);
     EXPECT_EQ(a.views[v].table_angle, b.views[v].table_angle);
     EXPECT_EQ(a.views[v].noise_seed, b.views[v].noise_seed);
     EXPECT_EQ(a.views[v].camera.intrinsics.width, 240);
@@ -110,6 +114,44 @@ TEST(Exr, HalfStorageErrorStaysWithinItsBound) {
   // The bound itself: half below 1 m rounds to 2^-12 m (0.24 mm), below 2 m to 0.49 mm.
   EXPECT_NEAR(ExrStorage{}.max_error(0.95), std::ldexp(1.0, -12), 1e-12);
   EXPECT_LT(ExrStorage{}.max_error(1.0), 0.0005);
+}
+
+TEST(Exr, DataWindowIsTheBoundingBoxOfReturns) {
+  DataPointRecord p = sample_point();
+  for (auto& v : p.views) {
+    for (int y = 0; y < 180; ++y)
+      for (int x = 0; x < 240; ++x)
+        if (x < 30 || x > 200 || y < 10 || y > 150) v.depth.at(x, y) = 0.0f;
+  }
+  const std::string path = temp_path("window.exr");
+  ASSERT_TRUE(ExrWriter().write_file(path, p));
+  {
+    Imf::InputFile file(path.c_str());
+    const Imath::Box2i data = file.header().dataWindow(), display = file.header().displayWindow();
+    EXPECT_EQ(data.min.x, 30);
+    EXPECT_EQ(data.max.x, 200);
+    EXPECT_EQ(data.min.y, 10);
+    EXPECT_EQ(data.max.y, 150);
+    EXPECT_EQ(display.max.x, 239);
+    EXPECT_EQ(display.max.y, 179);
+  }
+  auto back = read_exr(path);
+  ASSERT_TRUE(back);
+  for (int v = 0; v < 4; ++v) {
+    for (std::size_t i = 0; i < p.views[v].depth.depth.size(); ++i) {
+      ASSERT_NEAR(back->views[v].depth.depth[i], p.views[v].depth.depth[i], 0.0005);
+      ASSERT_EQ(back->views[v].depth.depth[i] == 0.0f, p.views[v].depth.depth[i] == 0.0f);
+    }
+  }
+  // All views empty: still a valid file of zeros.
+  for (auto& v : p.views) std::fill(v.depth.depth.begin(), v.depth.depth.end(), 0.0f);
+  auto bytes = ExrWriter().encode(p);
+  ASSERT_TRUE(bytes);
+  auto empty = read_exr(*bytes);
+  ASSERT_TRUE(empty);
+  EXPECT_EQ(empty->views[0].depth.foreground_count(), 0);
+  EXPECT_EQ(empty->views[0].depth.width, 240);
+  std::remove(path.c_str());
 }
 
 TEST(Exr, OpenExrsOwnApiSeesTheLayout) {
