@@ -70,46 +70,37 @@ DepthImage NoiseModel::apply(const DepthImage& clean, std::uint64_t seed) const 
   const AngleTables& tables = AngleTables::get();
   const float l0 = static_cast<float>(lateral_l0_px), l1 = static_cast<float>(lateral_l1_px);
 
-  // Lateral jitter: each pixel copies the clean pixel at a rounded Gaussian offset. Only pixels with a return
-  // within `reach` pixels can receive one (an offset beyond it has probability < 1e-9 for sigma_L < 0.8 px); the
-  // others keep no return and draw no numbers.
-  std::vector<float> z0 = clean.depth;
-  std::vector<float> c0(n, 1.0f);
-  if (have_incidence) c0 = clean.incidence;
-  if (lateral) {
-    constexpr int reach = 5;
-    // Rows, then columns: does any pixel within `reach` have a return?
-    std::vector<std::uint8_t> row_near(n, 0), near(n, 0);
-    for (int v = 0; v < H; ++v) {
-      int last = -1000000;
-      for (int u = 0; u < W; ++u) {
-        if (clean.depth[static_cast<std::size_t>(v) * W + u] > 0.0f) last = u;
-        if (u - last <= reach) row_near[static_cast<std::size_t>(v) * W + u] = 1;
-      }
-      last = 1000000;
-      for (int u = W - 1; u >= 0; --u) {
-        if (clean.depth[static_cast<std::size_t>(v) * W + u] > 0.0f) last = u;
-        if (last - u <= reach) row_near[static_cast<std::size_t>(v) * W + u] = 1;
-      }
-    }
+  // The box of pixels with a return, grown by `reach` pixels: outside it nothing can change (a lateral offset beyond
+  // `reach` has probability < 1e-9 for sigma_L < 0.8 px), so the noise neither visits nor draws numbers there.
+  constexpr int reach = 5;
+  int bx0 = W, by0 = H, bx1 = -1, by1 = -1;
+  for (int v = 0; v < H; ++v) {
+    const float* row = clean.depth.data() + static_cast<std::size_t>(v) * W;
     for (int u = 0; u < W; ++u) {
-      int last = -1000000;
-      for (int v = 0; v < H; ++v) {
-        if (row_near[static_cast<std::size_t>(v) * W + u]) last = v;
-        if (v - last <= reach) near[static_cast<std::size_t>(v) * W + u] = 1;
-      }
-      last = 1000000;
-      for (int v = H - 1; v >= 0; --v) {
-        if (row_near[static_cast<std::size_t>(v) * W + u]) last = v;
-        if (last - v <= reach) near[static_cast<std::size_t>(v) * W + u] = 1;
+      if (row[u] > 0.0f) {
+        bx0 = std::min(bx0, u);
+        bx1 = std::max(bx1, u);
+        by0 = std::min(by0, v);
+        by1 = std::max(by1, v);
       }
     }
+  }
+  DepthImage out(W, H);
+  if (bx1 < 0) return out;
+  bx0 = std::max(0, bx0 - reach);
+  by0 = std::max(0, by0 - reach);
+  bx1 = std::min(W - 1, bx1 + reach);
+  by1 = std::min(H - 1, by1 + reach);
+
+  // Lateral jitter: each pixel copies the clean pixel at a rounded Gaussian offset.
+  std::vector<float> z0 = clean.depth;
+  std::vector<float> c0 = have_incidence ? clean.incidence : std::vector<float>(n, 1.0f);
+  if (lateral) {
     Rng rng(mix_seed(seed, 1));
     const float background_sigma = static_cast<float>(lateral_sigma_px(0.0));
-    for (int v = 0; v < H; ++v) {
-      for (int u = 0; u < W; ++u) {
+    for (int v = by0; v <= by1; ++v) {
+      for (int u = bx0; u <= bx1; ++u) {
         const std::size_t i = static_cast<std::size_t>(v) * W + u;
-        if (!near[i]) continue;
         const float sigma =
             clean.depth[i] > 0.0f ? l0 + l1 * AngleTables::lookup(tables.ratio, cos_at(i)) : background_sigma;
         const int su = std::clamp(u + round_to_int(sigma * rng.gaussian()), 0, W - 1);
@@ -121,12 +112,11 @@ DepthImage NoiseModel::apply(const DepthImage& clean, std::uint64_t seed) const 
     }
   }
 
-  DepthImage out(W, H);
   Rng rng(mix_seed(seed, 2));
   const float cos_grazing = static_cast<float>(std::cos(grazing_max_deg * M_PI / 180.0));
   const double a = axial_scale * axial_a, b = axial_scale * axial_b, c = axial_scale * axial_c;
-  for (int v = 0; v < H; ++v) {
-    for (int u = 0; u < W; ++u) {
+  for (int v = by0; v <= by1; ++v) {
+    for (int u = bx0; u <= bx1; ++u) {
       const std::size_t i = static_cast<std::size_t>(v) * W + u;
       double z = z0[i];
       if (z <= 0.0) continue;
