@@ -122,16 +122,19 @@ void storage_table(DepthRenderer& renderer, const TriangleMesh& cloth, int data_
     const auto points = unwrap(render_data_points(renderer, cloth, request));
     int views = 0;
     long foreground = 0;
-    double z_max = 0.0;
+    double z_max = 0.0, z_min = 1e9;
     for (const auto& p : points) {
       for (const auto& v : p.views) {
         ++views;
         foreground += v.depth.foreground_count();
-        for (float z : v.depth.depth) z_max = std::max(z_max, static_cast<double>(z));
+        for (float z : v.depth.depth) {
+          z_max = std::max(z_max, static_cast<double>(z));
+          if (z > 0.0f) z_min = std::min(z_min, static_cast<double>(z));
+        }
       }
     }
-    fmt::print("\nstorage, noise {}: {} views, {:.0f} pixels with a return per view, depth up to {:.3f} m\n",
-               noisy ? "kinect" : "none", views, static_cast<double>(foreground) / views, z_max);
+    fmt::print("\nstorage, noise {}: {} views, {:.0f} pixels with a return per view, depth {:.3f} to {:.3f} m\n",
+               noisy ? "kinect" : "none", views, static_cast<double>(foreground) / views, z_min, z_max);
     fmt::print("  {:<28} {:>10} {:>12} {:>12} {:>12} {:>10}\n", "option", "bytes/view", "max err mm", "rms err mm",
                "bound mm", "ms/view");
     for (const auto& option : options) {
