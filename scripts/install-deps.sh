@@ -6,6 +6,7 @@ packages=(
   libeigen3-dev libsuitesparse-dev libopenblas0-serial
   libspdlog-dev libfmt-dev libcli11-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  libosmesa6-dev libopenexr-dev openexr libpng-dev
 )
 missing=()
 for p in "${packages[@]}"; do

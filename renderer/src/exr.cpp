@@ -1,0 +1,306 @@
+#include "drapegen/renderer/exr.hpp"
+
+#include <ImfChannelList.h>
+#include <ImfDoubleAttribute.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfIO.h>
+#include <ImfInputFile.h>
+#include <ImfIntAttribute.h>
+#include <ImfMatrixAttribute.h>
+#include <ImfOutputFile.h>
+#include <ImfStdIO.h>
+#include <ImfStringAttribute.h>
+#include <Imath/half.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fmt/format.h>
+#include <algorithm>
+#include <map>
+
+namespace drapegen::renderer {
+namespace {
+
+const std::map<std::string, Imf::Compression>& compressions() {
+  static const std::map<std::string, Imf::Compression> m = {
+      {"none", Imf::NO_COMPRESSION}, {"rle", Imf::RLE_COMPRESSION},     {"zips", Imf::ZIPS_COMPRESSION},
+      {"zip", Imf::ZIP_COMPRESSION}, {"piz", Imf::PIZ_COMPRESSION},     {"pxr24", Imf::PXR24_COMPRESSION},
+      {"b44", Imf::B44_COMPRESSION}, {"b44a", Imf::B44A_COMPRESSION},   {"dwaa", Imf::DWAA_COMPRESSION},
+      {"dwab", Imf::DWAB_COMPRESSION}};
+  return m;
+}
+
+class MemoryOStream final : public Imf::OStream {
+ public:
+  MemoryOStream() : Imf::OStream("<memory>") {}
+  void write(const char c[], int n) override {
+    if (position_ + n > data.size()) data.resize(position_ + n);
+    std::memcpy(data.data() + position_, c, static_cast<std::size_t>(n));
+    position_ += n;
+  }
+  std::uint64_t tellp() override { return position_; }
+  void seekp(std::uint64_t pos) override { position_ = pos; }
+  std::vector<char> data;
+
+ private:
+  std::uint64_t position_ = 0;
+};
+
+class MemoryIStream final : public Imf::IStream {
+ public:
+  explicit MemoryIStream(const std::vector<char>& bytes) : Imf::IStream("<memory>"), bytes_(bytes) {}
+  bool read(char c[], int n) override {
+    if (position_ + n > bytes_.size()) throw std::runtime_error("unexpected end of EXR data");
+    std::memcpy(c, bytes_.data() + position_, static_cast<std::size_t>(n));
+    position_ += n;
+    return position_ < bytes_.size();
+  }
+  std::uint64_t tellg() override { return position_; }
+  void seekg(std::uint64_t pos) override { position_ = pos; }
+
+ private:
+  const std::vector<char>& bytes_;
+  std::uint64_t position_ = 0;
+};
+
+/// Short on purpose (every byte of the header is a quarter byte per view); docs/RENDERER.md spells it out.
+constexpr const char* kUnits = "Z: camera z, m, 0 = none; K: px, OpenCV; meshToCamera: m, x' = M x; angles: rad";
+
+std::string channel_name(int view) { return fmt::format("view{}.Z", view); }
+
+Imath::M44f to_m44(const Eigen::Isometry3d& T) {
+  Imath::M44f m;
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) m[i][j] = static_cast<float>(T.matrix()(i, j));
+  return m;
+}
+
+Imath::M33f to_m33(const Eigen::Matrix3d& K) {
+  Imath::M33f m;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) m[i][j] = static_cast<float>(K(i, j));
+  return m;
+}
+
+template <class A>
+const A* find(const Imf::Header& h, const std::string& name) {
+  return h.findTypedAttribute<A>(name);
+}
+
+sim::Expected<DataPointRecord> decode(Imf::IStream& stream) {
+  Imf::InputFile file(stream, 0);
+  const Imf::Header& h = file.header();
+  const auto* views_attr = find<Imf::IntAttribute>(h, "drapegen.views");
+  if (views_attr == nullptr) return sim::Error{"not a drapegen depth file (no drapegen.views attribute)"};
+  const int views = views_attr->value();
+  if (views < 1 || views > 64) return sim::Error{fmt::format("bad view count {}", views)};
+  const Imath::Box2i display = h.displayWindow(), data = h.dataWindow();
+  const int W = display.max.x - display.min.x + 1, H = display.max.y - display.min.y + 1;
+  const int dw = data.max.x - data.min.x + 1, dh = data.max.y - data.min.y + 1;
+
+  DataPointRecord point;
+  if (const auto* a = find<Imf::IntAttribute>(h, "drapegen.index")) point.index = a->value();
+  if (const auto* a = find<Imf::DoubleAttribute>(h, "drapegen.orientation")) point.orientation = a->value();
+  if (const auto* a = find<Imf::StringAttribute>(h, "drapegen.seed")) point.seed = std::stoull(a->value());
+  if (const auto* a = find<Imf::StringAttribute>(h, "drapegen.noise")) point.noise = a->value();
+  if (const auto* a = find<Imf::StringAttribute>(h, "drapegen.source")) point.source = a->value();
+
+  std::vector<std::vector<float>> buffers(views, std::vector<float>(static_cast<std::size_t>(dw) * dh));
+  Imf::FrameBuffer fb;
+  for (int v = 0; v < views; ++v) {
+    if (h.channels().findChannel(channel_name(v)) == nullptr) {
+      return sim::Error{fmt::format("missing channel {}", channel_name(v))};
+    }
+    char* base = reinterpret_cast<char*>(buffers[v].data()) -
+                 (static_cast<std::ptrdiff_t>(data.min.y) * dw + data.min.x) * static_cast<std::ptrdiff_t>(sizeof(float));
+    fb.insert(channel_name(v), Imf::Slice(Imf::FLOAT, base, sizeof(float), sizeof(float) * dw));
+  }
+  file.setFrameBuffer(fb);
+  file.readPixels(data.min.y, data.max.y);
+
+  for (int v = 0; v < views; ++v) {
+    ViewRecord r;
+    r.depth = DepthImage(W, H);
+    for (int y = data.min.y; y <= data.max.y; ++y) {
+      for (int x = data.min.x; x <= data.max.x; ++x) {
+        if (x < display.min.x || x > display.max.x || y < display.min.y || y > display.max.y) continue;
+        r.depth.at(x - display.min.x, y - display.min.y) =
+            buffers[v][static_cast<std::size_t>(y - data.min.y) * dw + (x - data.min.x)];
+      }
+    }
+    const std::string prefix = fmt::format("view{}.", v);
+    const auto* K = find<Imf::M33fAttribute>(h, prefix + "K");
+    const auto* T = find<Imf::M44fAttribute>(h, prefix + "meshToCamera");
+    if (K == nullptr || T == nullptr) return sim::Error{fmt::format("missing camera of view {}", v)};
+    r.camera.intrinsics.width = W;
+    r.camera.intrinsics.height = H;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) r.camera.intrinsics.K(i, j) = K->value()[i][j];
+    Eigen::Matrix4d M;
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j) M(i, j) = T->value()[i][j];
+    r.camera.world_to_camera.matrix() = M;
+    if (const auto* a = find<Imf::DoubleAttribute>(h, prefix + "tableAngle")) r.table_angle = a->value();
+    if (const auto* a = find<Imf::StringAttribute>(h, prefix + "noiseSeed")) r.noise_seed = std::stoull(a->value());
+    point.views.push_back(std::move(r));
+  }
+  return point;
+}
+
+}  // namespace
+
+double ExrStorage::max_error(double z_max) const {
+  const int e = static_cast<int>(std::floor(std::log2(z_max)));
+  const double ulp = std::ldexp(1.0, e - (pixel == Pixel::kHalf ? 10 : 23));
+  return 0.5 * quantum + 0.5 * ulp;
+}
+
+ExrWriter::ExrWriter(ExrStorage storage) : storage_(std::move(storage)) {}
+
+sim::Status ExrWriter::validate() const {
+  if (!compressions().contains(storage_.compression)) {
+    return sim::Error{fmt::format("unknown EXR compression '{}'", storage_.compression)};
+  }
+  if (!(storage_.quantum >= 0.0 && storage_.quantum <= 0.01)) return sim::Error{"EXR quantum must be in [0, 0.01] m"};
+  if (storage_.zip_level < 1 || storage_.zip_level > 9) return sim::Error{"zip level must be 1..9"};
+  return {};
+}
+
+sim::Expected<std::vector<char>> ExrWriter::encode(const DataPointRecord& point) const {
+  if (sim::Status s = validate(); !s) return s.error();
+  if (point.views.empty()) return sim::Error{"data point has no views"};
+  const int W = point.views[0].depth.width, H = point.views[0].depth.height;
+  for (const auto& v : point.views) {
+    if (v.depth.width != W || v.depth.height != H || v.depth.depth.size() != static_cast<std::size_t>(W) * H) {
+      return sim::Error{"views differ in size"};
+    }
+  }
+  // The data window is the bounding box of the pixels with a return in any view (OpenEXR readers fill the rest of
+  // the display window with 0, which is what no return means here).
+  int x0 = W, y0 = H, x1 = -1, y1 = -1;
+  for (const auto& v : point.views) {
+    for (int y = 0; y < H; ++y) {
+      for (int x = 0; x < W; ++x) {
+        if (v.depth.at(x, y) > 0.0f) {
+          x0 = std::min(x0, x);
+          x1 = std::max(x1, x);
+          y0 = std::min(y0, y);
+          y1 = std::max(y1, y);
+        }
+      }
+    }
+  }
+  if (x1 < 0) x0 = y0 = x1 = y1 = 0;  // nothing anywhere: one pixel of 0
+  const int dw = x1 - x0 + 1, dh = y1 - y0 + 1;
+  try {
+    Imf::Header header(Imath::Box2i({0, 0}, {W - 1, H - 1}), Imath::Box2i({x0, y0}, {x1, y1}));
+    header.compression() = compressions().at(storage_.compression);
+    header.zipCompressionLevel() = storage_.zip_level;
+    const bool half = storage_.pixel == ExrStorage::Pixel::kHalf;
+    const int views = static_cast<int>(point.views.size());
+    for (int v = 0; v < views; ++v) header.channels().insert(channel_name(v), Imf::Channel(half ? Imf::HALF : Imf::FLOAT));
+    header.insert("drapegen.units", Imf::StringAttribute(kUnits));
+    header.insert("drapegen.views", Imf::IntAttribute(views));
+    header.insert("drapegen.index", Imf::IntAttribute(point.index));
+    header.insert("drapegen.orientation", Imf::DoubleAttribute(point.orientation));
+    header.insert("drapegen.seed", Imf::StringAttribute(std::to_string(point.seed)));
+    header.insert("drapegen.noise", Imf::StringAttribute(point.noise));
+    header.insert("drapegen.source", Imf::StringAttribute(point.source));
+    header.insert("drapegen.storage", Imf::StringAttribute(fmt::format(
+                                          "{} {} quantum={} m", half ? "half" : "float", storage_.compression,
+                                          storage_.quantum)));
+    for (int v = 0; v < views; ++v) {
+      const ViewRecord& r = point.views[v];
+      const std::string prefix = fmt::format("view{}.", v);
+      header.insert(prefix + "K", Imf::M33fAttribute(to_m33(r.camera.intrinsics.K)));
+      header.insert(prefix + "meshToCamera", Imf::M44fAttribute(to_m44(r.camera.world_to_camera)));
+      header.insert(prefix + "tableAngle", Imf::DoubleAttribute(r.table_angle));
+      header.insert(prefix + "noiseSeed", Imf::StringAttribute(std::to_string(r.noise_seed)));
+    }
+
+    const std::size_t n = static_cast<std::size_t>(dw) * dh;
+    std::vector<Imath::half> halves(half ? n * views : 0);
+    std::vector<float> floats(half ? 0 : n * views);
+    const double q = storage_.quantum;
+    Imf::FrameBuffer fb;
+    // Slices address pixel (x, y) of the data window at base + x * xStride + y * yStride.
+    const std::ptrdiff_t origin = static_cast<std::ptrdiff_t>(y0) * dw + x0;
+    for (int v = 0; v < views; ++v) {
+      const DepthImage& depth = point.views[v].depth;
+      for (int y = 0; y < dh; ++y) {
+        for (int x = 0; x < dw; ++x) {
+          float z = depth.at(x0 + x, y0 + y);
+          if (!(z > 0.0f) || !std::isfinite(z)) z = 0.0f;
+          if (q > 0.0 && z > 0.0f) z = static_cast<float>(q * std::round(z / q));
+          const std::size_t i = v * n + static_cast<std::size_t>(y) * dw + x;
+          if (half) {
+            halves[i] = Imath::half(z);
+          } else {
+            floats[i] = z;
+          }
+        }
+      }
+      if (half) {
+        fb.insert(channel_name(v), Imf::Slice(Imf::HALF, reinterpret_cast<char*>(halves.data() + v * n - origin),
+                                              sizeof(Imath::half), sizeof(Imath::half) * dw));
+      } else {
+        fb.insert(channel_name(v), Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(floats.data() + v * n - origin),
+                                              sizeof(float), sizeof(float) * dw));
+      }
+    }
+    MemoryOStream stream;
+    {
+      Imf::OutputFile file(stream, header, 0);
+      file.setFrameBuffer(fb);
+      file.writePixels(dh);
+    }
+    return std::move(stream.data);
+  } catch (const std::exception& e) {
+    return sim::Error{fmt::format("EXR encoding failed: {}", e.what())};
+  }
+}
+
+sim::Status ExrWriter::write_file(const std::string& path, const DataPointRecord& point) const {
+  auto bytes = encode(point);
+  if (!bytes) return bytes.error();
+  const std::string tmp = path + ".tmp";
+  std::FILE* f = std::fopen(tmp.c_str(), "wb");
+  if (f == nullptr) return sim::Error{fmt::format("cannot write {}: {}", path, std::strerror(errno))};
+  const bool written = std::fwrite(bytes->data(), 1, bytes->size(), f) == bytes->size();
+  const bool closed = std::fclose(f) == 0;
+  if (!written || !closed) {
+    std::remove(tmp.c_str());
+    return sim::Error{fmt::format("cannot write {}: {}", path, std::strerror(errno))};
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    const int err = errno;
+    std::remove(tmp.c_str());
+    return sim::Error{fmt::format("cannot write {}: {}", path, std::strerror(err))};
+  }
+  return {};
+}
+
+sim::Expected<DataPointRecord> read_exr(const std::vector<char>& bytes) {
+  try {
+    MemoryIStream stream(bytes);
+    return decode(stream);
+  } catch (const std::exception& e) {
+    return sim::Error{fmt::format("cannot read EXR data: {}", e.what())};
+  }
+}
+
+sim::Expected<DataPointRecord> read_exr(const std::string& path) {
+  try {
+    Imf::StdIFStream stream(path.c_str());
+    auto result = decode(stream);
+    if (!result) return sim::Error{fmt::format("{}: {}", path, result.error().message)};
+    return result;
+  } catch (const std::exception& e) {
+    return sim::Error{fmt::format("cannot read {}: {}", path, e.what())};
+  }
+}
+
+}  // namespace drapegen::renderer

@@ -1,0 +1,122 @@
+#include "drapegen/renderer/preview.hpp"
+
+#include <png.h>
+
+#include <algorithm>
+#include <array>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fmt/format.h>
+
+namespace drapegen::renderer {
+namespace {
+
+/// A perceptual-ish ramp from blue (far) through green and yellow to red (near); t in [0, 1].
+std::array<double, 3> ramp(double t) {
+  static constexpr std::array<std::array<double, 3>, 5> stops = {{{0.19, 0.25, 0.72},
+                                                                  {0.13, 0.62, 0.85},
+                                                                  {0.35, 0.78, 0.38},
+                                                                  {0.96, 0.80, 0.25},
+                                                                  {0.87, 0.27, 0.18}}};
+  t = std::clamp(t, 0.0, 1.0) * (stops.size() - 1);
+  const int i = std::min(static_cast<int>(t), static_cast<int>(stops.size()) - 2);
+  const double f = t - i;
+  return {stops[i][0] + f * (stops[i + 1][0] - stops[i][0]), stops[i][1] + f * (stops[i + 1][1] - stops[i][1]),
+          stops[i][2] + f * (stops[i + 1][2] - stops[i][2])};
+}
+
+void paint(const DepthImage& img, std::vector<unsigned char>& rgb, int stride, int x0, int y0) {
+  float lo = 1e30f, hi = 0.0f;
+  for (float z : img.depth) {
+    if (z > 0.0f) {
+      lo = std::min(lo, z);
+      hi = std::max(hi, z);
+    }
+  }
+  const double range = hi > lo ? hi - lo : 1.0;
+  const int W = img.width, H = img.height;
+  auto depth = [&](int u, int v, float fallback) {
+    if (u < 0 || u >= W || v < 0 || v >= H) return fallback;
+    const float z = img.at(u, v);
+    return z > 0.0f ? z : fallback;
+  };
+  const double light[3] = {-0.45, -0.55, 0.70};  // from the upper left, towards the camera
+  for (int v = 0; v < H; ++v) {
+    for (int u = 0; u < W; ++u) {
+      const float z = img.at(u, v);
+      unsigned char* p = &rgb[(static_cast<std::size_t>(y0 + v) * stride + x0 + u) * 3];
+      if (!(z > 0.0f)) continue;
+      // Normal from central differences, in units of pixels (x, y) and of the pixel footprint (z).
+      const double footprint = z / 250.0;
+      const double dzdu = (depth(u + 1, v, z) - depth(u - 1, v, z)) / (2.0 * footprint);
+      const double dzdv = (depth(u, v + 1, z) - depth(u, v - 1, z)) / (2.0 * footprint);
+      const double n[3] = {dzdu, dzdv, -1.0};
+      const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + 1.0);
+      const double lambert = std::max(0.0, -(n[0] * light[0] + n[1] * light[1] + n[2] * light[2]) / len);
+      const double shade = 0.35 + 0.65 * lambert;
+      const auto c = ramp(1.0 - (z - lo) / range);
+      for (int k = 0; k < 3; ++k) p[k] = static_cast<unsigned char>(std::clamp(255.0 * c[k] * shade, 0.0, 255.0));
+    }
+  }
+}
+
+}  // namespace
+
+sim::Status write_preview_png(const std::string& path, const std::vector<std::vector<DepthImage>>& rows) {
+  if (rows.empty() || rows[0].empty()) return sim::Error{"preview: no images"};
+  const int W = rows[0][0].width, H = rows[0][0].height;
+  std::size_t columns = 0;
+  for (const auto& row : rows) {
+    columns = std::max(columns, row.size());
+    for (const auto& img : row) {
+      if (img.width != W || img.height != H) return sim::Error{"preview: images differ in size"};
+    }
+  }
+  const int gap = 2;
+  const int width = static_cast<int>(columns) * (W + gap) - gap;
+  const int height = static_cast<int>(rows.size()) * (H + gap) - gap;
+  std::vector<unsigned char> rgb(static_cast<std::size_t>(width) * height * 3, 0);
+  for (std::size_t r = 0; r < rows.size(); ++r) {
+    for (std::size_t c = 0; c < rows[r].size(); ++c) {
+      paint(rows[r][c], rgb, width, static_cast<int>(c) * (W + gap), static_cast<int>(r) * (H + gap));
+    }
+  }
+  // Gaps between the cells in dark grey.
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      if (x % (W + gap) >= W || y % (H + gap) >= H) {
+        std::memset(&rgb[(static_cast<std::size_t>(y) * width + x) * 3], 64, 3);
+      }
+    }
+  }
+
+  const std::string tmp = path + ".tmp";
+  std::FILE* f = std::fopen(tmp.c_str(), "wb");
+  if (f == nullptr) return sim::Error{fmt::format("cannot write {}: {}", path, std::strerror(errno))};
+  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+  png_infop info = png != nullptr ? png_create_info_struct(png) : nullptr;
+  if (png == nullptr || info == nullptr || setjmp(png_jmpbuf(png))) {
+    png_destroy_write_struct(&png, &info);
+    std::fclose(f);
+    std::remove(tmp.c_str());
+    return sim::Error{fmt::format("cannot write {}: libpng failed", path)};
+  }
+  png_init_io(png, f);
+  png_set_IHDR(png, info, static_cast<png_uint_32>(width), static_cast<png_uint_32>(height), 8, PNG_COLOR_TYPE_RGB,
+               PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+  png_write_info(png, info);
+  for (int y = 0; y < height; ++y) png_write_row(png, &rgb[static_cast<std::size_t>(y) * width * 3]);
+  png_write_end(png, nullptr);
+  png_destroy_write_struct(&png, &info);
+  const bool closed = std::fclose(f) == 0;
+  if (!closed || std::rename(tmp.c_str(), path.c_str()) != 0) {
+    const int err = errno;
+    std::remove(tmp.c_str());
+    return sim::Error{fmt::format("cannot write {}: {}", path, std::strerror(err))};
+  }
+  return {};
+}
+
+}  // namespace drapegen::renderer

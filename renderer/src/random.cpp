@@ -1,0 +1,86 @@
+#include "drapegen/renderer/random.hpp"
+
+#include <cmath>
+#include <vector>
+
+namespace drapegen::renderer {
+namespace {
+
+std::uint64_t splitmix(std::uint64_t& x) {
+  std::uint64_t z = (x += 0x9e3779b97f4a7c15ULL);
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  return z ^ (z >> 31);
+}
+
+std::uint64_t rotl(std::uint64_t x, int k) { return (x << k) | (x >> (64 - k)); }
+
+/// Inverse of the standard normal CDF by bisection on std::erfc (only used to build the table once).
+double inverse_normal_cdf(double p) {
+  double lo = -10.0, hi = 10.0;
+  for (int i = 0; i < 80; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (0.5 * std::erfc(-mid / std::sqrt(2.0)) < p ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+const std::vector<float>& gaussian_table() {
+  static const std::vector<float> table = [] {
+    constexpr int n = 65536;
+    std::vector<double> values(n);
+    double sum_sq = 0.0;
+    for (int i = 0; i < n / 2; ++i) {  // symmetric: compute one half
+      const double x = inverse_normal_cdf((i + 0.5) / n);
+      values[i] = x;
+      values[n - 1 - i] = -x;
+      sum_sq += 2.0 * x * x;
+    }
+    const double scale = 1.0 / std::sqrt(sum_sq / n);
+    std::vector<float> t(n);
+    for (int i = 0; i < n; ++i) t[i] = static_cast<float>(values[i] * scale);
+    return t;
+  }();
+  return table;
+}
+
+}  // namespace
+
+std::uint64_t mix_seed(std::uint64_t seed, std::uint64_t stream) {
+  std::uint64_t x = seed ^ splitmix(stream);
+  return splitmix(x);
+}
+
+Rng::Rng(std::uint64_t seed) {
+  std::uint64_t x = seed;
+  for (auto& s : s_) s = splitmix(x);
+  (void)gaussian_table();
+}
+
+std::uint64_t Rng::next() {
+  const std::uint64_t result = rotl(s_[1] * 5, 7) * 9;
+  const std::uint64_t t = s_[1] << 17;
+  s_[2] ^= s_[0];
+  s_[3] ^= s_[1];
+  s_[1] ^= s_[2];
+  s_[0] ^= s_[3];
+  s_[2] ^= t;
+  s_[3] = rotl(s_[3], 45);
+  return result;
+}
+
+double Rng::uniform() { return static_cast<double>(next() >> 11) * 0x1.0p-53; }
+
+float Rng::gaussian() {
+  static const float* table = gaussian_table().data();
+  if (pooled_ == 0) {
+    pool_ = next();
+    pooled_ = 4;
+  }
+  const auto index = static_cast<std::uint16_t>(pool_);
+  pool_ >>= 16;
+  --pooled_;
+  return table[index];
+}
+
+}  // namespace drapegen::renderer
