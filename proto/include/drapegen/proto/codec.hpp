@@ -1,0 +1,43 @@
+#pragma once
+// Framing of the worker protocol: one Envelope per ZeroMQ frame, stamped with the protocol version on encode and
+// checked on decode (docs/SERVICE.md, "Protocol").
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+#include "drapegen/proto/worker.pb.h"
+#include "drapegen/sim/expected.hpp"
+
+namespace drapegen::proto {
+
+namespace v1 = ::drapegen::proto::v1;
+
+/// The version this build speaks (v1::PROTOCOL_VERSION_CURRENT).
+inline constexpr std::uint32_t kProtocolVersion = v1::PROTOCOL_VERSION_CURRENT;
+/// Largest frame either side accepts (a drape's mesh and EXR files are far below it).
+inline constexpr std::size_t kMaxFrameBytes = 256u << 20;
+
+/// Serializes `envelope` with protocol_version set to kProtocolVersion.
+[[nodiscard]] std::string encode(v1::Envelope envelope);
+
+/// Parses one frame. Errors (one line): too large, not a valid Envelope, another protocol version, no body, or a
+/// body that breaks the field rules of check().
+[[nodiscard]] sim::Expected<v1::Envelope> decode(const void* data, std::size_t size);
+[[nodiscard]] inline sim::Expected<v1::Envelope> decode(std::string_view frame) {
+  return decode(frame.data(), frame.size());
+}
+
+/// Field rules beyond the wire format: job ids > 0, attempts >= 1, a job spec with a known mode, a positive
+/// resolution and orientation count, finite parameters, a known failure reason, ...
+[[nodiscard]] sim::Status check(const v1::Envelope& envelope);
+
+/// The body's name ("ready", "job", ...; "none" without one), for logs.
+[[nodiscard]] const char* body_name(const v1::Envelope& envelope);
+
+/// The failure reason as stored in the manifest: "not_converged", "diverged", "self_intersection", "render_error",
+/// "worker_lost", "timeout", "invalid_job" ("unspecified" otherwise).
+[[nodiscard]] const char* reason_name(v1::FailureReason reason);
+
+}  // namespace drapegen::proto

@@ -1,0 +1,131 @@
+#include "drapegen/proto/codec.hpp"
+
+#include <cmath>
+#include <fmt/format.h>
+#include <google/protobuf/stubs/logging.h>
+#include <mutex>
+
+namespace drapegen::proto {
+namespace {
+
+sim::Status check_parameters(const v1::Parameters& p) {
+  const double values[] = {p.alpha_warp(), p.alpha_bias(), p.alpha_weft(), p.beta_warp(),
+                           p.beta_bias(),  p.beta_weft(),  p.density_g_per_m2()};
+  for (double v : values) {
+    if (!std::isfinite(v)) return sim::Error{"job: non-finite parameter"};
+  }
+  if (!(p.alpha_warp() > 0 && p.alpha_bias() > 0 && p.alpha_weft() > 0)) return sim::Error{"job: alpha must be > 0"};
+  if (!(p.density_g_per_m2() > 0)) return sim::Error{"job: density must be > 0"};
+  return {};
+}
+
+sim::Status check_spec(const v1::JobSpec& s) {
+  if (s.mode() != v1::JOB_MODE_DRAPE && s.mode() != v1::JOB_MODE_NOOP && s.mode() != v1::JOB_MODE_POISON) {
+    return sim::Error{fmt::format("job: unknown mode {}", static_cast<int>(s.mode()))};
+  }
+  if (s.mode() == v1::JOB_MODE_NOOP) return {};
+  if (s.resolution() < 3 || s.resolution() > 1000) return sim::Error{"job: resolution outside 3..1000"};
+  if (s.orientations() < 1 || s.orientations() > 360) return sim::Error{"job: orientations outside 1..360"};
+  if (s.noise() != "kinect" && s.noise() != "none") return sim::Error{"job: noise must be kinect or none"};
+  if (s.max_iterations() < 1) return sim::Error{"job: max_iterations must be >= 1"};
+  if (!(s.tolerance() > 0) || !std::isfinite(s.tolerance())) return sim::Error{"job: tolerance must be > 0"};
+  if (s.max_self_intersections() < 0) return sim::Error{"job: max_self_intersections must be >= 0"};
+  if (s.coarse_start_resolution() < 0) return sim::Error{"job: coarse_start_resolution must be >= 0"};
+  if (sim::Status st = check_parameters(s.parameters()); !st) return st;
+  const auto& r = s.recipe();
+  if (r.sample() < 0 || r.slot() < 0) return sim::Error{"job: negative sample or slot"};
+  if (r.kind() != v1::Recipe::KIND_SINE && r.kind() != v1::Recipe::KIND_FOLD && r.kind() != v1::Recipe::KIND_DRAPE) {
+    return sim::Error{"job: unknown recipe kind"};
+  }
+  if (!std::isfinite(r.rotation()) || !std::isfinite(r.drift_x_mm()) || !std::isfinite(r.drift_y_mm())) {
+    return sim::Error{"job: non-finite recipe value"};
+  }
+  return {};
+}
+
+}  // namespace
+
+std::string encode(v1::Envelope envelope) {
+  envelope.set_protocol_version(kProtocolVersion);
+  std::string out;
+  envelope.SerializeToString(&out);
+  return out;
+}
+
+sim::Expected<v1::Envelope> decode(const void* data, std::size_t size) {
+  // Hostile input must not flood stderr: libprotobuf logs every invalid UTF-8 string it parses.
+  static std::once_flag quiet;
+  std::call_once(quiet, [] { google::protobuf::SetLogHandler(nullptr); });
+  if (size > kMaxFrameBytes) return sim::Error{fmt::format("frame of {} bytes is too large", size)};
+  v1::Envelope envelope;
+  if (!envelope.ParseFromArray(data, static_cast<int>(size))) return sim::Error{"frame is not a protocol envelope"};
+  if (envelope.protocol_version() != kProtocolVersion) {
+    return sim::Error{fmt::format("protocol version {} (this build speaks {})", envelope.protocol_version(),
+                                  kProtocolVersion)};
+  }
+  if (envelope.body_case() == v1::Envelope::BODY_NOT_SET) return sim::Error{"envelope without a body"};
+  if (sim::Status s = check(envelope); !s) return s.error();
+  return envelope;
+}
+
+sim::Status check(const v1::Envelope& e) {
+  switch (e.body_case()) {
+    case v1::Envelope::kReady:
+      if (e.ready().worker_name().size() > 256) return sim::Error{"ready: worker name too long"};
+      return {};
+    case v1::Envelope::kJob:
+      if (e.job().job_id() == 0) return sim::Error{"job: id 0"};
+      if (e.job().attempt() == 0) return sim::Error{"job: attempt 0"};
+      return check_spec(e.job().spec());
+    case v1::Envelope::kHeartbeat:
+      return {};
+    case v1::Envelope::kResult:
+      if (e.result().job_id() == 0) return sim::Error{"result: job id 0"};
+      if (e.result().attempt() == 0) return sim::Error{"result: attempt 0"};
+      return {};
+    case v1::Envelope::kFailure:
+      if (e.failure().job_id() == 0) return sim::Error{"failure: job id 0"};
+      if (e.failure().attempt() == 0) return sim::Error{"failure: attempt 0"};
+      if (e.failure().reason() == v1::FAILURE_REASON_UNSPECIFIED ||
+          !v1::FailureReason_IsValid(e.failure().reason())) {
+        return sim::Error{"failure: unknown reason"};
+      }
+      return {};
+    case v1::Envelope::kDisconnect:
+    case v1::Envelope::kShutdown:
+      return {};
+    case v1::Envelope::BODY_NOT_SET:
+      break;
+  }
+  return sim::Error{"envelope without a body"};
+}
+
+const char* body_name(const v1::Envelope& e) {
+  switch (e.body_case()) {
+    case v1::Envelope::kReady: return "ready";
+    case v1::Envelope::kJob: return "job";
+    case v1::Envelope::kHeartbeat: return "heartbeat";
+    case v1::Envelope::kResult: return "result";
+    case v1::Envelope::kFailure: return "failure";
+    case v1::Envelope::kDisconnect: return "disconnect";
+    case v1::Envelope::kShutdown: return "shutdown";
+    case v1::Envelope::BODY_NOT_SET: break;
+  }
+  return "none";
+}
+
+const char* reason_name(v1::FailureReason reason) {
+  switch (reason) {
+    case v1::FAILURE_REASON_NOT_CONVERGED: return "not_converged";
+    case v1::FAILURE_REASON_DIVERGED: return "diverged";
+    case v1::FAILURE_REASON_SELF_INTERSECTION: return "self_intersection";
+    case v1::FAILURE_REASON_RENDER_ERROR: return "render_error";
+    case v1::FAILURE_REASON_WORKER_LOST: return "worker_lost";
+    case v1::FAILURE_REASON_TIMEOUT: return "timeout";
+    case v1::FAILURE_REASON_INVALID_JOB: return "invalid_job";
+    default: break;
+  }
+  return "unspecified";
+}
+
+}  // namespace drapegen::proto

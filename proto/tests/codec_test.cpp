@@ -1,0 +1,85 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "drapegen/proto/codec.hpp"
+
+namespace drapegen::proto {
+namespace {
+
+v1::Envelope valid_job() {
+  v1::Envelope e;
+  auto* job = e.mutable_job();
+  job->set_job_id(7);
+  job->set_attempt(1);
+  job->set_lease_ms(1000);
+  auto* s = job->mutable_spec();
+  s->set_mode(v1::JOB_MODE_DRAPE);
+  s->set_resolution(15);
+  s->set_orientations(1);
+  s->set_noise("kinect");
+  s->set_max_iterations(100);
+  s->set_tolerance(1e-3);
+  auto* p = s->mutable_parameters();
+  p->set_alpha_warp(1e4);
+  p->set_alpha_bias(1e4);
+  p->set_alpha_weft(1e4);
+  p->set_density_g_per_m2(300);
+  s->mutable_recipe()->set_kind(v1::Recipe::KIND_SINE);
+  return e;
+}
+
+TEST(Codec, RoundTripsAJob) {
+  const std::string frame = encode(valid_job());
+  const auto decoded = decode(frame);
+  ASSERT_TRUE(decoded) << decoded.error().message;
+  EXPECT_EQ(decoded->protocol_version(), kProtocolVersion);
+  EXPECT_EQ(decoded->job().job_id(), 7u);
+  EXPECT_EQ(decoded->job().spec().resolution(), 15);
+  EXPECT_STREQ(body_name(*decoded), "job");
+}
+
+TEST(Codec, RejectsAnotherVersion) {
+  v1::Envelope e = valid_job();
+  e.set_protocol_version(2);
+  std::string frame;
+  e.SerializeToString(&frame);
+  const auto decoded = decode(frame);
+  ASSERT_FALSE(decoded);
+  EXPECT_NE(decoded.error().message.find("protocol version 2"), std::string::npos);
+  e.set_protocol_version(0);
+  e.SerializeToString(&frame);
+  EXPECT_FALSE(decode(frame));
+}
+
+TEST(Codec, RejectsGarbageTruncationAndEmptyBodies) {
+  EXPECT_FALSE(decode(std::string("\xff\xff\xff\xff garbage", 12)));
+  const std::string frame = encode(valid_job());
+  int rejected = 0;
+  for (std::size_t n = 0; n < frame.size(); ++n) rejected += !decode(frame.substr(0, n));
+  EXPECT_EQ(rejected, static_cast<int>(frame.size()));  // every strict prefix fails (parse, version or rules)
+  v1::Envelope empty;
+  EXPECT_FALSE(decode(encode(empty)));
+}
+
+TEST(Codec, ChecksFieldRules) {
+  v1::Envelope e = valid_job();
+  e.mutable_job()->mutable_spec()->mutable_parameters()->set_alpha_bias(std::nan(""));
+  EXPECT_FALSE(decode(encode(e)));
+  e = valid_job();
+  e.mutable_job()->mutable_spec()->set_resolution(2);
+  EXPECT_FALSE(decode(encode(e)));
+  e = valid_job();
+  e.mutable_job()->set_attempt(0);
+  EXPECT_FALSE(decode(encode(e)));
+  v1::Envelope f;
+  f.mutable_failure()->set_job_id(3);
+  f.mutable_failure()->set_attempt(1);
+  EXPECT_FALSE(decode(encode(f)));  // no reason
+  f.mutable_failure()->set_reason(v1::FAILURE_REASON_DIVERGED);
+  EXPECT_TRUE(decode(encode(f)));
+  EXPECT_STREQ(reason_name(v1::FAILURE_REASON_DIVERGED), "diverged");
+}
+
+}  // namespace
+}  // namespace drapegen::proto

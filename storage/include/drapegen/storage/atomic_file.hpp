@@ -1,0 +1,19 @@
+#pragma once
+// Crash-safe file writes: the bytes go to `path + ".tmp"`, are fsync'ed, and the file is renamed over `path`; the
+// directory is fsync'ed (sync_directory) before the manifest transaction that refers to the file commits. A crash
+// at any instant leaves either no file, a stray ".tmp" (removed on resume) or the complete file.
+
+#include <string>
+#include <string_view>
+
+#include "drapegen/sim/expected.hpp"
+
+namespace drapegen::storage {
+
+/// Writes `bytes` to `path` atomically (tmp, fsync, rename). Errors name the path and the OS error (e.g. "No space
+/// left on device", "Permission denied").
+[[nodiscard]] sim::Status write_file_atomic(const std::string& path, std::string_view bytes);
+/// fsync of a directory, so that renames into it are durable.
+[[nodiscard]] sim::Status sync_directory(const std::string& directory);
+
+}  // namespace drapegen::storage

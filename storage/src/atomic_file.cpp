@@ -1,0 +1,65 @@
+#include "drapegen/storage/atomic_file.hpp"
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <fcntl.h>
+#include <unistd.h>
+
+namespace drapegen::storage {
+namespace {
+
+sim::Error os_error(const std::string& what, const std::string& path) {
+  return sim::Error{what + " " + path + ": " + std::strerror(errno)};
+}
+
+}  // namespace
+
+sim::Status write_file_atomic(const std::string& path, std::string_view bytes) {
+  const std::string tmp = path + ".tmp";
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) return os_error("cannot create", tmp);
+  std::size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      sim::Error e = os_error("cannot write", tmp);
+      ::close(fd);
+      ::unlink(tmp.c_str());
+      return e;
+    }
+    done += static_cast<std::size_t>(n);
+  }
+  if (::fsync(fd) != 0) {
+    sim::Error e = os_error("cannot sync", tmp);
+    ::close(fd);
+    ::unlink(tmp.c_str());
+    return e;
+  }
+  if (::close(fd) != 0) {
+    sim::Error e = os_error("cannot close", tmp);
+    ::unlink(tmp.c_str());
+    return e;
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    sim::Error e = os_error("cannot rename to", path);
+    ::unlink(tmp.c_str());
+    return e;
+  }
+  return {};
+}
+
+sim::Status sync_directory(const std::string& directory) {
+  const int fd = ::open(directory.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) return os_error("cannot open directory", directory);
+  if (::fsync(fd) != 0) {
+    sim::Error e = os_error("cannot sync directory", directory);
+    ::close(fd);
+    return e;
+  }
+  ::close(fd);
+  return {};
+}
+
+}  // namespace drapegen::storage

@@ -1,0 +1,574 @@
+#include "drapegen/storage/manifest.hpp"
+
+#include <cerrno>
+#include <charconv>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include "drapegen/storage/atomic_file.hpp"
+#include "schema.hpp"
+#include "sqlite.hpp"
+
+namespace drapegen::storage {
+
+using detail::exec;
+using detail::Statement;
+
+std::string_view to_string(JobState state) {
+  switch (state) {
+    case JobState::kPending: return "pending";
+    case JobState::kDone: return "done";
+    case JobState::kFailed: return "failed";
+  }
+  return "pending";
+}
+
+std::optional<JobState> parse_job_state(std::string_view text) {
+  if (text == "pending") return JobState::kPending;
+  if (text == "done") return JobState::kDone;
+  if (text == "failed") return JobState::kFailed;
+  return std::nullopt;
+}
+
+namespace {
+
+std::string u64_text(std::uint64_t v) { return std::to_string(v); }
+std::uint64_t parse_u64(const std::string& s) {
+  std::uint64_t v = 0;
+  std::from_chars(s.data(), s.data() + s.size(), v);
+  return v;
+}
+
+sim::Status sqlite_error(sqlite3* db, const std::string& what) {
+  return sim::Error{fmt::format("manifest: {}: {}", what, db ? sqlite3_errmsg(db) : "out of memory")};
+}
+
+/// Connection settings of every connection (writer and readers).
+sim::Status configure(sqlite3* db, bool writer) {
+  sqlite3_busy_timeout(db, 10000);
+  if (sim::Status s = exec(db, "PRAGMA foreign_keys = ON"); !s) return s;
+  if (writer) {
+    if (sim::Status s = exec(db, "PRAGMA journal_mode = WAL"); !s) return s;
+    if (sim::Status s = exec(db, "PRAGMA synchronous = FULL"); !s) return s;
+  }
+  return {};
+}
+
+sim::Status check_schema(sqlite3* db, const std::string& path) {
+  Statement st(db, "SELECT value FROM meta WHERE key = 'schema_version'");
+  if (!st.ok()) return sim::Error{fmt::format("{} is not a drapegen manifest ({})", path, st.prepare_error())};
+  if (st.step() != SQLITE_ROW) return sim::Error{fmt::format("{} is not a drapegen manifest (no schema version)", path)};
+  const std::string version = st.text(0);
+  if (version != std::to_string(kSchemaVersion)) {
+    return sim::Error{fmt::format("{} has manifest schema version {}; this build reads version {}", path, version,
+                                  kSchemaVersion)};
+  }
+  return {};
+}
+
+sim::Expected<sqlite3*> open_db(const std::string& path, int flags) {
+  sqlite3* db = nullptr;
+  if (sqlite3_open_v2(path.c_str(), &db, flags | SQLITE_OPEN_NOMUTEX, nullptr) != SQLITE_OK) {
+    std::string message = db ? sqlite3_errmsg(db) : "out of memory";
+    sqlite3_close(db);
+    return sim::Error{fmt::format("cannot open manifest {}: {}", path, message)};
+  }
+  sqlite3_extended_result_codes(db, 1);
+  return db;
+}
+
+std::string directory_of(const std::string& path) {
+  auto dir = std::filesystem::path(path).parent_path();
+  return dir.empty() ? std::string(".") : dir.string();
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------------------------
+// Reader
+
+struct ManifestReader::Impl {
+  sqlite3* db = nullptr;
+  bool owns = false;
+  ~Impl() {
+    if (owns) sqlite3_close(db);
+  }
+};
+
+ManifestReader::ManifestReader(std::unique_ptr<Impl> impl, std::string directory)
+    : impl_(std::move(impl)), directory_(std::move(directory)) {}
+ManifestReader::ManifestReader(ManifestReader&&) noexcept = default;
+ManifestReader& ManifestReader::operator=(ManifestReader&&) noexcept = default;
+ManifestReader::~ManifestReader() = default;
+
+sim::Expected<ManifestReader> ManifestReader::open(const std::string& path) {
+  if (!std::filesystem::is_regular_file(path)) return sim::Error{fmt::format("no manifest at {}", path)};
+  auto db = open_db(path, SQLITE_OPEN_READONLY);
+  if (!db) return db.error();
+  auto impl = std::make_unique<Impl>();
+  impl->db = *db;
+  impl->owns = true;
+  if (sim::Status s = configure(impl->db, false); !s) return s.error();
+  if (sim::Status s = check_schema(impl->db, path); !s) return s.error();
+  return ManifestReader(std::move(impl), directory_of(path));
+}
+
+sim::Expected<RunRecord> ManifestReader::run() const {
+  Statement st(impl_->db,
+               "SELECT id, created_at, seed, config_toml, code_version, total_jobs, state, endpoint FROM runs "
+               "ORDER BY id LIMIT 1");
+  if (!st.ok()) return sim::Error{"manifest: " + st.prepare_error()};
+  if (st.step() != SQLITE_ROW) return sim::Error{"manifest: no run"};
+  RunRecord r;
+  r.id = st.int64(0);
+  r.created_at = st.real(1);
+  r.seed = parse_u64(st.text(2));
+  r.config_toml = st.text(3);
+  r.code_version = st.text(4);
+  r.total_jobs = st.int64(5);
+  r.state = st.text(6);
+  r.endpoint = st.text(7);
+  return r;
+}
+
+sim::Expected<std::vector<SampleRecord>> ManifestReader::samples() const {
+  Statement st(impl_->db,
+               "SELECT sample, alpha_warp, alpha_bias, alpha_weft, beta_warp, beta_bias, beta_weft, density "
+               "FROM samples ORDER BY sample");
+  if (!st.ok()) return sim::Error{"manifest: " + st.prepare_error()};
+  std::vector<SampleRecord> out;
+  int rc;
+  while ((rc = st.step()) == SQLITE_ROW) {
+    SampleRecord s;
+    s.sample = st.int64(0);
+    for (int i = 0; i < 3; ++i) {
+      s.alpha[i] = st.real(1 + i);
+      s.beta[i] = st.real(4 + i);
+    }
+    s.density_g_per_m2 = st.real(7);
+    out.push_back(s);
+  }
+  if (rc != SQLITE_DONE) return sqlite_error(impl_->db, "reading samples").error();
+  return out;
+}
+
+sim::Expected<std::vector<JobRecord>> ManifestReader::jobs() const {
+  Statement st(impl_->db,
+               "SELECT id, sample, slot, recipe, render_seed, mode, state, attempts, worker, failure_reason, "
+               "coalesce(started_at, 0), coalesce(finished_at, 0) FROM jobs ORDER BY id");
+  if (!st.ok()) return sim::Error{"manifest: " + st.prepare_error()};
+  std::vector<JobRecord> out;
+  int rc;
+  while ((rc = st.step()) == SQLITE_ROW) {
+    JobRecord j;
+    j.id = st.int64(0);
+    j.sample = st.int64(1);
+    j.slot = static_cast<int>(st.int64(2));
+    j.recipe_json = st.text(3);
+    j.render_seed = parse_u64(st.text(4));
+    j.mode = st.text(5);
+    j.state = parse_job_state(st.text(6)).value_or(JobState::kPending);
+    j.attempts = static_cast<int>(st.int64(7));
+    j.worker = st.text(8);
+    j.failure_reason = st.text(9);
+    j.started_at = st.real(10);
+    j.finished_at = st.real(11);
+    out.push_back(std::move(j));
+  }
+  if (rc != SQLITE_DONE) return sqlite_error(impl_->db, "reading jobs").error();
+  return out;
+}
+
+sim::Expected<std::vector<ResultRecord>> ManifestReader::results() const {
+  Statement st(impl_->db,
+               "SELECT job_id, outcome, iterations, coarse_iterations, residual, energy, drape_coefficient, folds, "
+               "self_intersections, sim_seconds, render_seconds, bytes FROM results ORDER BY job_id");
+  if (!st.ok()) return sim::Error{"manifest: " + st.prepare_error()};
+  std::vector<ResultRecord> out;
+  int rc;
+  while ((rc = st.step()) == SQLITE_ROW) {
+    ResultRecord r;
+    r.job_id = st.int64(0);
+    r.outcome = st.text(1);
+    r.iterations = static_cast<int>(st.int64(2));
+    r.coarse_iterations = static_cast<int>(st.int64(3));
+    r.residual = st.real(4);
+    r.energy = st.real(5);
+    r.drape_coefficient = st.real(6);
+    r.folds = static_cast<int>(st.int64(7));
+    r.self_intersections = static_cast<int>(st.int64(8));
+    r.sim_seconds = st.real(9);
+    r.render_seconds = st.real(10);
+    r.bytes = st.int64(11);
+    out.push_back(std::move(r));
+  }
+  if (rc != SQLITE_DONE) return sqlite_error(impl_->db, "reading results").error();
+  return out;
+}
+
+sim::Expected<std::vector<FileRecord>> ManifestReader::files() const {
+  Statement st(impl_->db, "SELECT job_id, kind, idx, path, sha256, bytes FROM files ORDER BY job_id, kind, idx");
+  if (!st.ok()) return sim::Error{"manifest: " + st.prepare_error()};
+  std::vector<FileRecord> out;
+  int rc;
+  while ((rc = st.step()) == SQLITE_ROW) {
+    FileRecord f;
+    f.job_id = st.int64(0);
+    f.kind = st.text(1);
+    f.index = static_cast<int>(st.int64(2));
+    f.path = st.text(3);
+    f.sha256 = st.text(4);
+    f.bytes = st.int64(5);
+    out.push_back(std::move(f));
+  }
+  if (rc != SQLITE_DONE) return sqlite_error(impl_->db, "reading files").error();
+  return out;
+}
+
+sim::Expected<std::vector<FailureRecord>> ManifestReader::failures() const {
+  Statement st(impl_->db, "SELECT job_id, attempt, reason, message, worker, at FROM failures ORDER BY id");
+  if (!st.ok()) return sim::Error{"manifest: " + st.prepare_error()};
+  std::vector<FailureRecord> out;
+  int rc;
+  while ((rc = st.step()) == SQLITE_ROW) {
+    FailureRecord f;
+    f.job_id = st.int64(0);
+    f.attempt = static_cast<int>(st.int64(1));
+    f.reason = st.text(2);
+    f.message = st.text(3);
+    f.worker = st.text(4);
+    f.at = st.real(5);
+    out.push_back(std::move(f));
+  }
+  if (rc != SQLITE_DONE) return sqlite_error(impl_->db, "reading failures").error();
+  return out;
+}
+
+sim::Expected<std::string> ManifestReader::integrity_check() const {
+  Statement st(impl_->db, "PRAGMA integrity_check");
+  if (!st.ok()) return sim::Error{"manifest: " + st.prepare_error()};
+  std::string out;
+  while (st.step() == SQLITE_ROW) {
+    if (!out.empty()) out += "; ";
+    out += st.text(0);
+  }
+  Statement fk(impl_->db, "PRAGMA foreign_key_check");
+  if (fk.ok() && fk.step() == SQLITE_ROW) out += "; foreign key violation in table " + fk.text(0);
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// Writer
+
+struct Manifest::Impl {
+  sqlite3* db = nullptr;
+  bool in_transaction = false;
+  Statement begin, commit, rollback, savepoint, release, rollback_to;
+  Statement job_done, insert_result, insert_file, job_failed, job_attempt, insert_failure, update_recipe;
+  Statement run_state, run_endpoint;
+
+  ~Impl() {
+    // Statements must be finalised before the connection closes.
+    for (Statement* st : {&begin, &commit, &rollback, &savepoint, &release, &rollback_to, &job_done, &insert_result,
+                          &insert_file, &job_failed, &job_attempt, &insert_failure, &update_recipe, &run_state,
+                          &run_endpoint}) {
+      *st = Statement();
+    }
+    sqlite3_close(db);
+  }
+
+  sim::Status prepare() {
+    struct Item {
+      Statement* st;
+      const char* sql;
+    };
+    const Item items[] = {
+        {&begin, "BEGIN IMMEDIATE"},
+        {&commit, "COMMIT"},
+        {&rollback, "ROLLBACK"},
+        {&savepoint, "SAVEPOINT record"},
+        {&release, "RELEASE record"},
+        {&rollback_to, "ROLLBACK TO record"},
+        {&job_done,
+         "UPDATE jobs SET state = 'done', attempts = ?2, worker = ?3, started_at = ?4, finished_at = ?5, "
+         "failure_reason = '' WHERE id = ?1 AND state = 'pending'"},
+        {&insert_result,
+         "INSERT INTO results (job_id, outcome, iterations, coarse_iterations, residual, energy, drape_coefficient, "
+         "folds, self_intersections, sim_seconds, render_seconds, bytes) "
+         "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12)"},
+        {&insert_file,
+         "INSERT INTO files (job_id, kind, idx, path, sha256, bytes) VALUES (?1, ?2, ?3, ?4, ?5, ?6)"},
+        {&job_failed,
+         "UPDATE jobs SET state = 'failed', attempts = ?2, worker = ?3, started_at = ?4, finished_at = ?5, "
+         "failure_reason = ?6 WHERE id = ?1 AND state = 'pending'"},
+        {&job_attempt, "UPDATE jobs SET attempts = ?2 WHERE id = ?1 AND state = 'pending'"},
+        {&insert_failure,
+         "INSERT INTO failures (job_id, attempt, reason, message, worker, at) VALUES (?1, ?2, ?3, ?4, ?5, ?6)"},
+        {&update_recipe, "UPDATE jobs SET recipe = ?2 WHERE id = ?1 AND state = 'pending'"},
+        {&run_state, "UPDATE runs SET state = ?1"},
+        {&run_endpoint, "UPDATE runs SET endpoint = ?1"},
+    };
+    for (const auto& item : items) {
+      *item.st = Statement(db, item.sql);
+      if (!item.st->ok()) return sim::Error{"manifest: " + item.st->prepare_error()};
+    }
+    return {};
+  }
+
+  /// Runs `body` inside a savepoint: all of it or none of it.
+  template <class F>
+  sim::Status atomically(F&& body) {
+    if (!in_transaction) return sim::Error{"manifest: write outside begin()/commit()"};
+    if (sim::Status s = savepoint.run(); !s) return s;
+    sim::Status s = body();
+    if (!s) {
+      (void)rollback_to.run();
+      (void)release.run();
+      return s;
+    }
+    return release.run();
+  }
+
+  sim::Status expect_one_change(const char* what, std::int64_t job_id) {
+    if (sqlite3_changes(db) != 1) {
+      return sim::Error{fmt::format("manifest: {} of job {}: the job is not pending", what, job_id)};
+    }
+    return {};
+  }
+};
+
+Manifest::Manifest(std::unique_ptr<Impl> impl, std::unique_ptr<ManifestReader> reader)
+    : impl_(std::move(impl)), reader_(std::move(reader)) {}
+Manifest::Manifest(Manifest&&) noexcept = default;
+Manifest& Manifest::operator=(Manifest&&) noexcept = default;
+Manifest::~Manifest() {
+  if (impl_ && impl_->in_transaction) rollback();
+  reader_.reset();
+}
+
+sim::Expected<Manifest> Manifest::create(const std::string& path, const RunRecord& run,
+                                         const std::vector<SampleRecord>& samples,
+                                         const std::vector<JobRecord>& jobs) {
+  if (std::filesystem::exists(path)) {
+    return sim::Error{fmt::format("{} exists already (use --resume to continue that run)", path)};
+  }
+  const std::string tmp = path + ".tmp";
+  for (const char* suffix : {"", "-wal", "-shm", "-journal"}) std::filesystem::remove(tmp + suffix);
+  {
+    auto opened = open_db(tmp, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE);
+    if (!opened) return opened.error();
+    sqlite3* db = *opened;
+    auto fail = [&](sim::Status s) -> sim::Expected<Manifest> {
+      sqlite3_close(db);
+      std::filesystem::remove(tmp);
+      return s.error();
+    };
+    // Build in rollback-journal mode with one fsync at the end, then switch to WAL for the run.
+    if (sim::Status s = exec(db, "PRAGMA foreign_keys = ON; PRAGMA synchronous = FULL; BEGIN"); !s) return fail(s);
+    if (sim::Status s = exec(db, detail::kSchemaSql); !s) return fail(s);
+    {
+      Statement meta(db, "INSERT INTO meta (key, value) VALUES (?1, ?2)");
+      if (sim::Status s = meta.reset().bind(1, "schema_version").bind(2, std::to_string(kSchemaVersion)).run(); !s) {
+        return fail(s);
+      }
+      if (sim::Status s = meta.reset().bind(1, "application").bind(2, "drapegen").run(); !s) return fail(s);
+      Statement st(db,
+                   "INSERT INTO runs (id, created_at, seed, config_toml, code_version, total_jobs, state, endpoint) "
+                   "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8)");
+      if (sim::Status s = st.bind(1, run.id)
+                              .bind(2, run.created_at)
+                              .bind(3, u64_text(run.seed))
+                              .bind(4, run.config_toml)
+                              .bind(5, run.code_version)
+                              .bind(6, static_cast<std::int64_t>(jobs.size()))
+                              .bind(7, run.state)
+                              .bind(8, run.endpoint)
+                              .run();
+          !s) {
+        return fail(s);
+      }
+      Statement ss(db,
+                   "INSERT INTO samples (run_id, sample, alpha_warp, alpha_bias, alpha_weft, beta_warp, beta_bias, "
+                   "beta_weft, density) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9)");
+      for (const auto& s : samples) {
+        ss.reset().bind(1, run.id).bind(2, s.sample);
+        for (int i = 0; i < 3; ++i) ss.bind(3 + i, s.alpha[i]).bind(6 + i, s.beta[i]);
+        if (sim::Status r = ss.bind(9, s.density_g_per_m2).run(); !r) return fail(r);
+      }
+      Statement js(db,
+                   "INSERT INTO jobs (id, run_id, sample, slot, recipe, render_seed, mode, state) "
+                   "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, 'pending')");
+      for (const auto& j : jobs) {
+        if (sim::Status r = js.reset()
+                                .bind(1, j.id)
+                                .bind(2, run.id)
+                                .bind(3, j.sample)
+                                .bind(4, j.slot)
+                                .bind(5, j.recipe_json)
+                                .bind(6, u64_text(j.render_seed))
+                                .bind(7, j.mode)
+                                .run();
+            !r) {
+          return fail(r);
+        }
+      }
+    }
+    if (sim::Status s = exec(db, "COMMIT"); !s) return fail(s);
+    if (sim::Status s = exec(db, "PRAGMA journal_mode = WAL"); !s) return fail(s);
+    sqlite3_close(db);  // the last connection: checkpoints and removes the -wal file
+  }
+  // Make the database durable under its temporary name, then publish it.
+  {
+    std::FILE* f = std::fopen(tmp.c_str(), "rb+");
+    if (!f) return sim::Error{fmt::format("cannot reopen {}: {}", tmp, std::strerror(errno))};
+    const bool synced = ::fsync(fileno(f)) == 0;
+    std::fclose(f);
+    if (!synced) return sim::Error{fmt::format("cannot sync {}: {}", tmp, std::strerror(errno))};
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) return sim::Error{fmt::format("cannot rename {} to {}: {}", tmp, path, ec.message())};
+  if (sim::Status s = sync_directory(directory_of(path)); !s) return s.error();
+  return open(path);
+}
+
+sim::Expected<Manifest> Manifest::open(const std::string& path) {
+  if (!std::filesystem::is_regular_file(path)) return sim::Error{fmt::format("no manifest at {}", path)};
+  auto db = open_db(path, SQLITE_OPEN_READWRITE);
+  if (!db) return db.error();
+  auto impl = std::make_unique<Impl>();
+  impl->db = *db;
+  if (sim::Status s = configure(impl->db, true); !s) return s.error();
+  if (sim::Status s = check_schema(impl->db, path); !s) return s.error();
+  if (sim::Status s = impl->prepare(); !s) return s.error();
+  auto reader_impl = std::make_unique<ManifestReader::Impl>();
+  reader_impl->db = impl->db;
+  reader_impl->owns = false;
+  auto reader = std::unique_ptr<ManifestReader>(new ManifestReader(std::move(reader_impl), directory_of(path)));
+  return Manifest(std::move(impl), std::move(reader));
+}
+
+sim::Status Manifest::begin() {
+  if (impl_->in_transaction) return {};
+  if (sim::Status s = impl_->begin.run(); !s) return s;
+  impl_->in_transaction = true;
+  return {};
+}
+
+sim::Status Manifest::commit() {
+  if (!impl_->in_transaction) return {};
+  sim::Status s = impl_->commit.run();
+  if (!s) {
+    rollback();
+    return s;
+  }
+  impl_->in_transaction = false;
+  return {};
+}
+
+void Manifest::rollback() {
+  if (!impl_->in_transaction) return;
+  (void)impl_->rollback.run();
+  impl_->in_transaction = false;
+}
+
+bool Manifest::in_transaction() const { return impl_->in_transaction; }
+
+sim::Status Manifest::record_result(const JobRecord& job, const ResultRecord& r, const std::vector<FileRecord>& files) {
+  return impl_->atomically([&]() -> sim::Status {
+    if (sim::Status s = impl_->job_done.reset()
+                            .bind(1, job.id)
+                            .bind(2, job.attempts)
+                            .bind(3, job.worker)
+                            .bind(4, job.started_at)
+                            .bind(5, job.finished_at)
+                            .run();
+        !s) {
+      return s;
+    }
+    if (sim::Status s = impl_->expect_one_change("result", job.id); !s) return s;
+    if (sim::Status s = impl_->insert_result.reset()
+                            .bind(1, job.id)
+                            .bind(2, r.outcome)
+                            .bind(3, r.iterations)
+                            .bind(4, r.coarse_iterations)
+                            .bind(5, r.residual)
+                            .bind(6, r.energy)
+                            .bind(7, r.drape_coefficient)
+                            .bind(8, r.folds)
+                            .bind(9, r.self_intersections)
+                            .bind(10, r.sim_seconds)
+                            .bind(11, r.render_seconds)
+                            .bind(12, r.bytes)
+                            .run();
+        !s) {
+      return s;
+    }
+    for (const auto& f : files) {
+      if (sim::Status s = impl_->insert_file.reset()
+                              .bind(1, job.id)
+                              .bind(2, f.kind)
+                              .bind(3, f.index)
+                              .bind(4, f.path)
+                              .bind(5, f.sha256)
+                              .bind(6, f.bytes)
+                              .run();
+          !s) {
+        return s;
+      }
+    }
+    return {};
+  });
+}
+
+sim::Status Manifest::record_failure(const JobRecord& job, const FailureRecord& f, bool final) {
+  return impl_->atomically([&]() -> sim::Status {
+    if (sim::Status s = impl_->insert_failure.reset()
+                            .bind(1, job.id)
+                            .bind(2, f.attempt)
+                            .bind(3, f.reason)
+                            .bind(4, f.message)
+                            .bind(5, f.worker)
+                            .bind(6, f.at)
+                            .run();
+        !s) {
+      return s;
+    }
+    if (final) {
+      if (sim::Status s = impl_->job_failed.reset()
+                              .bind(1, job.id)
+                              .bind(2, job.attempts)
+                              .bind(3, job.worker)
+                              .bind(4, job.started_at)
+                              .bind(5, job.finished_at)
+                              .bind(6, f.reason)
+                              .run();
+          !s) {
+        return s;
+      }
+    } else {
+      if (sim::Status s = impl_->job_attempt.reset().bind(1, job.id).bind(2, job.attempts).run(); !s) return s;
+    }
+    return impl_->expect_one_change("failure", job.id);
+  });
+}
+
+sim::Status Manifest::update_recipe(std::int64_t job_id, const std::string& recipe_json) {
+  return impl_->atomically([&]() -> sim::Status {
+    if (sim::Status s = impl_->update_recipe.reset().bind(1, job_id).bind(2, recipe_json).run(); !s) return s;
+    return impl_->expect_one_change("recipe update", job_id);
+  });
+}
+
+sim::Status Manifest::set_run_state(const std::string& state) {
+  return impl_->atomically([&] { return impl_->run_state.reset().bind(1, state).run(); });
+}
+
+sim::Status Manifest::set_endpoint(const std::string& endpoint) {
+  return impl_->atomically([&] { return impl_->run_endpoint.reset().bind(1, endpoint).run(); });
+}
+
+}  // namespace drapegen::storage

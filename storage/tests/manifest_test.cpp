@@ -1,0 +1,159 @@
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <sqlite3.h>
+
+#include "drapegen/storage/manifest.hpp"
+
+namespace drapegen::storage {
+namespace {
+
+class ManifestTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() /
+           ("drapegen_manifest_test_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    std::filesystem::remove_all(dir_);
+    std::filesystem::create_directories(dir_);
+    path_ = (dir_ / "manifest.sqlite").string();
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+
+  Manifest make(int jobs = 4) {
+    RunRecord run;
+    run.seed = ~0ULL;  // the largest seed survives the round trip
+    run.config_toml = "seed = 1\n";
+    run.code_version = "test";
+    std::vector<SampleRecord> samples(2);
+    samples[1].sample = 1;
+    samples[1].alpha = {1, 2, 3};
+    samples[1].beta = {-4, -5, -6};
+    std::vector<JobRecord> list;
+    for (int i = 0; i < jobs; ++i) {
+      JobRecord j;
+      j.id = i + 1;
+      j.sample = i % 2;
+      j.slot = i / 2;
+      j.recipe_json = "{}";
+      j.render_seed = 1000 + i;
+      list.push_back(j);
+    }
+    auto m = Manifest::create(path_, run, samples, list);
+    EXPECT_TRUE(m) << (m ? "" : m.error().message);
+    return std::move(m).value();
+  }
+
+  std::filesystem::path dir_;
+  std::string path_;
+};
+
+TEST_F(ManifestTest, CreatesThePlanAtomicallyAndReadsItBack) {
+  { auto m = make(); }
+  EXPECT_FALSE(std::filesystem::exists(path_ + ".tmp"));
+  auto reader = ManifestReader::open(path_);
+  ASSERT_TRUE(reader) << reader.error().message;
+  EXPECT_EQ(reader->run()->seed, ~0ULL);
+  EXPECT_EQ(reader->run()->total_jobs, 4);
+  EXPECT_EQ(reader->run()->state, "running");
+  ASSERT_EQ(reader->samples()->size(), 2u);
+  EXPECT_EQ((*reader->samples())[1].beta[2], -6);
+  ASSERT_EQ(reader->jobs()->size(), 4u);
+  EXPECT_EQ((*reader->jobs())[3].render_seed, 1003u);
+  EXPECT_EQ(*reader->integrity_check(), "ok");
+  // WAL and full sync on the writer's connection.
+  auto writer = Manifest::open(path_);
+  ASSERT_TRUE(writer);
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open(path_.c_str(), &db), SQLITE_OK);
+  sqlite3_stmt* st = nullptr;
+  sqlite3_prepare_v2(db, "PRAGMA journal_mode", -1, &st, nullptr);
+  ASSERT_EQ(sqlite3_step(st), SQLITE_ROW);
+  EXPECT_STREQ(reinterpret_cast<const char*>(sqlite3_column_text(st, 0)), "wal");
+  sqlite3_finalize(st);
+  sqlite3_close(db);
+  // A second create refuses to overwrite.
+  const auto again = Manifest::create(path_, RunRecord{}, {}, {});
+  ASSERT_FALSE(again);
+  EXPECT_NE(again.error().message.find("--resume"), std::string::npos);
+}
+
+TEST_F(ManifestTest, RecordsEachJobExactlyOnce) {
+  auto m = make();
+  JobRecord job;
+  job.id = 2;
+  job.attempts = 1;
+  job.worker = "w1";
+  ResultRecord r;
+  r.outcome = "converged";
+  r.drape_coefficient = 0.61;
+  std::vector<FileRecord> files{{0, "mesh", 0, "data/a.ply", "00", 10}, {0, "exr", 0, "data/a_o00.exr", "11", 20}};
+  ASSERT_TRUE(m.begin());
+  ASSERT_TRUE(m.record_result(job, r, files));
+  // The same job again fails, and leaves the first record whole.
+  const auto twice = m.record_result(job, r, {{0, "mesh", 0, "data/b.ply", "22", 5}});
+  EXPECT_FALSE(twice);
+  ASSERT_TRUE(m.commit());
+  EXPECT_EQ(m.reader().results()->size(), 1u);
+  EXPECT_EQ(m.reader().files()->size(), 2u);
+  EXPECT_EQ((*m.reader().jobs())[1].state, JobState::kDone);
+  // A failure of a done job is refused too.
+  FailureRecord f{2, 2, "diverged", "x", "w1", 0.0};
+  ASSERT_TRUE(m.begin());
+  EXPECT_FALSE(m.record_failure(job, f, true));
+  // Retried failures, then the final one.
+  JobRecord j3;
+  j3.id = 3;
+  j3.attempts = 1;
+  ASSERT_TRUE(m.record_failure(j3, {3, 1, "diverged", "nan", "w1", 1.0}, false));
+  j3.attempts = 2;
+  ASSERT_TRUE(m.record_failure(j3, {3, 2, "diverged", "nan", "w2", 2.0}, true));
+  // An unknown reason violates the schema.
+  JobRecord j4;
+  j4.id = 4;
+  EXPECT_FALSE(m.record_failure(j4, {4, 1, "bad_luck", "", "", 0.0}, false));
+  ASSERT_TRUE(m.commit());
+  EXPECT_EQ(m.reader().failures()->size(), 2u);
+  const auto jobs = *m.reader().jobs();
+  EXPECT_EQ(jobs[2].state, JobState::kFailed);
+  EXPECT_EQ(jobs[2].attempts, 2);
+  EXPECT_EQ(jobs[2].failure_reason, "diverged");
+  EXPECT_EQ(jobs[3].state, JobState::kPending);
+  EXPECT_EQ(*m.reader().integrity_check(), "ok");
+}
+
+TEST_F(ManifestTest, UncommittedGroupsVanish) {
+  {
+    auto m = make();
+    ASSERT_TRUE(m.begin());
+    JobRecord job;
+    job.id = 1;
+    ASSERT_TRUE(m.record_result(job, ResultRecord{}, {}));
+    // destroyed without commit (as in a crash)
+  }
+  auto reader = ManifestReader::open(path_);
+  ASSERT_TRUE(reader);
+  EXPECT_EQ(reader->results()->size(), 0u);
+  EXPECT_EQ((*reader->jobs())[0].state, JobState::kPending);
+}
+
+TEST_F(ManifestTest, RefusesForeignFilesAndOtherSchemaVersions) {
+  EXPECT_FALSE(ManifestReader::open((dir_ / "missing.sqlite").string()));
+  sqlite3* db = nullptr;
+  const std::string other = (dir_ / "other.sqlite").string();
+  ASSERT_EQ(sqlite3_open(other.c_str(), &db), SQLITE_OK);
+  sqlite3_exec(db, "CREATE TABLE t (x)", nullptr, nullptr, nullptr);
+  sqlite3_close(db);
+  auto foreign = ManifestReader::open(other);
+  ASSERT_FALSE(foreign);
+  EXPECT_NE(foreign.error().message.find("not a drapegen manifest"), std::string::npos);
+  { auto m = make(); }
+  ASSERT_EQ(sqlite3_open(path_.c_str(), &db), SQLITE_OK);
+  sqlite3_exec(db, "UPDATE meta SET value = '99' WHERE key = 'schema_version'", nullptr, nullptr, nullptr);
+  sqlite3_close(db);
+  auto newer = Manifest::open(path_);
+  ASSERT_FALSE(newer);
+  EXPECT_NE(newer.error().message.find("schema version 99"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace drapegen::storage
