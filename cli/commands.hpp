@@ -15,10 +15,15 @@ enum ExitCode : int {
   kExitUsage = 1,        // bad input: one line on stderr says why
   kExitNotConverged = 2, // the computation ran but did not reach its goal (the outcome says why)
   kExitIo = 3,           // an output could not be written
+  kExitStopped = 4,      // a run stopped by SIGINT/SIGTERM before it completed (continue with --resume)
 };
 
 Runner add_simulate_command(CLI::App& app);
 Runner add_cantilever_command(CLI::App& app);
 Runner add_render_command(CLI::App& app);
+Runner add_run_command(CLI::App& app);
+Runner add_worker_command(CLI::App& app);
+Runner add_local_command(CLI::App& app);
+Runner add_stats_command(CLI::App& app);
 
 }  // namespace drapegen::cli

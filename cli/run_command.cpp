@@ -1,0 +1,94 @@
+// drapegen run: the coordinator of a generation run (docs/SERVICE.md).
+#include <fmt/format.h>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include "commands.hpp"
+#include "drapegen/coordinator/coordinator.hpp"
+#include "signals.hpp"
+
+namespace drapegen::cli {
+namespace {
+
+struct RunOptions {
+  std::string config;
+  std::string resume;
+  std::string bind;
+  std::string progress = "auto";
+};
+
+int fail(const std::string& message, int code = kExitUsage) {
+  std::cerr << "drapegen run: error: " << message << "\n";
+  return code;
+}
+
+coordinator::CoordinatorOptions::Progress parse_progress(const std::string& p) {
+  using P = coordinator::CoordinatorOptions::Progress;
+  if (p == "terminal") return P::kTerminal;
+  if (p == "log") return P::kLog;
+  if (p == "off") return P::kOff;
+  return P::kAuto;
+}
+
+}  // namespace
+
+sim::Expected<std::string> read_text_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return sim::Error{"cannot read " + path};
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+int report_run(const coordinator::RunSummary& s, const std::string& manifest, const char* sub) {
+  switch (s.outcome) {
+    case coordinator::RunOutcome::kComplete:
+      std::cout << fmt::format("run complete: {} done, {} failed of {} jobs ({} recorded in {:.1f} s); manifest {}\n",
+                               s.done, s.failed, s.total, s.recorded_this_session, s.seconds, manifest);
+      return kExitOk;
+    case coordinator::RunOutcome::kStopped:
+      std::cerr << fmt::format("drapegen {}: stopped with {} done, {} failed of {} jobs; continue with: drapegen run "
+                               "--resume {}\n",
+                               sub, s.done, s.failed, s.total, manifest);
+      return kExitStopped;
+    case coordinator::RunOutcome::kStorageError:
+      std::cerr << fmt::format("drapegen {}: error: {} (stopped with {} of {} jobs recorded; fix it, then: drapegen "
+                               "run --resume {})\n",
+                               sub, s.message, s.done + s.failed, s.total, manifest);
+      return kExitIo;
+  }
+  return kExitUsage;
+}
+
+Runner add_run_command(CLI::App& app) {
+  auto o = std::make_shared<RunOptions>();
+  auto* config = app.add_option("--config", o->config, "Run configuration (TOML; keys in docs/SERVICE.md)");
+  auto* resume = app.add_option("--resume", o->resume, "Continue the run of this manifest (OUTPUT/manifest.sqlite)");
+  config->excludes(resume);
+  app.add_option("--bind", o->bind, "Bind this endpoint instead of the configured/recorded one, e.g. tcp://127.0.0.1:*");
+  app.add_option("--progress", o->progress, "Progress display: auto (terminal line if stderr is a TTY), terminal, log, off")
+      ->check(CLI::IsMember({"auto", "terminal", "log", "off"}))
+      ->capture_default_str();
+  return [o] {
+    if (o->config.empty() == o->resume.empty()) return fail("give --config RUN.toml or --resume MANIFEST");
+    const auto& stop = install_stop_signals();
+    coordinator::CoordinatorOptions options;
+    options.bind_override = o->bind;
+    options.progress = parse_progress(o->progress);
+    sim::Expected<std::unique_ptr<coordinator::Coordinator>> c = sim::Error{""};
+    if (!o->config.empty()) {
+      auto text = read_text_file(o->config);
+      if (!text) return fail(text.error().message);
+      c = coordinator::Coordinator::create(*text, o->config, options);
+    } else {
+      c = coordinator::Coordinator::resume(o->resume, options);
+    }
+    if (!c) return fail(c.error().message);
+    const auto summary = (*c)->run(stop);
+    return report_run(summary, (*c)->manifest_path(), "run");
+  };
+}
+
+}  // namespace drapegen::cli

@@ -1,0 +1,44 @@
+// drapegen worker: computes jobs for a coordinator (docs/SERVICE.md, "Worker").
+#include <cstdio>
+#include <cstdlib>
+#include <iostream>
+#include <memory>
+
+#include "commands.hpp"
+#include "drapegen/worker/worker.hpp"
+#include "signals.hpp"
+
+namespace drapegen::cli {
+
+Runner add_worker_command(CLI::App& app) {
+  auto o = std::make_shared<worker::WorkerOptions>();
+  app.add_option("--connect", o->endpoint, "The coordinator's endpoint, e.g. tcp://HOST:PORT")->required();
+  app.add_option("--name", o->name, "Name in logs and the manifest (default HOST:PID)");
+  app.add_option("--heartbeat-ms", o->heartbeat_ms, "Heartbeat interval, ms")
+      ->check(CLI::Range(10, 600000))
+      ->capture_default_str();
+  app.add_option("--liveness", o->liveness, "Reconnect after this many silent coordinator intervals")
+      ->check(CLI::Range(2, 1000))
+      ->capture_default_str();
+  app.add_option("--backoff-max-ms", o->backoff_max_ms, "Longest reconnect delay, ms (exponential back-off)")
+      ->check(CLI::Range(10, 3600000))
+      ->capture_default_str();
+  app.add_option("--give-up", o->give_up_s, "Exit with an error after this many seconds without a coordinator (0: never)")
+      ->check(CLI::Range(0.0, 1e9))
+      ->capture_default_str();
+  return [o]() -> int {
+    const auto& stop = install_stop_signals();
+    const sim::Status s = worker::run_worker(*o, stop);
+    int code = kExitOk;
+    if (!s) {
+      std::cerr << "drapegen worker: error: " << s.error().message << "\n";
+      code = kExitUsage;
+    }
+    // A computation still running cannot be interrupted: leave without waiting for it.
+    std::fflush(stdout);
+    std::fflush(stderr);
+    std::_Exit(code);
+  };
+}
+
+}  // namespace drapegen::cli

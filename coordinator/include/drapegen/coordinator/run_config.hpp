@@ -1,0 +1,53 @@
+#pragma once
+// The configuration of a generation run (a TOML file; every key is documented in docs/SERVICE.md, "Configuration").
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "drapegen/sim/expected.hpp"
+
+namespace drapegen::coordinator {
+
+struct RunConfig {
+  // What to generate.
+  std::uint64_t seed = 0;
+  int samples = 6000;            // parameter vectors
+  int states_per_sample = 8;     // initial states per vector
+  int orientations = 12;         // data points (specimen orientations, 4 views each) per drape
+  int resolution = 100;          // vertices per side of the 300 mm specimen
+  std::string noise = "kinect";  // kinect | none
+  double density = 300.0;        // g/m^2 the sampled moduli are simulated at
+  std::string output = "drapegen-run";  // output directory (manifest.sqlite, data/)
+  std::string model;             // VAE model file; empty: the one committed with the source
+  // [recipes]
+  double weight_sine = 1.0, weight_fold = 1.0, weight_drape = 1.0;
+  double max_drift_mm = 3.0;
+  // [solver]
+  int max_iterations = 400;
+  double tolerance = 1e-3;
+  int coarse_start_resolution = 25;
+  int max_self_intersections = 0;
+  // [network]
+  std::string bind = "tcp://127.0.0.1:5555";
+  int heartbeat_ms = 1000;
+  int liveness = 5;
+  double lease_s = 900.0;
+  // [retry]
+  int max_attempts = 3;
+  // [progress]
+  double progress_interval_s = 10.0;
+  // [testing]
+  std::string mode = "drape";    // drape | noop
+  std::vector<std::int64_t> poison_samples;  // these samples' jobs run in poison mode (diverge)
+};
+
+/// Parses and validates a TOML configuration. Unknown keys, wrong types and out-of-range values are errors that
+/// name the key, e.g. "run.toml: samples: must be between 1 and 10000000".
+[[nodiscard]] sim::Expected<RunConfig> parse_run_config(const std::string& toml_text, const std::string& source_name);
+
+/// The embedded default configuration of `drapegen local`: a small run with coarse meshes (about a minute on two
+/// cores with two workers).
+[[nodiscard]] const std::string& default_config_toml();
+
+}  // namespace drapegen::coordinator

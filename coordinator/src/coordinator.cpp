@@ -1,0 +1,797 @@
+#include "drapegen/coordinator/coordinator.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <deque>
+#include <filesystem>
+#include <fmt/format.h>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <unistd.h>
+#include <unordered_map>
+#include <unordered_set>
+#include <zmq.hpp>
+#include <zmq_addon.hpp>
+
+#include "drapegen/coordinator/logging.hpp"
+#include "drapegen/coordinator/planner.hpp"
+#include "drapegen/proto/codec.hpp"
+#include "drapegen/proto/recipe.hpp"
+#include "drapegen/storage/atomic_file.hpp"
+#include "drapegen/storage/manifest.hpp"
+#include "drapegen/storage/sha256.hpp"
+
+namespace drapegen::coordinator {
+namespace v1 = proto::v1;
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+double unix_now() {
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+std::string format_duration(double seconds) {
+  if (!(seconds >= 0.0) || seconds > 1e8) return "?";
+  const auto s = static_cast<long>(seconds + 0.5);
+  if (s >= 3600) return fmt::format("{}h{:02d}m", s / 3600, (s % 3600) / 60);
+  if (s >= 60) return fmt::format("{}m{:02d}s", s / 60, s % 60);
+  return fmt::format("{}s", s);
+}
+
+/// True for endpoints only this machine can reach.
+bool is_loopback(const std::string& endpoint) {
+  if (endpoint.rfind("ipc://", 0) == 0 || endpoint.rfind("inproc://", 0) == 0) return true;
+  const std::string rest = endpoint.substr(endpoint.find("://") + 3);
+  return rest.rfind("127.", 0) == 0 || rest.rfind("localhost:", 0) == 0 || rest.rfind("[::1]:", 0) == 0;
+}
+
+std::string printable(const std::string& identity) {
+  std::string out;
+  for (unsigned char c : identity) out += fmt::format("{:02x}", c);
+  return out;
+}
+
+}  // namespace
+
+struct Coordinator::Impl {
+  struct JobSlot {
+    storage::JobRecord rec;
+    int attempts = 0;  // attempts started, this session included
+    bool leased = false;
+    std::string worker;  // routing id of the lease
+    double lease_started = 0.0;
+    Clock::time_point deadline;
+    std::int64_t waiting_on = 0;  // source job of a drape recipe, while it is pending
+  };
+  struct Worker {
+    std::string identity;
+    std::string name;
+    Clock::time_point last_seen, last_sent;
+    int interval_ms = 1000;
+    int liveness = 5;
+    std::int64_t job = 0;        // leased job
+    std::int64_t stale_job = 0;  // a job whose lease expired while this worker computed it
+    std::int64_t completed = 0;
+  };
+
+  RunConfig config;
+  CoordinatorOptions options;
+  std::string manifest_path, out_dir, data_dir;
+  std::unique_ptr<storage::Manifest> manifest;
+  std::vector<storage::SampleRecord> samples;
+  std::vector<JobSlot> jobs;  // index = id - 1
+  std::set<std::int64_t> ready;
+  std::unordered_map<std::int64_t, std::vector<std::int64_t>> dependents;
+  std::map<std::string, Worker> workers;
+  std::int64_t done = 0, failed = 0;
+  std::int64_t recorded = 0, rejected = 0;
+  std::string storage_error;
+  bool files_written = false;
+
+  zmq::context_t context{1};
+  zmq::socket_t socket{context, zmq::socket_type::router};
+  std::string endpoint;
+
+  std::shared_ptr<spdlog::logger> log = logger();
+  bool terminal_progress = false;
+  Clock::time_point start = Clock::now(), last_progress = Clock::now(), last_reject_log{};
+  std::int64_t done_at_start = 0;
+
+  // ---------------------------------------------------------------------------------------------------------------
+  // Setup
+
+  sim::Status bind(const std::string& preferred, const std::string& fallback) {
+    socket.set(zmq::sockopt::linger, 0);
+    socket.set(zmq::sockopt::maxmsgsize, static_cast<int64_t>(proto::kMaxFrameBytes));
+    socket.set(zmq::sockopt::sndhwm, 0);
+    socket.set(zmq::sockopt::rcvhwm, 0);
+    std::string error;
+    for (const std::string& candidate : {preferred, fallback}) {
+      if (candidate.empty()) continue;
+      if (!is_loopback(candidate)) {
+        error = fmt::format(
+            "refusing to bind {}: binding a non-loopback address requires CurveZMQ authentication, which this build "
+            "does not have yet (use 127.0.0.1, or an SSH tunnel)",
+            candidate);
+        continue;
+      }
+      try {
+        socket.bind(candidate);
+        endpoint = socket.get(zmq::sockopt::last_endpoint);
+        return {};
+      } catch (const zmq::error_t& e) {
+        error = fmt::format("cannot bind {}: {}", candidate, e.what());
+        if (candidate != fallback && !fallback.empty()) log->warn("{}; binding {} instead", error, fallback);
+      }
+    }
+    return sim::Error{error};
+  }
+
+  sim::Status load_state() {
+    const auto& reader = manifest->reader();
+    auto s = reader.samples();
+    if (!s) return s.error();
+    samples = std::move(s).value();
+    auto j = reader.jobs();
+    if (!j) return j.error();
+    jobs.clear();
+    jobs.reserve(j->size());
+    for (auto& rec : *j) {
+      if (rec.id != static_cast<std::int64_t>(jobs.size()) + 1) return sim::Error{"manifest: job ids not contiguous"};
+      JobSlot slot;
+      slot.attempts = rec.attempts;
+      slot.rec = std::move(rec);
+      jobs.push_back(std::move(slot));
+    }
+    for (const auto& slot : jobs) {
+      if (slot.rec.sample < 0 || slot.rec.sample >= static_cast<std::int64_t>(samples.size()) ||
+          samples[static_cast<std::size_t>(slot.rec.sample)].sample != slot.rec.sample) {
+        return sim::Error{fmt::format("manifest: job {} refers to a missing sample", slot.rec.id)};
+      }
+    }
+    if (sim::Status st = manifest->begin(); !st) return st;
+    for (auto& slot : jobs) {
+      if (slot.rec.state == storage::JobState::kDone) ++done;
+      if (slot.rec.state == storage::JobState::kFailed) ++failed;
+      if (slot.rec.state != storage::JobState::kPending) continue;
+      auto recipe = sampler::recipe_from_json(nlohmann::json::parse(slot.rec.recipe_json, nullptr, false));
+      if (!recipe) return sim::Error{fmt::format("manifest: job {}: {}", slot.rec.id, recipe.error().message)};
+      if (recipe->kind == sampler::RecipeKind::kDrape) {
+        const std::int64_t source = job_id(config, recipe->source.sample, recipe->source.slot);
+        if (source < 1 || source > static_cast<std::int64_t>(jobs.size())) {
+          return sim::Error{fmt::format("manifest: job {} has an unknown source drape", slot.rec.id)};
+        }
+        const auto state = jobs[static_cast<std::size_t>(source - 1)].rec.state;
+        if (state == storage::JobState::kPending) {
+          slot.waiting_on = source;
+          dependents[source].push_back(slot.rec.id);
+          continue;
+        }
+        if (state == storage::JobState::kFailed) {
+          if (sim::Status st = fall_back(slot); !st) return st;
+        }
+      }
+      ready.insert(slot.rec.id);
+    }
+    if (sim::Status st = manifest->set_run_state("running"); !st) return st;
+    if (sim::Status st = manifest->set_endpoint(endpoint); !st) return st;
+    if (sim::Status st = manifest->commit(); !st) return st;
+    done_at_start = done;
+    return {};
+  }
+
+  /// Removes files in data/ that the manifest does not list (results of a transaction that never committed) and
+  /// stray temporary files.
+  sim::Status remove_orphans() {
+    auto files = manifest->reader().files();
+    if (!files) return files.error();
+    std::unordered_set<std::string> known;
+    for (const auto& f : *files) known.insert(fs::path(f.path).filename().string());
+    int removed = 0;
+    std::error_code ec;
+    for (const auto& entry : fs::directory_iterator(data_dir, ec)) {
+      if (!entry.is_regular_file()) continue;
+      if (known.count(entry.path().filename().string())) continue;
+      fs::remove(entry.path(), ec);
+      if (ec) return sim::Error{fmt::format("cannot remove {}: {}", entry.path().string(), ec.message())};
+      ++removed;
+    }
+    if (ec) return sim::Error{fmt::format("cannot list {}: {}", data_dir, ec.message())};
+    if (removed > 0) log->info("removed {} file(s) of results that were never recorded", removed);
+    return {};
+  }
+
+  // ---------------------------------------------------------------------------------------------------------------
+  // Messages
+
+  void send(const std::string& identity, v1::Envelope envelope) {
+    const std::string frame = proto::encode(std::move(envelope));
+    try {
+      socket.send(zmq::buffer(identity), zmq::send_flags::sndmore);
+      socket.send(zmq::buffer(frame), zmq::send_flags::none);
+    } catch (const zmq::error_t& e) {
+      log->warn("cannot send to worker {}: {}", printable(identity), e.what());
+    }
+    if (auto it = workers.find(identity); it != workers.end()) it->second.last_sent = Clock::now();
+  }
+
+  void send_heartbeat(Worker& w) {
+    v1::Envelope e;
+    e.mutable_heartbeat()->set_interval_ms(static_cast<std::uint32_t>(config.heartbeat_ms));
+    e.mutable_heartbeat()->set_liveness(static_cast<std::uint32_t>(config.liveness));
+    send(w.identity, std::move(e));
+  }
+
+  void reject(const std::string& identity, const std::string& why) {
+    ++rejected;
+    const auto now = Clock::now();
+    if (now - last_reject_log > std::chrono::seconds(1)) {  // one line a second at most, whatever a peer sends
+      log->warn("dropped a message from {}: {} ({} dropped so far)", printable(identity), why, rejected);
+      last_reject_log = now;
+    }
+  }
+
+  void handle(const std::string& identity, const zmq::message_t& frame) {
+    auto decoded = proto::decode(frame.data(), frame.size());
+    if (!decoded) return reject(identity, decoded.error().message);
+    const v1::Envelope& e = *decoded;
+    auto it = workers.find(identity);
+    if (e.body_case() == v1::Envelope::kReady) {
+      if (it != workers.end()) {
+        // A known worker starting over: whatever it held is lost.
+        lose_worker(it->second, "worker re-registered");
+        workers.erase(it);
+      }
+      Worker w;
+      w.identity = identity;
+      w.name = e.ready().worker_name().empty() ? printable(identity) : e.ready().worker_name();
+      w.last_seen = w.last_sent = Clock::now();
+      if (e.ready().interval_ms() > 0) w.interval_ms = static_cast<int>(e.ready().interval_ms());
+      log->info("worker {} joined ({} connected)", w.name, workers.size() + 1);
+      workers.emplace(identity, std::move(w));
+      send_heartbeat(workers.at(identity));
+      return;
+    }
+    if (it == workers.end()) {
+      if (e.body_case() == v1::Envelope::kResult || e.body_case() == v1::Envelope::kFailure) {
+        reject(identity, fmt::format("{} from an unregistered worker", proto::body_name(e)));
+      }
+      if (e.body_case() != v1::Envelope::kDisconnect && e.body_case() != v1::Envelope::kShutdown) {
+        v1::Envelope d;
+        d.mutable_disconnect()->set_reason("unknown worker: send ready");
+        send(identity, std::move(d));
+      }
+      return;
+    }
+    Worker& w = it->second;
+    w.last_seen = Clock::now();
+    switch (e.body_case()) {
+      case v1::Envelope::kHeartbeat:
+        if (e.heartbeat().interval_ms() > 0) w.interval_ms = static_cast<int>(e.heartbeat().interval_ms());
+        if (e.heartbeat().liveness() > 0) w.liveness = static_cast<int>(e.heartbeat().liveness());
+        return;
+      case v1::Envelope::kResult:
+        return on_result(w, e.result());
+      case v1::Envelope::kFailure:
+        return on_failure(w, e.failure());
+      default:
+        return reject(identity, fmt::format("unexpected {} from a worker", proto::body_name(e)));
+    }
+  }
+
+  /// The slot of the attempt `(job_id, attempt)` if `w` holds its lease; otherwise the message is stale or forged.
+  JobSlot* leased_slot(Worker& w, std::uint64_t id, std::uint32_t attempt, const char* what) {
+    if (w.stale_job != 0 && static_cast<std::uint64_t>(w.stale_job) == id) {
+      w.stale_job = 0;  // the late answer of an expired lease: the worker is free again
+      reject(w.identity, fmt::format("{} for job {} after its lease expired", what, id));
+      return nullptr;
+    }
+    if (id == 0 || id > jobs.size()) {
+      reject(w.identity, fmt::format("{} for unknown job {}", what, id));
+      return nullptr;
+    }
+    JobSlot& slot = jobs[id - 1];
+    if (w.job != static_cast<std::int64_t>(id) || !slot.leased || slot.worker != w.identity ||
+        static_cast<std::uint32_t>(slot.attempts) != attempt) {
+      reject(w.identity, fmt::format("{} for job {} attempt {}, which this worker does not hold (job state {})", what,
+                                     id, attempt, storage::to_string(slot.rec.state)));
+      return nullptr;
+    }
+    return &slot;
+  }
+
+  std::string file_name(const JobSlot& slot, const char* suffix) const {
+    return fmt::format("s{:06d}_k{:02d}{}", slot.rec.sample, slot.rec.slot, suffix);
+  }
+
+  void on_result(Worker& w, const v1::Result& r) {
+    JobSlot* slot = leased_slot(w, r.job_id(), r.attempt(), "result");
+    if (!slot) return;
+    const bool noop = slot->rec.mode == "noop";
+    if (!noop && (r.mesh_ply().empty() || r.exr_size() != config.orientations)) {
+      v1::Failure f;
+      f.set_job_id(r.job_id());
+      f.set_attempt(r.attempt());
+      f.set_reason(v1::FAILURE_REASON_RENDER_ERROR);
+      f.set_message(fmt::format("incomplete result: {} mesh bytes, {} of {} EXR files", r.mesh_ply().size(),
+                                r.exr_size(), config.orientations));
+      return on_failure(w, f);
+    }
+    // Files first (temporary file, fsync, rename); the directory is synced before the manifest commits.
+    std::vector<storage::FileRecord> files;
+    std::int64_t bytes = 0;
+    auto write = [&](const std::string& name, const std::string& data, const char* kind, int index) {
+      if (sim::Status s = storage::write_file_atomic(data_dir + "/" + name, data); !s) {
+        storage_error = s.error().message;
+        return false;
+      }
+      files.push_back({slot->rec.id, kind, index, "data/" + name, storage::sha256_hex(data),
+                       static_cast<std::int64_t>(data.size())});
+      bytes += static_cast<std::int64_t>(data.size());
+      return true;
+    };
+    if (!noop) {
+      if (!write(file_name(*slot, ".ply"), r.mesh_ply(), "mesh", 0)) return;
+      for (int k = 0; k < r.exr_size(); ++k) {
+        if (!write(file_name(*slot, fmt::format("_o{:02d}.exr", k).c_str()), r.exr(k), "exr", k)) return;
+      }
+      files_written = true;
+    }
+    const auto& m = r.metrics();
+    storage::ResultRecord result;
+    result.job_id = slot->rec.id;
+    result.outcome = m.outcome();
+    result.iterations = m.iterations();
+    result.coarse_iterations = m.coarse_iterations();
+    result.residual = m.residual();
+    result.energy = m.energy();
+    result.drape_coefficient = m.drape_coefficient();
+    result.folds = m.folds();
+    result.self_intersections = m.self_intersections();
+    result.sim_seconds = m.sim_seconds();
+    result.render_seconds = m.render_seconds();
+    result.bytes = bytes;
+    storage::JobRecord rec = slot->rec;
+    rec.attempts = slot->attempts;
+    rec.worker = w.name;
+    rec.started_at = slot->lease_started;
+    rec.finished_at = unix_now();
+    if (sim::Status s = manifest->begin(); !s) {
+      storage_error = s.error().message;
+      return;
+    }
+    if (sim::Status s = manifest->record_result(rec, result, files); !s) {
+      storage_error = s.error().message;
+      return;
+    }
+    rec.state = storage::JobState::kDone;
+    slot->rec = rec;
+    slot->leased = false;
+    slot->worker.clear();
+    w.job = 0;
+    ++w.completed;
+    ++done;
+    ++recorded;
+    release_dependents(slot->rec.id, true);
+  }
+
+  void on_failure(Worker& w, const v1::Failure& f) {
+    JobSlot* slot = leased_slot(w, f.job_id(), f.attempt(), "failure");
+    if (!slot) return;
+    w.job = 0;
+    record_failed_attempt(*slot, f.reason(), f.message(), w.name);
+  }
+
+  /// Records a failed attempt; re-queues the job or, at the retry limit, fails it.
+  void record_failed_attempt(JobSlot& slot, v1::FailureReason reason, const std::string& message,
+                             const std::string& worker_name) {
+    slot.leased = false;
+    slot.worker.clear();
+    const bool final = slot.attempts >= config.max_attempts;
+    storage::JobRecord rec = slot.rec;
+    rec.attempts = slot.attempts;
+    rec.worker = worker_name;
+    rec.started_at = slot.lease_started;
+    rec.finished_at = unix_now();
+    storage::FailureRecord failure{rec.id, slot.attempts, proto::reason_name(reason), message, worker_name,
+                                   rec.finished_at};
+    if (sim::Status s = manifest->begin(); !s) {
+      storage_error = s.error().message;
+      return;
+    }
+    if (sim::Status s = manifest->record_failure(rec, failure, final); !s) {
+      storage_error = s.error().message;
+      return;
+    }
+    ++recorded;
+    if (final) {
+      rec.state = storage::JobState::kFailed;
+      rec.failure_reason = failure.reason;
+      slot.rec = rec;
+      ++failed;
+      log->warn("job {} (sample {} slot {}) failed after {} attempt(s): {}: {}", rec.id, rec.sample, rec.slot,
+                slot.attempts, failure.reason, message);
+      release_dependents(rec.id, false);
+    } else {
+      slot.rec.attempts = slot.attempts;
+      log->info("job {} attempt {} failed ({}: {}); re-queued", rec.id, slot.attempts, failure.reason, message);
+      ready.insert(rec.id);
+    }
+  }
+
+  /// A kDrape job whose source failed starts from its fallback recipe instead (recorded in the manifest).
+  sim::Status fall_back(JobSlot& slot) {
+    const auto recipe = fallback_recipe(config, slot.rec.sample, slot.rec.slot);
+    slot.rec.recipe_json = sampler::to_json(recipe).dump();
+    log->info("job {}: its source drape failed; falling back to a {} recipe", slot.rec.id,
+              sampler::to_string(recipe.kind));
+    return manifest->update_recipe(slot.rec.id, slot.rec.recipe_json);
+  }
+
+  void release_dependents(std::int64_t source, bool source_done) {
+    auto it = dependents.find(source);
+    if (it == dependents.end()) return;
+    for (std::int64_t id : it->second) {
+      JobSlot& slot = jobs[static_cast<std::size_t>(id - 1)];
+      slot.waiting_on = 0;
+      if (!source_done) {
+        if (sim::Status s = fall_back(slot); !s) {
+          storage_error = s.error().message;
+          return;
+        }
+      }
+      ready.insert(id);
+    }
+    dependents.erase(it);
+  }
+
+  void lose_worker(Worker& w, const char* why) {
+    if (w.job != 0) {
+      JobSlot& slot = jobs[static_cast<std::size_t>(w.job - 1)];
+      w.job = 0;
+      record_failed_attempt(slot, v1::FAILURE_REASON_WORKER_LOST, fmt::format("{}: {}", w.name, why), w.name);
+    }
+  }
+
+  // ---------------------------------------------------------------------------------------------------------------
+  // Dispatch and timers
+
+  sim::Expected<v1::Envelope> make_job(JobSlot& slot) {
+    v1::Envelope e;
+    auto* job = e.mutable_job();
+    job->set_job_id(static_cast<std::uint64_t>(slot.rec.id));
+    job->set_attempt(static_cast<std::uint32_t>(slot.attempts));
+    job->set_lease_ms(static_cast<std::uint64_t>(config.lease_s * 1000.0));
+    auto* spec = job->mutable_spec();
+    spec->set_mode(slot.rec.mode == "noop"     ? v1::JOB_MODE_NOOP
+                   : slot.rec.mode == "poison" ? v1::JOB_MODE_POISON
+                                               : v1::JOB_MODE_DRAPE);
+    const auto& s = samples[static_cast<std::size_t>(slot.rec.sample)];
+    auto* p = spec->mutable_parameters();
+    p->set_alpha_warp(s.alpha[0]);
+    p->set_alpha_bias(s.alpha[1]);
+    p->set_alpha_weft(s.alpha[2]);
+    p->set_beta_warp(s.beta[0]);
+    p->set_beta_bias(s.beta[1]);
+    p->set_beta_weft(s.beta[2]);
+    p->set_density_g_per_m2(s.density_g_per_m2);
+    auto recipe = sampler::recipe_from_json(nlohmann::json::parse(slot.rec.recipe_json, nullptr, false));
+    if (!recipe) return sim::Error{fmt::format("job {}: {}", slot.rec.id, recipe.error().message)};
+    *spec->mutable_recipe() = proto::to_proto(*recipe);
+    spec->set_resolution(config.resolution);
+    spec->set_orientations(config.orientations);
+    spec->set_noise(config.noise);
+    spec->set_render_seed(slot.rec.render_seed);
+    spec->set_max_iterations(config.max_iterations);
+    spec->set_tolerance(config.tolerance);
+    spec->set_max_self_intersections(config.max_self_intersections);
+    spec->set_coarse_start_resolution(config.coarse_start_resolution);
+    if (recipe->kind == sampler::RecipeKind::kDrape && slot.rec.mode != "noop") {
+      const JobSlot& source = jobs[static_cast<std::size_t>(job_id(config, recipe->source.sample,
+                                                                    recipe->source.slot) - 1)];
+      const std::string path = data_dir + "/" + file_name(source, ".ply");
+      std::ifstream in(path, std::ios::binary);
+      std::ostringstream bytes;
+      bytes << in.rdbuf();
+      if (!in || bytes.str().empty()) return sim::Error{fmt::format("cannot read the source drape {}", path)};
+      job->set_source_mesh(bytes.str());
+    }
+    return e;
+  }
+
+  void dispatch() {
+    if (ready.empty()) return;
+    for (auto& [identity, w] : workers) {
+      if (ready.empty()) return;
+      if (w.job != 0 || w.stale_job != 0) continue;
+      const std::int64_t id = *ready.begin();
+      ready.erase(ready.begin());
+      JobSlot& slot = jobs[static_cast<std::size_t>(id - 1)];
+      ++slot.attempts;
+      auto job = make_job(slot);
+      if (!job) {
+        storage_error = job.error().message;
+        return;
+      }
+      slot.leased = true;
+      slot.worker = identity;
+      slot.lease_started = unix_now();
+      slot.deadline = Clock::now() + std::chrono::milliseconds(static_cast<long>(config.lease_s * 1000.0));
+      w.job = id;
+      send(identity, std::move(job).value());
+    }
+  }
+
+  void timers() {
+    const auto now = Clock::now();
+    for (auto it = workers.begin(); it != workers.end();) {
+      Worker& w = it->second;
+      const auto silence = std::chrono::milliseconds(static_cast<long>(w.interval_ms) * config.liveness);
+      if (now - w.last_seen > silence) {
+        log->warn("worker {} lost (silent for {} ms)", w.name,
+                  std::chrono::duration_cast<std::chrono::milliseconds>(now - w.last_seen).count());
+        lose_worker(w, "silent beyond its liveness");
+        it = workers.erase(it);
+        continue;
+      }
+      if (w.job != 0) {
+        JobSlot& slot = jobs[static_cast<std::size_t>(w.job - 1)];
+        if (now > slot.deadline) {
+          const std::int64_t id = w.job;
+          w.job = 0;
+          w.stale_job = id;
+          record_failed_attempt(slot, v1::FAILURE_REASON_TIMEOUT,
+                                fmt::format("no result within the lease of {} s", config.lease_s), w.name);
+        }
+      }
+      if (now - w.last_sent >= std::chrono::milliseconds(config.heartbeat_ms)) send_heartbeat(w);
+      ++it;
+    }
+  }
+
+  void progress(bool force) {
+    if (options.progress == CoordinatorOptions::Progress::kOff) return;
+    const auto now = Clock::now();
+    const double interval = terminal_progress ? 0.5 : config.progress_interval_s;
+    if (!force && std::chrono::duration<double>(now - last_progress).count() < interval) return;
+    last_progress = now;
+    const double elapsed = std::chrono::duration<double>(now - start).count();
+    const std::int64_t total = static_cast<std::int64_t>(jobs.size());
+    const double rate = elapsed > 0 ? static_cast<double>(done + failed - done_at_start) / elapsed : 0.0;
+    const std::int64_t left = total - done - failed;
+    const std::string eta = rate > 0 ? format_duration(static_cast<double>(left) / rate) : "?";
+    const std::string line =
+        fmt::format("{}/{} done, {} failed, {:.2f} jobs/s, ETA {}, {} worker(s), {} in flight", done, total, failed,
+                    rate, eta, workers.size(),
+                    std::count_if(workers.begin(), workers.end(), [](const auto& w) { return w.second.job != 0; }));
+    if (terminal_progress) {
+      std::fprintf(stderr, "\r\033[K%s", line.c_str());
+      std::fflush(stderr);
+    } else {
+      log->info("progress: {}", line);
+    }
+  }
+
+  /// Files of this pass are durable (directory synced) before the manifest commits them.
+  void commit() {
+    if (!manifest->in_transaction()) return;
+    if (files_written) {
+      if (sim::Status s = storage::sync_directory(data_dir); !s) {
+        storage_error = s.error().message;
+        manifest->rollback();
+        return;
+      }
+      files_written = false;
+    }
+    if (sim::Status s = manifest->commit(); !s) storage_error = s.error().message;
+  }
+
+  void shutdown_workers(const std::string& reason) {
+    for (auto& [identity, w] : workers) {
+      v1::Envelope e;
+      e.mutable_shutdown()->set_reason(reason);
+      send(identity, std::move(e));
+    }
+    // Answer late or reconnecting workers with Shutdown for a moment too.
+    const auto until = Clock::now() + std::chrono::milliseconds(options.shutdown_linger_ms);
+    while (Clock::now() < until) {
+      zmq::pollitem_t item{socket.handle(), 0, ZMQ_POLLIN, 0};
+      try {
+        zmq::poll(&item, 1, std::chrono::milliseconds(50));
+      } catch (const zmq::error_t&) {
+        break;
+      }
+      if (!(item.revents & ZMQ_POLLIN)) continue;
+      std::vector<zmq::message_t> frames;
+      if (!zmq::recv_multipart(socket, std::back_inserter(frames), zmq::recv_flags::dontwait)) continue;
+      if (frames.empty()) continue;
+      v1::Envelope e;
+      e.mutable_shutdown()->set_reason(reason);
+      send(frames[0].to_string(), std::move(e));
+    }
+  }
+
+  RunSummary summary(RunOutcome outcome) {
+    RunSummary s;
+    s.outcome = outcome;
+    s.message = storage_error;
+    s.total = static_cast<std::int64_t>(jobs.size());
+    s.done = done;
+    s.failed = failed;
+    s.recorded_this_session = recorded;
+    s.rejected_messages = rejected;
+    s.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    return s;
+  }
+
+  RunSummary loop(const std::atomic<bool>& stop) {
+    start = last_progress = Clock::now();
+    progress(true);
+    const auto total = static_cast<std::int64_t>(jobs.size());
+    std::vector<zmq::message_t> frames;
+    while (true) {
+      if (!storage_error.empty()) break;
+      if (done + failed == total) break;
+      if (stop.load()) break;
+      dispatch();
+      if (!storage_error.empty()) break;
+      zmq::pollitem_t item{socket.handle(), 0, ZMQ_POLLIN, 0};
+      try {
+        zmq::poll(&item, 1, std::chrono::milliseconds(std::min(config.heartbeat_ms, 100)));
+      } catch (const zmq::error_t& e) {
+        if (e.num() != EINTR) throw;
+        continue;  // a signal: the loop condition sees the stop flag
+      }
+      if (item.revents & ZMQ_POLLIN) {
+        // Drain what has arrived (up to a bound), then commit once: group commit.
+        for (int n = 0; n < 1024 && storage_error.empty(); ++n) {
+          frames.clear();
+          std::optional<std::size_t> got;
+          try {
+            got = zmq::recv_multipart(socket, std::back_inserter(frames), zmq::recv_flags::dontwait);
+          } catch (const zmq::error_t& e) {
+            if (e.num() == EINTR) break;
+            throw;
+          }
+          if (!got) break;
+          if (frames.size() != 2) {
+            reject(frames.empty() ? std::string() : frames[0].to_string(),
+                   fmt::format("{} frames (expected one after the routing id)", frames.size() - 1));
+            continue;
+          }
+          handle(frames[0].to_string(), frames[1]);
+          if (done + failed == total) break;
+          if (n % 64 == 63) dispatch();  // keep workers busy during a long drain
+        }
+      }
+      timers();
+      commit();
+      progress(false);
+    }
+    RunOutcome outcome = RunOutcome::kComplete;
+    std::string reason = "the run is complete";
+    if (!storage_error.empty()) {
+      outcome = RunOutcome::kStorageError;
+      reason = "the coordinator stopped on a storage error";
+      manifest->rollback();
+      // Best effort: the manifest may be on the failing disk too.
+      if (manifest->begin() && manifest->set_run_state("stopped")) (void)manifest->commit();
+    } else if (done + failed < total) {
+      outcome = RunOutcome::kStopped;
+      reason = "the coordinator was stopped";
+      commit();
+      if (manifest->begin() && manifest->set_run_state("stopped")) commit();
+    } else {
+      commit();
+      if (manifest->begin() && manifest->set_run_state("complete")) commit();
+    }
+    if (!storage_error.empty() && outcome != RunOutcome::kStorageError) outcome = RunOutcome::kStorageError;
+    progress(true);
+    if (terminal_progress) std::fprintf(stderr, "\n");
+    shutdown_workers(reason);
+    return summary(outcome);
+  }
+};
+
+Coordinator::Coordinator(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+Coordinator::~Coordinator() = default;
+
+namespace {
+
+void setup_progress(Coordinator::Impl& impl) {
+  using P = CoordinatorOptions::Progress;
+  impl.terminal_progress = impl.options.progress == P::kTerminal ||
+                           (impl.options.progress == P::kAuto && ::isatty(STDERR_FILENO) == 1);
+  if (impl.terminal_progress) set_terminal_pattern(true);
+}
+
+}  // namespace
+
+sim::Expected<std::unique_ptr<Coordinator>> Coordinator::create(const std::string& config_text,
+                                                                const std::string& config_name,
+                                                                const CoordinatorOptions& options) {
+  auto config = parse_run_config(config_text, config_name);
+  if (!config) return config.error();
+  auto impl = std::make_unique<Impl>();
+  impl->config = *config;
+  impl->options = options;
+  setup_progress(*impl);
+  impl->out_dir = config->output;
+  impl->data_dir = config->output + "/data";
+  impl->manifest_path = config->output + "/manifest.sqlite";
+  if (fs::exists(impl->manifest_path)) {
+    return sim::Error{fmt::format("{} exists already: continue it with drapegen run --resume {}", impl->manifest_path,
+                                  impl->manifest_path)};
+  }
+  std::error_code ec;
+  fs::create_directories(impl->data_dir, ec);
+  if (ec) return sim::Error{fmt::format("cannot create {}: {}", impl->data_dir, ec.message())};
+  // Bind before planning, so a taken port fails fast and leaves no manifest behind.
+  if (sim::Status s = impl->bind(options.bind_override.empty() ? config->bind : options.bind_override, ""); !s) {
+    return s.error();
+  }
+  impl->log->info("planning {} samples x {} initial states (seed {})", config->samples, config->states_per_sample,
+                  config->seed);
+  auto plan = plan_run(*config);
+  if (!plan) return plan.error();
+  storage::RunRecord run;
+  run.created_at = unix_now();
+  run.seed = config->seed;
+  run.config_toml = config_text;
+  run.code_version = DRAPEGEN_VERSION;
+  run.endpoint = impl->endpoint;
+  auto manifest = storage::Manifest::create(impl->manifest_path, run, plan->samples, plan->jobs);
+  if (!manifest) return manifest.error();
+  impl->manifest = std::make_unique<storage::Manifest>(std::move(manifest).value());
+  if (sim::Status s = impl->load_state(); !s) return s.error();
+  impl->log->info("run planned: {} jobs in {}; listening on {}", impl->jobs.size(), impl->manifest_path,
+                  impl->endpoint);
+  if (sim::Status s = storage::write_file_atomic(impl->out_dir + "/endpoint", impl->endpoint + "\n"); !s) {
+    return s.error();
+  }
+  return std::unique_ptr<Coordinator>(new Coordinator(std::move(impl)));
+}
+
+sim::Expected<std::unique_ptr<Coordinator>> Coordinator::resume(const std::string& manifest_path,
+                                                                const CoordinatorOptions& options) {
+  auto manifest = storage::Manifest::open(manifest_path);
+  if (!manifest) return manifest.error();
+  auto run = manifest->reader().run();
+  if (!run) return run.error();
+  auto config = parse_run_config(run->config_toml, manifest_path + " (stored configuration)");
+  if (!config) return config.error();
+  auto impl = std::make_unique<Impl>();
+  impl->config = *config;
+  impl->options = options;
+  setup_progress(*impl);
+  impl->manifest_path = manifest_path;
+  impl->out_dir = manifest->reader().directory();
+  impl->data_dir = impl->out_dir + "/data";
+  impl->manifest = std::make_unique<storage::Manifest>(std::move(manifest).value());
+  std::error_code ec;
+  fs::create_directories(impl->data_dir, ec);
+  if (ec) return sim::Error{fmt::format("cannot create {}: {}", impl->data_dir, ec.message())};
+  if (sim::Status s = impl->remove_orphans(); !s) return s.error();
+  const std::string preferred = options.bind_override.empty() ? run->endpoint : options.bind_override;
+  if (sim::Status s = impl->bind(preferred, options.bind_override.empty() ? config->bind : ""); !s) return s.error();
+  if (sim::Status s = impl->load_state(); !s) return s.error();
+  impl->log->info("resumed {}: {} of {} jobs done, {} failed; listening on {}", manifest_path, impl->done,
+                  impl->jobs.size(), impl->failed, impl->endpoint);
+  if (sim::Status s = storage::write_file_atomic(impl->out_dir + "/endpoint", impl->endpoint + "\n"); !s) {
+    return s.error();
+  }
+  return std::unique_ptr<Coordinator>(new Coordinator(std::move(impl)));
+}
+
+const std::string& Coordinator::endpoint() const { return impl_->endpoint; }
+const std::string& Coordinator::manifest_path() const { return impl_->manifest_path; }
+const RunConfig& Coordinator::config() const { return impl_->config; }
+
+RunSummary Coordinator::run(const std::atomic<bool>& stop) { return impl_->loop(stop); }
+
+}  // namespace drapegen::coordinator

@@ -1,0 +1,209 @@
+#include "drapegen/coordinator/run_config.hpp"
+
+#include <cmath>
+#include <fmt/format.h>
+#include <set>
+#include <toml++/toml.h>
+
+namespace drapegen::coordinator {
+namespace {
+
+class Reader {
+ public:
+  Reader(const toml::table& root, std::string source) : root_(root), source_(std::move(source)) {}
+
+  const std::string& error() const { return error_; }
+  bool ok() const { return error_.empty(); }
+
+  void fail(const std::string& key, const std::string& message) {
+    if (error_.empty()) error_ = fmt::format("{}: {}: {}", source_, key, message);
+  }
+
+  const toml::table* table(const std::string& name) {
+    const toml::node* node = root_.get(name);
+    if (!node) return nullptr;
+    if (!node->is_table()) {
+      fail(name, "must be a table ([" + name + "])");
+      return nullptr;
+    }
+    return node->as_table();
+  }
+
+  /// Reads an integer key into `out` within [low, high].
+  template <class T>
+  void integer(const toml::table* t, const std::string& section, const std::string& key, T& out, std::int64_t low,
+               std::int64_t high) {
+    const toml::node* node = t ? t->get(key) : nullptr;
+    if (!node) return;
+    const std::string name = section.empty() ? key : section + "." + key;
+    if (!node->is_integer()) return fail(name, "must be an integer");
+    const std::int64_t v = node->as_integer()->get();
+    if (v < low || v > high) return fail(name, fmt::format("must be between {} and {}", low, high));
+    out = static_cast<T>(v);
+  }
+
+  void real(const toml::table* t, const std::string& section, const std::string& key, double& out, double low,
+            double high) {
+    const toml::node* node = t ? t->get(key) : nullptr;
+    if (!node) return;
+    const std::string name = section.empty() ? key : section + "." + key;
+    double v;
+    if (node->is_floating_point()) {
+      v = node->as_floating_point()->get();
+    } else if (node->is_integer()) {
+      v = static_cast<double>(node->as_integer()->get());
+    } else {
+      return fail(name, "must be a number");
+    }
+    if (!std::isfinite(v) || v < low || v > high) return fail(name, fmt::format("must be between {} and {}", low, high));
+    out = v;
+  }
+
+  void text(const toml::table* t, const std::string& section, const std::string& key, std::string& out,
+            const std::set<std::string>& allowed = {}) {
+    const toml::node* node = t ? t->get(key) : nullptr;
+    if (!node) return;
+    const std::string name = section.empty() ? key : section + "." + key;
+    if (!node->is_string()) return fail(name, "must be a string");
+    const std::string v = node->as_string()->get();
+    if (!allowed.empty() && !allowed.count(v)) {
+      std::string list;
+      for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+      return fail(name, fmt::format("'{}' is not one of {}", v, list));
+    }
+    out = v;
+  }
+
+  void only_keys(const toml::table* t, const std::string& section, const std::set<std::string>& keys) {
+    if (!t) return;
+    for (const auto& [k, v] : *t) {
+      const std::string key(k.str());
+      if (!keys.count(key)) {
+        fail(section.empty() ? key : section + "." + key,
+             section.empty() && v.is_table() ? "unknown section" : "unknown key");
+      }
+    }
+  }
+
+ private:
+  const toml::table& root_;
+  std::string source_;
+  std::string error_;
+};
+
+}  // namespace
+
+sim::Expected<RunConfig> parse_run_config(const std::string& toml_text, const std::string& source_name) {
+  toml::table root;
+  try {
+    root = toml::parse(toml_text, source_name);
+  } catch (const toml::parse_error& e) {
+    const auto& where = e.source().begin;
+    return sim::Error{fmt::format("{}:{}:{}: {}", source_name, where.line, where.column, e.description())};
+  }
+  RunConfig c;
+  Reader r(root, source_name);
+  r.only_keys(&root, "",
+              {"seed", "samples", "states_per_sample", "orientations", "resolution", "noise", "density", "output",
+               "model", "recipes", "solver", "network", "retry", "progress", "testing"});
+  if (const toml::node* seed = root.get("seed")) {
+    if (!seed->is_integer() || seed->as_integer()->get() < 0) {
+      r.fail("seed", "must be a non-negative integer");
+    } else {
+      c.seed = static_cast<std::uint64_t>(seed->as_integer()->get());
+    }
+  }
+  r.integer(&root, "", "samples", c.samples, 1, 10'000'000);
+  r.integer(&root, "", "states_per_sample", c.states_per_sample, 1, 64);
+  r.integer(&root, "", "orientations", c.orientations, 1, 360);
+  r.integer(&root, "", "resolution", c.resolution, 5, 400);
+  r.text(&root, "", "noise", c.noise, {"kinect", "none"});
+  r.real(&root, "", "density", c.density, 1.0, 1e5);
+  r.text(&root, "", "output", c.output);
+  r.text(&root, "", "model", c.model);
+  if (r.ok() && c.output.empty()) r.fail("output", "must not be empty");
+
+  const toml::table* recipes = r.table("recipes");
+  r.only_keys(recipes, "recipes", {"weight_sine", "weight_fold", "weight_drape", "max_drift_mm"});
+  r.real(recipes, "recipes", "weight_sine", c.weight_sine, 0.0, 1e6);
+  r.real(recipes, "recipes", "weight_fold", c.weight_fold, 0.0, 1e6);
+  r.real(recipes, "recipes", "weight_drape", c.weight_drape, 0.0, 1e6);
+  r.real(recipes, "recipes", "max_drift_mm", c.max_drift_mm, 0.0, 50.0);
+  if (r.ok() && !(c.weight_sine + c.weight_fold > 0.0)) {
+    r.fail("recipes", "weight_sine + weight_fold must be positive (a drape recipe needs a fallback)");
+  }
+
+  const toml::table* solver = r.table("solver");
+  r.only_keys(solver, "solver", {"max_iterations", "tolerance", "coarse_start_resolution", "max_self_intersections"});
+  r.integer(solver, "solver", "max_iterations", c.max_iterations, 1, 100000);
+  r.real(solver, "solver", "tolerance", c.tolerance, 1e-12, 1.0);
+  r.integer(solver, "solver", "coarse_start_resolution", c.coarse_start_resolution, 0, 400);
+  r.integer(solver, "solver", "max_self_intersections", c.max_self_intersections, 0, 1'000'000);
+
+  const toml::table* network = r.table("network");
+  r.only_keys(network, "network", {"bind", "heartbeat_ms", "liveness", "lease_s"});
+  r.text(network, "network", "bind", c.bind);
+  r.integer(network, "network", "heartbeat_ms", c.heartbeat_ms, 10, 600000);
+  r.integer(network, "network", "liveness", c.liveness, 2, 1000);
+  r.real(network, "network", "lease_s", c.lease_s, 0.1, 7 * 86400.0);
+  if (r.ok() && c.bind.rfind("tcp://", 0) != 0 && c.bind.rfind("ipc://", 0) != 0) {
+    r.fail("network.bind", "must be a tcp:// or ipc:// endpoint, e.g. tcp://127.0.0.1:5555");
+  }
+
+  const toml::table* retry = r.table("retry");
+  r.only_keys(retry, "retry", {"max_attempts"});
+  r.integer(retry, "retry", "max_attempts", c.max_attempts, 1, 1000);
+
+  const toml::table* progress = r.table("progress");
+  r.only_keys(progress, "progress", {"interval_s"});
+  r.real(progress, "progress", "interval_s", c.progress_interval_s, 0.1, 86400.0);
+
+  const toml::table* testing = r.table("testing");
+  r.only_keys(testing, "testing", {"mode", "poison_samples"});
+  r.text(testing, "testing", "mode", c.mode, {"drape", "noop"});
+  if (testing) {
+    if (const toml::node* poison = testing->get("poison_samples")) {
+      if (!poison->is_array()) {
+        r.fail("testing.poison_samples", "must be an array of sample indices");
+      } else {
+        for (const auto& item : *poison->as_array()) {
+          if (!item.is_integer() || item.as_integer()->get() < 0) {
+            r.fail("testing.poison_samples", "must hold non-negative integers");
+            break;
+          }
+          c.poison_samples.push_back(item.as_integer()->get());
+        }
+      }
+    }
+  }
+  if (!r.ok()) return sim::Error{r.error()};
+  return c;
+}
+
+const std::string& default_config_toml() {
+  static const std::string text = R"toml(# drapegen local's embedded default: a small run with coarse meshes (docs/SERVICE.md lists every key).
+seed = 1
+samples = 6             # parameter vectors from the VAE sampler
+states_per_sample = 2   # initial states per vector (paper: 8)
+orientations = 1        # data points of 4 depth views per drape (paper: 12)
+resolution = 20         # vertices per side of the 300 mm specimen (paper: 100)
+noise = "kinect"
+output = "out/local-run"
+
+[solver]
+max_iterations = 400
+tolerance = 1e-3
+max_self_intersections = 1000000   # coarse meshes: record self-intersections, do not reject them
+
+[network]
+bind = "tcp://127.0.0.1:*"
+heartbeat_ms = 500
+liveness = 6
+
+[retry]
+max_attempts = 2
+)toml";
+  return text;
+}
+
+}  // namespace drapegen::coordinator

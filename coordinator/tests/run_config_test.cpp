@@ -1,0 +1,105 @@
+#include <gtest/gtest.h>
+
+#include "drapegen/coordinator/planner.hpp"
+#include "drapegen/coordinator/run_config.hpp"
+
+namespace drapegen::coordinator {
+namespace {
+
+std::string error_of(const std::string& text) {
+  auto c = parse_run_config(text, "run.toml");
+  return c ? std::string() : c.error().message;
+}
+
+TEST(RunConfig, ParsesEveryKey) {
+  auto c = parse_run_config(R"(
+seed = 7
+samples = 3
+states_per_sample = 2
+orientations = 2
+resolution = 15
+noise = "none"
+density = 250
+output = "x"
+model = ""
+[recipes]
+weight_sine = 1
+weight_fold = 0.5
+weight_drape = 0
+max_drift_mm = 2
+[solver]
+max_iterations = 50
+tolerance = 1e-4
+coarse_start_resolution = 0
+max_self_intersections = 3
+[network]
+bind = "tcp://127.0.0.1:*"
+heartbeat_ms = 100
+liveness = 3
+lease_s = 60
+[retry]
+max_attempts = 4
+[progress]
+interval_s = 1
+[testing]
+mode = "noop"
+poison_samples = [1, 2]
+)",
+                            "run.toml");
+  ASSERT_TRUE(c) << c.error().message;
+  EXPECT_EQ(c->seed, 7u);
+  EXPECT_EQ(c->resolution, 15);
+  EXPECT_EQ(c->noise, "none");
+  EXPECT_EQ(c->density, 250.0);
+  EXPECT_EQ(c->weight_fold, 0.5);
+  EXPECT_EQ(c->max_self_intersections, 3);
+  EXPECT_EQ(c->lease_s, 60.0);
+  EXPECT_EQ(c->max_attempts, 4);
+  EXPECT_EQ(c->mode, "noop");
+  EXPECT_EQ(c->poison_samples, (std::vector<std::int64_t>{1, 2}));
+  EXPECT_TRUE(parse_run_config(default_config_toml(), "default"));
+}
+
+TEST(RunConfig, NamesTheKeyOfEveryError) {
+  EXPECT_EQ(error_of("samples = 0"), "run.toml: samples: must be between 1 and 10000000");
+  EXPECT_EQ(error_of("sampels = 3"), "run.toml: sampels: unknown key");
+  EXPECT_EQ(error_of("noise = \"loud\""), "run.toml: noise: 'loud' is not one of kinect, none");
+  EXPECT_EQ(error_of("[solver]\ntolerance = \"small\""), "run.toml: solver.tolerance: must be a number");
+  EXPECT_EQ(error_of("[network]\nbind = \"http://x\""),
+            "run.toml: network.bind: must be a tcp:// or ipc:// endpoint, e.g. tcp://127.0.0.1:5555");
+  EXPECT_EQ(error_of("[network]\nport = 1"), "run.toml: network.port: unknown key");
+  EXPECT_EQ(error_of("[extra]\nx = 1"), "run.toml: extra: unknown section");
+  EXPECT_EQ(error_of("seed = -1"), "run.toml: seed: must be a non-negative integer");
+  EXPECT_EQ(error_of("[testing]\npoison_samples = [\"a\"]"), "run.toml: testing.poison_samples: must hold non-negative integers");
+  EXPECT_NE(error_of("seed = = 1").find("run.toml:1:"), std::string::npos);
+}
+
+TEST(Planner, IsAPureFunctionOfTheConfiguration) {
+  auto c = parse_run_config("seed = 3\nsamples = 5\nstates_per_sample = 4\n[testing]\npoison_samples = [2]", "t");
+  ASSERT_TRUE(c);
+  auto a = plan_run(*c);
+  auto b = plan_run(*c);
+  ASSERT_TRUE(a) << a.error().message;
+  ASSERT_TRUE(b);
+  ASSERT_EQ(a->jobs.size(), 20u);
+  ASSERT_EQ(a->samples.size(), 5u);
+  for (std::size_t i = 0; i < a->jobs.size(); ++i) {
+    EXPECT_EQ(a->jobs[i].id, static_cast<std::int64_t>(i) + 1);
+    EXPECT_EQ(a->jobs[i].recipe_json, b->jobs[i].recipe_json);
+    EXPECT_EQ(a->jobs[i].render_seed, b->jobs[i].render_seed);
+    EXPECT_EQ(a->jobs[i].mode, a->jobs[i].sample == 2 ? "poison" : "drape");
+  }
+  for (std::size_t i = 0; i < a->samples.size(); ++i) EXPECT_EQ(a->samples[i].alpha, b->samples[i].alpha);
+  // Another seed, another plan.
+  c->seed = 4;
+  auto other = plan_run(*c);
+  ASSERT_TRUE(other);
+  EXPECT_NE(other->samples[0].alpha, a->samples[0].alpha);
+  // A fallback recipe is never a drape recipe.
+  for (int slot = 0; slot < 4; ++slot) {
+    EXPECT_NE(fallback_recipe(*c, 4, slot).kind, sampler::RecipeKind::kDrape);
+  }
+}
+
+}  // namespace
+}  // namespace drapegen::coordinator

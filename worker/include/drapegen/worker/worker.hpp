@@ -1,0 +1,29 @@
+#pragma once
+// A worker process's main loop (docs/SERVICE.md, "Worker"): connects a DEALER socket to the coordinator, registers,
+// computes leased jobs on a separate thread while it keeps heartbeating, reconnects with exponential back-off when
+// the coordinator goes silent (re-registering with a restarted one), and returns when told to shut down.
+
+#include <atomic>
+#include <string>
+
+#include "drapegen/sim/expected.hpp"
+
+namespace drapegen::worker {
+
+struct WorkerOptions {
+  std::string endpoint;          // e.g. tcp://127.0.0.1:5555
+  std::string name;              // for logs and the manifest; default "HOST:PID"
+  int heartbeat_ms = 1000;       // this worker's heartbeat interval
+  int liveness = 5;              // coordinator silent for liveness x its interval: reconnect
+  int backoff_initial_ms = 250;  // first reconnect delay, doubled up to backoff_max_ms
+  int backoff_max_ms = 8000;
+  double give_up_s = 0.0;        // > 0: fail after this long without hearing from a coordinator
+  std::string scratch_dir;       // temporary files; default a fresh directory under the system temp dir
+};
+
+/// Runs until the coordinator sends Shutdown (Status ok), `stop` becomes true (ok), or give_up_s passes without a
+/// coordinator (an error). A job still computing when the worker returns is abandoned (the coordinator re-queues
+/// it); callers should exit the process promptly (the computing thread cannot be interrupted).
+[[nodiscard]] sim::Status run_worker(const WorkerOptions& options, const std::atomic<bool>& stop);
+
+}  // namespace drapegen::worker

@@ -1,0 +1,244 @@
+#include "drapegen/worker/worker.hpp"
+
+#include <chrono>
+#include <condition_variable>
+#include <filesystem>
+#include <fmt/format.h>
+#include <mutex>
+#include <optional>
+#include <thread>
+#include <unistd.h>
+#include <zmq.hpp>
+
+#include "drapegen/coordinator/logging.hpp"
+#include "drapegen/proto/codec.hpp"
+#include "drapegen/worker/job_runner.hpp"
+
+namespace drapegen::worker {
+namespace v1 = proto::v1;
+using Clock = std::chrono::steady_clock;
+using std::chrono::milliseconds;
+
+namespace {
+
+/// The computing thread: one job at a time, its answer picked up by the I/O loop.
+class Executor {
+ public:
+  explicit Executor(std::string scratch) : runner_(std::move(scratch)), thread_([this] { loop(); }) {}
+  ~Executor() {
+    {
+      std::lock_guard lock(mutex_);
+      quit_ = true;
+    }
+    cv_.notify_all();
+    if (busy_) {
+      thread_.detach();  // a computation cannot be interrupted; the process exits without waiting for it
+    } else {
+      thread_.join();
+    }
+  }
+  void submit(v1::Job job) {
+    {
+      std::lock_guard lock(mutex_);
+      job_ = std::move(job);
+      busy_ = true;
+    }
+    cv_.notify_all();
+  }
+  [[nodiscard]] bool busy() const { return busy_; }
+  std::optional<v1::Envelope> take() {
+    std::lock_guard lock(mutex_);
+    std::optional<v1::Envelope> out = std::move(answer_);
+    answer_.reset();
+    if (out) busy_ = false;
+    return out;
+  }
+
+ private:
+  void loop() {
+    for (;;) {
+      v1::Job job;
+      {
+        std::unique_lock lock(mutex_);
+        cv_.wait(lock, [&] { return quit_ || job_.has_value(); });
+        if (quit_) return;
+        job = std::move(*job_);
+        job_.reset();
+      }
+      v1::Envelope answer = runner_.run(job);
+      std::lock_guard lock(mutex_);
+      answer_ = std::move(answer);
+    }
+  }
+
+  JobRunner runner_;
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  std::optional<v1::Job> job_;
+  std::optional<v1::Envelope> answer_;
+  std::atomic<bool> busy_{false};
+  bool quit_ = false;
+  std::thread thread_;
+};
+
+std::string default_name() {
+  char host[256] = {};
+  ::gethostname(host, sizeof host - 1);
+  return fmt::format("{}:{}", host, ::getpid());
+}
+
+}  // namespace
+
+sim::Status run_worker(const WorkerOptions& o, const std::atomic<bool>& stop) {
+  auto log = coordinator::logger();
+  const std::string name = o.name.empty() ? default_name() : o.name;
+  std::string scratch = o.scratch_dir;
+  if (scratch.empty()) {
+    scratch = (std::filesystem::temp_directory_path() / fmt::format("drapegen-worker-{}", ::getpid())).string();
+  }
+  struct RemoveScratch {
+    std::string dir;
+    ~RemoveScratch() {
+      std::error_code ec;
+      std::filesystem::remove_all(dir, ec);
+    }
+  } remove_scratch{o.scratch_dir.empty() ? scratch : std::string()};
+  Executor executor(scratch);
+  zmq::context_t context{1};
+  int backoff_ms = o.backoff_initial_ms;
+  auto last_contact = Clock::now();  // with any coordinator
+  std::int64_t current_job = 0;      // job being computed (0: none)
+  std::uint32_t current_attempt = 0;
+
+  while (!stop.load()) {
+    zmq::socket_t socket(context, zmq::socket_type::dealer);
+    socket.set(zmq::sockopt::linger, 0);
+    socket.set(zmq::sockopt::maxmsgsize, static_cast<int64_t>(proto::kMaxFrameBytes));
+    try {
+      socket.connect(o.endpoint);
+    } catch (const zmq::error_t& e) {
+      return sim::Error{fmt::format("cannot connect to {}: {}", o.endpoint, e.what())};
+    }
+    auto send = [&](v1::Envelope e) {
+      const std::string frame = proto::encode(std::move(e));
+      socket.send(zmq::buffer(frame), zmq::send_flags::dontwait);
+    };
+    {
+      v1::Envelope ready;
+      ready.mutable_ready()->set_worker_name(name);
+      ready.mutable_ready()->set_code_version(DRAPEGEN_VERSION);
+      ready.mutable_ready()->set_interval_ms(static_cast<std::uint32_t>(o.heartbeat_ms));
+      send(std::move(ready));
+    }
+    // A job computed for an earlier connection is of no use: its lease is gone with that connection.
+    bool stale_computation = executor.busy();
+    int peer_interval_ms = o.heartbeat_ms;
+    auto last_recv = Clock::now();
+    auto last_send = Clock::now();
+    bool connected = false;  // heard from the coordinator on this socket
+    bool reconnect = false;
+    while (!stop.load() && !reconnect) {
+      zmq::pollitem_t item{socket.handle(), 0, ZMQ_POLLIN, 0};
+      const int timeout = executor.busy() ? std::min(o.heartbeat_ms, 20) : std::min(o.heartbeat_ms, 100);
+      try {
+        zmq::poll(&item, 1, milliseconds(timeout));
+      } catch (const zmq::error_t& e) {
+        if (e.num() == EINTR) continue;
+        throw;
+      }
+      if (item.revents & ZMQ_POLLIN) {
+        zmq::message_t frame;
+        while (socket.recv(frame, zmq::recv_flags::dontwait)) {
+          auto decoded = proto::decode(frame.data(), frame.size());
+          if (!decoded) {
+            log->warn("dropped a message from the coordinator: {}", decoded.error().message);
+            continue;
+          }
+          last_recv = last_contact = Clock::now();
+          if (!connected) {
+            connected = true;
+            backoff_ms = o.backoff_initial_ms;
+            log->info("worker {}: connected to {}", name, o.endpoint);
+          }
+          const v1::Envelope& e = *decoded;
+          switch (e.body_case()) {
+            case v1::Envelope::kHeartbeat:
+              if (e.heartbeat().interval_ms() > 0) peer_interval_ms = static_cast<int>(e.heartbeat().interval_ms());
+              break;
+            case v1::Envelope::kJob:
+              if (current_job != 0 || executor.busy()) {
+                log->warn("worker {}: got job {} while busy; ignored", name, e.job().job_id());
+                break;
+              }
+              if (e.job().spec().mode() == v1::JOB_MODE_NOOP) {  // answered at once, no thread hop
+                v1::Envelope r;
+                r.mutable_result()->set_job_id(e.job().job_id());
+                r.mutable_result()->set_attempt(e.job().attempt());
+                r.mutable_result()->mutable_metrics()->set_outcome("noop");
+                send(std::move(r));
+                last_send = Clock::now();
+                break;
+              }
+              current_job = static_cast<std::int64_t>(e.job().job_id());
+              current_attempt = e.job().attempt();
+              executor.submit(e.job());
+              break;
+            case v1::Envelope::kDisconnect:
+              log->info("worker {}: coordinator does not know us ({}); registering again", name,
+                        e.disconnect().reason());
+              reconnect = true;
+              backoff_ms = 0;
+              break;
+            case v1::Envelope::kShutdown:
+              log->info("worker {}: shutdown ({})", name, e.shutdown().reason());
+              return {};
+            default:
+              log->warn("worker {}: unexpected {} from the coordinator", name, proto::body_name(e));
+              break;
+          }
+          if (reconnect) break;
+        }
+      }
+      if (auto answer = executor.take()) {
+        if (stale_computation) {
+          stale_computation = false;
+        } else if (current_job != 0) {
+          send(std::move(*answer));
+          last_send = Clock::now();
+        }
+        current_job = 0;
+        current_attempt = 0;
+      }
+      const auto now = Clock::now();
+      if (now - last_send >= milliseconds(o.heartbeat_ms)) {
+        v1::Envelope hb;
+        hb.mutable_heartbeat()->set_job_id(static_cast<std::uint64_t>(current_job));
+        hb.mutable_heartbeat()->set_interval_ms(static_cast<std::uint32_t>(o.heartbeat_ms));
+        hb.mutable_heartbeat()->set_liveness(static_cast<std::uint32_t>(o.liveness));
+        send(std::move(hb));
+        last_send = now;
+      }
+      if (now - last_recv > milliseconds(static_cast<long>(peer_interval_ms) * o.liveness)) {
+        log->warn("worker {}: coordinator at {} silent for {} ms; reconnecting in {} ms", name, o.endpoint,
+                  std::chrono::duration_cast<milliseconds>(now - last_recv).count(), backoff_ms);
+        reconnect = true;
+      }
+    }
+    if (stop.load()) break;
+    // The job in flight (if any) belonged to this connection.
+    if (current_job != 0) {
+      current_job = 0;
+      (void)current_attempt;
+    }
+    if (o.give_up_s > 0 &&
+        std::chrono::duration<double>(Clock::now() - last_contact).count() > o.give_up_s) {
+      return sim::Error{fmt::format("no coordinator at {} for {} s; giving up", o.endpoint, o.give_up_s)};
+    }
+    const auto until = Clock::now() + milliseconds(backoff_ms);
+    while (Clock::now() < until && !stop.load()) std::this_thread::sleep_for(milliseconds(20));
+    backoff_ms = std::min(std::max(backoff_ms * 2, o.backoff_initial_ms), o.backoff_max_ms);
+  }
+  return {};
+}
+
+}  // namespace drapegen::worker

@@ -1,0 +1,96 @@
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "drapegen/proto/recipe.hpp"
+#include "drapegen/renderer/exr.hpp"
+#include "drapegen/sampler/recipe_generator.hpp"
+#include "drapegen/worker/job_runner.hpp"
+
+namespace drapegen::worker {
+namespace {
+namespace v1 = proto::v1;
+
+v1::Job tiny_job(v1::JobMode mode) {
+  v1::Job job;
+  job.set_job_id(5);
+  job.set_attempt(1);
+  auto* s = job.mutable_spec();
+  s->set_mode(mode);
+  s->set_resolution(15);
+  s->set_orientations(2);
+  s->set_noise("kinect");
+  s->set_render_seed(11);
+  s->set_max_iterations(400);
+  s->set_tolerance(1e-3);
+  s->set_max_self_intersections(1000000);
+  s->set_coarse_start_resolution(0);
+  auto* p = s->mutable_parameters();
+  p->set_alpha_warp(13923);
+  p->set_alpha_bias(11455);
+  p->set_alpha_weft(8821);
+  p->set_beta_warp(-35390);
+  p->set_beta_bias(-29660);
+  p->set_beta_weft(-22042);
+  p->set_density_g_per_m2(300);
+  sampler::RecipeOptions options;
+  options.seed = 1;
+  *s->mutable_recipe() = proto::to_proto(sampler::make_recipes(options, 0, {})[0]);
+  return job;
+}
+
+std::string scratch() {
+  return (std::filesystem::temp_directory_path() / "drapegen_job_runner_test").string();
+}
+
+TEST(JobRunner, ComputesADrapeWithItsFilesInMemory) {
+  JobRunner runner(scratch());
+  const auto answer = runner.run(tiny_job(v1::JOB_MODE_DRAPE));
+  ASSERT_EQ(answer.body_case(), v1::Envelope::kResult) << answer.failure().message();
+  const auto& r = answer.result();
+  EXPECT_EQ(r.job_id(), 5u);
+  EXPECT_EQ(r.metrics().outcome(), "converged");
+  EXPECT_GT(r.metrics().drape_coefficient(), 0.1);
+  EXPECT_LT(r.metrics().drape_coefficient(), 1.0);
+  EXPECT_EQ(r.mesh_ply().rfind("ply", 0), 0u);
+  ASSERT_EQ(r.exr_size(), 2);
+  const auto point = renderer::read_exr(std::vector<char>(r.exr(1).begin(), r.exr(1).end()));
+  ASSERT_TRUE(point) << point.error().message;
+  EXPECT_EQ(point->index, 1);
+  EXPECT_EQ(point->views.size(), 4u);
+  // Replay: the same job gives the same bytes.
+  const auto again = runner.run(tiny_job(v1::JOB_MODE_DRAPE));
+  ASSERT_EQ(again.body_case(), v1::Envelope::kResult);
+  EXPECT_EQ(again.result().mesh_ply(), r.mesh_ply());
+  EXPECT_EQ(again.result().exr(0), r.exr(0));
+}
+
+TEST(JobRunner, PoisonDiverges) {
+  JobRunner runner(scratch());
+  const auto answer = runner.run(tiny_job(v1::JOB_MODE_POISON));
+  ASSERT_EQ(answer.body_case(), v1::Envelope::kFailure);
+  EXPECT_EQ(answer.failure().reason(), v1::FAILURE_REASON_DIVERGED) << answer.failure().message();
+  EXPECT_EQ(answer.failure().attempt(), 1u);
+}
+
+TEST(JobRunner, RefusesADrapeRecipeWithoutItsMesh) {
+  JobRunner runner(scratch());
+  auto job = tiny_job(v1::JOB_MODE_DRAPE);
+  job.mutable_spec()->mutable_recipe()->set_kind(v1::Recipe::KIND_DRAPE);
+  job.mutable_spec()->mutable_recipe()->set_source_sample(1);
+  job.mutable_spec()->mutable_recipe()->set_source_slot(0);
+  const auto answer = runner.run(job);
+  ASSERT_EQ(answer.body_case(), v1::Envelope::kFailure);
+  EXPECT_EQ(answer.failure().reason(), v1::FAILURE_REASON_INVALID_JOB);
+}
+
+TEST(JobRunner, NoopAnswersAtOnce) {
+  JobRunner runner(scratch());
+  const auto answer = runner.run(tiny_job(v1::JOB_MODE_NOOP));
+  ASSERT_EQ(answer.body_case(), v1::Envelope::kResult);
+  EXPECT_EQ(answer.result().metrics().outcome(), "noop");
+  EXPECT_TRUE(answer.result().mesh_ply().empty());
+}
+
+}  // namespace
+}  // namespace drapegen::worker
