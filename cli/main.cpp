@@ -22,6 +22,10 @@ int main(int argc, char** argv) {
   add("run", "Coordinate a generation run: plan it, serve its jobs to workers, record results (or --resume one)",
       drapegen::cli::add_run_command);
   add("worker", "Compute jobs (simulate + render) for a coordinator", drapegen::cli::add_worker_command);
+  add("local", "Run a coordinator and N workers on this machine (default: a small embedded run), then print stats",
+      drapegen::cli::add_local_command);
+  add("stats", "Summarise a run's manifest (counts, failures, throughput, distributions, storage)",
+      drapegen::cli::add_stats_command);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

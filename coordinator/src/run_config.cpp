@@ -183,10 +183,10 @@ sim::Expected<RunConfig> parse_run_config(const std::string& toml_text, const st
 const std::string& default_config_toml() {
   static const std::string text = R"toml(# drapegen local's embedded default: a small run with coarse meshes (docs/SERVICE.md lists every key).
 seed = 1
-samples = 6             # parameter vectors from the VAE sampler
-states_per_sample = 2   # initial states per vector (paper: 8)
-orientations = 1        # data points of 4 depth views per drape (paper: 12)
-resolution = 20         # vertices per side of the 300 mm specimen (paper: 100)
+samples = 30            # parameter vectors from the VAE sampler
+states_per_sample = 4   # initial states per vector (paper: 8)
+orientations = 2        # data points of 4 depth views per drape (paper: 12)
+resolution = 25         # vertices per side of the 300 mm specimen (paper: 100)
 noise = "kinect"
 output = "out/local-run"
 

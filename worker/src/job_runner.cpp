@@ -66,8 +66,9 @@ sim::Expected<sim::DrapeConfig> drape_config(const v1::JobSpec& spec, const std:
   config.solver.max_iterations = spec.max_iterations();
   config.solver.tolerance = spec.tolerance();
   config.coarse_start_resolution = spec.coarse_start_resolution();
-  // Poison (test only): a non-finite gravity makes every energy non-finite, so the real solver diverges.
-  if (spec.mode() == v1::JOB_MODE_POISON) config.gravity = std::numeric_limits<double>::quiet_NaN();
+  // Poison (test only): the largest finite gravity overflows the energy and the forces, so the real solver ends
+  // with a non-finite residual (classified as diverged below).
+  if (spec.mode() == v1::JOB_MODE_POISON) config.gravity = std::numeric_limits<double>::max();
   return config;
 }
 
@@ -128,6 +129,14 @@ v1::Envelope JobRunner::compute(const v1::Job& job) {
   metrics.set_folds(drape->measures.folds);
   metrics.set_self_intersections(drape->measures.self_intersections);
   metrics.set_sim_seconds(seconds_since(sim_start));
+  // A solve that ends with a non-finite residual or energy diverged, whatever the solver called its stop.
+  const bool non_finite = !std::isfinite(drape->report.residual) || !std::isfinite(drape->report.energy);
+  if (non_finite && drape->report.outcome != sim::SolveOutcome::kConverged) {
+    return failure(job, v1::FAILURE_REASON_DIVERGED,
+                   fmt::format("{} with a non-finite {}: {}", sim::to_string(drape->report.outcome),
+                               std::isfinite(drape->report.residual) ? "energy" : "residual", drape->report.message),
+                   &metrics);
+  }
   switch (drape->report.outcome) {
     case sim::SolveOutcome::kConverged: break;
     case sim::SolveOutcome::kIterationLimit:

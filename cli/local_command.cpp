@@ -1,0 +1,179 @@
+// drapegen local: a coordinator plus N worker processes on this machine, then the run's statistics.
+#include <chrono>
+#include <csignal>
+#include <fmt/format.h>
+#include <iostream>
+#include <memory>
+#include <mutex>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <thread>
+#include <unistd.h>
+#include <vector>
+
+#include "commands.hpp"
+#include "drapegen/coordinator/coordinator.hpp"
+#include "drapegen/coordinator/logging.hpp"
+#include "drapegen/coordinator/run_config.hpp"
+#include "drapegen/coordinator/stats.hpp"
+#include "signals.hpp"
+
+extern char** environ;
+
+namespace drapegen::cli {
+
+sim::Expected<std::string> read_text_file(const std::string& path);
+int report_run(const coordinator::RunSummary& s, const std::string& manifest, const char* sub);
+
+namespace {
+
+struct LocalOptions {
+  int workers = 2;
+  std::string config;
+  std::string resume;
+  std::string output;
+  bool print_config = false;
+};
+
+int fail(const std::string& message, int code = kExitUsage) {
+  std::cerr << "drapegen local: error: " << message << "\n";
+  return code;
+}
+
+/// The worker processes: started after the coordinator binds, restarted if one dies before the run ends.
+class WorkerPool {
+ public:
+  WorkerPool(std::string endpoint, int count) : endpoint_(std::move(endpoint)), count_(count) {}
+
+  sim::Status start() {
+    for (int k = 0; k < count_; ++k) {
+      auto pid = spawn(k);
+      if (!pid) return pid.error();
+      pids_.push_back(*pid);
+    }
+    supervisor_ = std::thread([this] { supervise(); });
+    return {};
+  }
+
+  /// Waits for the workers to exit (they were told to shut down), then terminates any left.
+  void finish() {
+    finishing_ = true;
+    if (supervisor_.joinable()) supervisor_.join();
+    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+    for (pid_t& pid : pids_) {
+      while (pid > 0) {
+        if (::waitpid(pid, nullptr, WNOHANG) == pid) {
+          pid = -1;
+          break;
+        }
+        if (std::chrono::steady_clock::now() > until) {
+          ::kill(pid, SIGTERM);
+          ::waitpid(pid, nullptr, 0);
+          pid = -1;
+          break;
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      }
+    }
+  }
+
+ private:
+  sim::Expected<pid_t> spawn(int k) {
+    const std::string self = "/proc/self/exe";
+    const std::string name = fmt::format("local-{}", k);
+    std::vector<std::string> args = {"drapegen", "worker", "--connect", endpoint_, "--name", name, "--give-up", "60"};
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    pid_t pid = 0;
+    if (const int rc = ::posix_spawn(&pid, self.c_str(), nullptr, nullptr, argv.data(), environ); rc != 0) {
+      return sim::Error{fmt::format("cannot start a worker: {}", std::strerror(rc))};
+    }
+    return pid;
+  }
+
+  void supervise() {
+    int restarts = 0;
+    while (!finishing_) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(200));
+      for (std::size_t k = 0; k < pids_.size() && !finishing_; ++k) {
+        int status = 0;
+        if (pids_[k] <= 0 || ::waitpid(pids_[k], &status, WNOHANG) != pids_[k]) continue;
+        pids_[k] = -1;
+        const bool clean_exit = WIFEXITED(status) && WEXITSTATUS(status) == 0;  // told to shut down
+        if (finishing_ || clean_exit || restarts >= 3 * count_) continue;
+        coordinator::logger()->warn("worker local-{} exited ({}); starting another", k,
+                                    WIFSIGNALED(status) ? fmt::format("signal {}", WTERMSIG(status))
+                                                        : fmt::format("status {}", WEXITSTATUS(status)));
+        if (auto pid = spawn(static_cast<int>(k))) pids_[k] = *pid;
+        ++restarts;
+      }
+    }
+  }
+
+  std::string endpoint_;
+  int count_;
+  std::vector<pid_t> pids_;
+  std::thread supervisor_;
+  std::atomic<bool> finishing_{false};
+};
+
+}  // namespace
+
+Runner add_local_command(CLI::App& app) {
+  auto o = std::make_shared<LocalOptions>();
+  app.add_option("--workers", o->workers, "Worker processes to start")->check(CLI::Range(1, 1024))->capture_default_str();
+  auto* config = app.add_option("--config", o->config, "Run configuration (TOML); default: the embedded small run");
+  auto* resume = app.add_option("--resume", o->resume, "Continue the run of this manifest instead");
+  config->excludes(resume);
+  app.add_option("--output", o->output, "Override the configuration's output directory");
+  app.add_flag("--print-config", o->print_config, "Print the embedded default configuration and exit");
+  return [o]() -> int {
+    if (o->print_config) {
+      std::cout << coordinator::default_config_toml();
+      return kExitOk;
+    }
+    const auto& stop = install_stop_signals();
+    coordinator::CoordinatorOptions options;
+    options.bind_override = "tcp://127.0.0.1:*";  // local workers only; any free port
+    sim::Expected<std::unique_ptr<coordinator::Coordinator>> c = sim::Error{""};
+    if (!o->resume.empty()) {
+      c = coordinator::Coordinator::resume(o->resume, options);
+    } else {
+      std::string text = coordinator::default_config_toml();
+      std::string name = "the embedded default configuration";
+      if (!o->config.empty()) {
+        auto file = read_text_file(o->config);
+        if (!file) return fail(file.error().message);
+        text = *file;
+        name = o->config;
+      }
+      if (!o->output.empty()) {
+        // The override becomes the first line; the file's own top-level output line is removed.
+        auto parsed = coordinator::parse_run_config(text, name);
+        if (!parsed) return fail(parsed.error().message);
+        text = fmt::format("output = \"{}\"\n", o->output) + text;
+        const auto pos = text.find("\noutput =");
+        if (pos != std::string::npos) {
+          const auto end = text.find('\n', pos + 1);
+          text.erase(pos, end - pos);
+        }
+      }
+      c = coordinator::Coordinator::create(text, name, options);
+    }
+    if (!c) return fail(c.error().message);
+    WorkerPool pool((*c)->endpoint(), o->workers);
+    if (sim::Status s = pool.start(); !s) return fail(s.error().message);
+    const auto summary = (*c)->run(stop);
+    pool.finish();
+    const int code = report_run(summary, (*c)->manifest_path(), "local");
+    if (summary.outcome == coordinator::RunOutcome::kComplete) {
+      auto stats = coordinator::compute_stats((*c)->manifest_path(), {});
+      if (!stats) return fail(stats.error().message);
+      std::cout << coordinator::format_stats(*stats);
+    }
+    return code;
+  };
+}
+
+}  // namespace drapegen::cli

@@ -1,0 +1,51 @@
+// drapegen stats: what a run's manifest holds (docs/SERVICE.md, "Statistics").
+#include <iostream>
+#include <memory>
+
+#include "commands.hpp"
+#include "drapegen/coordinator/stats.hpp"
+
+namespace drapegen::cli {
+namespace {
+
+struct StatsOptions {
+  std::string manifest;
+  bool json = false;
+  std::string plots;
+  std::string fabrics;
+};
+
+int fail(const std::string& message, int code = kExitUsage) {
+  std::cerr << "drapegen stats: error: " << message << "\n";
+  return code;
+}
+
+}  // namespace
+
+Runner add_stats_command(CLI::App& app) {
+  auto o = std::make_shared<StatsOptions>();
+  app.add_option("manifest", o->manifest, "The run's manifest (OUTPUT/manifest.sqlite)")->required();
+  app.add_flag("--json", o->json, "Print the statistics as JSON");
+  app.add_option("--plots", o->plots, "Also write SVG histograms into this directory");
+  app.add_option("--fabrics", o->fabrics, "The measured fabrics (fabrics618.csv) to compare the parameters with");
+  return [o]() -> int {
+    coordinator::StatsOptions options;
+    options.fabrics_csv = o->fabrics;
+    auto stats = coordinator::compute_stats(o->manifest, options);
+    if (!stats) return fail(stats.error().message);
+    if (!o->plots.empty()) {
+      auto written = coordinator::write_stat_plots(o->manifest, options, o->plots);
+      if (!written) return fail(written.error().message, kExitIo);
+      (*stats)["plots"] = *written;
+    }
+    if (o->json) {
+      std::cout << stats->dump(2) << "\n";
+    } else {
+      std::cout << coordinator::format_stats(*stats);
+      if (stats->contains("plots")) std::cout << "  plots: " << (*stats)["plots"].size() << " SVG files in " << o->plots << "\n";
+    }
+    return kExitOk;
+  };
+}
+
+}  // namespace drapegen::cli

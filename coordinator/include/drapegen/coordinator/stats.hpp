@@ -1,0 +1,30 @@
+#pragma once
+// What a manifest holds (drapegen stats): job counts by state and failure reason, throughput per worker and overall,
+// time per job, the sampled parameters against the measured fabrics, drape coefficient and fold distributions,
+// storage used; as JSON, as text, and as SVG histograms.
+
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "drapegen/sim/expected.hpp"
+
+namespace drapegen::coordinator {
+
+struct StatsOptions {
+  /// The measured fabrics (fabrics618.csv); empty: the copy beside the source tree (../shared/data). A missing file
+  /// only drops the comparison.
+  std::string fabrics_csv;
+};
+
+/// Reads the manifest (read-only; safe while a coordinator writes) and computes the statistics.
+[[nodiscard]] sim::Expected<nlohmann::json> compute_stats(const std::string& manifest_path,
+                                                          const StatsOptions& options);
+/// A few lines a person can read.
+[[nodiscard]] std::string format_stats(const nlohmann::json& stats);
+/// Histograms as SVG files in `directory` (created): drape_coefficient.svg, folds.svg, job_seconds.svg and one
+/// per parameter feature (run against measured fabrics). Returns the files written.
+[[nodiscard]] sim::Expected<std::vector<std::string>> write_stat_plots(const std::string& manifest_path,
+                                                                       const StatsOptions& options,
+                                                                       const std::string& directory);
+
+}  // namespace drapegen::coordinator
