@@ -1,7 +1,9 @@
 #include "drapegen/coordinator/coordinator.hpp"
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
+#include <cstring>
 #include <cstdio>
 #include <deque>
 #include <filesystem>
@@ -495,10 +497,14 @@ struct Coordinator::Impl {
       const JobSlot& source = jobs[static_cast<std::size_t>(job_id(config, recipe->source.sample,
                                                                     recipe->source.slot) - 1)];
       const std::string path = data_dir + "/" + file_name(source, ".ply");
+      errno = 0;
       std::ifstream in(path, std::ios::binary);
       std::ostringstream bytes;
-      bytes << in.rdbuf();
-      if (!in || bytes.str().empty()) return sim::Error{fmt::format("cannot read the source drape {}", path)};
+      if (in) bytes << in.rdbuf();
+      if (!in || bytes.str().empty()) {
+        return sim::Error{fmt::format("cannot read the source drape {}: {}", path,
+                                      errno ? std::strerror(errno) : "empty file")};
+      }
       job->set_source_mesh(bytes.str());
     }
     return e;
@@ -693,6 +699,7 @@ struct Coordinator::Impl {
     if (!storage_error.empty() && outcome != RunOutcome::kStorageError) outcome = RunOutcome::kStorageError;
     progress(true);
     if (terminal_progress) std::fprintf(stderr, "\n");
+    if (rejected > 0) log->warn("{} message(s) dropped during this session (undecodable, stale or forged)", rejected);
     shutdown_workers(reason);
     return summary(outcome);
   }

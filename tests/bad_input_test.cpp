@@ -1,0 +1,205 @@
+// Acceptance 4: random bytes, truncated frames, wrong protocol versions, and results for unknown or finished jobs
+// sent to the coordinator's port leave it running and the manifest unchanged.
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <random>
+#include <sys/socket.h>
+#include <unistd.h>
+#include <zmq.hpp>
+
+#include "drapegen/proto/codec.hpp"
+#include "service_harness.hpp"
+
+namespace drapegen::test {
+namespace {
+namespace v1 = proto::v1;
+
+/// Everything the manifest records, as text.
+std::string dump(const fs::path& manifest) {
+  auto reader = storage::ManifestReader::open(manifest.string());
+  if (!reader) return "unreadable: " + reader.error().message;
+  std::ostringstream s;
+  for (const auto& j : all(reader->jobs())) {
+    s << "job " << j.id << " " << storage::to_string(j.state) << " " << j.attempts << " " << j.worker << " "
+      << j.failure_reason << " " << j.recipe_json << "\n";
+  }
+  for (const auto& r : all(reader->results())) s << "result " << r.job_id << " " << r.outcome << "\n";
+  for (const auto& f : all(reader->files())) s << "file " << f.path << " " << f.sha256 << "\n";
+  for (const auto& f : all(reader->failures())) s << "failure " << f.job_id << " " << f.attempt << " " << f.reason << "\n";
+  return s.str();
+}
+
+/// A hand-driven worker: a DEALER socket speaking (or abusing) the protocol.
+class FakeWorker {
+ public:
+  FakeWorker(zmq::context_t& context, const std::string& endpoint) : socket_(context, zmq::socket_type::dealer) {
+    socket_.set(zmq::sockopt::linger, 0);
+    socket_.connect(endpoint);
+  }
+  void send_raw(const std::string& bytes) { socket_.send(zmq::buffer(bytes), zmq::send_flags::none); }
+  void send(v1::Envelope e) { send_raw(proto::encode(std::move(e))); }
+  void send_frames(const std::vector<std::string>& frames) {
+    for (std::size_t i = 0; i < frames.size(); ++i) {
+      socket_.send(zmq::buffer(frames[i]), i + 1 < frames.size() ? zmq::send_flags::sndmore : zmq::send_flags::none);
+    }
+  }
+  /// The next envelope of the given kind (heartbeats skipped), or none within the timeout.
+  std::optional<v1::Envelope> expect(v1::Envelope::BodyCase kind, std::chrono::milliseconds timeout) {
+    const auto until = std::chrono::steady_clock::now() + timeout;
+    while (std::chrono::steady_clock::now() < until) {
+      zmq::pollitem_t item{socket_.handle(), 0, ZMQ_POLLIN, 0};
+      zmq::poll(&item, 1, std::chrono::milliseconds(20));
+      zmq::message_t frame;
+      while (socket_.recv(frame, zmq::recv_flags::dontwait)) {
+        auto e = proto::decode(frame.data(), frame.size());
+        if (e && e->body_case() == kind) return *e;
+      }
+    }
+    return std::nullopt;
+  }
+  void heartbeat() {
+    v1::Envelope e;
+    e.mutable_heartbeat()->set_interval_ms(10000);
+    send(std::move(e));
+  }
+
+ private:
+  zmq::socket_t socket_;
+};
+
+v1::Envelope ready(const std::string& name) {
+  v1::Envelope e;
+  e.mutable_ready()->set_worker_name(name);
+  e.mutable_ready()->set_interval_ms(10000);  // a slow heartbeat: the test pauses between messages
+  return e;
+}
+
+v1::Envelope result(std::uint64_t job, std::uint32_t attempt) {
+  v1::Envelope e;
+  e.mutable_result()->set_job_id(job);
+  e.mutable_result()->set_attempt(attempt);
+  e.mutable_result()->mutable_metrics()->set_outcome("noop");
+  return e;
+}
+
+v1::Envelope failure(std::uint64_t job, std::uint32_t attempt) {
+  v1::Envelope e;
+  e.mutable_failure()->set_job_id(job);
+  e.mutable_failure()->set_attempt(attempt);
+  e.mutable_failure()->set_reason(v1::FAILURE_REASON_DIVERGED);
+  e.mutable_failure()->set_message("forged");
+  return e;
+}
+
+/// Raw TCP: connect, write `bytes`, close (no ZMTP handshake, or a broken one).
+void raw_tcp(int port, const std::string& bytes) {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_port = htons(static_cast<std::uint16_t>(port));
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  if (::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) == 0) {
+    (void)!::write(fd, bytes.data(), bytes.size());
+    std::this_thread::sleep_for(5ms);
+  }
+  ::close(fd);
+}
+
+TEST(Service, BadInputLeavesTheCoordinatorRunningAndTheManifestUnchanged) {
+  const fs::path dir = test_dir("bad_input");
+  const fs::path out = dir / "run";
+  // No-op jobs: the fake worker can complete one legitimately.
+  write_text(dir / "run.toml", small_config(out, 3, 2, "[testing]\nmode = \"noop\"\n"));
+  Process coordinator({"run", "--config", (dir / "run.toml").string()}, (dir / "coordinator").string());
+  const std::string endpoint = wait_endpoint(out, coordinator, 30s);
+  ASSERT_FALSE(endpoint.empty()) << coordinator.err();
+  const fs::path manifest = out / "manifest.sqlite";
+  const int port = std::stoi(endpoint.substr(endpoint.rfind(':') + 1));
+
+  zmq::context_t context(1);
+  FakeWorker a(context, endpoint);
+  a.send(ready("fake-a"));
+  auto job1 = a.expect(v1::Envelope::kJob, 5s);
+  ASSERT_TRUE(job1);
+  const std::uint64_t first = job1->job().job_id();
+  a.send(result(first, job1->job().attempt()));  // a legitimate result
+  auto job2 = a.expect(v1::Envelope::kJob, 5s);  // and the next lease
+  ASSERT_TRUE(job2);
+  const std::uint64_t second = job2->job().job_id();
+  const auto until = std::chrono::steady_clock::now() + 10s;
+  while (recorded_jobs(manifest) < 1 && std::chrono::steady_clock::now() < until) std::this_thread::sleep_for(10ms);
+  ASSERT_EQ(recorded_jobs(manifest), 1);
+  const std::string before = dump(manifest);
+
+  std::mt19937_64 rng(3);
+  auto random_bytes = [&](std::size_t n) {
+    std::string s(n, '\0');
+    for (auto& c : s) c = static_cast<char>(rng());
+    return s;
+  };
+  FakeWorker b(context, endpoint);  // never registers
+  for (int round = 0; round < 3; ++round) {
+    // Random bytes and truncated frames on the protocol.
+    for (int i = 0; i < 50; ++i) {
+      a.send_raw(random_bytes(rng() % 200));
+      b.send_raw(random_bytes(rng() % 200));
+    }
+    const std::string valid = proto::encode(result(second, job2->job().attempt()));
+    for (std::size_t n = 0; n < valid.size(); ++n) b.send_raw(valid.substr(0, n));
+    for (std::size_t n = 0; n + 1 < valid.size(); ++n) a.send_raw(valid.substr(0, n));
+    // Wrong protocol versions.
+    for (std::uint32_t version : {0u, 2u, 99u}) {
+      v1::Envelope e = result(second, job2->job().attempt());
+      e.set_protocol_version(version);
+      std::string bytes;
+      e.SerializeToString(&bytes);
+      a.send_raw(bytes);
+      b.send_raw(bytes);
+    }
+    // Several frames, empty frames.
+    a.send_frames({proto::encode(result(second, 1)), "x"});
+    a.send_raw("");
+    // Results and failures for finished, unknown and not-held jobs, and for a wrong attempt.
+    a.send(result(first, job1->job().attempt()));
+    a.send(failure(first, job1->job().attempt()));
+    a.send(result(999, 1));
+    a.send(failure(999, 1));
+    a.send(result(second, job2->job().attempt() + 1));
+    for (std::uint64_t other = 1; other <= 6; ++other) {
+      if (other != first && other != second) a.send(result(other, 1));
+    }
+    b.send(result(second, job2->job().attempt()));  // unregistered peer
+    b.send(failure(first, 1));
+    // Raw TCP: garbage instead of a ZMTP greeting, a truncated greeting.
+    raw_tcp(port, random_bytes(64));
+    raw_tcp(port, std::string("\xff\0\0\0\0\0\0\0\x01\x7f\x03", 11));
+    raw_tcp(port, "");
+    a.heartbeat();
+    std::this_thread::sleep_for(100ms);
+  }
+  // The unregistered peer is told to register.
+  EXPECT_TRUE(b.expect(v1::Envelope::kDisconnect, 2s));
+  std::this_thread::sleep_for(300ms);
+  ASSERT_TRUE(coordinator.running()) << coordinator.err();
+  EXPECT_EQ(dump(manifest), before);
+  EXPECT_NE(coordinator.err().find("dropped a message"), std::string::npos);
+
+  // The coordinator still works: the fake finishes its lease, a real worker does the rest.
+  a.send(result(second, job2->job().attempt()));
+  Process worker = start_worker(endpoint, dir, 1);
+  // The fake keeps answering whatever it gets until the run ends.
+  const auto end = std::chrono::steady_clock::now() + 30s;
+  while (coordinator.running() && std::chrono::steady_clock::now() < end) {
+    if (auto job = a.expect(v1::Envelope::kJob, 50ms)) a.send(result(job->job().job_id(), job->job().attempt()));
+    a.heartbeat();
+  }
+  ASSERT_EQ(coordinator.wait(10s), 0) << coordinator.err();
+  check_manifest(manifest, 2);
+  auto reader = storage::ManifestReader::open(manifest.string());
+  ASSERT_TRUE(reader);
+  EXPECT_EQ(reader->results()->size(), 6u);
+  EXPECT_TRUE(reader->failures()->empty());
+}
+
+}  // namespace
+}  // namespace drapegen::test

@@ -1,0 +1,253 @@
+// The distributed generation service end to end (issue 5 acceptance 1, 2, 3, 5, 6): real coordinator and worker
+// processes on 127.0.0.1 with ephemeral ports, coarse meshes.
+#include <random>
+
+#include "service_harness.hpp"
+
+namespace drapegen::test {
+namespace {
+
+// Acceptance 1: two workers produce the manifest and the EXR files; checksums match; integrity ok.
+TEST(Service, EndToEndWithTwoWorkers) {
+  const fs::path dir = test_dir("end_to_end");
+  const fs::path out = dir / "run";
+  write_text(dir / "run.toml", small_config(out, 4, 2));
+  Process coordinator({"run", "--config", (dir / "run.toml").string()}, (dir / "coordinator").string());
+  const std::string endpoint = wait_endpoint(out, coordinator, 30s);
+  ASSERT_FALSE(endpoint.empty()) << coordinator.err();
+  EXPECT_EQ(endpoint.rfind("tcp://127.0.0.1:", 0), 0u);
+  Process w1 = start_worker(endpoint, dir, 1), w2 = start_worker(endpoint, dir, 2);
+  ASSERT_EQ(coordinator.wait(120s), 0) << coordinator.err();
+  EXPECT_NE(coordinator.out().find("run complete: 8 done, 0 failed of 8 jobs"), std::string::npos)
+      << coordinator.out();
+  // Both workers are told to exit.
+  EXPECT_EQ(w1.wait(10s), 0) << w1.err();
+  EXPECT_EQ(w2.wait(10s), 0) << w2.err();
+  check_manifest(out / "manifest.sqlite", 2);
+  auto reader = storage::ManifestReader::open((out / "manifest.sqlite").string());
+  ASSERT_TRUE(reader);
+  EXPECT_EQ(reader->run()->state, "complete");
+  std::set<std::string> workers;
+  int exr = 0;
+  for (const auto& j : all(reader->jobs())) workers.insert(j.worker);
+  for (const auto& f : all(reader->files())) exr += f.kind == "exr";
+  EXPECT_EQ(exr, 16);
+  EXPECT_EQ(workers, (std::set<std::string>{"w1", "w2"}));
+  // stats reads it.
+  Process stats({"stats", (out / "manifest.sqlite").string(), "--json", "--plots", (dir / "plots").string()},
+                (dir / "stats").string());
+  ASSERT_EQ(stats.wait(30s), 0) << stats.err();
+  EXPECT_NE(stats.out().find("\"done\": 8"), std::string::npos) << stats.out();
+  EXPECT_TRUE(fs::exists(dir / "plots" / "drape_coefficient.svg"));
+  // A second run into the same output refuses, naming --resume, in one line.
+  Process again({"run", "--config", (dir / "run.toml").string()}, (dir / "again").string());
+  EXPECT_EQ(again.wait(30s), 1);
+  EXPECT_NE(again.err().find("drapegen run: error: "), std::string::npos);
+  EXPECT_NE(again.err().find("--resume"), std::string::npos);
+}
+
+// Acceptance 2: workers killed with SIGKILL again and again (and new ones started): the run completes, every job
+// is recorded exactly once, no orphan files.
+TEST(Service, SurvivesWorkerKills) {
+  const fs::path dir = test_dir("worker_kills");
+  const fs::path out = dir / "run";
+  write_text(dir / "run.toml", small_config(out, 8, 2, "[retry]\nmax_attempts = 20\n"));
+  Process coordinator({"run", "--config", (dir / "run.toml").string()}, (dir / "coordinator").string());
+  const std::string endpoint = wait_endpoint(out, coordinator, 30s);
+  ASSERT_FALSE(endpoint.empty()) << coordinator.err();
+  std::mt19937 rng(42);
+  std::vector<Process> workers;
+  int next = 0;
+  for (; next < 2; ++next) workers.push_back(start_worker(endpoint, dir, next));
+  int kills = 0;
+  const auto deadline = std::chrono::steady_clock::now() + 150s;
+  while (coordinator.running() && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(150 + rng() % 350));
+    if (kills < 8 && coordinator.running()) {
+      auto& victim = workers[rng() % workers.size()];
+      victim.kill9();
+      ++kills;
+      victim = start_worker(endpoint, dir, next++);
+    }
+  }
+  ASSERT_EQ(coordinator.wait(60s), 0) << coordinator.err();
+  EXPECT_GE(kills, 4);
+  check_manifest(out / "manifest.sqlite", 2);
+  auto reader = storage::ManifestReader::open((out / "manifest.sqlite").string());
+  ASSERT_TRUE(reader);
+  int done = 0, lost = 0;
+  for (const auto& j : all(reader->jobs())) done += j.state == storage::JobState::kDone;
+  for (const auto& f : all(reader->failures())) {
+    lost += f.reason == "worker_lost";
+    EXPECT_TRUE(f.reason == "worker_lost" || f.reason == "timeout") << f.reason << ": " << f.message;
+  }
+  EXPECT_EQ(done, 16);
+  EXPECT_EQ(reader->results()->size(), 16u);
+  std::printf("[ info ] %d workers killed, %d leases lost with them\n", kills, lost);
+}
+
+struct RunSnapshot {
+  std::vector<std::string> jobs;     // id, sample, slot, recipe, render seed, mode, state
+  std::vector<std::string> samples;  // every parameter, exactly
+  std::map<std::string, std::string> checksums;  // file -> sha256
+};
+
+RunSnapshot snapshot(const fs::path& manifest) {
+  RunSnapshot s;
+  auto reader = storage::ManifestReader::open(manifest.string());
+  EXPECT_TRUE(reader);
+  if (!reader) return s;
+  for (const auto& j : all(reader->jobs())) {
+    std::ostringstream line;
+    line << j.id << " " << j.sample << " " << j.slot << " " << j.recipe_json << " " << j.render_seed << " " << j.mode
+         << " " << storage::to_string(j.state);
+    s.jobs.push_back(line.str());
+  }
+  for (const auto& p : all(reader->samples())) {
+    char line[512];
+    std::snprintf(line, sizeof line, "%lld %a %a %a %a %a %a %a", static_cast<long long>(p.sample), p.alpha[0],
+                  p.alpha[1], p.alpha[2], p.beta[0], p.beta[1], p.beta[2], p.density_g_per_m2);
+    s.samples.emplace_back(line);
+  }
+  for (const auto& f : all(reader->files())) s.checksums[f.path] = f.sha256;
+  return s;
+}
+
+// Acceptance 3: the coordinator killed with SIGKILL at random moments, then resumed: the run completes, and its
+// jobs, parameters, initial states (and, since jobs replay bit for bit, its files) equal an uninterrupted run's.
+TEST(Service, ResumesAfterCoordinatorKills) {
+  const fs::path dir = test_dir("coordinator_kills");
+  // The uninterrupted reference.
+  const fs::path ref = dir / "reference";
+  write_text(dir / "reference.toml", small_config(ref, 5, 2));
+  Process reference({"local", "--workers", "2", "--config", (dir / "reference.toml").string()},
+                    (dir / "reference").string());
+  ASSERT_EQ(reference.wait(120s), 0) << reference.err();
+
+  const fs::path out = dir / "killed";
+  write_text(dir / "killed.toml", small_config(out, 5, 2));
+  const fs::path manifest = out / "manifest.sqlite";
+  std::mt19937 rng(7);
+  std::vector<Process> workers;
+  std::string worker_endpoint;
+  int kills = 0, starts = 0;
+  int code = -1;
+  for (int round = 0; round < 20 && code != 0; ++round) {
+    const bool resume = fs::exists(manifest);
+    fs::remove(out / "endpoint");
+    Process coordinator(resume ? std::vector<std::string>{"run", "--resume", manifest.string()}
+                               : std::vector<std::string>{"run", "--config", (dir / "killed.toml").string()},
+                        (dir / ("coordinator" + std::to_string(round))).string());
+    ++starts;
+    if (kills < 5) {
+      // Kill at a random moment: during planning, between results, or in the middle of a commit.
+      std::this_thread::sleep_for(std::chrono::milliseconds(rng() % 1500));
+      if (coordinator.running()) {
+        coordinator.kill9();
+        ++kills;
+        std::printf("[ info ] kill %d: %ld of 10 jobs recorded\n", kills, recorded_jobs(manifest));
+        continue;
+      }
+    }
+    const std::string endpoint = wait_endpoint(out, coordinator, 30s);
+    if (endpoint.empty()) {
+      code = coordinator.wait(60s);
+      ASSERT_EQ(code, 0) << coordinator.err();
+      break;
+    }
+    if (endpoint != worker_endpoint) {  // the first start, or a kill before the endpoint was recorded
+      workers.clear();
+      for (int k = 0; k < 2; ++k) workers.push_back(start_worker(endpoint, dir, 10 * round + k));
+      worker_endpoint = endpoint;
+    }
+    code = coordinator.wait(120s);
+    ASSERT_EQ(code, 0) << coordinator.err();
+  }
+  ASSERT_EQ(code, 0);
+  std::printf("[ info ] coordinator killed %d times, started %d times\n", kills, starts);
+  EXPECT_GE(kills, 3);
+  check_manifest(manifest, 2);
+  const auto a = snapshot(ref / "manifest.sqlite");
+  const auto b = snapshot(manifest);
+  EXPECT_EQ(a.jobs, b.jobs);
+  EXPECT_EQ(a.samples, b.samples);
+  EXPECT_EQ(a.checksums, b.checksums);
+  EXPECT_EQ(a.jobs.size(), 10u);
+}
+
+// Acceptance 5: a poison job (its simulation diverges) ends as failed with its reason after the retry limit; the
+// run completes.
+TEST(Service, PoisonJobFailsAfterTheRetryLimit) {
+  const fs::path dir = test_dir("poison");
+  const fs::path out = dir / "run";
+  write_text(dir / "run.toml", small_config(out, 3, 2, "[retry]\nmax_attempts = 3\n[testing]\npoison_samples = [1]\n"));
+  Process local({"local", "--workers", "2", "--config", (dir / "run.toml").string()}, (dir / "local").string());
+  ASSERT_EQ(local.wait(120s), 0) << local.err();
+  EXPECT_NE(local.out().find("run complete: 4 done, 2 failed of 6 jobs"), std::string::npos) << local.out();
+  EXPECT_NE(local.out().find("2 diverged"), std::string::npos) << local.out();  // the stats
+  check_manifest(out / "manifest.sqlite", 2);
+  auto reader = storage::ManifestReader::open((out / "manifest.sqlite").string());
+  ASSERT_TRUE(reader);
+  std::map<std::int64_t, int> attempts_failed;
+  for (const auto& f : all(reader->failures())) {
+    EXPECT_EQ(f.reason, "diverged") << f.message;
+    ++attempts_failed[f.job_id];
+  }
+  for (const auto& j : all(reader->jobs())) {
+    if (j.sample == 1) {
+      EXPECT_EQ(j.state, storage::JobState::kFailed);
+      EXPECT_EQ(j.failure_reason, "diverged");
+      EXPECT_EQ(j.attempts, 3);
+      EXPECT_EQ(attempts_failed[j.id], 3);
+      EXPECT_EQ(j.mode, "poison");
+    } else {
+      EXPECT_EQ(j.state, storage::JobState::kDone) << "job " << j.id;
+      EXPECT_EQ(j.recipe_json.find("\"source\":{\"sample\":1"), std::string::npos)
+          << "a drape recipe from the failed sample must fall back: " << j.recipe_json;
+    }
+  }
+}
+
+// Acceptance 6: the output directory becomes unwritable: the coordinator stops with a clear error and nothing
+// half-written; after the fix, --resume completes the run with nothing lost.
+TEST(Service, StopsOnAnUnwritableOutputAndResumes) {
+  const fs::path dir = test_dir("storage_fault");
+  const fs::path out = dir / "run";
+  write_text(dir / "run.toml", small_config(out, 8, 2));
+  const fs::path manifest = out / "manifest.sqlite";
+  Process coordinator({"run", "--config", (dir / "run.toml").string()}, (dir / "coordinator").string());
+  const std::string endpoint = wait_endpoint(out, coordinator, 30s);
+  ASSERT_FALSE(endpoint.empty()) << coordinator.err();
+  Process worker = start_worker(endpoint, dir, 1);
+  const auto until = std::chrono::steady_clock::now() + 60s;
+  while (recorded_jobs(manifest) < 3 && std::chrono::steady_clock::now() < until) std::this_thread::sleep_for(20ms);
+  ASSERT_GE(recorded_jobs(manifest), 3);
+  // data/ turns into a regular file: every write under it fails (ENOTDIR), even for root.
+  fs::rename(out / "data", dir / "data.saved");
+  write_text(out / "data", "not a directory");
+  ASSERT_EQ(coordinator.wait(60s), 3) << coordinator.err();
+  const std::string err = coordinator.err();
+  const auto last_line = err.substr(err.rfind('\n', err.size() - 2) + 1);
+  EXPECT_EQ(last_line.rfind("drapegen run: error: cannot ", 0), 0u) << err;
+  EXPECT_NE(last_line.find("Not a directory"), std::string::npos) << err;
+  EXPECT_NE(last_line.find("drapegen run --resume"), std::string::npos) << err;
+  const long recorded = recorded_jobs(manifest);
+  EXPECT_LT(recorded, 16);
+  EXPECT_EQ(worker.wait(10s), 0) << worker.err();
+  // Fix it and resume.
+  fs::remove(out / "data");
+  fs::rename(dir / "data.saved", out / "data");
+  Process resumed({"run", "--resume", manifest.string()}, (dir / "resumed").string());
+  const std::string endpoint2 = wait_endpoint(out, resumed, 30s);
+  ASSERT_FALSE(endpoint2.empty()) << resumed.err();
+  Process worker2 = start_worker(endpoint2, dir, 2);
+  ASSERT_EQ(resumed.wait(120s), 0) << resumed.err();
+  check_manifest(manifest, 2);
+  auto reader = storage::ManifestReader::open(manifest.string());
+  ASSERT_TRUE(reader);
+  EXPECT_EQ(reader->results()->size(), 16u);
+  EXPECT_EQ(reader->run()->state, "complete");
+}
+
+}  // namespace
+}  // namespace drapegen::test
