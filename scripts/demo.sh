@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
-# The main job until the distributed generation run exists: simulate one drape of a median fabric from
-# ../shared/data/fabrics618.csv on the drape tester and print its summary.
+# The main job: installs deps, builds, and generates a small data set with the distributed service on this machine
+# (drapegen local: a coordinator plus one worker per core, the embedded default run of coarse meshes), then prints
+# the manifest's statistics. Output: out/local-run/ (manifest.sqlite, data/*.ply, data/*.exr); a previous demo run
+# there is replaced.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
 scripts/build.sh
-mkdir -p out
-build/bin/drapegen simulate --alpha 13923,11455,8821 --beta=-35390,-29660,-22042 --density 300 \
-  --init sine --seed 1 --drift 2 --out out/drape.ply "$@"
+rm -rf out/local-run
+build/bin/drapegen local --workers "$(nproc)" --output out/local-run "$@"

@@ -7,6 +7,7 @@ packages=(
   libspdlog-dev libfmt-dev libcli11-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libosmesa6-dev libopenexr-dev openexr libpng-dev
+  cppzmq-dev libzmq3-dev libprotobuf-dev protobuf-compiler libsqlite3-dev libtomlplusplus-dev
 )
 missing=()
 for p in "${packages[@]}"; do

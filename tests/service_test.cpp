@@ -249,5 +249,37 @@ TEST(Service, StopsOnAnUnwritableOutputAndResumes) {
   EXPECT_EQ(reader->run()->state, "complete");
 }
 
+// SIGTERM (as SIGINT): the coordinator commits, marks the run stopped, shuts the workers down and exits with 4;
+// --resume completes the run.
+TEST(Service, StopsCleanlyOnSigterm) {
+  const fs::path dir = test_dir("sigterm");
+  const fs::path out = dir / "run";
+  write_text(dir / "run.toml", small_config(out, 8, 2));
+  const fs::path manifest = out / "manifest.sqlite";
+  Process coordinator({"run", "--config", (dir / "run.toml").string()}, (dir / "coordinator").string());
+  const std::string endpoint = wait_endpoint(out, coordinator, 30s);
+  ASSERT_FALSE(endpoint.empty()) << coordinator.err();
+  Process worker = start_worker(endpoint, dir, 1);
+  const auto until = std::chrono::steady_clock::now() + 60s;
+  while (recorded_jobs(manifest) < 2 && std::chrono::steady_clock::now() < until) std::this_thread::sleep_for(20ms);
+  ::kill(coordinator.pid(), SIGTERM);
+  ASSERT_EQ(coordinator.wait(30s), 4) << coordinator.err();
+  EXPECT_NE(coordinator.err().find("drapegen run --resume"), std::string::npos) << coordinator.err();
+  EXPECT_EQ(worker.wait(10s), 0) << worker.err();
+  {
+    auto reader = storage::ManifestReader::open(manifest.string());
+    ASSERT_TRUE(reader);
+    EXPECT_EQ(reader->run()->state, "stopped");
+  }
+  check_manifest(manifest, 2);
+  Process resumed({"run", "--resume", manifest.string()}, (dir / "resumed").string());
+  const std::string endpoint2 = wait_endpoint(out, resumed, 30s);
+  ASSERT_FALSE(endpoint2.empty()) << resumed.err();
+  Process worker2 = start_worker(endpoint2, dir, 2);
+  ASSERT_EQ(resumed.wait(120s), 0) << resumed.err();
+  check_manifest(manifest, 2);
+  EXPECT_EQ(recorded_jobs(manifest), 16);
+}
+
 }  // namespace
 }  // namespace drapegen::test
