@@ -25,5 +25,6 @@ Runner add_run_command(CLI::App& app);
 Runner add_worker_command(CLI::App& app);
 Runner add_local_command(CLI::App& app);
 Runner add_stats_command(CLI::App& app);
+Runner add_keygen_command(CLI::App& app);
 
 }  // namespace drapegen::cli

@@ -26,6 +26,8 @@ int main(int argc, char** argv) {
       drapegen::cli::add_local_command);
   add("stats", "Summarise a run's manifest (counts, failures, throughput, distributions, storage)",
       drapegen::cli::add_stats_command);
+  add("keygen", "Make a CurveZMQ key pair (coordinator or worker) for runs on non-loopback addresses",
+      drapegen::cli::add_keygen_command);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -26,6 +26,8 @@ Runner add_worker_command(CLI::App& app) {
   app.add_option("--give-up", o->give_up_s, "Exit with an error after this many seconds without a coordinator (0: never)")
       ->check(CLI::Range(0.0, 1e9))
       ->capture_default_str();
+  app.add_option("--server-key", o->server_key, "CurveZMQ: the coordinator's public key (Z85, or a .pub file)");
+  app.add_option("--key", o->key_file, "CurveZMQ: this worker's secret key file (drapegen keygen)");
   return [o]() -> int {
     const auto& stop = install_stop_signals();
     const sim::Status s = worker::run_worker(*o, stop);

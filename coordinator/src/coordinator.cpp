@@ -1,6 +1,7 @@
 #include "drapegen/coordinator/coordinator.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
 #include <chrono>
 #include <cstring>
@@ -18,6 +19,7 @@
 #include <zmq.hpp>
 #include <zmq_addon.hpp>
 
+#include "drapegen/coordinator/curve_keys.hpp"
 #include "drapegen/coordinator/logging.hpp"
 #include "drapegen/coordinator/planner.hpp"
 #include "drapegen/proto/codec.hpp"
@@ -96,18 +98,70 @@ struct Coordinator::Impl {
   bool files_written = false;
 
   zmq::context_t context{1};
+  zmq::socket_t zap{context, zmq::socket_type::rep};  // ZAP handler (CurveZMQ only); bound before the ROUTER
   zmq::socket_t socket{context, zmq::socket_type::router};
   std::string endpoint;
+  bool curve = false;
+  std::set<std::string> authorized;  // raw 32-byte worker public keys
+  std::int64_t refused_handshakes = 0;
 
   std::shared_ptr<spdlog::logger> log = logger();
   bool terminal_progress = false;
-  Clock::time_point start = Clock::now(), last_progress = Clock::now(), last_reject_log{};
+  Clock::time_point start = Clock::now(), last_progress = Clock::now(), last_reject_log{}, last_refuse_log{};
   std::int64_t done_at_start = 0;
 
   // ---------------------------------------------------------------------------------------------------------------
   // Setup
 
+  /// CurveZMQ: the server key on the ROUTER and a ZAP handler that admits only the authorised worker keys.
+  sim::Status setup_curve() {
+    if (config.server_secret_key.empty()) return {};
+    auto keys = read_secret_key(config.server_secret_key);
+    if (!keys) return keys.error();
+    auto allowed = read_authorized_keys(config.authorized_keys);
+    if (!allowed) return allowed.error();
+    authorized = std::move(allowed).value();
+    try {
+      zap.set(zmq::sockopt::linger, 0);
+      zap.bind("inproc://zeromq.zap.01");
+      socket.set(zmq::sockopt::curve_server, 1);
+      socket.set(zmq::sockopt::curve_secretkey, keys->secret_z85);
+      socket.set(zmq::sockopt::zap_domain, "drapegen");
+    } catch (const zmq::error_t& e) {
+      return sim::Error{fmt::format("cannot set up CurveZMQ: {}", e.what())};
+    }
+    curve = true;
+    log->info("CurveZMQ on: {} authorised worker key(s); server public key {}", authorized.size(), keys->public_z85);
+    return {};
+  }
+
+  /// One ZAP request (RFC 27): admit the CURVE client if its public key is authorised.
+  void answer_zap() {
+    std::vector<zmq::message_t> request;
+    if (!zmq::recv_multipart(zap, std::back_inserter(request), zmq::recv_flags::dontwait)) return;
+    std::string status = "400", text = "unauthorised key";
+    if (request.size() >= 7 && request[5].to_string() == "CURVE" && authorized.count(request[6].to_string())) {
+      status = "200";
+      text = "OK";
+    } else {
+      ++refused_handshakes;
+      const auto now = Clock::now();
+      if (now - last_refuse_log > std::chrono::seconds(1)) {  // one line a second at most
+        log->warn("refused a connection from {} ({}; {} refused so far)",
+                  request.size() > 3 ? request[3].to_string() : "?",
+                  request.size() > 5 ? request[5].to_string() : "no mechanism", refused_handshakes);
+        last_refuse_log = now;
+      }
+    }
+    const std::string version = "1.0";
+    const std::string id = request.size() > 1 ? request[1].to_string() : "";
+    std::array<zmq::const_buffer, 6> reply = {zmq::buffer(version), zmq::buffer(id),   zmq::buffer(status),
+                                              zmq::buffer(text),    zmq::buffer("", 0), zmq::buffer("", 0)};
+    zmq::send_multipart(zap, reply);
+  }
+
   sim::Status bind(const std::string& preferred, const std::string& fallback) {
+    if (sim::Status s = setup_curve(); !s) return s;
     socket.set(zmq::sockopt::linger, 0);
     socket.set(zmq::sockopt::maxmsgsize, static_cast<int64_t>(proto::kMaxFrameBytes));
     socket.set(zmq::sockopt::sndhwm, 0);
@@ -115,10 +169,10 @@ struct Coordinator::Impl {
     std::string error;
     for (const std::string& candidate : {preferred, fallback}) {
       if (candidate.empty()) continue;
-      if (!is_loopback(candidate)) {
+      if (!is_loopback(candidate) && !curve) {
         error = fmt::format(
-            "refusing to bind {}: binding a non-loopback address requires CurveZMQ authentication, which this build "
-            "does not have yet (use 127.0.0.1, or an SSH tunnel)",
+            "refusing to bind {} without authentication: a non-loopback address needs [security] server_secret_key "
+            "and authorized_keys (CurveZMQ; drapegen keygen makes keys)",
             candidate);
         continue;
       }
@@ -606,13 +660,14 @@ struct Coordinator::Impl {
     // Answer late or reconnecting workers with Shutdown for a moment too.
     const auto until = Clock::now() + std::chrono::milliseconds(options.shutdown_linger_ms);
     while (Clock::now() < until) {
-      zmq::pollitem_t item{socket.handle(), 0, ZMQ_POLLIN, 0};
+      zmq::pollitem_t items[2] = {{socket.handle(), 0, ZMQ_POLLIN, 0}, {zap.handle(), 0, ZMQ_POLLIN, 0}};
       try {
-        zmq::poll(&item, 1, std::chrono::milliseconds(50));
+        zmq::poll(items, curve ? 2 : 1, std::chrono::milliseconds(50));
       } catch (const zmq::error_t&) {
         break;
       }
-      if (!(item.revents & ZMQ_POLLIN)) continue;
+      if (curve && (items[1].revents & ZMQ_POLLIN)) answer_zap();
+      if (!(items[0].revents & ZMQ_POLLIN)) continue;
       std::vector<zmq::message_t> frames;
       if (!zmq::recv_multipart(socket, std::back_inserter(frames), zmq::recv_flags::dontwait)) continue;
       if (frames.empty()) continue;
@@ -646,13 +701,15 @@ struct Coordinator::Impl {
       if (stop.load()) break;
       dispatch();
       if (!storage_error.empty()) break;
-      zmq::pollitem_t item{socket.handle(), 0, ZMQ_POLLIN, 0};
+      zmq::pollitem_t items[2] = {{socket.handle(), 0, ZMQ_POLLIN, 0}, {zap.handle(), 0, ZMQ_POLLIN, 0}};
+      zmq::pollitem_t& item = items[0];
       try {
-        zmq::poll(&item, 1, std::chrono::milliseconds(std::min(config.heartbeat_ms, 100)));
+        zmq::poll(items, curve ? 2 : 1, std::chrono::milliseconds(std::min(config.heartbeat_ms, 100)));
       } catch (const zmq::error_t& e) {
         if (e.num() != EINTR) throw;
         continue;  // a signal: the loop condition sees the stop flag
       }
+      if (curve && (items[1].revents & ZMQ_POLLIN)) answer_zap();
       if (item.revents & ZMQ_POLLIN) {
         // Drain what has arrived (up to a bound), then commit once: group commit.
         for (int n = 0; n < 1024 && storage_error.empty(); ++n) {

@@ -105,7 +105,7 @@ sim::Expected<RunConfig> parse_run_config(const std::string& toml_text, const st
   Reader r(root, source_name);
   r.only_keys(&root, "",
               {"seed", "samples", "states_per_sample", "orientations", "resolution", "noise", "density", "output",
-               "model", "recipes", "solver", "network", "retry", "progress", "testing"});
+               "model", "recipes", "solver", "network", "security", "retry", "progress", "testing"});
   if (const toml::node* seed = root.get("seed")) {
     if (!seed->is_integer() || seed->as_integer()->get() < 0) {
       r.fail("seed", "must be a non-negative integer");
@@ -148,6 +148,26 @@ sim::Expected<RunConfig> parse_run_config(const std::string& toml_text, const st
   r.real(network, "network", "lease_s", c.lease_s, 0.1, 7 * 86400.0);
   if (r.ok() && c.bind.rfind("tcp://", 0) != 0 && c.bind.rfind("ipc://", 0) != 0) {
     r.fail("network.bind", "must be a tcp:// or ipc:// endpoint, e.g. tcp://127.0.0.1:5555");
+  }
+
+  const toml::table* security = r.table("security");
+  r.only_keys(security, "security", {"curve", "server_secret_key", "authorized_keys"});
+  if (security) {
+    if (const toml::node* curve = security->get("curve")) {
+      if (!curve->is_boolean()) {
+        r.fail("security.curve", "must be true or false");
+      } else {
+        c.curve = curve->as_boolean()->get();
+      }
+    }
+  }
+  r.text(security, "security", "server_secret_key", c.server_secret_key);
+  r.text(security, "security", "authorized_keys", c.authorized_keys);
+  if (r.ok() && c.server_secret_key.empty() != c.authorized_keys.empty()) {
+    r.fail("security", "server_secret_key and authorized_keys go together");
+  }
+  if (r.ok() && c.curve && c.server_secret_key.empty()) {
+    r.fail("security.curve", "needs server_secret_key and authorized_keys");
   }
 
   const toml::table* retry = r.table("retry");

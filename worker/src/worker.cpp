@@ -10,6 +10,7 @@
 #include <unistd.h>
 #include <zmq.hpp>
 
+#include "drapegen/coordinator/curve_keys.hpp"
 #include "drapegen/coordinator/logging.hpp"
 #include "drapegen/proto/codec.hpp"
 #include "drapegen/worker/job_runner.hpp"
@@ -103,6 +104,17 @@ sim::Status run_worker(const WorkerOptions& o, const std::atomic<bool>& stop) {
       std::filesystem::remove_all(dir, ec);
     }
   } remove_scratch{o.scratch_dir.empty() ? scratch : std::string()};
+  std::optional<coordinator::CurveKeyPair> own_key;
+  std::string server_key;
+  if (!o.server_key.empty() || !o.key_file.empty()) {
+    if (o.server_key.empty() || o.key_file.empty()) return sim::Error{"CurveZMQ needs both --server-key and --key"};
+    auto server = coordinator::read_public_key(o.server_key);
+    if (!server) return server.error();
+    server_key = *server;
+    auto own = coordinator::read_secret_key(o.key_file);
+    if (!own) return own.error();
+    own_key = *own;
+  }
   Executor executor(scratch);
   zmq::context_t context{1};
   int backoff_ms = o.backoff_initial_ms;
@@ -115,6 +127,11 @@ sim::Status run_worker(const WorkerOptions& o, const std::atomic<bool>& stop) {
     socket.set(zmq::sockopt::linger, 0);
     socket.set(zmq::sockopt::maxmsgsize, static_cast<int64_t>(proto::kMaxFrameBytes));
     try {
+      if (own_key) {
+        socket.set(zmq::sockopt::curve_serverkey, server_key);
+        socket.set(zmq::sockopt::curve_publickey, own_key->public_z85);
+        socket.set(zmq::sockopt::curve_secretkey, own_key->secret_z85);
+      }
       socket.connect(o.endpoint);
     } catch (const zmq::error_t& e) {
       return sim::Error{fmt::format("cannot connect to {}: {}", o.endpoint, e.what())};

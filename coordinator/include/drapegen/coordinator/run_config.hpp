@@ -33,6 +33,10 @@ struct RunConfig {
   int heartbeat_ms = 1000;
   int liveness = 5;
   double lease_s = 900.0;
+  // [security]
+  bool curve = false;               // require CurveZMQ on loopback too (always required on other addresses)
+  std::string server_secret_key;    // the coordinator's secret key file (drapegen keygen)
+  std::string authorized_keys;      // worker public keys, one per line
   // [retry]
   int max_attempts = 3;
   // [progress]

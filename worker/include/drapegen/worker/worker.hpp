@@ -19,6 +19,8 @@ struct WorkerOptions {
   int backoff_max_ms = 8000;
   double give_up_s = 0.0;        // > 0: fail after this long without hearing from a coordinator
   std::string scratch_dir;       // temporary files; default a fresh directory under the system temp dir
+  std::string server_key;        // CurveZMQ: the coordinator's public key (Z85 or a file); empty: plain TCP
+  std::string key_file;          // CurveZMQ: this worker's secret key file (its public key must be authorised)
 };
 
 /// Runs until the coordinator sends Shutdown (Status ok), `stop` becomes true (ok), or give_up_s passes without a
