@@ -17,6 +17,9 @@ struct RunOptions {
   std::string resume;
   std::string bind;
   std::string progress = "auto";
+  std::string server_key;
+  std::string authorized_keys;
+  std::string endpoint_file;
 };
 
 int fail(const std::string& message, int code = kExitUsage) {
@@ -71,12 +74,18 @@ Runner add_run_command(CLI::App& app) {
   app.add_option("--progress", o->progress, "Progress display: auto (terminal line if stderr is a TTY), terminal, log, off")
       ->check(CLI::IsMember({"auto", "terminal", "log", "off"}))
       ->capture_default_str();
+  app.add_option("--server-key", o->server_key, "CurveZMQ secret key file (overrides [security] server_secret_key)");
+  app.add_option("--authorized-keys", o->authorized_keys, "Worker public keys file (overrides [security] authorized_keys)");
+  app.add_option("--endpoint-file", o->endpoint_file, "Also write the bound endpoint to this file");
   return [o] {
     if (o->config.empty() == o->resume.empty()) return fail("give --config RUN.toml or --resume MANIFEST");
     const auto& stop = install_stop_signals();
     coordinator::CoordinatorOptions options;
     options.bind_override = o->bind;
     options.progress = parse_progress(o->progress);
+    options.server_secret_key = o->server_key;
+    options.authorized_keys = o->authorized_keys;
+    options.endpoint_file = o->endpoint_file;
     sim::Expected<std::unique_ptr<coordinator::Coordinator>> c = sim::Error{""};
     if (!o->config.empty()) {
       auto text = read_text_file(o->config);

@@ -8,6 +8,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libosmesa6-dev libopenexr-dev openexr libpng-dev
   cppzmq-dev libzmq3-dev libprotobuf-dev protobuf-compiler libsqlite3-dev libtomlplusplus-dev
+  slurm-wlm munge sqlite3
 )
 missing=()
 for p in "${packages[@]}"; do

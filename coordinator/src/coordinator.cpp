@@ -115,6 +115,13 @@ struct Coordinator::Impl {
 
   /// CurveZMQ: the server key on the ROUTER and a ZAP handler that admits only the authorised worker keys.
   sim::Status setup_curve() {
+    if (!options.server_secret_key.empty() || !options.authorized_keys.empty()) {
+      if (options.server_secret_key.empty() || options.authorized_keys.empty()) {
+        return sim::Error{"--server-key and --authorized-keys go together"};
+      }
+      config.server_secret_key = options.server_secret_key;
+      config.authorized_keys = options.authorized_keys;
+    }
     if (config.server_secret_key.empty()) return {};
     auto keys = read_secret_key(config.server_secret_key);
     if (!keys) return keys.error();
@@ -186,6 +193,12 @@ struct Coordinator::Impl {
       }
     }
     return sim::Error{error};
+  }
+
+  sim::Status publish_endpoint() {
+    if (sim::Status s = storage::write_file_atomic(out_dir + "/endpoint", endpoint + "\n"); !s) return s;
+    if (!options.endpoint_file.empty()) return storage::write_file_atomic(options.endpoint_file, endpoint + "\n");
+    return {};
   }
 
   sim::Status load_state() {
@@ -818,9 +831,7 @@ sim::Expected<std::unique_ptr<Coordinator>> Coordinator::create(const std::strin
   if (sim::Status s = impl->load_state(); !s) return s.error();
   impl->log->info("run planned: {} jobs in {}; listening on {}", impl->jobs.size(), impl->manifest_path,
                   impl->endpoint);
-  if (sim::Status s = storage::write_file_atomic(impl->out_dir + "/endpoint", impl->endpoint + "\n"); !s) {
-    return s.error();
-  }
+  if (sim::Status s = impl->publish_endpoint(); !s) return s.error();
   return std::unique_ptr<Coordinator>(new Coordinator(std::move(impl)));
 }
 
@@ -849,9 +860,7 @@ sim::Expected<std::unique_ptr<Coordinator>> Coordinator::resume(const std::strin
   if (sim::Status s = impl->load_state(); !s) return s.error();
   impl->log->info("resumed {}: {} of {} jobs done, {} failed; listening on {}", manifest_path, impl->done,
                   impl->jobs.size(), impl->failed, impl->endpoint);
-  if (sim::Status s = storage::write_file_atomic(impl->out_dir + "/endpoint", impl->endpoint + "\n"); !s) {
-    return s.error();
-  }
+  if (sim::Status s = impl->publish_endpoint(); !s) return s.error();
   return std::unique_ptr<Coordinator>(new Coordinator(std::move(impl)));
 }
 

@@ -19,6 +19,12 @@ struct CoordinatorOptions {
   std::string bind_override;
   /// Progress: a self-updating line on a terminal, or plain log lines; "auto" decides by isatty(stderr).
   enum class Progress { kAuto, kTerminal, kLog, kOff } progress = Progress::kAuto;
+  /// CurveZMQ keys instead of the configuration's [security] files (deployment, not part of the run: a resumed run
+  /// may use other keys).
+  std::string server_secret_key;
+  std::string authorized_keys;
+  /// Also write the bound endpoint to this file (besides OUTPUT/endpoint).
+  std::string endpoint_file;
   /// After the run completes, keep answering workers with Shutdown for this long (so reconnecting ones exit too).
   int shutdown_linger_ms = 1000;
 };
