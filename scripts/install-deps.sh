@@ -9,6 +9,7 @@ packages=(
   libosmesa6-dev libopenexr-dev openexr libpng-dev
   cppzmq-dev libzmq3-dev libprotobuf-dev protobuf-compiler libsqlite3-dev libtomlplusplus-dev
   slurm-wlm munge sqlite3
+  python3 python3-numpy python3-torch python3-openimageio
 )
 missing=()
 for p in "${packages[@]}"; do

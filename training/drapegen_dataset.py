@@ -1,0 +1,105 @@
+"""A PyTorch Dataset over a drapegen run: the manifest (SQLite, read-only) and its OpenEXR files.
+
+One item is one data point: the 4 depth views of one specimen orientation of one drape, as a float32 tensor of shape
+(4, H, W) (camera-space z in metres, 0 where the camera saw nothing), and the drape's 6-D bending parameter target:
+the features sign(k) ln|k| of (alpha warp, bias, weft, beta warp, bias, weft) normalised to 300 g/m^2 (as the
+sampler works), standardised by a mean and std (by default those of the run's done samples; pass the training
+set's to a validation set). Only done jobs are items. Schema: docs/SERVICE.md, "Manifest schema".
+
+Needs python3-torch, python3-numpy and python3-openimageio (Debian).
+"""
+
+import hashlib
+import math
+import os
+import sqlite3
+
+import numpy as np
+import OpenImageIO as oiio
+import torch
+from torch.utils.data import Dataset
+
+FEATURES = ("alpha_warp", "alpha_bias", "alpha_weft", "beta_warp", "beta_bias", "beta_weft")
+STANDARD_DENSITY = 300.0  # g/m^2
+
+
+def features(moduli, density):
+    """sign(k) ln|k| of the six moduli at 300 g/m^2 (k * 300 / density)."""
+    out = []
+    for k in moduli:
+        k = k * STANDARD_DENSITY / density
+        out.append(math.copysign(math.log(abs(k)), k))
+    return out
+
+
+def read_views(path):
+    """The depth views of one drapegen EXR file: float32 array (views, H, W) over the full display window."""
+    inp = oiio.ImageInput.open(path)
+    if inp is None:
+        raise IOError(f"cannot open {path}: {oiio.geterror()}")
+    try:
+        spec = inp.spec()
+        names = list(spec.channelnames)
+        pixels = inp.read_image("float")
+        if pixels is None:
+            raise IOError(f"cannot read {path}: {inp.geterror()}")
+    finally:
+        inp.close()
+    full = np.zeros((spec.full_height, spec.full_width, spec.nchannels), dtype=np.float32)
+    y0, x0 = spec.y - spec.full_y, spec.x - spec.full_x
+    full[y0:y0 + spec.height, x0:x0 + spec.width, :] = pixels.reshape(spec.height, spec.width, spec.nchannels)
+    order = sorted(range(len(names)), key=lambda i: names[i])  # view0.Z, view1.Z, ...
+    return np.ascontiguousarray(np.transpose(full[:, :, order], (2, 0, 1)))
+
+
+class DrapeDataset(Dataset):
+    """Data points of the done jobs of a run, in (job id, orientation) order."""
+
+    def __init__(self, manifest, mean=None, std=None, verify_checksums=False):
+        self.manifest = os.path.abspath(manifest)
+        self.root = os.path.dirname(self.manifest)
+        self.verify = verify_checksums
+        db = sqlite3.connect(f"file:{self.manifest}?mode=ro", uri=True)
+        try:
+            (version,) = db.execute("SELECT value FROM meta WHERE key = 'schema_version'").fetchone()
+            if version != "1":
+                raise ValueError(f"{manifest}: manifest schema version {version}, this reader reads 1")
+            rows = db.execute(
+                "SELECT j.id, j.sample, j.slot, f.idx, f.path, f.sha256, s.alpha_warp, s.alpha_bias, s.alpha_weft, "
+                "s.beta_warp, s.beta_bias, s.beta_weft, s.density "
+                "FROM jobs j JOIN files f ON f.job_id = j.id AND f.kind = 'exr' "
+                "JOIN samples s ON s.run_id = j.run_id AND s.sample = j.sample "
+                "WHERE j.state = 'done' ORDER BY j.id, f.idx").fetchall()
+        finally:
+            db.close()
+        self.items = []
+        for job, sample, slot, idx, path, sha, aw, ab, af, bw, bb, bf, density in rows:
+            self.items.append({"job": job, "sample": sample, "slot": slot, "orientation": idx, "path": path,
+                               "sha256": sha, "features": features((aw, ab, af, bw, bb, bf), density)})
+        raw = np.array([it["features"] for it in self.items], dtype=np.float64).reshape(-1, len(FEATURES))
+        self.mean = np.asarray(mean, dtype=np.float64) if mean is not None else (
+            raw.mean(axis=0) if len(raw) else np.zeros(len(FEATURES)))
+        if std is not None:
+            self.std = np.asarray(std, dtype=np.float64)
+        else:
+            self.std = raw.std(axis=0) if len(raw) else np.ones(len(FEATURES))
+            self.std[self.std == 0] = 1.0
+
+    def __len__(self):
+        return len(self.items)
+
+    def __getitem__(self, i):
+        it = self.items[i]
+        path = os.path.join(self.root, it["path"])
+        if self.verify:
+            with open(path, "rb") as f:
+                digest = hashlib.sha256(f.read()).hexdigest()
+            if digest != it["sha256"]:
+                raise IOError(f"{path}: checksum {digest} does not match the manifest's {it['sha256']}")
+        views = torch.from_numpy(read_views(path))
+        target = torch.tensor((np.asarray(it["features"]) - self.mean) / self.std, dtype=torch.float32)
+        return views, target
+
+    def denormalise(self, target):
+        """Standardised targets back to sign(k) ln|k| features."""
+        return np.asarray(target) * self.std + self.mean

@@ -1,0 +1,71 @@
+"""Reads a run generated in the test (drapegen local, tiny) through DrapeDataset.
+
+Usage: dataset_test.py DRAPEGEN_BINARY WORK_DIR
+"""
+
+import os
+import shutil
+import sqlite3
+import subprocess
+import sys
+
+import numpy as np
+import torch
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from drapegen_dataset import DrapeDataset, features  # noqa: E402
+
+drapegen, work = sys.argv[1], sys.argv[2]
+shutil.rmtree(work, ignore_errors=True)
+os.makedirs(work)
+config = os.path.join(work, "run.toml")
+with open(config, "w") as f:
+    f.write(f"""seed = 4
+samples = 3
+states_per_sample = 2
+orientations = 2
+resolution = 15
+output = "{work}/run"
+[solver]
+max_self_intersections = 1000000
+[testing]
+poison_samples = [2]
+[retry]
+max_attempts = 1
+""")
+subprocess.run([drapegen, "local", "--workers", "2", "--config", config], check=True, capture_output=True)
+manifest = os.path.join(work, "run", "manifest.sqlite")
+
+ds = DrapeDataset(manifest, verify_checksums=True)
+db = sqlite3.connect(manifest)
+done = db.execute("SELECT count(*) FROM jobs WHERE state = 'done'").fetchone()[0]
+failed = db.execute("SELECT count(*) FROM jobs WHERE state = 'failed'").fetchone()[0]
+assert done == 4 and failed == 2, (done, failed)
+assert len(ds) == done * 2, len(ds)  # 2 data points per done drape; failed jobs are no items
+
+views, target = ds[0]
+assert views.dtype == torch.float32 and tuple(views.shape) == (4, 180, 240), views.shape
+assert torch.isfinite(views).all()
+covered = (views > 0).float().mean(dim=(1, 2))
+assert (covered > 0.01).all(), covered  # every view sees the drape
+z = views[views > 0]
+assert 0.3 < float(z.min()) and float(z.max()) < 1.5, (float(z.min()), float(z.max()))  # metres from the camera
+assert tuple(target.shape) == (6,)
+
+# Targets: the sample's moduli, as features, standardised over the dataset.
+targets = torch.stack([ds[i][1] for i in range(len(ds))]).numpy()
+assert np.allclose(targets.mean(axis=0), 0.0, atol=1e-5), targets.mean(axis=0)
+row = db.execute("SELECT alpha_warp, alpha_bias, alpha_weft, beta_warp, beta_bias, beta_weft, density "
+                 "FROM samples WHERE sample = ?", (ds.items[0]["sample"],)).fetchone()
+assert np.allclose(ds.denormalise(target.numpy()), features(row[:6], row[6]), atol=1e-5)
+
+# Two orientations of one drape differ (other table angles), the same item read twice does not.
+a, _ = ds[0]
+b, _ = ds[1]
+assert ds.items[0]["job"] == ds.items[1]["job"] and not torch.equal(a, b)
+assert torch.equal(a, ds[0][0])
+
+loader = torch.utils.data.DataLoader(ds, batch_size=4, shuffle=False)
+batch_views, batch_targets = next(iter(loader))
+assert tuple(batch_views.shape) == (4, 4, 180, 240) and tuple(batch_targets.shape) == (4, 6)
+print(f"dataset_test: ok ({len(ds)} items of 4 views 180x240 from {done} drapes)")
