@@ -147,8 +147,10 @@ sim::Status run_worker(const WorkerOptions& o, const std::atomic<bool>& stop) {
       ready.mutable_ready()->set_interval_ms(static_cast<std::uint32_t>(o.heartbeat_ms));
       send(std::move(ready));
     }
-    // A job computed for an earlier connection is of no use: its lease is gone with that connection.
+    // A job computed for an earlier connection is of no use: its lease is gone with that connection. Until it
+    // finishes, a job leased on this connection waits in `queued`.
     bool stale_computation = executor.busy();
+    std::optional<v1::Job> queued;
     int peer_interval_ms = o.heartbeat_ms;
     auto last_recv = Clock::now();
     auto last_send = Clock::now();
@@ -183,8 +185,9 @@ sim::Status run_worker(const WorkerOptions& o, const std::atomic<bool>& stop) {
               if (e.heartbeat().interval_ms() > 0) peer_interval_ms = static_cast<int>(e.heartbeat().interval_ms());
               break;
             case v1::Envelope::kJob:
-              if (current_job != 0 || executor.busy()) {
-                log->warn("worker {}: got job {} while busy; ignored", name, e.job().job_id());
+              if (current_job != 0) {
+                log->warn("worker {}: got job {} while computing job {}; ignored", name, e.job().job_id(),
+                          current_job);
                 break;
               }
               if (e.job().spec().mode() == v1::JOB_MODE_NOOP) {  // answered at once, no thread hop
@@ -198,7 +201,11 @@ sim::Status run_worker(const WorkerOptions& o, const std::atomic<bool>& stop) {
               }
               current_job = static_cast<std::int64_t>(e.job().job_id());
               current_attempt = e.job().attempt();
-              executor.submit(e.job());
+              if (executor.busy()) {
+                queued = e.job();  // the stale computation still runs; this one starts when it ends
+              } else {
+                executor.submit(e.job());
+              }
               break;
             case v1::Envelope::kDisconnect:
               log->info("worker {}: coordinator does not know us ({}); registering again", name,
@@ -219,12 +226,16 @@ sim::Status run_worker(const WorkerOptions& o, const std::atomic<bool>& stop) {
       if (auto answer = executor.take()) {
         if (stale_computation) {
           stale_computation = false;
+          if (queued) {
+            executor.submit(std::move(*queued));
+            queued.reset();
+          }
         } else if (current_job != 0) {
           send(std::move(*answer));
           last_send = Clock::now();
+          current_job = 0;
+          current_attempt = 0;
         }
-        current_job = 0;
-        current_attempt = 0;
       }
       const auto now = Clock::now();
       if (now - last_send >= milliseconds(o.heartbeat_ms)) {
