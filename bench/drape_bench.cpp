@@ -68,6 +68,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--pcg-tolerance", pcg_tolerance, "SolverOptions::pcg_tolerance")->capture_default_str();
   double outer_below = drapegen::sim::SolverOptions{}.lagged_outer_below;
+  double gn_above = drapegen::sim::DrapeConfig{}.solver.gauss_newton_above;
+  app.add_option("--gn-above", gn_above, "SolverOptions::gauss_newton_above")->capture_default_str();
   app.add_option("--outer-below", outer_below, "SolverOptions::lagged_outer_below")->capture_default_str();
   double exact_below = drapegen::sim::SolverOptions{}.exact_hessian_below;
   int max_iterations = drapegen::sim::SolverOptions{}.max_iterations;
@@ -100,6 +102,7 @@ int main(int argc, char** argv) {
       config.solver.max_pcg_iterations = pcg_iterations;
       config.solver.pcg_tolerance = pcg_tolerance;
       config.solver.lagged_outer_below = outer_below;
+      config.solver.gauss_newton_above = gn_above;
       config.solver.exact_hessian_below = exact_below;
       config.solver.max_iterations = max_iterations;
       config.coarse_start_resolution = coarse;

@@ -136,7 +136,7 @@ double DihedralBending::evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd* gr
   Vector12d g;
   Matrix12d h2;
   Matrix12d element;
-  const bool exact_second = hessian != nullptr && (hessian->mode() == HessianMode::kExact || !gauss_newton_);
+  const bool exact_second = hessian != nullptr && hessian->mode() != HessianMode::kGaussNewton;
   for (std::size_t i = 0; i < hinges_.size(); ++i) {
     const Hinge& h = hinges_[i];
     const double c = 2.0 / rest_[i].height_sum;
@@ -156,7 +156,7 @@ double DihedralBending::evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd* gr
     element.noalias() = d2e * g * g.transpose();
     if (exact_second) {
       element.noalias() += de * h2;
-      if (hessian->mode() == HessianMode::kProjected) project_to_psd<12>(element);
+      if (hessian->mode() != HessianMode::kExact) project_to_psd<12>(element);
     }
     hessian->add(static_cast<int>(i), element.data());
   }

@@ -12,11 +12,9 @@ namespace drapegen::sim {
 namespace {
 
 std::unique_ptr<EnergyTerm> make_bending(const ClothMesh& mesh, const Topology& topology, const FabricParameters& fabric,
-                                         BendingModel model, AnisotropyRule rule, bool gauss_newton) {
+                                         BendingModel model, AnisotropyRule rule) {
   if (model == BendingModel::kQuadratic) return std::make_unique<QuadraticBending>(mesh, topology, fabric.gamma, rule);
-  auto bending = std::make_unique<DihedralBending>(mesh, topology, DihedralModuli{fabric.alpha, fabric.beta}, rule);
-  bending->set_gauss_newton(gauss_newton);
-  return bending;
+  return std::make_unique<DihedralBending>(mesh, topology, DihedralModuli{fabric.alpha, fabric.beta}, rule);
 }
 
 }  // namespace
@@ -40,8 +38,7 @@ Expected<DrapeResult> simulate_drape(const DrapeConfig& config,
     const Topology topology = build_topology(mesh);
     CorotationalMembrane membrane(mesh, config.membrane);
     std::unique_ptr<EnergyTerm> bending =
-        make_bending(mesh, topology, fabric, config.bending_model, config.anisotropy,
-                     config.gauss_newton_bending);
+        make_bending(mesh, topology, fabric, config.bending_model, config.anisotropy);
     Gravity gravity(mesh, fabric.density, config.gravity);
     PlatformContact contact(mesh, config.platform);
 

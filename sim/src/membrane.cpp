@@ -137,7 +137,7 @@ double CorotationalMembrane::energy(const Eigen::Matrix3Xd& x) const {
 double CorotationalMembrane::evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd* gradient,
                                       HessianSink* hessian) const {
   double total = 0.0;
-  const bool project = hessian != nullptr && hessian->mode() == HessianMode::kProjected;
+  const bool project = hessian != nullptr && hessian->mode() != HessianMode::kExact;
   for (int t = 0; t < element_count(); ++t) {
     const Svd32 svd = svd32(deformation_gradient(x, t));
     const double scale = params_.stiffness * area_[t];

@@ -58,9 +58,6 @@ class DihedralBending final : public EnergyTerm {
   [[nodiscard]] double energy(const Eigen::Matrix3Xd& x) const override;
   double evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd* gradient, HessianSink* hessian) const override;
 
-  /// Use the Gauss-Newton Hessian (drop tau * d^2 theta) in projected mode instead of an eigen-projection of the
-  /// full element Hessian. Cheaper per iteration; PSD by construction since the torque law is monotone.
-  void set_gauss_newton(bool on) { gauss_newton_ = on; }
   [[nodiscard]] const std::vector<TorqueLaw>& laws() const { return laws_; }
   [[nodiscard]] const Eigen::VectorXd& bending_angles() const { return phi_; }
 
@@ -76,7 +73,6 @@ class DihedralBending final : public EnergyTerm {
   Eigen::VectorXd phi_;
   DihedralModuli moduli_;
   AnisotropyRule rule_;
-  bool gauss_newton_ = false;
 };
 
 /// Bergou et al. 2006 (paper Eq. 4): E_h = 3 gamma / ((H0 + H1) e) * |K x|^2 with the hinge's cotangent weights K.
