@@ -11,6 +11,7 @@
 #include "drapegen/sim/initial_state.hpp"
 #include "drapegen/sim/membrane.hpp"
 #include "drapegen/sim/newton_solver.hpp"
+#include "drapegen/sim/physical_effects.hpp"
 #include "drapegen/sim/platform.hpp"
 #include "drapegen/sim/specimen.hpp"
 
@@ -30,8 +31,11 @@ struct DrapeConfig {
   /// against 878 with Gauss-Newton only above a residual of 10 and 1169 without it), and cheaper.
   SolverOptions solver{.gauss_newton_above = 0.0};
   double gravity = kStandardGravity;
-  /// Hold the vertices that start on the platform top (static friction, Section 5.2.1).
+  /// Hold the vertices that start on the platform top (static friction, Section 5.2.1). Ignored with
+  /// effects.friction, which replaces it.
   bool adhesion = true;
+  /// Effects beyond the paper's model (none by default). Edge curl and bending plasticity need the dihedral model.
+  PhysicalEffects effects;
   /// Solve first on specimens of half the resolution, recursively down to this many vertices per side, from the same
   /// initial state, and start each finer solve from the coarser drape (0: off; ignored for mesh initial states and
   /// specimens with fewer than twice this many vertices per side).
