@@ -36,20 +36,11 @@ TrellisMembrane::TrellisMembrane(const ClothMesh& mesh, const TrellisParameters&
   weights_.resize(nt);
   area_.resize(nt);
   for (int t = 0; t < nt; ++t) {
-    Eigen::Matrix2d dm;
-    dm.col(0) = mesh.rest.col(triangles_(1, t)) - mesh.rest.col(triangles_(0, t));
-    dm.col(1) = mesh.rest.col(triangles_(2, t)) - mesh.rest.col(triangles_(0, t));
-    const double det = dm.determinant();
-    if (!(det > 0.0)) throw std::invalid_argument("trellis membrane: degenerate or inverted rest triangle");
-    const Eigen::Matrix2d inverse = dm.inverse();
     // F = sum_v x_v grad(N_v)^T, so F d = sum_v x_v (grad(N_v) . d).
-    Eigen::Matrix<double, 3, 2> grad;
-    grad.row(1) = inverse.row(0);
-    grad.row(2) = inverse.row(1);
-    grad.row(0) = -(grad.row(1) + grad.row(2));
-    weights_[t].col(0) = grad * warp;
-    weights_[t].col(1) = grad * weft;
-    area_[t] = 0.5 * det;
+    const RestTriangle rest = rest_triangle(mesh, t);
+    weights_[t].col(0) = rest.gradients * warp;
+    weights_[t].col(1) = rest.gradients * weft;
+    area_[t] = rest.area;
   }
 }
 
