@@ -58,7 +58,7 @@ bool preconditioned_cg(const HessianAssembler& a, double shift, SparseCholesky& 
   Eigen::VectorXd r = -g, z(n), p(n), ap(n);
   step.setZero(n);
   iterations = 0;
-  if (!preconditioner.solve(r, z)) return false;
+  if (!preconditioner.solve_approximate(r, z)) return false;
   p = z;
   double rz = r.dot(z);
   const double goal = tolerance * g.norm();
@@ -71,7 +71,7 @@ bool preconditioned_cg(const HessianAssembler& a, double shift, SparseCholesky& 
     step += step_size * p;
     r -= step_size * ap;
     if (r.norm() <= goal) return step.allFinite();
-    if (!preconditioner.solve(r, z)) return false;
+    if (!preconditioner.solve_approximate(r, z)) return false;
     const double rz_next = r.dot(z);
     p = z + (rz_next / rz) * p;
     rz = rz_next;
