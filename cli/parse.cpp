@@ -35,6 +35,53 @@ sim::Expected<sim::DirectionalValues> parse_directional(const std::string& text,
   return sim::Error{what + ": expected W,B,F (warp, bias, weft) or one value, got '" + text + "'"};
 }
 
+sim::Expected<sim::PhysicalEffects> parse_effects(const std::vector<std::string>& items) {
+  sim::PhysicalEffects effects;
+  auto number = [](const std::string& text, double& out) {
+    std::size_t used = 0;
+    try {
+      out = std::stod(text, &used);
+    } catch (const std::exception&) {
+      return false;
+    }
+    return used == text.size() && std::isfinite(out);
+  };
+  for (const std::string& item : items) {
+    const auto eq = item.find('=');
+    const std::string name = item.substr(0, eq), value = eq == std::string::npos ? "" : item.substr(eq + 1);
+    const std::string usage = "--effect " + item + ": ";
+    if (eq == std::string::npos || value.empty()) {
+      return sim::Error{usage + "expected NAME=VALUE with NAME curl, yield, shear or friction"};
+    }
+    double v = 0.0;
+    if (name == "curl") {
+      if (effects.edge_curl) return sim::Error{usage + "curl given twice"};
+      const auto comma = value.find(',');
+      double width_mm = 10.0;
+      if (!number(value.substr(0, comma), v) ||
+          (comma != std::string::npos && !(number(value.substr(comma + 1), width_mm) && width_mm > 0.0))) {
+        return sim::Error{usage + "expected curl=K or curl=K,W (K in 1/m, W > 0 in mm)"};
+      }
+      effects.edge_curl = sim::EdgeCurl{v, width_mm * 1e-3};
+    } else if (name == "yield") {
+      if (effects.bending_yield_curvature) return sim::Error{usage + "yield given twice"};
+      if (!number(value, v) || !(v > 0.0)) return sim::Error{usage + "expected yield=K with K > 0 in 1/m"};
+      effects.bending_yield_curvature = v;
+    } else if (name == "shear") {
+      if (effects.shear_stiffness) return sim::Error{usage + "shear given twice"};
+      if (!number(value, v) || !(v >= 0.0)) return sim::Error{usage + "expected shear=G with G >= 0 in kg/s^2"};
+      effects.shear_stiffness = v;
+    } else if (name == "friction") {
+      if (effects.friction) return sim::Error{usage + "friction given twice"};
+      if (!number(value, v) || !(v >= 0.0)) return sim::Error{usage + "expected friction=MU with MU >= 0"};
+      effects.friction = sim::FrictionParameters{v};
+    } else {
+      return sim::Error{usage + "unknown effect '" + name + "' (curl, yield, shear or friction)"};
+    }
+  }
+  return effects;
+}
+
 sim::Status check_writable(const std::string& path) {
   // A unique probe beside the target (never touches an existing file), removed again.
   std::string probe = path + ".probe-XXXXXX";

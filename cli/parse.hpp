@@ -2,14 +2,21 @@
 // Parsing of command-line values shared by the subcommands.
 
 #include <string>
+#include <vector>
 
 #include "drapegen/sim/anisotropy.hpp"
 #include "drapegen/sim/expected.hpp"
+#include "drapegen/sim/physical_effects.hpp"
 
 namespace drapegen::cli {
 
 /// "W,B,F" (warp, bias, weft) or a single value for all three directions. Rejects non-numbers and non-finite values.
 [[nodiscard]] sim::Expected<sim::DirectionalValues> parse_directional(const std::string& text, const std::string& what);
+
+/// "--effect" values, each NAME=VALUE: curl=K[,W] (edge rest curvature K 1/m over W mm, default 10), yield=K (bending
+/// yields at curvature K 1/m), shear=G (trellis membrane, shear stiffness G kg/s^2), friction=MU (Coulomb friction on
+/// the platform top instead of adhesion). Each name at most once.
+[[nodiscard]] sim::Expected<sim::PhysicalEffects> parse_effects(const std::vector<std::string>& items);
 
 /// Whether a file can be created at `path` (probes with a temporary file beside it, then removes it).
 [[nodiscard]] sim::Status check_writable(const std::string& path);

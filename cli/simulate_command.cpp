@@ -35,6 +35,7 @@ struct SimulateOptions {
   int max_iterations = 400;
   double tolerance = 1e-3;
   bool verbose = false;
+  std::vector<std::string> effects;
 };
 
 /// "--drift MM": a distance in a direction drawn from the seed; "--drift DX,DY": an offset. Millimetres.
@@ -80,6 +81,8 @@ int run_simulate(const SimulateOptions& o) {
   if (!std::isfinite(o.rotation_deg)) return fail("--rotation must be finite");
   if (!(o.tolerance > 0.0) || !std::isfinite(o.tolerance)) return fail("--tolerance must be positive");
   if (o.max_iterations < 1) return fail("--max-iterations must be at least 1");
+  const auto effects = parse_effects(o.effects);
+  if (!effects) return fail(effects.error().message);
 
   sim::DrapeConfig config;
   config.fabric = sim::fabric_from_paper_units(*alpha, *beta, o.density);
@@ -89,6 +92,11 @@ int run_simulate(const SimulateOptions& o) {
     config.fabric.gamma = {config.fabric.alpha.warp / 3, config.fabric.alpha.bias / 3, config.fabric.alpha.weft / 3};
   }
   config.anisotropy = o.anisotropy == "edge" ? sim::AnisotropyRule::kEdge : sim::AnisotropyRule::kCurvature;
+  config.effects = *effects;
+  if (config.bending_model == sim::BendingModel::kQuadratic &&
+      (config.effects.edge_curl || config.effects.bending_yield_curvature)) {
+    return fail("--effect curl and yield need --model dihedral");
+  }
   config.membrane.stiffness = o.sigma;
   {
     const auto comma = o.band.find(',');
@@ -142,6 +150,7 @@ int run_simulate(const SimulateOptions& o) {
   summary["density_g_per_m2"] = o.density;
   summary["init"] = o.init;
   summary["seed"] = o.seed;
+  if (!o.effects.empty()) summary["effects"] = o.effects;
   if (!o.out.empty()) summary["mesh"] = o.out;
   if (o.json) {
     std::cout << summary.dump(2) << "\n";
@@ -184,13 +193,17 @@ Runner add_simulate_command(CLI::App& app) {
   app.add_option("--anisotropy", o->anisotropy, "Bending direction rule: curvature (paper) or edge (naive)")
       ->check(CLI::IsMember({"curvature", "edge"}))
       ->capture_default_str();
-  app.add_option("--sigma", o->sigma, "In-plane stiffness, kg/s^2")->capture_default_str();
+  app.add_option("--sigma", o->sigma, "In-plane stiffness at the standard density (300 g/m^2), kg/s^2")->capture_default_str();
   app.add_option("--band", o->band, "Stretch band LOW,HIGH absorbed by the adaptive reference (1,1: none)")
       ->capture_default_str();
   app.add_flag("--structured", o->structured, "Use a regular grid instead of the perturbed triangulation");
   app.add_option("--max-iterations", o->max_iterations, "Newton iteration limit")->capture_default_str();
   app.add_option("--tolerance", o->tolerance, "Residual force over the largest vertex weight")->capture_default_str();
   app.add_flag("-v,--verbose", o->verbose, "Print every Newton iteration on stderr");
+  app.add_option("--effect", o->effects,
+                 "Physical effect beyond the paper's model (repeatable): curl=K[,W] (edge rest curvature K 1/m over "
+                 "W mm), yield=K (bending yields at curvature K 1/m), shear=G (woven membrane, shear stiffness G "
+                 "kg/s^2), friction=MU (Coulomb friction on the top instead of adhesion)");
   return [o] { return run_simulate(*o); };
 }
 

@@ -35,5 +35,25 @@ TEST(CheckWritable, ReportsMissingDirectory) {
   EXPECT_NE(s.error().message.find("/nonexistent-dir/x.ply"), std::string::npos);
 }
 
+TEST(ParseEffects, EveryEffectAndItsErrors) {
+  const auto all = parse_effects({"curl=30,15", "yield=40", "shear=2.5", "friction=0.3"});
+  ASSERT_TRUE(all.has_value()) << all.error().message;
+  ASSERT_TRUE(all->edge_curl && all->bending_yield_curvature && all->shear_stiffness && all->friction);
+  EXPECT_DOUBLE_EQ(all->edge_curl->curvature, 30.0);
+  EXPECT_DOUBLE_EQ(all->edge_curl->width, 0.015);
+  EXPECT_DOUBLE_EQ(*all->bending_yield_curvature, 40.0);
+  EXPECT_DOUBLE_EQ(*all->shear_stiffness, 2.5);
+  EXPECT_DOUBLE_EQ(all->friction->coefficient, 0.3);
+  const auto none = parse_effects({});
+  ASSERT_TRUE(none.has_value());
+  EXPECT_FALSE(none->any());
+  EXPECT_DOUBLE_EQ(parse_effects({"curl=-20"})->edge_curl->width, 0.01);  // default width, curling down
+  for (const char* bad : {"curl", "curl=", "curl=x", "curl=1,0", "curl=1,", "yield=0", "yield=-1", "shear=-1",
+                          "friction=nan", "friction=-0.1", "plasticity=1", "=3"}) {
+    EXPECT_FALSE(parse_effects({bad}).has_value()) << bad;
+  }
+  EXPECT_FALSE(parse_effects({"shear=1", "shear=2"}).has_value());
+}
+
 }  // namespace
 }  // namespace drapegen::cli

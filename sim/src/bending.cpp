@@ -78,8 +78,21 @@ DihedralBending::DihedralBending(const ClothMesh& mesh, const Topology& topology
   validate_directional(moduli.alpha, "alpha", true);
   validate_directional(moduli.beta, "beta", false);
   phi_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(hinges_.size()));
+  rest_angle_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(hinges_.size()));
   if (!moduli_.isotropic()) hinge_bending_angles(mesh, topology, AnisotropyRule::kEdge, phi_);
   assign_laws();
+}
+
+void DihedralBending::set_rest_angles(const Eigen::VectorXd& angles) {
+  if (angles.size() != rest_angle_.size() || !angles.allFinite() || angles.cwiseAbs().maxCoeff() >= 3.0) {
+    throw std::invalid_argument("bending: one finite rest angle below 3 rad per hinge expected");
+  }
+  rest_angle_ = angles;
+}
+
+void DihedralBending::set_yield_curvature(double yield_curvature) {
+  if (!(yield_curvature > 0.0)) throw std::invalid_argument("bending: the yield curvature must be positive");
+  yield_curvature_ = yield_curvature;
 }
 
 void DihedralBending::element_vertices(int element, int* out) const {
@@ -112,18 +125,36 @@ double DihedralBending::assign_laws() {
 }
 
 double DihedralBending::update_lagged(const Eigen::Matrix3Xd& x) {
-  if (moduli_.isotropic() || rule_ == AnisotropyRule::kEdge) return 0.0;
-  ClothMesh current = *mesh_;  // the anisotropy rule reads positions from a mesh
-  current.positions = x;
-  hinge_bending_angles(current, *topology_, rule_, phi_);
-  return assign_laws();
+  double change = 0.0;
+  if (!moduli_.isotropic() && rule_ == AnisotropyRule::kCurvature) {
+    ClothMesh current = *mesh_;  // the anisotropy rule reads positions from a mesh
+    current.positions = x;
+    hinge_bending_angles(current, *topology_, rule_, phi_);
+    change = assign_laws();
+  }
+  if (std::isfinite(yield_curvature_)) {
+    // Return mapping: the elastic angle |theta - rest| may not exceed the one whose torque is the yield torque,
+    // i.e. min(yield curvature, the law's peak) / c. The change is measured against the hinge's yield angle.
+    for (std::size_t i = 0; i < hinges_.size(); ++i) {
+      const Hinge& h = hinges_[i];
+      const double c = 2.0 / rest_[i].height_sum;
+      const double limit = std::min(yield_curvature_, laws_[i].peak_curvature()) / c;
+      const double theta = dihedral_angle(x.col(h.v0), x.col(h.v1), x.col(h.v2), x.col(h.v3));
+      const double elastic = theta - rest_angle_[i];
+      if (std::abs(elastic) <= limit) continue;
+      const double flow = elastic - std::copysign(limit, elastic);
+      rest_angle_[i] += flow;
+      change = std::max(change, std::abs(flow) / limit);
+    }
+  }
+  return change;
 }
 
 double DihedralBending::energy(const Eigen::Matrix3Xd& x) const {
   double total = 0.0;
   for (std::size_t i = 0; i < hinges_.size(); ++i) {
     const Hinge& h = hinges_[i];
-    const double theta = dihedral_angle(x.col(h.v0), x.col(h.v1), x.col(h.v2), x.col(h.v3));
+    const double theta = dihedral_angle(x.col(h.v0), x.col(h.v1), x.col(h.v2), x.col(h.v3)) - rest_angle_[i];
     const double c = 2.0 / rest_[i].height_sum;
     total += rest_[i].edge_length / c * laws_[i].work(c * std::abs(theta));
   }
@@ -136,14 +167,15 @@ double DihedralBending::evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd* gr
   Vector12d g;
   Matrix12d h2;
   Matrix12d element;
-  const bool exact_second = hessian != nullptr && (hessian->mode() == HessianMode::kExact || !gauss_newton_);
+  const bool exact_second = hessian != nullptr && hessian->mode() != HessianMode::kGaussNewton;
   for (std::size_t i = 0; i < hinges_.size(); ++i) {
     const Hinge& h = hinges_[i];
     const double c = 2.0 / rest_[i].height_sum;
     const double e = rest_[i].edge_length;
-    const double theta = exact_second
-                             ? dihedral_angle_hessian(x.col(h.v0), x.col(h.v1), x.col(h.v2), x.col(h.v3), g, h2)
-                             : dihedral_angle_gradient(x.col(h.v0), x.col(h.v1), x.col(h.v2), x.col(h.v3), g);
+    const double theta = (exact_second
+                              ? dihedral_angle_hessian(x.col(h.v0), x.col(h.v1), x.col(h.v2), x.col(h.v3), g, h2)
+                              : dihedral_angle_gradient(x.col(h.v0), x.col(h.v1), x.col(h.v2), x.col(h.v3), g)) -
+                         rest_angle_[i];
     const double kappa = c * std::abs(theta);
     const TorqueLaw& law = laws_[i];
     total += e / c * law.work(kappa);
@@ -156,7 +188,7 @@ double DihedralBending::evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd* gr
     element.noalias() = d2e * g * g.transpose();
     if (exact_second) {
       element.noalias() += de * h2;
-      if (hessian->mode() == HessianMode::kProjected) project_to_psd<12>(element);
+      if (hessian->mode() != HessianMode::kExact) project_to_psd<12>(element);
     }
     hessian->add(static_cast<int>(i), element.data());
   }

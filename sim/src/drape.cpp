@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "drapegen/sim/bending.hpp"
+#include "drapegen/sim/trellis_membrane.hpp"
 #include "drapegen/sim/gravity.hpp"
 #include "drapegen/sim/measures.hpp"
 #include "drapegen/sim/mesh_transfer.hpp"
@@ -12,11 +13,26 @@ namespace drapegen::sim {
 namespace {
 
 std::unique_ptr<EnergyTerm> make_bending(const ClothMesh& mesh, const Topology& topology, const FabricParameters& fabric,
-                                         BendingModel model, AnisotropyRule rule, bool gauss_newton) {
-  if (model == BendingModel::kQuadratic) return std::make_unique<QuadraticBending>(mesh, topology, fabric.gamma, rule);
-  auto bending = std::make_unique<DihedralBending>(mesh, topology, DihedralModuli{fabric.alpha, fabric.beta}, rule);
-  bending->set_gauss_newton(gauss_newton);
+                                         const DrapeConfig& config) {
+  const PhysicalEffects& fx = config.effects;
+  if (config.bending_model == BendingModel::kQuadratic) {
+    if (fx.edge_curl || fx.bending_yield_curvature) {
+      throw std::invalid_argument("edge curl and bending plasticity need the dihedral bending model");
+    }
+    return std::make_unique<QuadraticBending>(mesh, topology, fabric.gamma, config.anisotropy);
+  }
+  auto bending =
+      std::make_unique<DihedralBending>(mesh, topology, DihedralModuli{fabric.alpha, fabric.beta}, config.anisotropy);
+  if (fx.edge_curl) bending->set_rest_angles(edge_curl_rest_angles(mesh, topology, *fx.edge_curl));
+  if (fx.bending_yield_curvature) bending->set_yield_curvature(*fx.bending_yield_curvature);
   return bending;
+}
+
+std::unique_ptr<EnergyTerm> make_membrane(const ClothMesh& mesh, const DrapeConfig& config) {
+  if (config.effects.shear_stiffness) {
+    return std::make_unique<TrellisMembrane>(mesh, TrellisParameters{config.membrane, *config.effects.shear_stiffness});
+  }
+  return std::make_unique<CorotationalMembrane>(mesh, config.membrane);
 }
 
 }  // namespace
@@ -38,26 +54,29 @@ Expected<DrapeResult> simulate_drape(const DrapeConfig& config,
   const FabricParameters fabric = normalized(config.fabric);  // the drape depends on k / rho only
   try {
     const Topology topology = build_topology(mesh);
-    CorotationalMembrane membrane(mesh, config.membrane);
-    std::unique_ptr<EnergyTerm> bending =
-        make_bending(mesh, topology, fabric, config.bending_model, config.anisotropy,
-                     config.gauss_newton_bending);
+    const std::unique_ptr<EnergyTerm> membrane = make_membrane(mesh, config);
+    const std::unique_ptr<EnergyTerm> bending = make_bending(mesh, topology, fabric, config);
     Gravity gravity(mesh, fabric.density, config.gravity);
     PlatformContact contact(mesh, config.platform);
 
-    std::vector<bool> fixed(mesh.vertex_count(), false);
-    if (config.adhesion) {
-      for (int v : contact.vertices_on_top(mesh.positions, 5e-4)) fixed[v] = true;
-    }
-    result.fixed_vertices = static_cast<int>(std::count(fixed.begin(), fixed.end(), true));
-    if (config.adhesion && result.fixed_vertices == 0) {
+    const std::vector<int> on_top = contact.vertices_on_top(mesh.positions, 5e-4);
+    if ((config.adhesion || config.effects.friction) && on_top.empty()) {
       return Error{"no vertex of the initial state rests on the platform top (drift too large, or the initial mesh "
                    "is not on the platform)"};
     }
+    std::vector<bool> fixed(mesh.vertex_count(), false);
+    std::unique_ptr<PlatformFriction> friction;
+    if (config.effects.friction) {
+      friction = std::make_unique<PlatformFriction>(contact, on_top, mesh.positions, *config.effects.friction);
+    } else if (config.adhesion) {
+      for (int v : on_top) fixed[v] = true;
+    }
+    result.fixed_vertices = static_cast<int>(std::count(fixed.begin(), fixed.end(), true));
 
     NewtonSolver solver(config.solver);
     if (progress) solver.set_progress(progress);
-    std::vector<EnergyTerm*> terms{&membrane, bending.get(), &gravity, &contact};
+    std::vector<EnergyTerm*> terms{membrane.get(), bending.get(), &gravity, &contact};
+    if (friction) terms.push_back(friction.get());
     Eigen::Matrix3Xd x = mesh.positions;
     const int coarse = config.coarse_start_resolution;
     if (coarse >= 3 && initial.shape != InitialShape::kMesh && config.specimen.vertices_x >= 2 * coarse &&

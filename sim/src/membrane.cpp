@@ -47,13 +47,6 @@ Svd32 svd32(const Eigen::Matrix<double, 3, 2>& f) {
 }
 
 /// Shape-function weights: F.col(c) = sum_k w(k, c) * x_k for the triangle's three vertices.
-Eigen::Matrix<double, 3, 2> shape_weights(const Eigen::Matrix2d& inverse_rest) {
-  Eigen::Matrix<double, 3, 2> w;
-  w.row(1) = inverse_rest.row(0);
-  w.row(2) = inverse_rest.row(1);
-  w.row(0) = -(w.row(1) + w.row(2));
-  return w;
-}
 
 }  // namespace
 
@@ -69,17 +62,8 @@ CorotationalMembrane::CorotationalMembrane(const ClothMesh& mesh, const Membrane
     throw std::invalid_argument("membrane band stiffness ratio must be in (0, 1]");
   }
   const int nt = mesh.triangle_count();
-  rest_inverse_.resize(nt);
-  area_.resize(nt);
-  for (int t = 0; t < nt; ++t) {
-    Eigen::Matrix2d dm;
-    dm.col(0) = mesh.rest.col(triangles_(1, t)) - mesh.rest.col(triangles_(0, t));
-    dm.col(1) = mesh.rest.col(triangles_(2, t)) - mesh.rest.col(triangles_(0, t));
-    const double det = dm.determinant();
-    if (!(det > 0.0)) throw std::invalid_argument("membrane: degenerate or inverted rest triangle");
-    rest_inverse_[t] = dm.inverse();
-    area_[t] = 0.5 * det;
-  }
+  rest_.reserve(nt);
+  for (int t = 0; t < nt; ++t) rest_.push_back(rest_triangle(mesh, t));
 }
 
 void CorotationalMembrane::element_vertices(int element, int* out) const {
@@ -90,7 +74,7 @@ Eigen::Matrix<double, 3, 2> CorotationalMembrane::deformation_gradient(const Eig
   Eigen::Matrix<double, 3, 2> ds;
   ds.col(0) = x.col(triangles_(1, t)) - x.col(triangles_(0, t));
   ds.col(1) = x.col(triangles_(2, t)) - x.col(triangles_(0, t));
-  return ds * rest_inverse_[t];
+  return ds * rest_[t].inverse;
 }
 
 namespace {
@@ -129,7 +113,7 @@ double CorotationalMembrane::energy(const Eigen::Matrix3Xd& x) const {
     const double mean = 0.5 * (c(0, 0) + c(1, 1));
     const double radius = std::hypot(0.5 * (c(0, 0) - c(1, 1)), c(0, 1));
     const double s1 = std::sqrt(mean + radius), s2 = std::sqrt(std::max(mean - radius, 0.0));
-    total += params_.stiffness * area_[t] * (stretch_energy(s1).value + stretch_energy(s2).value);
+    total += params_.stiffness * rest_[t].area * (stretch_energy(s1).value + stretch_energy(s2).value);
   }
   return total;
 }
@@ -137,14 +121,14 @@ double CorotationalMembrane::energy(const Eigen::Matrix3Xd& x) const {
 double CorotationalMembrane::evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd* gradient,
                                       HessianSink* hessian) const {
   double total = 0.0;
-  const bool project = hessian != nullptr && hessian->mode() == HessianMode::kProjected;
+  const bool project = hessian != nullptr && hessian->mode() != HessianMode::kExact;
   for (int t = 0; t < element_count(); ++t) {
     const Svd32 svd = svd32(deformation_gradient(x, t));
-    const double scale = params_.stiffness * area_[t];
+    const double scale = params_.stiffness * rest_[t].area;
     const StretchEnergy g1 = stretch_energy(svd.s[0]), g2 = stretch_energy(svd.s[1]);
     const Eigen::Vector2d dpsi(scale * g1.first, scale * g2.first);
     total += scale * (g1.value + g2.value);
-    const Eigen::Matrix<double, 3, 2> w = shape_weights(rest_inverse_[t]);
+    const Eigen::Matrix<double, 3, 2>& w = rest_[t].gradients;
 
     if (gradient != nullptr) {
       const Eigen::Matrix<double, 3, 2> p = svd.u.leftCols<2>() * dpsi.asDiagonal() * svd.v.transpose();

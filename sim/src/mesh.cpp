@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <map>
+#include <Eigen/LU>
 #include <stdexcept>
 #include <utility>
 
@@ -43,6 +44,21 @@ Topology build_topology(const ClothMesh& mesh) {
   }
   for (auto& n : topo.vertex_neighbours) std::sort(n.begin(), n.end());
   return topo;
+}
+
+RestTriangle rest_triangle(const ClothMesh& mesh, int triangle) {
+  Eigen::Matrix2d dm;
+  dm.col(0) = mesh.rest.col(mesh.triangles(1, triangle)) - mesh.rest.col(mesh.triangles(0, triangle));
+  dm.col(1) = mesh.rest.col(mesh.triangles(2, triangle)) - mesh.rest.col(mesh.triangles(0, triangle));
+  const double det = dm.determinant();
+  if (!(det > 0.0)) throw std::invalid_argument("degenerate or inverted rest triangle");
+  RestTriangle rest;
+  rest.inverse = dm.inverse();
+  rest.gradients.row(1) = rest.inverse.row(0);
+  rest.gradients.row(2) = rest.inverse.row(1);
+  rest.gradients.row(0) = -(rest.gradients.row(1) + rest.gradients.row(2));
+  rest.area = 0.5 * det;
+  return rest;
 }
 
 Eigen::VectorXd rest_triangle_areas(const ClothMesh& mesh) {

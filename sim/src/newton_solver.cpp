@@ -58,7 +58,7 @@ bool preconditioned_cg(const HessianAssembler& a, double shift, SparseCholesky& 
   Eigen::VectorXd r = -g, z(n), p(n), ap(n);
   step.setZero(n);
   iterations = 0;
-  if (!preconditioner.solve(r, z)) return false;
+  if (!preconditioner.solve_approximate(r, z)) return false;
   p = z;
   double rz = r.dot(z);
   const double goal = tolerance * g.norm();
@@ -71,7 +71,7 @@ bool preconditioned_cg(const HessianAssembler& a, double shift, SparseCholesky& 
     step += step_size * p;
     r -= step_size * ap;
     if (r.norm() <= goal) return step.allFinite();
-    if (!preconditioner.solve(r, z)) return false;
+    if (!preconditioner.solve_approximate(r, z)) return false;
     const double rz_next = r.dot(z);
     p = z + (rz_next / rz) * p;
     rz = rz_next;
@@ -118,6 +118,7 @@ SolveReport NewtonSolver::solve(const std::vector<EnergyTerm*>& terms, const std
     return report;
   }
 
+  report.residual = std::numeric_limits<double>::infinity();  // until the first assembly
   int exact_cooldown = 0;  // iterations to wait before trying the exact Hessian again
   bool frozen = false;     // state-dependent parameters no longer updated
   int outer_updates = 0;
@@ -139,7 +140,10 @@ SolveReport NewtonSolver::solve(const std::vector<EnergyTerm*>& terms, const std
     exact_cooldown = std::max(0, exact_cooldown - 1);
     auto t0 = Clock::now();
     gradient.setZero();
-    double energy = assembler.assemble(x, exact ? HessianMode::kExact : HessianMode::kProjected, gradient);
+    // The residual of the previous iteration (infinite before the first) picks the positive semi-definite model.
+    const HessianMode psd =
+        report.residual > options_.gauss_newton_above ? HessianMode::kGaussNewton : HessianMode::kProjected;
+    double energy = assembler.assemble(x, exact ? HessianMode::kExact : psd, gradient);
     report.assembly_seconds += since(t0);
     gather(gradient, g);
     report.energy = energy;
@@ -193,7 +197,7 @@ SolveReport NewtonSolver::solve(const std::vector<EnergyTerm*>& terms, const std
         exact_cooldown = 5;
         t0 = Clock::now();
         gradient.setZero();
-        energy = assembler.assemble(x, HessianMode::kProjected, gradient);
+        energy = assembler.assemble(x, psd, gradient);
         report.assembly_seconds += since(t0);
         continue;
       }
@@ -240,7 +244,7 @@ SolveReport NewtonSolver::solve(const std::vector<EnergyTerm*>& terms, const std
         exact = false;
         exact_cooldown = 5;
         gradient.setZero();
-        energy = assembler.assemble(x, HessianMode::kProjected, gradient);
+        energy = assembler.assemble(x, psd, gradient);
         continue;
       }
       if (!accepted) {

@@ -16,6 +16,9 @@ struct SparseCholesky::Impl {
   std::vector<int> colptr, rowind;
   std::vector<double> values;
   bool analysed = false;
+  std::vector<float> single;  // single-precision copy of a supernodal factor's values, empty until needed
+  std::vector<float> work;
+  Eigen::VectorXf update;  // scratch for one supernode's rows below its diagonal block
 
   Impl() {
     cholmod_start(&common);
@@ -70,6 +73,7 @@ FactorStatus SparseCholesky::factorize(const HessianAssembler& matrix, double sh
     logger()->debug("cholmod: n {} nnz(A) {} nnz(L) {:.0f} flops {:.3g} supernodal {} ordering {}", a.nrow, a.nzmax,
                     m.common.lnz, m.common.fl, m.factor->is_super, m.common.method[m.common.selected].ordering);
   }
+  m.single.clear();
   const int ok = cholmod_factorize(&a, m.factor, &m.common);
   if (m.common.status == CHOLMOD_NOT_POSDEF) return FactorStatus::kNotPositiveDefinite;
   if (!ok || m.common.status < CHOLMOD_OK) return FactorStatus::kFailed;
@@ -92,6 +96,58 @@ bool SparseCholesky::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution
   solution.resize(rhs.size());
   std::memcpy(solution.data(), x->x, sizeof(double) * static_cast<size_t>(rhs.size()));
   cholmod_free_dense(&x, &m.common);
+  return solution.allFinite();
+}
+
+bool SparseCholesky::solve_approximate(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution) {
+  Impl& m = *impl_;
+  cholmod_factor* f = m.factor;
+  if (f == nullptr || f->minor < f->n) return false;
+  if (!f->is_super || !f->is_ll || f->itype != CHOLMOD_INT) return solve(rhs, solution);
+  const int* super = static_cast<const int*>(f->super);
+  const int* pi = static_cast<const int*>(f->pi);
+  const int* px = static_cast<const int*>(f->px);
+  const int* s = static_cast<const int*>(f->s);
+  const int* perm = static_cast<const int*>(f->Perm);
+  const int nsuper = static_cast<int>(f->nsuper);
+  const int n = static_cast<int>(f->n);
+  if (m.single.empty()) {
+    const double* x = static_cast<const double*>(f->x);
+    m.single.assign(x, x + f->xsize);
+  }
+  m.work.resize(n);
+  if (m.update.size() < n) m.update.resize(n);
+  Eigen::Map<Eigen::VectorXf> y(m.work.data(), n);
+  for (int k = 0; k < n; ++k) y[k] = static_cast<float>(rhs[perm[k]]);
+  using Block = Eigen::Map<const Eigen::MatrixXf>;
+  // L y = P b, supernode by supernode: the dense diagonal block, then the rows below it.
+  for (int k = 0; k < nsuper; ++k) {
+    const int k1 = super[k], ncol = super[k + 1] - k1, nrow = pi[k + 1] - pi[k];
+    const Block block(m.single.data() + px[k], nrow, ncol);
+    auto own = y.segment(k1, ncol);
+    block.topRows(ncol).triangularView<Eigen::Lower>().solveInPlace(own);
+    if (nrow > ncol) {
+      auto update = m.update.head(nrow - ncol);
+      update.noalias() = block.bottomRows(nrow - ncol) * own;
+      const int* rows = s + pi[k] + ncol;
+      for (int i = 0; i < nrow - ncol; ++i) y[rows[i]] -= update[i];
+    }
+  }
+  // L^T x = y, in reverse.
+  for (int k = nsuper - 1; k >= 0; --k) {
+    const int k1 = super[k], ncol = super[k + 1] - k1, nrow = pi[k + 1] - pi[k];
+    const Block block(m.single.data() + px[k], nrow, ncol);
+    auto own = y.segment(k1, ncol);
+    if (nrow > ncol) {
+      auto gathered = m.update.head(nrow - ncol);
+      const int* rows = s + pi[k] + ncol;
+      for (int i = 0; i < nrow - ncol; ++i) gathered[i] = y[rows[i]];
+      own.noalias() -= block.bottomRows(nrow - ncol).transpose() * gathered;
+    }
+    block.topRows(ncol).triangularView<Eigen::Lower>().transpose().solveInPlace(own);
+  }
+  solution.resize(n);
+  for (int k = 0; k < n; ++k) solution[perm[k]] = static_cast<double>(y[k]);
   return solution.allFinite();
 }
 

@@ -3,6 +3,7 @@
 // anisotropic by Eq. 8 with a bending direction per hinge (curvature-based or edge-based rule, Section 4.4).
 
 #include <Eigen/Core>
+#include <limits>
 #include <vector>
 
 #include "drapegen/sim/anisotropy.hpp"
@@ -58,11 +59,18 @@ class DihedralBending final : public EnergyTerm {
   [[nodiscard]] double energy(const Eigen::Matrix3Xd& x) const override;
   double evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd* gradient, HessianSink* hessian) const override;
 
-  /// Use the Gauss-Newton Hessian (drop tau * d^2 theta) in projected mode instead of an eigen-projection of the
-  /// full element Hessian. Cheaper per iteration; PSD by construction since the torque law is monotone.
-  void set_gauss_newton(bool on) { gauss_newton_ = on; }
   [[nodiscard]] const std::vector<TorqueLaw>& laws() const { return laws_; }
   [[nodiscard]] const Eigen::VectorXd& bending_angles() const { return phi_; }
+
+  /// Rest dihedral angles (0 by default: flat): E_h = e * integral_0^|theta - theta_rest| tau(c xi) dxi. Edge curl
+  /// sets them (edge_curl.hpp); plastic flow moves them.
+  void set_rest_angles(const Eigen::VectorXd& angles);
+  [[nodiscard]] const Eigen::VectorXd& rest_angles() const { return rest_angle_; }
+
+  /// Elastoplastic hinges (bending hysteresis, internal friction): the torque cannot exceed the torque the hinge's
+  /// law gives at `yield_curvature` (1/m). At every update_lagged() a hinge loaded beyond it flows: its rest angle
+  /// moves until the torque equals the yield torque (return mapping). Infinity (the default) is elastic.
+  void set_yield_curvature(double yield_curvature);
 
  private:
   /// Sets every hinge's torque law from its bending angle; returns the largest relative change of alpha or beta.
@@ -76,7 +84,8 @@ class DihedralBending final : public EnergyTerm {
   Eigen::VectorXd phi_;
   DihedralModuli moduli_;
   AnisotropyRule rule_;
-  bool gauss_newton_ = false;
+  Eigen::VectorXd rest_angle_;
+  double yield_curvature_ = std::numeric_limits<double>::infinity();
 };
 
 /// Bergou et al. 2006 (paper Eq. 4): E_h = 3 gamma / ((H0 + H1) e) * |K x|^2 with the hinge's cotangent weights K.

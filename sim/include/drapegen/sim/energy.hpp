@@ -10,6 +10,8 @@ namespace drapegen::sim {
 enum class HessianMode {
   kExact,      // the true second derivative (used by derivative checks)
   kProjected,  // projected to positive semi-definite per element (what Newton uses)
+  kGaussNewton,  // a cheaper positive semi-definite approximation where a term has one (bending: without the torque
+                 // times the angle's second derivative), else as kProjected; for Newton far from equilibrium
 };
 
 /// Receives one dense element Hessian at a time, (3 * arity) x (3 * arity), column-major, vertex-major DOF order.

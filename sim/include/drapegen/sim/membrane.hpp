@@ -56,8 +56,7 @@ class CorotationalMembrane final : public EnergyTerm {
   [[nodiscard]] Eigen::Matrix<double, 3, 2> deformation_gradient(const Eigen::Matrix3Xd& x, int t) const;
 
   Eigen::Matrix3Xi triangles_;
-  std::vector<Eigen::Matrix2d> rest_inverse_;  // Dm^-1 of the rest triangle
-  Eigen::VectorXd area_;
+  std::vector<RestTriangle> rest_;
   MembraneParameters params_;
 };
 

@@ -42,6 +42,16 @@ struct Topology {
 /// Builds the topology. The mesh must be a manifold (every edge shared by at most two triangles).
 [[nodiscard]] Topology build_topology(const ClothMesh& mesh);
 
+/// A rest triangle's linear shape functions: `gradients` row k is the rest-frame gradient of vertex k's barycentric
+/// coordinate (so the deformation gradient is F = sum_k x_k gradients.row(k)), `inverse` is Dm^-1 for the edge matrix
+/// Dm = [r1 - r0, r2 - r0], `area` the rest area. Throws std::invalid_argument for a degenerate or inverted triangle.
+struct RestTriangle {
+  Eigen::Matrix<double, 3, 2> gradients;
+  Eigen::Matrix2d inverse;
+  double area = 0.0;
+};
+[[nodiscard]] RestTriangle rest_triangle(const ClothMesh& mesh, int triangle);
+
 /// Rest area of every triangle (m^2).
 [[nodiscard]] Eigen::VectorXd rest_triangle_areas(const ClothMesh& mesh);
 

@@ -3,6 +3,7 @@
 
 #include <Eigen/Core>
 #include <functional>
+#include <limits>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -33,6 +34,9 @@ struct SolverOptions {
   /// Below this residual, try the exact (unprojected) Hessian first: near a stable equilibrium it is positive
   /// definite and restores quadratic convergence; where CHOLMOD finds it indefinite, the projected one is used.
   double exact_hessian_below = 1.0;
+  /// Above this residual, Gauss-Newton element Hessians where a term has them (HessianMode::kGaussNewton); between
+  /// the two thresholds, element Hessians projected to PSD.
+  double gauss_newton_above = std::numeric_limits<double>::infinity();
   /// State-dependent parameters (anisotropy directions, EnergyTerm::update_lagged) are updated at every iteration
   /// while the residual is above `lagged_every_above`; below it, only once the residual has dropped under
   /// `lagged_outer_below` for the current parameters (an outer fixed-point loop), until the parameters change by
