@@ -81,7 +81,8 @@ class WorkerPool {
   sim::Expected<pid_t> spawn(int k) {
     const std::string self = "/proc/self/exe";
     const std::string name = fmt::format("local-{}", k);
-    std::vector<std::string> args = {"drapegen", "worker", "--connect", endpoint_, "--name", name, "--give-up", "60"};
+    std::vector<std::string> args = {"drapegen", "worker", "--connect", endpoint_, "--name", name, "--give-up", "60",
+                                     "--log-level", "warn"};
     std::vector<char*> argv;
     for (auto& a : args) argv.push_back(a.data());
     argv.push_back(nullptr);

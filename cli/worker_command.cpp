@@ -5,6 +5,7 @@
 #include <memory>
 
 #include "commands.hpp"
+#include "drapegen/coordinator/logging.hpp"
 #include "drapegen/worker/worker.hpp"
 #include "signals.hpp"
 
@@ -28,7 +29,12 @@ Runner add_worker_command(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--server-key", o->server_key, "CurveZMQ: the coordinator's public key (Z85, or a .pub file)");
   app.add_option("--key", o->key_file, "CurveZMQ: this worker's secret key file (drapegen keygen)");
-  return [o]() -> int {
+  auto level = std::make_shared<std::string>("info");
+  app.add_option("--log-level", *level, "Log level: debug, info, warn, error")
+      ->check(CLI::IsMember({"debug", "info", "warn", "error"}))
+      ->capture_default_str();
+  return [o, level]() -> int {
+    coordinator::logger()->set_level(spdlog::level::from_str(*level));
     const auto& stop = install_stop_signals();
     const sim::Status s = worker::run_worker(*o, stop);
     int code = kExitOk;
