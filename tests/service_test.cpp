@@ -269,6 +269,48 @@ TEST(Service, StopsOnAnUnwritableOutputAndResumes) {
   EXPECT_EQ(reader->run()->state, "complete");
 }
 
+// Acceptance 6, the disk-full half: the output directory is a small tmpfs that fills up during the run; the
+// coordinator stops with a clear error; after the filesystem grows, --resume completes the run. Needs the right to
+// mount (root); skipped otherwise.
+TEST(Service, StopsOnAFullDiskAndResumes) {
+  const fs::path dir = test_dir("disk_full");
+  const fs::path out = dir / "run";
+  fs::create_directories(out);
+  const std::string mount = "mount -t tmpfs -o size=400k drapegen-test " + out.string() + " 2> /dev/null";
+  if (std::system(mount.c_str()) != 0) GTEST_SKIP() << "cannot mount a tmpfs here (not root?)";
+  struct Unmount {
+    std::string path;
+    ~Unmount() { (void)!std::system(("umount " + path + " 2> /dev/null").c_str()); }
+  } unmount{out.string()};
+  write_text(dir / "run.toml", small_config(out, 8, 2));
+  const fs::path manifest = out / "manifest.sqlite";
+  Process coordinator({"run", "--config", (dir / "run.toml").string()}, (dir / "coordinator").string());
+  const std::string endpoint = wait_endpoint(out, coordinator, 30s);
+  ASSERT_FALSE(endpoint.empty()) << coordinator.err();
+  Process worker = start_worker(endpoint, dir, 1);
+  ASSERT_EQ(coordinator.wait(120s), 3) << coordinator.err();
+  const std::string err = coordinator.err();
+  const auto last_line = err.substr(err.rfind('\n', err.size() - 2) + 1);
+  EXPECT_EQ(last_line.rfind("drapegen run: error: ", 0), 0u) << err;
+  EXPECT_TRUE(last_line.find("No space left on device") != std::string::npos ||
+              last_line.find("disk is full") != std::string::npos)
+      << last_line;
+  EXPECT_NE(last_line.find("drapegen run --resume"), std::string::npos) << err;
+  const long recorded = recorded_jobs(manifest);
+  std::printf("[ info ] disk full after %ld of 16 jobs: %s", recorded, last_line.c_str());
+  EXPECT_LT(recorded, 16);
+  EXPECT_EQ(worker.wait(10s), 0) << worker.err();
+  // More space, then resume.
+  ASSERT_EQ(std::system(("mount -o remount,size=64m " + out.string()).c_str()), 0);
+  Process resumed({"run", "--resume", manifest.string()}, (dir / "resumed").string());
+  const std::string endpoint2 = wait_endpoint(out, resumed, 30s);
+  ASSERT_FALSE(endpoint2.empty()) << resumed.err();
+  Process worker2 = start_worker(endpoint2, dir, 2);
+  ASSERT_EQ(resumed.wait(120s), 0) << resumed.err();
+  check_manifest(manifest, 2);
+  EXPECT_EQ(recorded_jobs(manifest), 16);
+}
+
 // SIGTERM (as SIGINT): the coordinator commits, marks the run stopped, shuts the workers down and exits with 4;
 // --resume completes the run.
 TEST(Service, StopsCleanlyOnSigterm) {
