@@ -201,5 +201,56 @@ TEST(Service, BadInputLeavesTheCoordinatorRunningAndTheManifestUnchanged) {
   EXPECT_TRUE(reader->failures()->empty());
 }
 
+// Leases: a worker that keeps heartbeating but never answers loses its lease after network.lease_s (a `timeout`
+// failure, the job re-queued and done by another worker); its late answer is dropped.
+TEST(Service, ExpiredLeasesAreRequeued) {
+  const fs::path dir = test_dir("lease");
+  const fs::path out = dir / "run";
+  // The lease goes into small_config's [network] table.
+  std::string text = small_config(out, 2, 1, "[testing]\nmode = \"noop\"\n[retry]\nmax_attempts = 3\n");
+  text.replace(text.find("liveness = 4\n"), 13, "liveness = 4\nlease_s = 0.5\n");
+  write_text(dir / "run.toml", text);
+  const fs::path manifest = out / "manifest.sqlite";
+  Process coordinator({"run", "--config", (dir / "run.toml").string()}, (dir / "coordinator").string());
+  const std::string endpoint = wait_endpoint(out, coordinator, 30s);
+  ASSERT_FALSE(endpoint.empty()) << coordinator.err();
+
+  zmq::context_t context(1);
+  FakeWorker slow(context, endpoint);
+  slow.send(ready("slow"));
+  auto job = slow.expect(v1::Envelope::kJob, 5s);
+  ASSERT_TRUE(job);
+  const std::uint64_t id = job->job().job_id();
+  // Alive but silent about the job for 1.5 s (three leases).
+  for (int i = 0; i < 15; ++i) {
+    slow.heartbeat();
+    std::this_thread::sleep_for(100ms);
+  }
+  slow.send(result(id, job->job().attempt()));  // too late: dropped
+  Process worker = start_worker(endpoint, dir, 1);
+  const auto end = std::chrono::steady_clock::now() + 30s;
+  while (coordinator.running() && std::chrono::steady_clock::now() < end) {
+    if (auto next = slow.expect(v1::Envelope::kJob, 50ms)) {
+      slow.send(result(next->job().job_id(), next->job().attempt()));
+    }
+    slow.heartbeat();
+  }
+  ASSERT_EQ(coordinator.wait(10s), 0) << coordinator.err();
+  check_manifest(manifest, 2);
+  auto reader = storage::ManifestReader::open(manifest.string());
+  ASSERT_TRUE(reader);
+  const auto failures = all(reader->failures());
+  ASSERT_GE(failures.size(), 1u);
+  EXPECT_EQ(failures[0].job_id, static_cast<std::int64_t>(id));
+  EXPECT_EQ(failures[0].attempt, 1);
+  EXPECT_EQ(failures[0].reason, "timeout");
+  EXPECT_EQ(failures[0].worker, "slow");
+  for (const auto& j : all(reader->jobs())) {
+    EXPECT_EQ(j.state, storage::JobState::kDone);
+    if (j.id == static_cast<std::int64_t>(id)) EXPECT_GE(j.attempts, 2);
+  }
+  EXPECT_NE(coordinator.err().find("after its lease expired"), std::string::npos) << coordinator.err();
+}
+
 }  // namespace
 }  // namespace drapegen::test
