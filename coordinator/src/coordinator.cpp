@@ -20,6 +20,7 @@
 #include <zmq_addon.hpp>
 
 #include "drapegen/coordinator/curve_keys.hpp"
+#include "drapegen/coordinator/job_message.hpp"
 #include "drapegen/coordinator/logging.hpp"
 #include "drapegen/coordinator/planner.hpp"
 #include "drapegen/proto/codec.hpp"
@@ -375,7 +376,7 @@ struct Coordinator::Impl {
   }
 
   std::string file_name(const JobSlot& slot, const char* suffix) const {
-    return fmt::format("s{:06d}_k{:02d}{}", slot.rec.sample, slot.rec.slot, suffix);
+    return result_stem(slot.rec.sample, slot.rec.slot) + suffix;
   }
 
   void on_result(Worker& w, const v1::Result& r) {
@@ -531,35 +532,9 @@ struct Coordinator::Impl {
   // Dispatch and timers
 
   sim::Expected<v1::Envelope> make_job(JobSlot& slot) {
-    v1::Envelope e;
-    auto* job = e.mutable_job();
-    job->set_job_id(static_cast<std::uint64_t>(slot.rec.id));
-    job->set_attempt(static_cast<std::uint32_t>(slot.attempts));
-    job->set_lease_ms(static_cast<std::uint64_t>(config.lease_s * 1000.0));
-    auto* spec = job->mutable_spec();
-    spec->set_mode(slot.rec.mode == "noop"     ? v1::JOB_MODE_NOOP
-                   : slot.rec.mode == "poison" ? v1::JOB_MODE_POISON
-                                               : v1::JOB_MODE_DRAPE);
-    const auto& s = samples[static_cast<std::size_t>(slot.rec.sample)];
-    auto* p = spec->mutable_parameters();
-    p->set_alpha_warp(s.alpha[0]);
-    p->set_alpha_bias(s.alpha[1]);
-    p->set_alpha_weft(s.alpha[2]);
-    p->set_beta_warp(s.beta[0]);
-    p->set_beta_bias(s.beta[1]);
-    p->set_beta_weft(s.beta[2]);
-    p->set_density_g_per_m2(s.density_g_per_m2);
     auto recipe = sampler::recipe_from_json(nlohmann::json::parse(slot.rec.recipe_json, nullptr, false));
     if (!recipe) return sim::Error{fmt::format("job {}: {}", slot.rec.id, recipe.error().message)};
-    *spec->mutable_recipe() = proto::to_proto(*recipe);
-    spec->set_resolution(config.resolution);
-    spec->set_orientations(config.orientations);
-    spec->set_noise(config.noise);
-    spec->set_render_seed(slot.rec.render_seed);
-    spec->set_max_iterations(config.max_iterations);
-    spec->set_tolerance(config.tolerance);
-    spec->set_max_self_intersections(config.max_self_intersections);
-    spec->set_coarse_start_resolution(config.coarse_start_resolution);
+    std::string source_mesh;
     if (recipe->kind == sampler::RecipeKind::kDrape && slot.rec.mode != "noop") {
       const JobSlot& source = jobs[static_cast<std::size_t>(job_id(config, recipe->source.sample,
                                                                     recipe->source.slot) - 1)];
@@ -572,8 +547,13 @@ struct Coordinator::Impl {
         return sim::Error{fmt::format("cannot read the source drape {}: {}", path,
                                       errno ? std::strerror(errno) : "empty file")};
       }
-      job->set_source_mesh(bytes.str());
+      source_mesh = bytes.str();
     }
+    auto job = make_job_message(config, samples[static_cast<std::size_t>(slot.rec.sample)], slot.rec, slot.attempts,
+                                std::move(source_mesh));
+    if (!job) return job.error();
+    v1::Envelope e;
+    *e.mutable_job() = std::move(job).value();
     return e;
   }
 
