@@ -19,5 +19,6 @@ enum ExitCode : int {
 
 Runner add_simulate_command(CLI::App& app);
 Runner add_cantilever_command(CLI::App& app);
+Runner add_sample_command(CLI::App& app);
 
 }  // namespace drapegen::cli

@@ -17,6 +17,8 @@ int main(int argc, char** argv) {
   add("simulate", "Simulate one drape on the drape tester and print its summary", drapegen::cli::add_simulate_command);
   add("cantilever", "Simulate a clamped strip hanging under its own weight (physical validation)",
       drapegen::cli::add_cantilever_command);
+  add("sample", "Sample parameter vectors from the VAE subspace and their initial states, or report coverage",
+      drapegen::cli::add_sample_command);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

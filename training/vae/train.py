@@ -102,11 +102,14 @@ def main():
                     torch.save({"name": name, "hidden": hidden, "latent": latent, "state_dict": model.state_dict()},
                                args.checkpoint)
         res["seconds"] = round(time.time() - t0, 1)
+        if not name.startswith("GMM-"):
+            res["epochs"] = args.epochs
+            res["steps"] = args.epochs * ((len(tr) + 15) // 16)
         results["models"][name] = res
         log(f"{name}: " + ", ".join(f"{k} {v:.3f}" if isinstance(v, float) else f"{k} {v}" for k, v in res.items()))
-    if args.results:
-        with open(args.results, "w") as f:
-            json.dump(results, f, indent=1)
+        if args.results:  # after every model, so a long run keeps what it has
+            with open(args.results, "w") as f:
+                json.dump(results, f, indent=1)
     return 0
 
 
