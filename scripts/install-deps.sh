@@ -6,6 +6,7 @@ packages=(
   libeigen3-dev libsuitesparse-dev libopenblas0-serial
   libspdlog-dev libfmt-dev libcli11-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  libpng-dev python3-torch python3-numpy python3-scipy
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -5,6 +5,7 @@
 #include <unordered_map>
 
 #include "drapegen/sampler/random.hpp"
+#include "drapegen/sim/logging.hpp"
 
 namespace drapegen::sampler {
 namespace {
@@ -142,6 +143,8 @@ sim::Expected<SampledParameters> sample_parameters(const VaeModel& model, const 
     }
     next += kBatch;
   }
+  sim::logger()->debug("sampler: {} vectors from {} candidates ({} outside the range, {} near-duplicates), seed {}",
+                       out.vectors.size(), out.candidates, out.rejected_range, out.rejected_duplicate, options.seed);
   return out;
 }
 
