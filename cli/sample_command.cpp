@@ -11,6 +11,7 @@
 
 #include "commands.hpp"
 #include "drapegen/sampler/coverage.hpp"
+#include "drapegen/sampler/fabric_data.hpp"
 #include "drapegen/sampler/parameter_sampler.hpp"
 #include "drapegen/sampler/recipe_generator.hpp"
 #include "drapegen/sampler/scatter_plot.hpp"

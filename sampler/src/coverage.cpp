@@ -1,6 +1,7 @@
 #include "drapegen/sampler/coverage.hpp"
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <stdexcept>
 

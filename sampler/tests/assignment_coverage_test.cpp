@@ -7,6 +7,7 @@
 
 #include "drapegen/sampler/assignment.hpp"
 #include "drapegen/sampler/coverage.hpp"
+#include "drapegen/sampler/fabric_data.hpp"
 #include "drapegen/sampler/parameters.hpp"
 #include "drapegen/sampler/random.hpp"
 #include "drapegen/sampler/vae_model.hpp"

@@ -1,3 +1,4 @@
+#include "drapegen/sampler/fabric_data.hpp"
 #include "drapegen/sampler/parameters.hpp"
 
 #include <gtest/gtest.h>
