@@ -37,6 +37,7 @@ struct SampleOptions {
   std::string plot_x = "alpha_warp";
   std::string plot_y = "beta_warp";
   int iw_samples = 1000;
+  bool no_plot = false;
 };
 
 int fail(const std::string& message, int code = kExitUsage) {
@@ -263,11 +264,15 @@ Runner add_sample_command(CLI::App& app) {
       ->capture_default_str();
   app.add_flag("--report", o->report, "Report the coverage of the measured fabrics instead of sampling");
   app.add_option("--data", o->data, "--report: the measured fabrics (fabrics618.csv)")->capture_default_str();
-  app.add_option("--plot", o->plot, "--report: scatter plot PNG (empty: none)")->capture_default_str();
+  app.add_option("--plot", o->plot, "--report: scatter plot PNG")->capture_default_str();
+  app.add_flag("--no-plot", o->no_plot, "--report: no scatter plot");
   app.add_option("--plot-x", o->plot_x, "--report: feature on the plot's x axis")->capture_default_str();
   app.add_option("--plot-y", o->plot_y, "--report: feature on the plot's y axis")->capture_default_str();
   app.add_option("--iw-samples", o->iw_samples, "--report: importance samples per fabric")->capture_default_str();
-  return [o] { return run(*o); };
+  return [o] {
+    if (o->no_plot) o->plot.clear();
+    return run(*o);
+  };
 }
 
 }  // namespace drapegen::cli
