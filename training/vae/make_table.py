@@ -16,7 +16,8 @@ def describe(name, res):
     if name.startswith("GMM"):
         return f"K = {name[4:]}, full covariances, EM 200 it."
     hidden, latent = vae.ARCHITECTURES[name]
-    return f"FC {'-'.join(map(str, hidden))}, latent {latent}, {res['epochs']} epochs ({res['steps']} steps)"
+    return (f"FC {'-'.join(map(str, hidden))}, latent {latent}; epoch {res['chosen_epoch']} of "
+            f"{res['epochs']} (early stop)")
 
 
 def main():
@@ -39,21 +40,24 @@ def main():
     with open(args.merged, "w") as f:
         json.dump(merged, f, indent=1)
     lines = [
-        "| model | configuration | LL train | LL validation | W1 prior | W1 widened | paper: LL train / val / W |",
+        "| model | configuration | LL train | LL validation (median) | W1 prior | W1 widened "
+        "| paper: LL train / val / W |",
         "|---|---|---:|---:|---:|---:|---|",
     ]
     for name in sorted(merged["models"], key=lambda n: (n[:3], n)):
         r = merged["models"][name]
         widened = f"{r['w_widened']:.3f}" if "w_widened" in r else "-"
         p = PAPER.get(name)
-        lines.append(f"| {name} | {describe(name, r)} | {r['ll_train']:.3f} | {r['ll_validation']:.3f} | "
+        lines.append(f"| {name} | {describe(name, r)} | {r['ll_train']:.3f} | {r['ll_validation']:.3f} "
+                     f"({r['ll_validation_median']:.3f}) | "
                      f"{r['w_prior']:.3f} +- {r['w_prior_std']:.3f} | {widened} | "
                      f"{p[0]:.2f} / {p[1]:.2f} / {p[2]:.1f} |")
     lines.append("")
     lines.append(f"{merged['distinct_fabrics']} distinct fabrics, {merged['train']} train / {merged['validation']} "
-                 f"validation (split seed {merged['seed']}); VAE log-likelihoods importance-weighted with "
-                 f"K = {merged['iw_samples']}; W1 against all {merged['distinct_fabrics']} distinct fabrics from "
-                 f"{merged['generated']} generated vectors.")
+                 f"validation (split seed {merged['seed']}); log-likelihoods in nats per fabric, mean (median); "
+                 f"VAE: importance sampling with K = {merged['iw_samples']} (defensive mixture proposal), GMM: exact; "
+                 f"W1 against all {merged['distinct_fabrics']} distinct fabrics from {merged['generated']} generated "
+                 f"vectors (mean +- std over {merged['models']['GMM-3']['w_chunks']} chunks).")
     with open(args.doc) as f:
         text = f.read()
     begin, end = "<!-- TABLE BEGIN -->\n", "<!-- TABLE END -->"

@@ -21,8 +21,9 @@ struct WassersteinResult {
 [[nodiscard]] WassersteinResult wasserstein_exact(const std::vector<Features>& generated,
                                                   const std::vector<Features>& data);
 
-/// Mean over `data` of the importance-weighted estimate of log p(x) in feature space (nats per fabric), with
-/// `samples` draws from the encoder's q(z | x) per fabric: log mean_k p(x | z_k) p(z_k) / q(z_k | x).
+/// Mean over `data` of an importance-sampling estimate of log p(x) in feature space (nats per fabric): log mean_k
+/// p(x | z_k) p(z_k) / r(z_k | x) with `samples` (>= 3) draws per fabric from the defensive mixture r = 1/3 q(z|x) +
+/// 1/3 q(z|x) with 3x its standard deviation + 1/3 N(0, I), as training/vae/vae.py (VAE.log_likelihood) computes it.
 [[nodiscard]] double mean_log_likelihood(const VaeModel& model, const std::vector<Features>& data, int samples,
                                          std::uint64_t seed);
 
