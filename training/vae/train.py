@@ -7,7 +7,8 @@ Metrics (docs/SAMPLER.md):
   x = sign(k) ln|k| of the six moduli normalised to 300 g/m^2. GMM: exact. VAE: importance sampling with K draws from
   the defensive mixture 1/3 q(z|x) + 1/3 q(z|x) widened 3x + 1/3 N(0, I) (vae.VAE.log_likelihood); the plain IWAE
   estimate (K draws from q(z|x)) of the validation set is recorded too.
-- VAE training: early stopping on a tenth of the training fabrics (the "stop" set), never on the validation set.
+- VAE training: early stopping by the median log-likelihood of a tenth of the training fabrics (the "stop" set),
+  never on the validation set.
 - Wasserstein: exact W1 with Euclidean cost in the same feature space, between the distinct fabrics (train and
   validation) and 6,000 generated vectors, as the mean over the disjoint chunks of generated vectors of the size of
   the data (scipy.optimize.linear_sum_assignment). VAE vectors are decoder means (as the sampler uses them).
