@@ -219,11 +219,11 @@ int run_report(const SampleOptions& o, const sampler::VaeModel& model, const std
   std::cout << fmt::format("coverage of {} distinct fabrics ({} rows of {}) by {}, seed {}, {} generated vectors\n",
                            data.size(), fabrics->size(), o.data, model_path, o.seed, o.n);
   std::cout << "space: sign(k) ln|k| of alpha (g*mm^2/s^2) and beta (g*mm^3/s^2), normalised to 300 g/m^2\n\n";
-  std::cout << fmt::format("{:<60} {:>10}\n", "metric", "value");
-  std::cout << fmt::format("{:<60} {:>10.3f}\n",
+  std::cout << fmt::format("{:<66} {:>9}\n", "metric", "value");
+  std::cout << fmt::format("{:<66} {:>9.3f}\n",
                            fmt::format("log-likelihood, importance sampling K={}, nats/fabric", o.iw_samples), ll);
   for (const Row& row : rows) {
-    std::cout << fmt::format("{:<60} {:>10.3f}  (+- {:.3f} over {} chunks)\n", "W1 exact: " + row.name, row.w.mean,
+    std::cout << fmt::format("{:<66} {:>9.3f}  (+- {:.3f} over {} chunks)\n", "W1 exact: " + row.name, row.w.mean,
                              row.w.stddev, row.w.chunks);
   }
   std::cout << fmt::format("\nsampler output: {} candidates, {} outside the range (data range widened by {:.0f}% per "
