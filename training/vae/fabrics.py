@@ -54,3 +54,33 @@ def split(n, seed, validation_fraction=0.2):
     order = np.random.default_rng(seed).permutation(n)
     n_val = int(round(validation_fraction * n))
     return np.sort(order[n_val:]), np.sort(order[:n_val])
+
+
+def summary(path, seed=0):
+    """The facts about the data that docs/SAMPLER.md quotes."""
+    density, moduli = read_rows(path)
+    rows = np.column_stack([density, moduli])
+    _, counts = np.unique(rows, axis=0, return_counts=True)
+    x = distinct_fabrics(path)
+    tr, va = split(len(x), seed)
+    positive = (x[:, 3:] > 0).any(axis=1)
+    k = moduli * (STANDARD_DENSITY / density[:, None])
+    return "\n".join([
+        f"rows {len(rows)}, distinct fabrics {len(x)}, most repeats of one fabric {counts.max()}",
+        f"rows with a positive beta {int((moduli[:, 3:] > 0).any(axis=1).sum())}, distinct {int(positive.sum())}: "
+        f"{int(positive[tr].sum())} in the training split, {int(positive[va].sum())} in validation (seed {seed}, "
+        f"{len(tr)} / {len(va)})",
+        f"of them in the VAEs' early-stopping set (train.py: a tenth of the training split, seed {seed + 1}): "
+        f"{int(positive[tr[split(len(tr), seed + 1, 0.1)[1]]].sum())}",
+        f"smallest normalised |k| {np.abs(k).min():.1f}",
+        "feature min " + " ".join(f"{v:.2f}" for v in x.min(0)),
+        "feature max " + " ".join(f"{v:.2f}" for v in x.max(0)),
+    ])
+
+
+if __name__ == "__main__":
+    import os
+    import sys
+    here = os.path.dirname(os.path.abspath(__file__))
+    print(summary(sys.argv[1] if len(sys.argv) > 1 else os.path.join(here, "..", "..", "..", "shared", "data",
+                                                                        "fabrics618.csv")))
