@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <sstream>
 
 #include "drapegen/sampler/vae_model.hpp"
@@ -90,6 +92,30 @@ TEST(TorchReference, FreshlyTrainedDecoderMatchesPyTorch) {
   const double worst = max_difference(*model, reference, 64);
   std::cout << "freshly trained VAE-4: largest |C++ - PyTorch| over 64 latents x 6 features = " << worst << "\n";
   EXPECT_LT(worst, 1e-5);
+  fs::remove_all(dir);
+}
+
+std::string file_bytes(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+TEST(TorchReference, TrainingIsReproducibleFromASeed) {
+  if (!torch_available()) GTEST_SKIP() << kPython << " cannot import torch/numpy/scipy: apt-get install python3-torch";
+  const fs::path dir = fs::temp_directory_path() / ("drapegen_seed_test_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  auto train = [&](int seed, const std::string& name) {
+    std::string out;
+    EXPECT_TRUE(run(kPython + " " + kSource + "/training/vae/train.py --models VAE-4 --epochs 4 --check-every 2" +
+                        " --iw-samples 9 --generated 300 --seed " + std::to_string(seed) + " --export VAE-4=" +
+                        (dir / name).string() + " 2>/dev/null",
+                    out));
+    return file_bytes(dir / name);
+  };
+  const std::string a = train(5, "a.dgvae"), b = train(5, "b.dgvae"), c = train(6, "c.dgvae");
+  ASSERT_FALSE(a.empty());
+  EXPECT_EQ(a, b) << "two trainings with seed 5 exported different weights";
+  EXPECT_NE(a, c) << "seeds 5 and 6 exported the same weights";
   fs::remove_all(dir);
 }
 
