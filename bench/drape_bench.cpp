@@ -1,4 +1,4 @@
-// Timing benchmark of the quasistatic drape (docs/BENCHMARKS.md): fabrics from ../shared/data/fabrics618.csv
+// Timing benchmark of the quasistatic drape (docs/BENCHMARKS.md): fabrics from sampler/data/fabrics618.csv
 // spanning soft to stiff, every initial-state type, one core. Prints one line per drape and a summary.
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -57,7 +57,7 @@ double cpu_seconds() {
 
 int main(int argc, char** argv) {
   CLI::App app{"drape timing benchmark"};
-  std::string data = "../shared/data/fabrics618.csv";
+  std::string data = DRAPEGEN_FABRIC_DATA_DEFAULT;
   int resolution = 100, fabrics = 5;
   std::vector<std::string> inits{"flat", "sine", "fold"};
   bool json = false;

@@ -20,5 +20,6 @@ enum ExitCode : int {
 Runner add_simulate_command(CLI::App& app);
 Runner add_cantilever_command(CLI::App& app);
 Runner add_render_command(CLI::App& app);
+Runner add_sample_command(CLI::App& app);
 
 }  // namespace drapegen::cli

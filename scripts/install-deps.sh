@@ -7,6 +7,7 @@ packages=(
   libspdlog-dev libfmt-dev libcli11-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libosmesa6-dev libopenexr-dev openexr libpng-dev
+  python3-torch python3-numpy python3-scipy
 )
 missing=()
 for p in "${packages[@]}"; do
