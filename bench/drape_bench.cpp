@@ -1,4 +1,4 @@
-// Timing benchmark of the quasistatic drape (docs/BENCHMARKS.md): fabrics from ../shared/data/fabrics618.csv
+// Timing benchmark of the quasistatic drape (docs/BENCHMARKS.md): fabrics from sampler/data/fabrics618.csv
 // spanning soft to stiff, every initial-state type, one core. Prints one line per drape and a summary.
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -57,7 +57,7 @@ double cpu_seconds() {
 
 int main(int argc, char** argv) {
   CLI::App app{"drape timing benchmark"};
-  std::string data = "../shared/data/fabrics618.csv";
+  std::string data = DRAPEGEN_FABRIC_DATA_DEFAULT;
   int resolution = 100, fabrics = 5;
   std::vector<std::string> inits{"flat", "sine", "fold"};
   bool json = false;
@@ -68,6 +68,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--pcg-tolerance", pcg_tolerance, "SolverOptions::pcg_tolerance")->capture_default_str();
   double outer_below = drapegen::sim::SolverOptions{}.lagged_outer_below;
+  double refactor_fraction = drapegen::sim::SolverOptions{}.pcg_refactor_fraction;
+  app.add_option("--pcg-refactor", refactor_fraction, "SolverOptions::pcg_refactor_fraction")->capture_default_str();
   double gn_above = drapegen::sim::DrapeConfig{}.solver.gauss_newton_above;
   app.add_option("--gn-above", gn_above, "SolverOptions::gauss_newton_above")->capture_default_str();
   app.add_option("--outer-below", outer_below, "SolverOptions::lagged_outer_below")->capture_default_str();
@@ -102,6 +104,7 @@ int main(int argc, char** argv) {
       config.solver.max_pcg_iterations = pcg_iterations;
       config.solver.pcg_tolerance = pcg_tolerance;
       config.solver.lagged_outer_below = outer_below;
+      config.solver.pcg_refactor_fraction = refactor_fraction;
       config.solver.gauss_newton_above = gn_above;
       config.solver.exact_hessian_below = exact_below;
       config.solver.max_iterations = max_iterations;
@@ -141,12 +144,12 @@ int main(int argc, char** argv) {
         std::cout << fmt::format(
             "fabric {:3d} alpha {:7.0f},{:7.0f},{:7.0f} beta {:8.0f},{:8.0f},{:8.0f} {:5s}: {:15s} {:4d} it "
             "(+{:3d} coarse) {:6.2f} s, CPU {:6.2f} s (coarse {:4.2f} s, factorisation {:4.1f}%, PCG {:4.1f}%, assembly {:4.1f}%, "
-            "{} of {} steps by PCG, {} CG it) DC {:.3f} folds {}\n",
+            "{} of {} steps by PCG, {} CG it, {} failed PCG) DC {:.3f} folds {}\n",
             index, fabric.alpha.warp, fabric.alpha.bias, fabric.alpha.weft, fabric.beta.warp, fabric.beta.bias,
             fabric.beta.weft, init, drapegen::sim::to_string(r.outcome), r.iterations, c.iterations, wall, cpu,
             c.seconds, 100 * factor_share.back(), 100 * (r.pcg_seconds + c.pcg_seconds) / wall,
             100 * (r.assembly_seconds + c.assembly_seconds) / wall, r.reused_factorizations + c.reused_factorizations,
-            r.iterations + c.iterations, r.pcg_iterations + c.pcg_iterations,
+            r.iterations + c.iterations, r.pcg_iterations + c.pcg_iterations, r.pcg_failures + c.pcg_failures,
             result->measures.drape_coefficient, result->measures.folds);
       }
       std::cout.flush();

@@ -19,6 +19,8 @@ int main(int argc, char** argv) {
       drapegen::cli::add_cantilever_command);
   add("render", "Render a drape to noisy multi-view depth images (OpenEXR) as the drape tester sees it",
       drapegen::cli::add_render_command);
+  add("sample", "Sample parameter vectors from the VAE subspace and their initial states, or report coverage",
+      drapegen::cli::add_sample_command);
   add("run", "Coordinate a generation run: plan it, serve its jobs to workers, record results (or --resume one)",
       drapegen::cli::add_run_command);
   add("worker", "Compute jobs (simulate + render) for a coordinator", drapegen::cli::add_worker_command);

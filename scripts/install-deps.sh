@@ -7,9 +7,10 @@ packages=(
   libspdlog-dev libfmt-dev libcli11-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libosmesa6-dev libopenexr-dev openexr libpng-dev
+  python3-torch python3-numpy python3-scipy
   cppzmq-dev libzmq3-dev libprotobuf-dev protobuf-compiler libsqlite3-dev libtomlplusplus-dev
   slurm-wlm munge sqlite3
-  python3 python3-numpy python3-torch python3-openimageio
+  python3 python3-openimageio
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -9,6 +9,7 @@
 
 #include "drapegen/sampler/fabric_data.hpp"
 #include "drapegen/sampler/parameters.hpp"
+#include "drapegen/sampler/vae_model.hpp"
 #include "drapegen/storage/manifest_reader.hpp"
 
 namespace drapegen::coordinator {
@@ -42,13 +43,7 @@ nlohmann::json summary(const std::vector<double>& v) {
           {"max", quantile(v, 1.0)}};
 }
 
-std::string default_fabrics() {
-#ifdef DRAPEGEN_FABRIC_DATA
-  return DRAPEGEN_FABRIC_DATA;
-#else
-  return "";
-#endif
-}
+std::string default_fabrics() { return sampler::default_fabric_data_path(); }
 
 sim::Expected<Data> gather(const std::string& manifest_path, const StatsOptions& options) {
   auto reader = storage::ManifestReader::open(manifest_path);

@@ -133,6 +133,7 @@ nlohmann::json to_json(const DrapeResult& result) {
       {"lagged_updates", r.lagged_updates},
       {"reused_factorizations", r.reused_factorizations},
       {"pcg_iterations", r.pcg_iterations},
+      {"pcg_failures", r.pcg_failures},
       {"lagged_change", r.lagged_change},
       {"line_search_failures", r.line_search_failures},
       {"vertices", result.mesh.vertex_count()},

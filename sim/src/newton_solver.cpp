@@ -34,6 +34,7 @@ void SolveReport::add_work(const SolveReport& other) {
   lagged_updates += other.lagged_updates;
   reused_factorizations += other.reused_factorizations;
   pcg_iterations += other.pcg_iterations;
+  pcg_failures += other.pcg_failures;
   line_search_failures += other.line_search_failures;
 }
 
@@ -123,6 +124,7 @@ SolveReport NewtonSolver::solve(const std::vector<EnergyTerm*>& terms, const std
   bool frozen = false;     // state-dependent parameters no longer updated
   int outer_updates = 0;
   bool have_factor = false;
+  int last_cg_iterations = 0;  // CG iterations of the last PCG attempt since the last factorisation
   int creeping = 0;  // consecutive iterations whose step moved no vertex measurably
   for (int it = 0; it < options_.max_iterations; ++it) {
     report.iterations = it;
@@ -167,7 +169,10 @@ SolveReport NewtonSolver::solve(const std::vector<EnergyTerm*>& terms, const std
     // Inexact Newton: while an earlier factorisation still preconditions the current Hessian well, conjugate
     // gradients replace the factorisation (a product and two triangular solves per iteration instead of a
     // factorisation).
-    bool reuse = have_factor && lambda == 0.0 && options_.max_pcg_iterations > 0;
+    // A preconditioner that needed most of the allowed CG iterations last time will likely fail now: factorise
+    // straight away instead of spending the iterations first.
+    bool reuse = have_factor && lambda == 0.0 && options_.max_pcg_iterations > 0 &&
+                 last_cg_iterations <= options_.pcg_refactor_fraction * options_.max_pcg_iterations;
     bool solved = false;
     while (!accepted) {
       FactorStatus status = FactorStatus::kOk;
@@ -181,7 +186,9 @@ SolveReport NewtonSolver::solve(const std::vector<EnergyTerm*>& terms, const std
                                    cg_iterations);
         report.pcg_seconds += since(t0);
         report.pcg_iterations += cg_iterations;
+        last_cg_iterations = cg_iterations;
         if (!solved) {
+          ++report.pcg_failures;
           reuse = false;
           continue;
         }
@@ -191,6 +198,7 @@ SolveReport NewtonSolver::solve(const std::vector<EnergyTerm*>& terms, const std
         status = cholesky.factorize(assembler, lambda * mean_diagonal);
         report.factorization_seconds += since(t0);
         have_factor = status == FactorStatus::kOk;
+        last_cg_iterations = 0;
       }
       if (exact && status != FactorStatus::kOk) {  // indefinite: fall back to the projected Hessian
         exact = false;

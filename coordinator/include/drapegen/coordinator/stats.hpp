@@ -11,8 +11,8 @@
 namespace drapegen::coordinator {
 
 struct StatsOptions {
-  /// The measured fabrics (fabrics618.csv); empty: the copy beside the source tree (../shared/data). A missing file
-  /// only drops the comparison.
+  /// The measured fabrics (fabrics618.csv); empty: the copy committed with the source (sampler/data). A missing
+  /// file only drops the comparison.
   std::string fabrics_csv;
 };
 

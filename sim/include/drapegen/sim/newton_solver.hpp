@@ -53,6 +53,9 @@ struct SolverOptions {
   /// every iteration.
   int max_pcg_iterations = 20;
   double pcg_tolerance = 0.1;
+  /// After a PCG solve that needed more than this fraction of max_pcg_iterations, the next iteration factorises
+  /// without trying PCG first (1: always try).
+  double pcg_refactor_fraction = 0.5;
   /// Outer updates after which the parameters are fixed anyway (directions in nearly flat regions can cycle).
   int max_lagged_outer_updates = 6;
 };
@@ -69,7 +72,8 @@ struct SolveReport {
   int exact_hessian_iterations = 0;  // iterations that stepped with the unprojected Hessian
   int lagged_updates = 0;            // updates of state-dependent parameters
   int reused_factorizations = 0;     // iterations that stepped with an earlier factorisation (by PCG)
-  int pcg_iterations = 0;            // conjugate-gradient iterations in those steps
+  int pcg_iterations = 0;            // conjugate-gradient iterations (also of PCG attempts that failed)
+  int pcg_failures = 0;              // PCG attempts that failed (too many iterations, negative curvature)
   double pcg_seconds = 0.0;
   double lagged_change = 0.0;        // relative change at the last update
   int line_search_failures = 0;

@@ -1,0 +1,78 @@
+#include "drapegen/sampler/fabric_data.hpp"
+
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <string_view>
+
+namespace drapegen::sampler {
+namespace {
+
+bool parse_double(std::string_view text, double& out) {
+  while (!text.empty() && (text.front() == ' ' || text.front() == '\t')) text.remove_prefix(1);
+  while (!text.empty() && (text.back() == ' ' || text.back() == '\t' || text.back() == '\r')) text.remove_suffix(1);
+  if (text.empty()) return false;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), out);
+  return ec == std::errc() && end == text.data() + text.size() && std::isfinite(out);
+}
+
+}  // namespace
+
+sim::Expected<std::vector<MeasuredFabric>> read_fabric_csv(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) return sim::Error{"cannot open fabric data '" + path + "'"};
+  std::string line;
+  if (!std::getline(in, line)) return sim::Error{"fabric data '" + path + "' is empty or unreadable"};
+  std::vector<MeasuredFabric> fabrics;
+  int line_number = 1;
+  while (std::getline(in, line)) {
+    ++line_number;
+    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    double v[7];
+    std::size_t start = 0;
+    int count = 0;
+    bool ok = true;
+    while (ok) {
+      const std::size_t comma = line.find(',', start);
+      const std::string_view field(line.data() + start, (comma == std::string::npos ? line.size() : comma) - start);
+      if (count == 7 || !parse_double(field, v[count])) ok = false;
+      ++count;
+      if (comma == std::string::npos) break;
+      start = comma + 1;
+    }
+    if (!ok || count != 7) {
+      return sim::Error{"fabric data '" + path + "' line " + std::to_string(line_number) +
+                        ": expected 7 finite numbers (density, 3 linear and 3 nonlinear moduli)"};
+    }
+    if (!(v[0] > 0.0) || v[1] == 0.0 || v[2] == 0.0 || v[3] == 0.0 || v[4] == 0.0 || v[5] == 0.0 || v[6] == 0.0) {
+      return sim::Error{"fabric data '" + path + "' line " + std::to_string(line_number) +
+                        ": density must be positive and moduli non-zero"};
+    }
+    MeasuredFabric f;
+    f.density_g_per_m2 = v[0] * 1e3;
+    // CSV: warp, weft, diag; the paper (and DirectionalValues): warp, bias (= diag), weft.
+    f.moduli.alpha = {v[1], v[3], v[2]};
+    f.moduli.beta = {v[4], v[6], v[5]};
+    fabrics.push_back(f);
+  }
+  if (in.bad()) return sim::Error{"error reading fabric data '" + path + "'"};
+  if (fabrics.empty()) return sim::Error{"fabric data '" + path + "' has no rows"};
+  return fabrics;
+}
+
+std::vector<Features> distinct_features(const std::vector<MeasuredFabric>& fabrics) {
+  std::vector<Features> out;
+  std::map<std::array<double, 7>, bool> seen;
+  for (const MeasuredFabric& f : fabrics) {
+    const std::array<double, 7> key{f.density_g_per_m2, f.moduli.alpha.warp, f.moduli.alpha.bias,
+                                    f.moduli.alpha.weft, f.moduli.beta.warp,  f.moduli.beta.bias,
+                                    f.moduli.beta.weft};
+    if (!seen.emplace(key, true).second) continue;
+    out.push_back(to_features(normalise_density(f.moduli, f.density_g_per_m2)));
+  }
+  return out;
+}
+
+}  // namespace drapegen::sampler
