@@ -2,6 +2,7 @@
 
 #include <filesystem>
 #include <sqlite3.h>
+#include <unistd.h>
 
 #include "drapegen/storage/manifest.hpp"
 
@@ -12,7 +13,8 @@ class ManifestTest : public ::testing::Test {
  protected:
   void SetUp() override {
     dir_ = std::filesystem::temp_directory_path() /
-           ("drapegen_manifest_test_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+           ("drapegen_manifest_test_" + std::to_string(::getpid()) + "_" +
+            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
     std::filesystem::remove_all(dir_);
     std::filesystem::create_directories(dir_);
     path_ = (dir_ / "manifest.sqlite").string();

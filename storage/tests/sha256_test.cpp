@@ -2,6 +2,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <unistd.h>
 
 #include "drapegen/storage/atomic_file.hpp"
 #include "drapegen/storage/sha256.hpp"
@@ -21,7 +22,7 @@ TEST(Sha256, KnownVectors) {  // FIPS 180-4 examples
 }
 
 TEST(AtomicFile, WritesAndChecksums) {
-  const auto dir = std::filesystem::temp_directory_path() / "drapegen_atomic_test";
+  const auto dir = std::filesystem::temp_directory_path() / ("drapegen_atomic_test_" + std::to_string(::getpid()));
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   const std::string path = (dir / "a.bin").string();

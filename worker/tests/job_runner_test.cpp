@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <unistd.h>
 
 #include "drapegen/proto/recipe.hpp"
 #include "drapegen/renderer/exr.hpp"
@@ -39,8 +40,19 @@ v1::Job tiny_job(v1::JobMode mode) {
   return job;
 }
 
+std::string scratch();
+
+// The scratch directory goes at exit.
+const struct RemoveScratch {
+  ~RemoveScratch() {
+    std::error_code ec;
+    std::filesystem::remove_all(scratch(), ec);
+  }
+} remove_scratch;
+
 std::string scratch() {
-  return (std::filesystem::temp_directory_path() / "drapegen_job_runner_test").string();
+  return (std::filesystem::temp_directory_path() / ("drapegen_job_runner_test_" + std::to_string(::getpid())))
+      .string();
 }
 
 TEST(JobRunner, ComputesADrapeWithItsFilesInMemory) {
