@@ -19,6 +19,10 @@ int main(int argc, char** argv) {
       drapegen::cli::add_cantilever_command);
   add("render", "Render a drape to noisy multi-view depth images (OpenEXR) as the drape tester sees it",
       drapegen::cli::add_render_command);
+  add("reality", "Simulate and render a capture with effects the baseline model lacks, truth in a separate file",
+      drapegen::cli::add_reality_command);
+  add("diagnose", "Diagnose a capture's sim-to-real gap: fit, floors, localisation, attribution",
+      drapegen::cli::add_diagnose_command);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
