@@ -60,8 +60,12 @@ nlohmann::json bending_json(const BendingParameters& p) {
 
 nlohmann::json view_json(const ScoredDrape& d) {
   nlohmann::json views = nlohmann::json::array();
-  for (const auto& v : d.views) {
+  for (std::size_t k = 0; k < d.views.size(); ++k) {
+    const auto& v = d.views[k];
     views.push_back({{"score_mm", v.score * 1e3},
+                     {"stable_rms_mm", v.stable_rms * 1e3},
+                     {"stable_px", v.stable_pixels},
+                     {"radial_mm", k < d.radial.size() ? d.radial[k] * 1e3 : 0.0},
                      {"depth_rms_mm", v.depth_rms * 1e3},
                      {"silhouette_mismatch", v.silhouette},
                      {"fold_rms_deg", v.fold_rms_deg},
@@ -187,6 +191,7 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                    {"best_state", r.fit.best.state},
                    {"turn_deg", r.fit.best.angle * 180.0 / M_PI},
                    {"converged", r.fit.best.converged},
+                   {"hem_spectrum_mm", r.fit.best.hem_spectrum * 1e3},
                    {"views", view_json(r.fit.best)}};
   const auto& L = r.localisation;
   nlohmann::json regions = nlohmann::json::array();

@@ -147,7 +147,7 @@ sim::Expected<ScoredDrape> ForwardModel::score(const sim::ClothMesh& mesh, const
   double fit = 0.0, held = 0.0, all = 0.0;
   int nf = 0, nh = 0;
   for (std::size_t v = 0; v < d.views.size(); ++v) {
-    const double s = d.views[v].score + w * d.radial[v];
+    const double s = d.views[v].score + settings_.weights.radial * d.radial[v];
     all += s;
     if (is_fit_view_[v]) {
       fit += s, ++nf;

@@ -257,7 +257,9 @@ RadialProfile radial_profile(const Eigen::Matrix3Xd& points, double cylinder_rad
   for (int i = 0; i < points.cols(); ++i) {
     const Eigen::Vector3d q = points.col(i);
     if (q.z() >= kBelowTop) continue;
-    const int k = static_cast<int>((std::hypot(q.x(), q.y()) - r0) / kStep);
+    const double t = (std::hypot(q.x(), q.y()) - r0) / kStep;  // the cylinder side (r ~ R) stays out
+    if (t < 0.0) continue;
+    const int k = static_cast<int>(t);
     if (k < 0 || k >= bins) continue;
     sum[k] += q.z();
     ++p.count[k];

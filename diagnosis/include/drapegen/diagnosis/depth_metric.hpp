@@ -28,6 +28,8 @@ struct MetricWeights {
   double pixel = 0.25;
   /// m per m of the distance between the hem outlines' rotation-invariant spectra (ForwardModel).
   double hem_spectrum = 1.0;
+  /// m per m of the radial-profile difference per view (ForwardModel).
+  double radial = 0.25;
 };
 
 /// What is precomputed once per captured (or pseudo-captured) view: depth, smoothed normals, fold mask.

@@ -45,7 +45,7 @@ struct ScoredDrape {
   std::vector<ViewComparison> views;  // every view of the capture
   double hem_spectrum = 0.0;  // m, spectrum_distance of the fit views' outlines (capture, model render)
   std::vector<double> radial; // m, per view: radial_distance of capture and model render
-  /// Each a mean over its views of (view score + shape weight * radial), plus shape weight * hem_spectrum for the
+  /// Each a mean over its views of (view score + radial weight * radial), plus hem weight * hem_spectrum for the
   /// fit and all-view scores (the held-out score uses the held-out view alone).
   double fit_score = 0.0;
   double held_out_score = 0.0;
