@@ -21,5 +21,7 @@ Runner add_simulate_command(CLI::App& app);
 Runner add_cantilever_command(CLI::App& app);
 Runner add_render_command(CLI::App& app);
 Runner add_sample_command(CLI::App& app);
+Runner add_reality_command(CLI::App& app);
+Runner add_diagnose_command(CLI::App& app);
 
 }  // namespace drapegen::cli
