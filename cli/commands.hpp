@@ -22,6 +22,8 @@ Runner add_simulate_command(CLI::App& app);
 Runner add_cantilever_command(CLI::App& app);
 Runner add_render_command(CLI::App& app);
 Runner add_sample_command(CLI::App& app);
+Runner add_reality_command(CLI::App& app);
+Runner add_diagnose_command(CLI::App& app);
 Runner add_run_command(CLI::App& app);
 Runner add_worker_command(CLI::App& app);
 Runner add_local_command(CLI::App& app);

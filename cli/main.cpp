@@ -21,6 +21,10 @@ int main(int argc, char** argv) {
       drapegen::cli::add_render_command);
   add("sample", "Sample parameter vectors from the VAE subspace and their initial states, or report coverage",
       drapegen::cli::add_sample_command);
+  add("reality", "Simulate and render a capture with effects the baseline model lacks, truth in a separate file",
+      drapegen::cli::add_reality_command);
+  add("diagnose", "Diagnose a capture's sim-to-real gap: fit, floors, localisation, attribution",
+      drapegen::cli::add_diagnose_command);
   add("run", "Coordinate a generation run: plan it, serve its jobs to workers, record results (or --resume one)",
       drapegen::cli::add_run_command);
   add("worker", "Compute jobs (simulate + render) for a coordinator", drapegen::cli::add_worker_command);

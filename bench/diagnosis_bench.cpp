@@ -1,0 +1,254 @@
+// The diagnosis benchmark (issue 6, acceptance 1-3): generates captures with the reality generator (>= N per effect
+// family over fabrics from fabrics618.csv, plus no-effect controls), runs `drapegen diagnose` on each (J processes
+// at a time), and scores the verdicts against the truth files: confusion matrix, top-1 accuracy, controls within
+// the floors, median shrinkage, region match, runtime. The diagnosis never sees the truth: it runs on a copy of
+// each capture directory without truth.json.
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fmt/format.h>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <thread>
+
+#include "drapegen/diagnosis/reality.hpp"
+#include "drapegen/renderer/random.hpp"
+
+namespace fs = std::filesystem;
+using namespace drapegen;
+
+namespace {
+
+struct Fabric {
+  diagnosis::BendingParameters bending;
+  double density = 300.0;
+};
+
+std::vector<Fabric> read_fabrics(const std::string& path) {
+  std::vector<Fabric> out;
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);  // header
+  while (std::getline(in, line)) {
+    std::stringstream ss(line);
+    std::vector<double> v;
+    std::string cell;
+    while (std::getline(ss, cell, ',')) v.push_back(std::stod(cell));
+    if (v.size() < 7) continue;
+    Fabric f;
+    f.density = v[0] * 1000.0;  // kg/m^2 -> g/m^2
+    f.bending.alpha = {v[1], v[3], v[2]};  // warp, diag (bias), weft
+    f.bending.beta = {v[4], v[6], v[5]};
+    out.push_back(f);
+  }
+  return out;
+}
+
+struct Case {
+  std::string name, family, effect;
+  double strength = 0.0;
+  std::uint64_t seed = 0;
+  Fabric fabric;
+};
+
+/// Strengths per effect, drawn uniformly in [lo, hi].
+const std::map<std::string, std::pair<double, double>> kStrength = {
+    {"yield", {10.0, 25.0}}, {"shear", {0.3, 1.0}},       {"curl", {30.0, 50.0}}, {"friction", {0.02, 0.1}},
+    {"misalign", {15.0, 30.0}}, {"pose", {1.0, 2.0}},     {"bias", {5.0, 10.0}},  {"multipath", {15.0, 30.0}}};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"drapegen diagnosis benchmark: reality captures, diagnoses, confusion matrix"};
+  std::string out = "out/diagnosis_bench", fabrics_path = DRAPEGEN_FABRIC_DATA_DEFAULT, drapegen;
+  int per_family = 5, controls = 5, jobs = 1, resolution = 30, diagnose_jobs = 1;
+  bool quick = false, generate_only = false, score_only = false;
+  std::uint64_t seed = 1;
+  std::vector<std::string> families{"yield", "shear", "curl", "friction", "misalignment", "sensor"};
+  app.add_option("--out", out, "Benchmark directory")->capture_default_str();
+  app.add_option("--fabrics", fabrics_path, "fabrics618.csv")->capture_default_str();
+  app.add_option("--drapegen", drapegen, "The drapegen program (default: beside this program)");
+  app.add_option("--per-family", per_family, "Captures per effect family")->capture_default_str();
+  app.add_option("--controls", controls, "No-effect captures (sensor noise only)")->capture_default_str();
+  app.add_option("--families", families, "Effect families to include")->capture_default_str();
+  app.add_option("--jobs", jobs, "Diagnoses run at once (processes)")->capture_default_str();
+  app.add_option("--diagnose-jobs", diagnose_jobs, "--jobs of each diagnosis (refit threads)")->capture_default_str();
+  app.add_option("--resolution", resolution, "Reality mesh resolution")->capture_default_str();
+  app.add_option("--seed", seed, "Seed of fabrics, strengths and captures")->capture_default_str();
+  app.add_flag("--quick", quick, "Diagnose with --quick");
+  app.add_flag("--generate-only", generate_only, "Only generate the captures");
+  app.add_flag("--score-only", score_only, "Only score existing diagnoses");
+  CLI11_PARSE(app, argc, argv);
+  if (drapegen.empty()) drapegen = (fs::path(argv[0]).parent_path() / "drapegen").string();
+
+  const auto fabrics = read_fabrics(fabrics_path);
+  if (fabrics.empty()) {
+    std::cerr << "diagnosis_bench: error: no fabrics in " << fabrics_path << "\n";
+    return 1;
+  }
+  renderer::Rng rng(seed);
+  std::vector<Case> cases;
+  int sensor_kind = 0;
+  auto add = [&](const std::string& family, int index) {
+    Case c;
+    c.family = family;
+    c.seed = seed * 1000 + cases.size();
+    c.fabric = fabrics[static_cast<std::size_t>(rng.uniform() * fabrics.size()) % fabrics.size()];
+    if (family == "none") {
+      c.effect = "";
+    } else if (family == "sensor") {
+      static const char* kinds[] = {"pose", "bias", "multipath"};
+      c.effect = kinds[sensor_kind++ % 3];
+    } else if (family == "misalignment") {
+      c.effect = "misalign";
+    } else {
+      c.effect = family;
+    }
+    if (!c.effect.empty()) {
+      const auto [lo, hi] = kStrength.at(c.effect);
+      c.strength = lo + (hi - lo) * rng.uniform();
+    }
+    c.name = fmt::format("{}_{:02d}", family, index);
+    cases.push_back(c);
+  };
+  for (int k = 0; k < controls; ++k) add("none", k);
+  for (const auto& f : families)
+    for (int k = 0; k < per_family; ++k) add(f, k);
+
+  fs::create_directories(out);
+  // 1. Generate (truth in OUT/truth/NAME.json; the capture directories hold no truth).
+  if (!score_only) {
+    for (const auto& c : cases) {
+      const fs::path dir = fs::path(out) / "captures" / c.name;
+      if (fs::exists(dir / "capture.json")) continue;
+      diagnosis::RealitySpec spec;
+      spec.bending = c.fabric.bending;
+      spec.density = c.fabric.density;
+      spec.resolution = resolution;
+      spec.seed = c.seed;
+      if (!c.effect.empty()) spec.effects.push_back({c.effect, c.strength});
+      auto r = diagnosis::generate_reality(spec, dir.string());
+      if (!r) {
+        std::cerr << "diagnosis_bench: " << c.name << ": " << r.error().message << "\n";
+        return 1;
+      }
+      fs::create_directories(fs::path(out) / "truth");
+      fs::rename(r->truth_path, fs::path(out) / "truth" / (c.name + ".json"));
+      std::cout << fmt::format("generated {} ({} {:.3g}) in {:.1f} s\n", c.name, c.effect, c.strength, r->seconds);
+    }
+  }
+  if (generate_only) return 0;
+
+  // 2. Diagnose, J at a time.
+  if (!score_only) {
+    std::atomic<std::size_t> next{0};
+    std::mutex io;
+    std::vector<std::thread> workers;
+    for (int j = 0; j < std::max(1, jobs); ++j) {
+      workers.emplace_back([&] {
+        for (std::size_t k = next++; k < cases.size(); k = next++) {
+          const auto& c = cases[k];
+          const fs::path dir = fs::path(out) / "captures" / c.name;
+          const fs::path result = fs::path(out) / "diagnoses" / (c.name + ".json");
+          if (fs::exists(result) && fs::file_size(result) > 0) continue;
+          fs::create_directories(result.parent_path());
+          const std::string cmd = fmt::format("'{}' diagnose --capture '{}' --json{} --jobs {} > '{}.tmp' 2> '{}.err'",
+                                              drapegen, dir.string(), quick ? " --quick" : "", diagnose_jobs,
+                                              result.string(), result.string());
+          const auto t0 = std::chrono::steady_clock::now();
+          const int rc = std::system(cmd.c_str());
+          const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+          if (rc == 0) fs::rename(result.string() + ".tmp", result);
+          std::lock_guard lock(io);
+          std::cout << fmt::format("diagnosed {} in {:.0f} s (exit {})\n", c.name, s, rc) << std::flush;
+        }
+      });
+    }
+    for (auto& w : workers) w.join();
+  }
+
+  // 3. Score.
+  const std::vector<std::string> columns{"none", "unexplained", "yield", "shear", "curl", "friction", "misalignment", "sensor"};
+  std::vector<std::string> rows{"none"};
+  for (const auto& f : families) rows.push_back(f);
+  std::map<std::string, std::map<std::string, int>> confusion;
+  int effect_total = 0, effect_correct = 0, control_total = 0, control_within = 0, region_total = 0, region_match = 0;
+  std::vector<double> shrinkages, seconds;
+  nlohmann::json per_case = nlohmann::json::array();
+  for (const auto& c : cases) {
+    const fs::path result = fs::path(out) / "diagnoses" / (c.name + ".json");
+    const fs::path truth_path = fs::path(out) / "truth" / (c.name + ".json");
+    if (!fs::exists(result) || !fs::exists(truth_path)) continue;
+    nlohmann::json d, t;
+    try {
+      d = nlohmann::json::parse(std::ifstream(result));
+      t = nlohmann::json::parse(std::ifstream(truth_path));
+    } catch (const std::exception&) {
+      continue;
+    }
+    const std::string verdict = d.value("verdict", "?");
+    const std::string family = t.value("family", "none");
+    const std::string region = d["localisation"].value("region", "?");
+    confusion[family][verdict]++;
+    seconds.push_back(d["runtime"].value("seconds", 0.0));
+    double shrink = std::numeric_limits<double>::quiet_NaN();
+    bool region_ok = false;
+    if (family == "none") {
+      ++control_total;
+      control_within += verdict == "none";
+    } else {
+      ++effect_total;
+      effect_correct += verdict == family;
+      // Shrinkage once the named effect is added: the top candidate's (0 when nothing is named).
+      shrink = verdict != "none" && verdict != "unexplained" ? d.value("shrinkage", 0.0) : 0.0;
+      shrinkages.push_back(shrink);
+      ++region_total;
+      for (const auto& r : t["regions"]) region_ok = region_ok || r.get<std::string>() == region;
+      region_match += region_ok;
+    }
+    per_case.push_back({{"case", c.name}, {"family", family}, {"effect", c.effect}, {"strength", c.strength},
+                        {"verdict", verdict}, {"runner_up", d.value("runner_up", "")},
+                        {"confidence", d.value("confidence", 0.0)}, {"region", region}, {"region_ok", region_ok},
+                        {"gap_mm", d["gap_mm"]["all_views"]}, {"floor_mm", d["floors"]["all_views_mm"]},
+                        {"shrinkage", family == "none" ? nlohmann::json(nullptr) : nlohmann::json(shrink)},
+                        {"seconds", d["runtime"]["seconds"]}});
+  }
+  auto median = [](std::vector<double> v) {
+    if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
+    std::sort(v.begin(), v.end());
+    return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+  };
+  std::string md = fmt::format("Cases scored: {} effect captures, {} controls ({}).\n\n", effect_total, control_total,
+                               quick ? "diagnose --quick" : "diagnose defaults");
+  md += "| truth \\ verdict |";
+  for (const auto& c : columns) md += " " + c + " |";
+  md += "\n|---|";
+  for (std::size_t k = 0; k < columns.size(); ++k) md += "---|";
+  md += "\n";
+  for (const auto& r : rows) {
+    md += "| " + r + " |";
+    for (const auto& c : columns) md += fmt::format(" {} |", confusion[r][c]);
+    md += "\n";
+  }
+  md += fmt::format("\n- top-1 correct on effect captures: {}/{} ({:.0f}%)\n", effect_correct, effect_total,
+                    effect_total ? 100.0 * effect_correct / effect_total : 0.0);
+  md += fmt::format("- controls within the floors: {}/{} ({:.0f}%)\n", control_within, control_total,
+                    control_total ? 100.0 * control_within / control_total : 0.0);
+  md += fmt::format("- median shrinkage of the held-out gap above the floor once the named effect is added (0 when "
+                    "none is named): {:.0f}%\n", 100.0 * median(shrinkages));
+  md += fmt::format("- localised region matches the effect's region: {}/{}\n", region_match, region_total);
+  md += fmt::format("- runtime per capture: median {:.0f} s, max {:.0f} s\n", median(seconds),
+                    seconds.empty() ? 0.0 : *std::max_element(seconds.begin(), seconds.end()));
+  std::ofstream(fs::path(out) / "summary.md") << md;
+  std::ofstream(fs::path(out) / "cases.json") << per_case.dump(2) << "\n";
+  std::cout << md;
+  return 0;
+}

@@ -1,0 +1,103 @@
+// drapegen diagnose: where the sim-to-real gap of a capture lies and which unmodelled effect explains it (issue 6).
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+
+#include <fmt/format.h>
+
+#include "commands.hpp"
+#include "drapegen/diagnosis/capture.hpp"
+#include "drapegen/diagnosis/diagnosis.hpp"
+#include "drapegen/diagnosis/report.hpp"
+#include "drapegen/sim/logging.hpp"
+#include "parse.hpp"
+
+namespace drapegen::cli {
+namespace {
+
+struct DiagnoseOptions {
+  std::string capture;
+  std::string report;
+  bool json = false;
+  bool quick = false;
+  int resolution = 0;
+  int states = 0;
+  int evaluations = 0;
+  int refit_evaluations = 0;
+  int jobs = 1;
+  bool verbose = false;
+};
+
+int fail(const std::string& message, int code = kExitUsage) {
+  std::cerr << "drapegen diagnose: error: " << message << "\n";
+  return code;
+}
+
+int run_diagnose(const DiagnoseOptions& o) {
+  if (o.jobs < 1 || o.jobs > 64) return fail("--jobs must be 1 .. 64");
+  if (o.resolution != 0 && (o.resolution < 6 || o.resolution > 60)) return fail("--resolution must be 6 .. 60");
+  if (o.states < 0 || o.states > 16) return fail("--states must be 1 .. 16");
+  if (o.evaluations < 0 || o.evaluations > 10000 || o.refit_evaluations < 0 || o.refit_evaluations > 10000) {
+    return fail("--evaluations and --refit-evaluations must be 1 .. 10000");
+  }
+  if (o.verbose) sim::logger()->set_level(spdlog::level::info);
+  auto capture = diagnosis::read_capture(o.capture);
+  if (!capture) return fail(capture.error().message);
+  if (!o.report.empty()) {
+    if (sim::Status s = check_writable(o.report + ".probe"); !s) return fail(s.error().message, kExitIo);
+  }
+  diagnosis::DiagnosisSettings settings = o.quick ? diagnosis::DiagnosisSettings::quick() : diagnosis::DiagnosisSettings{};
+  if (o.resolution > 0) settings.fit.resolution = o.resolution;
+  if (o.states > 0) settings.fit.initial_states = o.states;
+  if (o.evaluations > 0) settings.baseline_optimiser.max_evaluations = o.evaluations;
+  if (o.refit_evaluations > 0) settings.attribution.optimiser.max_evaluations = o.refit_evaluations;
+  settings.attribution.jobs = o.jobs;
+  auto result = diagnosis::diagnose(*capture, settings);
+  if (!result) return fail(result.error().message);
+  if (!o.report.empty()) {
+    auto model = diagnosis::ForwardModel::create(*capture, settings.fit);
+    if (!model) return fail(model.error().message);
+    if (sim::Status s = diagnosis::write_report(o.report, *result, *capture, **model); !s) {
+      return fail(s.error().message, kExitIo);
+    }
+  }
+  const nlohmann::json j = diagnosis::to_json(*result, *capture);
+  if (o.json) {
+    std::cout << j.dump(2) << "\n";
+  } else {
+    const auto& r = *result;
+    std::cout << fmt::format("diagnose: {} in {:.0f} s\n", o.capture, r.seconds);
+    std::cout << fmt::format("  gap {:.2f} mm (all views), {:.2f} mm (held-out view); floor {:.2f} / {:.2f} mm\n",
+                             r.gap_all * 1e3, r.gap_held_out * 1e3, r.floors.all * 1e3, r.floors.held_out * 1e3);
+    std::cout << fmt::format("  localised: {}\n", diagnosis::region_name(r.localisation.dominant));
+    if (r.verdict == "none") {
+      std::cout << "  verdict: within the floors (no effect named)\n";
+    } else if (r.verdict == "unexplained") {
+      std::cout << "  verdict: above the floors, no candidate shrinks it significantly\n";
+    } else {
+      std::cout << fmt::format("  verdict: {} (confidence {:.2f}, runner-up {}), shrinkage {:.0f}%\n", r.verdict,
+                               r.attribution.confidence, r.runner_up, 100 * r.attribution.candidates[0].shrinkage);
+    }
+    if (!o.report.empty()) std::cout << "  report: " << o.report << "/report.md\n";
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+Runner add_diagnose_command(CLI::App& app) {
+  auto o = std::make_shared<DiagnoseOptions>();
+  app.add_option("--capture", o->capture, "Capture directory (docs/CAPTURE.md)")->required();
+  app.add_option("--report", o->report, "Write report.json, report.md and residual PNGs here");
+  app.add_flag("--json", o->json, "Print the result as JSON");
+  app.add_flag("--quick", o->quick, "Small budgets (16x16 mesh, 2 initial states, fewer evaluations)");
+  app.add_option("--resolution", o->resolution, "Fitting mesh vertices per side (default 20; quick 16)");
+  app.add_option("--states", o->states, "Initial states per evaluation (default 3; quick 2)");
+  app.add_option("--evaluations", o->evaluations, "Baseline fit evaluations (default 40; quick 20)");
+  app.add_option("--refit-evaluations", o->refit_evaluations, "Evaluations per candidate refit (default 14; quick 8)");
+  app.add_option("--jobs", o->jobs, "Candidate refits in parallel threads")->capture_default_str();
+  app.add_flag("-v,--verbose", o->verbose, "Log progress on stderr");
+  return [o] { return run_diagnose(*o); };
+}
+
+}  // namespace drapegen::cli

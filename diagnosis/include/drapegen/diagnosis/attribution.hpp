@@ -1,0 +1,58 @@
+#pragma once
+// Which effect explains the gap: each candidate is added to the model with its own parameters, refitted on the fit
+// views (with the bending scale free as well), and judged by how much it shrinks the gap above the floor on the
+// held-out view. Confidence: a block bootstrap over the held-out view's residual tiles of the named effect against
+// the runner-up.
+
+#include <string>
+#include <vector>
+
+#include "drapegen/diagnosis/candidate_effect.hpp"
+#include "drapegen/diagnosis/floors.hpp"
+#include "drapegen/diagnosis/forward_model.hpp"
+#include "drapegen/diagnosis/nelder_mead.hpp"
+
+namespace drapegen::diagnosis {
+
+struct CandidateResult {
+  Effect effect = Effect::kYield;
+  std::vector<std::string> names;
+  std::vector<double> parameters;   // as in effect_space
+  double alpha_scale = 1.0;         // the refitted bending scale relative to the baseline fit
+  double fit_score = 0.0, held_out_score = 0.0, all_score = 0.0;
+  double shrinkage = 0.0;           // held-out gap above the floor: 1 - excess_after / excess_before
+  double raw_shrinkage = 0.0;       // 1 - held_out_after / held_out_before
+  int evaluations = 0;
+  double seconds = 0.0;
+  ScoredDrape drape;
+};
+
+struct AttributionSettings {
+  NelderMeadOptions optimiser{.max_evaluations = 14};
+  int sensor_evaluations = 200;     // render-only refits are cheap
+  double significant_shrinkage = 0.25;
+  int bootstrap_samples = 1000;
+  int tile_px = 16;
+  int jobs = 1;                     // candidate refits in parallel (one forward model per thread)
+  std::vector<Effect> candidates{std::begin(kAllEffects), std::end(kAllEffects)};
+};
+
+struct Attribution {
+  std::vector<CandidateResult> candidates;  // sorted by shrinkage, best first
+  bool named = false;                       // the best shrinks the gap significantly
+  double confidence = 0.0;                  // bootstrap P(best beats runner-up on the held-out view)
+};
+
+/// `baseline` is the fitted setup and `fit` its evaluation; `floors` from measure_floors. make_model creates a
+/// forward model for another thread (jobs > 1).
+[[nodiscard]] sim::Expected<Attribution> attribute(
+    ForwardModel& model, const ModelSetup& baseline, const Evaluation& fit, const Floors& floors,
+    const AttributionSettings& settings,
+    const std::function<sim::Expected<std::unique_ptr<ForwardModel>>()>& make_model = {});
+
+/// The probability, by block bootstrap over tiles of the held-out views, that `a`'s squared residuals are smaller
+/// than `b`'s in total.
+[[nodiscard]] double bootstrap_confidence(const ForwardModel& model, const ScoredDrape& a, const ScoredDrape& b,
+                                          int samples, int tile_px, std::uint64_t seed);
+
+}  // namespace drapegen::diagnosis

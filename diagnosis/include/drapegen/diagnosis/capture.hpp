@@ -1,0 +1,53 @@
+#pragma once
+// A capture: what a drape tester (or the reality generator) recorded of one specimen, and all the diagnosis reads.
+// Format: docs/CAPTURE.md (a directory with capture.json, one depth EXR per view, optionally a scanned mesh).
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "drapegen/renderer/camera.hpp"
+#include "drapegen/renderer/depth_image.hpp"
+#include "drapegen/sim/expected.hpp"
+
+namespace drapegen::diagnosis {
+
+/// Facts about the specimen and the tester that the operator knows.
+struct SpecimenFacts {
+  double size_x = 0.3;             // m
+  double size_y = 0.3;             // m
+  double density = 300.0;          // g/m^2
+  double cylinder_diameter = 0.1;  // m
+};
+
+struct CaptureView {
+  std::string file;  // relative to the capture directory
+  /// Camera-space z, metres, 0 = no return.
+  renderer::DepthImage depth;
+  /// Intrinsics and pose in the specimen frame (platform top in z = 0, axis along z, as drapegen::sim).
+  renderer::Camera camera;
+};
+
+struct Capture {
+  std::string directory;
+  SpecimenFacts specimen;
+  std::vector<CaptureView> views;
+  std::optional<std::string> scan_mesh;  // a PLY file, relative to the directory
+  std::string source;                    // free text, e.g. "drapegen reality"
+};
+
+/// The number of views a capture must have (the tester's four).
+constexpr int kCaptureViews = 4;
+
+/// Reads DIR/capture.json and its depth files. Every failure is one line naming the file and the problem: missing
+/// capture.json or view, malformed JSON, wrong view count, depth size not the camera's, NaN/infinite/negative depth,
+/// a view without any return, implausible specimen facts.
+[[nodiscard]] sim::Expected<Capture> read_capture(const std::string& directory);
+
+/// Writes capture.json and the depth EXRs (float) into `directory` (created if needed). capture.directory is ignored.
+[[nodiscard]] sim::Status write_capture(const std::string& directory, const Capture& capture);
+
+/// Checks one view's depth: size, finite, non-negative, some return.
+[[nodiscard]] sim::Status check_view(const CaptureView& view);
+
+}  // namespace drapegen::diagnosis

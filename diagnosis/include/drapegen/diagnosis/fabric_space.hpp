@@ -1,0 +1,29 @@
+#pragma once
+// The baseline model's six bending parameters and the reduced coordinates the fit searches in.
+
+#include <array>
+
+#include "drapegen/sim/anisotropy.hpp"
+
+namespace drapegen::diagnosis {
+
+/// Paper units: alpha in g*mm^2/s^2, beta in g*mm^3/s^2 (warp, bias, weft).
+struct BendingParameters {
+  sim::DirectionalValues alpha{10000.0, 10000.0, 10000.0};
+  sim::DirectionalValues beta{-25000.0, -25000.0, -25000.0};
+};
+
+/// Reduced coordinates (the fit's search space, all of similar scale):
+///   x0 = ln(geometric mean of alpha),  x1 = ln(alpha_warp / alpha_weft),
+///   x2 = ln(alpha_bias / sqrt(alpha_warp alpha_weft)),  x3 = -beta / alpha in mm (one ratio for all directions).
+/// The six parameters have a 4-dimensional image: beta is alpha times one shared (negative) length.
+using ReducedBending = std::array<double, 4>;
+[[nodiscard]] BendingParameters from_reduced(const ReducedBending& x);
+/// The reduced coordinates of `p` (x3 is the alpha-weighted mean ratio).
+[[nodiscard]] ReducedBending to_reduced(const BendingParameters& p);
+
+/// The search box: alpha 200 .. 200000, ratios e^+-1.5, -beta/alpha 0 .. 6 mm (fabrics618: up to about 5).
+[[nodiscard]] ReducedBending reduced_lower();
+[[nodiscard]] ReducedBending reduced_upper();
+
+}  // namespace drapegen::diagnosis

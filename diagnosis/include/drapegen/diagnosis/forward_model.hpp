@@ -1,0 +1,106 @@
+#pragma once
+// Simulation in the loop: a model setup is simulated from several initial states on a coarse mesh, each drape is
+// turned to the capture's outline (the specimen's orientation on the table is arbitrary), rendered into the
+// capture's cameras and compared view by view; the best initial state counts (multiple stable drapes).
+
+#include <memory>
+#include <vector>
+
+#include "drapegen/diagnosis/capture.hpp"
+#include "drapegen/diagnosis/depth_metric.hpp"
+#include "drapegen/diagnosis/hem_profile.hpp"
+#include "drapegen/diagnosis/model_setup.hpp"
+#include "drapegen/renderer/depth_renderer.hpp"
+#include "drapegen/sim/expected.hpp"
+#include "drapegen/sim/initial_state.hpp"
+#include "drapegen/sim/mesh.hpp"
+
+namespace drapegen::diagnosis {
+
+struct FitSettings {
+  int resolution = 20;                 // vertices per side of the fitting mesh
+  int initial_states = 3;              // flat, then sine waves with seeds 1, 2, ...
+  int max_newton_iterations = 200;
+  double tolerance = 2e-3;
+  std::vector<int> fit_views{0, 1, 2}; // the rest are held out
+  MetricWeights weights;
+};
+
+/// The initial states of the fit: flat, then sine seeds 1.. (count in total).
+[[nodiscard]] std::vector<sim::InitialStateSpec> fit_initial_states(int count, std::uint64_t first_seed = 1);
+
+/// What a model drape is compared with: per view features and radial profiles, and the outline of the fit views.
+struct Target {
+  std::vector<ViewFeatures> views;
+  std::vector<RadialProfile> radial;  // per view
+  HemProfile outline;                 // from the fit views
+};
+
+/// One drape of the model, turned to best match an outline, and how it compares with each view.
+struct ScoredDrape {
+  sim::ClothMesh mesh;        // as simulated (not turned)
+  double angle = 0.0;         // radians: the turn applied before rendering
+  int state = 0;              // index of the initial state
+  bool converged = true;
+  std::vector<ViewComparison> views;  // every view of the capture
+  double hem_spectrum = 0.0;  // m, spectrum_distance of the fit views' outlines (capture, model render)
+  std::vector<double> radial; // m, per view: radial_distance of capture and model render
+  /// Each a mean over its views of (view score + radial weight * radial), plus hem weight * hem_spectrum for the
+  /// fit and all-view scores (the held-out score uses the held-out view alone).
+  double fit_score = 0.0;
+  double held_out_score = 0.0;
+  double all_score = 0.0;
+};
+
+struct Evaluation {
+  ScoredDrape best;                  // the best state by fit_score
+  std::vector<ScoredDrape> states;   // every state (same order as the initial states)
+};
+
+class ForwardModel {
+ public:
+  [[nodiscard]] static sim::Expected<std::unique_ptr<ForwardModel>> create(const Capture& capture,
+                                                                           const FitSettings& settings);
+
+  /// Simulates `setup` from initial state `state` (fit_initial_states order, or any spec via the overload).
+  [[nodiscard]] sim::Expected<sim::ClothMesh> simulate(const ModelSetup& setup, const sim::InitialStateSpec& state,
+                                                       bool* converged = nullptr);
+  /// Turns `mesh` to match `target` (the capture's outline unless given), renders with setup.sensor, compares.
+  [[nodiscard]] sim::Expected<ScoredDrape> score(const sim::ClothMesh& mesh, const ModelSetup& setup,
+                                                 const Target& target);
+  /// The target of a capture with these views (same cameras as the capture).
+  [[nodiscard]] Target make_target(const std::vector<renderer::DepthImage>& depth) const;
+  [[nodiscard]] sim::Expected<ScoredDrape> score(const sim::ClothMesh& mesh, const ModelSetup& setup);
+  /// Every initial state simulated and scored; the best by fit score.
+  [[nodiscard]] sim::Expected<Evaluation> evaluate(const ModelSetup& setup);
+  /// Re-scores given meshes (no simulation): the sensor candidate's refit.
+  [[nodiscard]] sim::Expected<Evaluation> rescore(const std::vector<sim::ClothMesh>& meshes, const ModelSetup& setup);
+
+  /// Clean renders of `mesh` turned by `angle` in every view (with the setup's sensor error).
+  [[nodiscard]] sim::Expected<std::vector<renderer::DepthImage>> render(const sim::ClothMesh& mesh, double angle,
+                                                                        const renderer::SensorError& sensor);
+
+  [[nodiscard]] const Capture& capture() const { return capture_; }
+  [[nodiscard]] const FitSettings& settings() const { return settings_; }
+  [[nodiscard]] const std::vector<ViewFeatures>& features() const { return target_.views; }
+  [[nodiscard]] const HemProfile& outline() const { return target_.outline; }
+  [[nodiscard]] const std::vector<sim::InitialStateSpec>& initial_states() const { return states_; }
+  [[nodiscard]] int simulations() const { return simulations_; }
+  [[nodiscard]] double simulation_seconds() const { return simulation_seconds_; }
+  /// Means over the fit views / held-out views / all of per-view scores.
+  [[nodiscard]] double fit_mean(const std::vector<ViewComparison>& views) const;
+  [[nodiscard]] double held_out_mean(const std::vector<ViewComparison>& views) const;
+
+ private:
+  ForwardModel(const Capture& capture, const FitSettings& settings, renderer::DepthRenderer renderer);
+  Capture capture_;
+  FitSettings settings_;
+  renderer::DepthRenderer renderer_;
+  Target target_;
+  std::vector<sim::InitialStateSpec> states_;
+  std::vector<bool> is_fit_view_;
+  int simulations_ = 0;
+  double simulation_seconds_ = 0.0;
+};
+
+}  // namespace drapegen::diagnosis

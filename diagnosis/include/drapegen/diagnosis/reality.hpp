@@ -1,0 +1,52 @@
+#pragma once
+// The reality generator: a capture of a drape with effects the baseline model lacks (physical ones in the
+// simulation, sensor ones in the rendering), and its ground truth in a separate file the diagnosis never reads.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "drapegen/diagnosis/capture.hpp"
+#include "drapegen/diagnosis/fabric_space.hpp"
+#include "drapegen/sim/expected.hpp"
+
+namespace drapegen::diagnosis {
+
+/// One --effect NAME[=STRENGTH]:
+///   yield=K       elastoplastic bending, hinges yield at curvature K 1/m (default 20)
+///   shear=G       trellis membrane with shear stiffness G kg/s^2 (default 1)
+///   curl=K        edge rest curvature K 1/m over 30 mm (default 25)
+///   friction=MU   Coulomb friction on the top instead of adhesion (default 0.05)
+///   misalign=MM   specimen centre MM mm off the axis, seeded direction (default 15; the data's augmentation: 2)
+///   pose=DEG      camera pose error: rotation DEG degrees about a seeded axis and translation 5*DEG mm (default 1)
+///   bias=MM       depth bias MM mm (default 5)
+///   multipath=MM  multipath gain MM mm (default 15)
+struct RealityEffect {
+  std::string name;
+  double strength = 0.0;
+};
+[[nodiscard]] sim::Expected<RealityEffect> parse_reality_effect(const std::string& text);
+/// The family the diagnosis should name: yield, shear, curl, friction, misalignment or sensor (pose, bias,
+/// multipath).
+[[nodiscard]] std::string reality_family(const std::string& effect_name);
+
+struct RealitySpec {
+  BendingParameters bending;
+  double density = 300.0;   // g/m^2
+  int resolution = 30;      // the "real" specimen's mesh
+  std::uint64_t seed = 0;   // initial state, orientation, drift, camera augmentation, noise
+  std::vector<RealityEffect> effects;
+  bool noise = true;
+};
+
+struct RealityResult {
+  std::string truth_path;
+  double seconds = 0.0;
+  bool converged = true;
+};
+
+/// Simulates and renders DIR/capture.json + DIR/view{0..3}.exr, writes the truth to DIR/truth.json and a preview to
+/// DIR/preview.png.
+[[nodiscard]] sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std::string& directory);
+
+}  // namespace drapegen::diagnosis

@@ -1,0 +1,21 @@
+#pragma once
+// The human report of a diagnosis: report.json, report.md and the residual maps as PNG images.
+
+#include <string>
+#include <vector>
+
+#include "drapegen/diagnosis/diagnosis.hpp"
+
+namespace drapegen::diagnosis {
+
+/// Signed residual images side by side, diverging colours (blue: the capture is nearer the camera than the model,
+/// red: farther), saturating at +-`range` m; black where neither returns. 8-bit RGB PNG via libpng.
+[[nodiscard]] sim::Status write_residual_png(const std::string& path, const std::vector<std::vector<float>>& residuals,
+                                             int width, int height, double range);
+
+/// Writes DIR/report.json, DIR/report.md, DIR/residual.png (capture - fitted baseline per view), DIR/views.png
+/// (capture over fitted drape) and DIR/residual_after.png (after adding the named effect, if any).
+[[nodiscard]] sim::Status write_report(const std::string& directory, const DiagnosisResult& result,
+                                       const Capture& capture, ForwardModel& model);
+
+}  // namespace drapegen::diagnosis

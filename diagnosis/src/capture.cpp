@@ -1,0 +1,190 @@
+#include "drapegen/diagnosis/capture.hpp"
+
+#include <cmath>
+#include <filesystem>
+#include <fmt/format.h>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "drapegen/diagnosis/depth_exr.hpp"
+
+namespace drapegen::diagnosis {
+namespace fs = std::filesystem;
+namespace {
+
+constexpr const char* kFormat = "drapegen-capture";
+
+nlohmann::json matrix_json(const Eigen::MatrixXd& m) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (int i = 0; i < m.rows(); ++i) {
+    nlohmann::json row = nlohmann::json::array();
+    for (int j = 0; j < m.cols(); ++j) row.push_back(m(i, j));
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+sim::Expected<Eigen::MatrixXd> matrix_from(const nlohmann::json& j, int rows, int cols, const std::string& what) {
+  if (!j.is_array() || static_cast<int>(j.size()) != rows) {
+    return sim::Error{fmt::format("{} must be a {}x{} array of rows", what, rows, cols)};
+  }
+  Eigen::MatrixXd m(rows, cols);
+  for (int i = 0; i < rows; ++i) {
+    if (!j[i].is_array() || static_cast<int>(j[i].size()) != cols) {
+      return sim::Error{fmt::format("{} must be a {}x{} array of rows", what, rows, cols)};
+    }
+    for (int k = 0; k < cols; ++k) {
+      if (!j[i][k].is_number()) return sim::Error{fmt::format("{} has a non-number", what)};
+      m(i, k) = j[i][k].get<double>();
+      if (!std::isfinite(m(i, k))) return sim::Error{fmt::format("{} has a non-finite entry", what)};
+    }
+  }
+  return m;
+}
+
+}  // namespace
+
+sim::Status check_view(const CaptureView& view) {
+  const auto& d = view.depth;
+  const auto& in = view.camera.intrinsics;
+  if (d.width != in.width || d.height != in.height) {
+    return sim::Error{fmt::format("{}: depth is {}x{} but the camera is {}x{}", view.file, d.width, d.height,
+                                  in.width, in.height)};
+  }
+  int returns = 0;
+  for (std::size_t i = 0; i < d.depth.size(); ++i) {
+    const float z = d.depth[i];
+    if (!std::isfinite(z)) {
+      return sim::Error{fmt::format("{}: non-finite depth (NaN or inf) at pixel ({}, {}); use 0 for no return",
+                                    view.file, i % d.width, i / d.width)};
+    }
+    if (z < 0.0f) {
+      return sim::Error{fmt::format("{}: negative depth {} at pixel ({}, {})", view.file, z, i % d.width, i / d.width)};
+    }
+    returns += z > 0.0f;
+  }
+  if (returns == 0) return sim::Error{fmt::format("{}: all-zero depth (no return in the whole view)", view.file)};
+  if (returns < 100) return sim::Error{fmt::format("{}: only {} pixels return; not a drape view", view.file, returns)};
+  return {};
+}
+
+sim::Expected<Capture> read_capture(const std::string& directory) {
+  const fs::path dir(directory);
+  const fs::path json_path = dir / "capture.json";
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) return sim::Error{fmt::format("{}: not a directory", directory)};
+  if (!fs::is_regular_file(json_path, ec)) return sim::Error{fmt::format("{}: no such file", json_path.string())};
+  nlohmann::json j;
+  try {
+    std::ifstream in(json_path);
+    j = nlohmann::json::parse(in);
+  } catch (const std::exception& e) {
+    return sim::Error{fmt::format("{}: malformed JSON: {}", json_path.string(), e.what())};
+  }
+  const std::string where = json_path.string();
+  try {
+    if (!j.is_object() || j.value("format", "") != kFormat) {
+      return sim::Error{fmt::format("{}: not a capture (\"format\" must be \"{}\")", where, kFormat)};
+    }
+    if (j.value("version", 0) != 1) return sim::Error{fmt::format("{}: unsupported version (expected 1)", where)};
+    Capture c;
+    c.directory = directory;
+    c.source = j.value("source", "");
+    if (!j.contains("specimen") || !j["specimen"].is_object()) {
+      return sim::Error{fmt::format("{}: missing \"specimen\"", where)};
+    }
+    const auto& s = j["specimen"];
+    const auto size = s.at("size_mm");
+    if (!size.is_array() || size.size() != 2) return sim::Error{fmt::format("{}: specimen.size_mm must be [X, Y]", where)};
+    c.specimen.size_x = size[0].get<double>() * 1e-3;
+    c.specimen.size_y = size[1].get<double>() * 1e-3;
+    c.specimen.density = s.at("density_g_per_m2").get<double>();
+    c.specimen.cylinder_diameter = s.at("cylinder_diameter_mm").get<double>() * 1e-3;
+    if (!(c.specimen.size_x >= 0.05 && c.specimen.size_x <= 2.0 && c.specimen.size_y >= 0.05 &&
+          c.specimen.size_y <= 2.0)) {
+      return sim::Error{fmt::format("{}: specimen size must be 50 .. 2000 mm", where)};
+    }
+    if (!(c.specimen.density >= 1.0 && c.specimen.density <= 1e5)) {
+      return sim::Error{fmt::format("{}: density must be 1 .. 100000 g/m^2", where)};
+    }
+    if (!(c.specimen.cylinder_diameter >= 0.01 && c.specimen.cylinder_diameter < std::min(c.specimen.size_x, c.specimen.size_y))) {
+      return sim::Error{fmt::format("{}: cylinder diameter must be 10 mm .. the specimen size", where)};
+    }
+    if (!j.contains("views") || !j["views"].is_array()) return sim::Error{fmt::format("{}: missing \"views\"", where)};
+    const auto& views = j["views"];
+    if (static_cast<int>(views.size()) != kCaptureViews) {
+      return sim::Error{fmt::format("{}: {} views listed, the tester takes {}", where, views.size(), kCaptureViews)};
+    }
+    for (std::size_t v = 0; v < views.size(); ++v) {
+      const auto& jv = views[v];
+      const std::string what = fmt::format("{}: views[{}]", where, v);
+      CaptureView view;
+      view.file = jv.at("depth").get<std::string>();
+      view.camera.intrinsics.width = jv.at("width").get<int>();
+      view.camera.intrinsics.height = jv.at("height").get<int>();
+      if (view.camera.intrinsics.width < 8 || view.camera.intrinsics.height < 8 ||
+          view.camera.intrinsics.width > 8192 || view.camera.intrinsics.height > 8192) {
+        return sim::Error{what + ": width and height must be 8 .. 8192"};
+      }
+      auto K = matrix_from(jv.at("K"), 3, 3, what + ".K");
+      if (!K) return K.error();
+      if ((*K)(2, 0) != 0.0 || (*K)(2, 1) != 0.0 || (*K)(2, 2) != 1.0) return sim::Error{what + ".K: last row must be 0 0 1"};
+      view.camera.intrinsics.K = *K;
+      auto T = matrix_from(jv.at("world_to_camera"), 4, 4, what + ".world_to_camera");
+      if (!T) return T.error();
+      const Eigen::Matrix3d R = T->topLeftCorner(3, 3);
+      if ((R.transpose() * R - Eigen::Matrix3d::Identity()).norm() > 1e-4 || R.determinant() < 0.0) {
+        return sim::Error{what + ".world_to_camera: not a rigid transform (rotation part not orthonormal)"};
+      }
+      view.camera.world_to_camera.matrix() = *T;
+      auto depth = read_depth_exr((dir / view.file).string());
+      if (!depth) return sim::Error{fmt::format("view {}: {}", v, depth.error().message)};
+      view.depth = std::move(*depth);
+      view.file = (dir / view.file).string();
+      if (sim::Status st = check_view(view); !st) return sim::Error{fmt::format("view {}: {}", v, st.error().message)};
+      c.views.push_back(std::move(view));
+    }
+    if (j.contains("scan") && !j["scan"].is_null()) {
+      const std::string scan = j["scan"].get<std::string>();
+      if (!fs::is_regular_file(dir / scan, ec)) return sim::Error{fmt::format("{}: scan {} not found", where, scan)};
+      c.scan_mesh = scan;
+    }
+    return c;
+  } catch (const nlohmann::json::exception& e) {
+    return sim::Error{fmt::format("{}: missing or malformed field: {}", where, e.what())};
+  }
+}
+
+sim::Status write_capture(const std::string& directory, const Capture& capture) {
+  const fs::path dir(directory);
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) return sim::Error{fmt::format("{}: cannot create directory: {}", directory, ec.message())};
+  nlohmann::json views = nlohmann::json::array();
+  for (std::size_t v = 0; v < capture.views.size(); ++v) {
+    const auto& view = capture.views[v];
+    const std::string file = view.file.empty() ? fmt::format("view{}.exr", v) : fs::path(view.file).filename().string();
+    if (sim::Status s = write_depth_exr((dir / file).string(), view.depth); !s) return s;
+    views.push_back({{"depth", file},
+                     {"width", view.camera.intrinsics.width},
+                     {"height", view.camera.intrinsics.height},
+                     {"K", matrix_json(view.camera.intrinsics.K)},
+                     {"world_to_camera", matrix_json(view.camera.world_to_camera.matrix())}});
+  }
+  nlohmann::json j = {{"format", kFormat},
+                      {"version", 1},
+                      {"source", capture.source},
+                      {"specimen",
+                       {{"size_mm", {capture.specimen.size_x * 1e3, capture.specimen.size_y * 1e3}},
+                        {"density_g_per_m2", capture.specimen.density},
+                        {"cylinder_diameter_mm", capture.specimen.cylinder_diameter * 1e3}}},
+                      {"views", views}};
+  if (capture.scan_mesh) j["scan"] = *capture.scan_mesh;
+  const fs::path path = dir / "capture.json";
+  std::ofstream out(path);
+  out << j.dump(2) << "\n";
+  if (!out) return sim::Error{fmt::format("{}: cannot write", path.string())};
+  return {};
+}
+
+}  // namespace drapegen::diagnosis

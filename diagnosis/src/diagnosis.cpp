@@ -1,0 +1,245 @@
+#include "drapegen/diagnosis/diagnosis.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <nlohmann/json.hpp>
+
+#include "drapegen/sim/logging.hpp"
+
+namespace drapegen::diagnosis {
+namespace {
+
+double since(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+ModelSetup baseline_setup(const ReducedBending& x) {
+  ModelSetup s;
+  s.bending = from_reduced(x);
+  return s;
+}
+
+/// The initial guess: the drape coefficient of the capture's outline against that of isotropic drapes at a few
+/// stiffness levels (flat start), interpolated in ln(alpha).
+sim::Expected<ReducedBending> initial_guess(ForwardModel& model, int levels) {
+  const HemProfile& outline = model.outline();
+  const double target = drape_coefficient(outline, model.capture().specimen);
+  const ReducedBending lo = reduced_lower(), hi = reduced_upper();
+  const double a0 = std::log(1000.0), a1 = std::log(60000.0);
+  std::vector<std::pair<double, double>> samples;  // (ln alpha, drape coefficient)
+  for (int k = 0; k < levels; ++k) {
+    const double la = levels > 1 ? a0 + (a1 - a0) * k / (levels - 1) : 0.5 * (a0 + a1);
+    ReducedBending x{la, 0.0, 0.0, 2.5};
+    auto mesh = model.simulate(baseline_setup(x), model.initial_states().front());
+    if (!mesh) return mesh.error();
+    samples.emplace_back(la, drape_coefficient(hem_profile_from_mesh(*mesh), model.capture().specimen));
+  }
+  double la = samples.front().first;
+  if (target <= samples.front().second) {
+    la = samples.front().first;
+  } else if (target >= samples.back().second) {
+    la = samples.back().first;
+  } else {
+    for (std::size_t k = 0; k + 1 < samples.size(); ++k) {
+      const auto& [x0, d0] = samples[k];
+      const auto& [x1, d1] = samples[k + 1];
+      if ((target - d0) * (target - d1) <= 0.0 && d1 != d0) {
+        la = x0 + (x1 - x0) * (target - d0) / (d1 - d0);
+        break;
+      }
+    }
+  }
+  return ReducedBending{std::clamp(la, lo[0], hi[0]), 0.0, 0.0, 2.5};
+}
+
+nlohmann::json bending_json(const BendingParameters& p) {
+  return {{"alpha", {p.alpha.warp, p.alpha.bias, p.alpha.weft}}, {"beta", {p.beta.warp, p.beta.bias, p.beta.weft}}};
+}
+
+nlohmann::json view_json(const ScoredDrape& d) {
+  nlohmann::json views = nlohmann::json::array();
+  for (std::size_t k = 0; k < d.views.size(); ++k) {
+    const auto& v = d.views[k];
+    views.push_back({{"score_mm", v.score * 1e3},
+                     {"stable_rms_mm", v.stable_rms * 1e3},
+                     {"stable_px", v.stable_pixels},
+                     {"radial_mm", k < d.radial.size() ? d.radial[k] * 1e3 : 0.0},
+                     {"depth_rms_mm", v.depth_rms * 1e3},
+                     {"silhouette_mismatch", v.silhouette},
+                     {"fold_rms_deg", v.fold_rms_deg},
+                     {"overlap_px", v.overlap}});
+  }
+  return views;
+}
+
+}  // namespace
+
+DiagnosisSettings DiagnosisSettings::quick() {
+  DiagnosisSettings s;
+  s.fit.resolution = 16;
+  s.fit.initial_states = 2;
+  s.fit.max_newton_iterations = 150;
+  s.baseline_optimiser.max_evaluations = 20;
+  s.guess_levels = 3;
+  s.floors.noise_seeds = 2;
+  s.floors.extra_states = 2;
+  s.attribution.optimiser.max_evaluations = 8;
+  s.attribution.sensor_evaluations = 100;
+  s.attribution.bootstrap_samples = 400;
+  return s;
+}
+
+sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisSettings& settings) {
+  const auto start = std::chrono::steady_clock::now();
+  auto created = ForwardModel::create(capture, settings.fit);
+  if (!created) return created.error();
+  ForwardModel& model = **created;
+  DiagnosisResult r;
+
+  // 1. Baseline fit in the reduced space, from the drape-coefficient guess.
+  auto guess = initial_guess(model, std::max(1, settings.guess_levels));
+  if (!guess) return guess.error();
+  r.initial_guess = from_reduced(*guess);
+  std::optional<sim::Error> error;
+  double best = std::numeric_limits<double>::infinity();
+  auto objective = [&](const std::vector<double>& x) -> double {
+    if (error) return std::numeric_limits<double>::infinity();
+    auto e = model.evaluate(baseline_setup({x[0], x[1], x[2], x[3]}));
+    if (!e) {
+      error = e.error();
+      return std::numeric_limits<double>::infinity();
+    }
+    const double value = e->best.fit_score;
+    if (value < best) {
+      best = value;
+      r.fit = std::move(*e);
+    }
+    return value;
+  };
+  const ReducedBending lo = reduced_lower(), hi = reduced_upper();
+  const NelderMeadResult nm = nelder_mead(objective, {guess->begin(), guess->end()}, {0.35, 0.4, 0.4, 1.0},
+                                          {lo.begin(), lo.end()}, {hi.begin(), hi.end()}, settings.baseline_optimiser);
+  if (error) return *error;
+  r.fitted_reduced = {nm.x[0], nm.x[1], nm.x[2], nm.x[3]};
+  r.fitted = from_reduced(r.fitted_reduced);
+  r.baseline_evaluations = nm.evaluations;
+  r.baseline_history = nm.history;
+  r.seconds_fit = since(start);
+  const ModelSetup fitted = baseline_setup(r.fitted_reduced);
+
+  // 2. Floors and the gap.
+  const auto floors_start = std::chrono::steady_clock::now();
+  auto floors = measure_floors(model, fitted, r.fit, settings.floors);
+  if (!floors) return floors.error();
+  r.floors = *floors;
+  r.seconds_floors = since(floors_start);
+  r.gap_all = r.fit.best.all_score;
+  r.gap_fit = r.fit.best.fit_score;
+  r.gap_held_out = r.fit.best.held_out_score;
+  r.within_floors = r.gap_all <= r.floors.all;
+
+  // 3. Where the gap sits.
+  r.localisation = localise(model, r.fit.best);
+
+  // 4. Which effect explains it (not when the gap is within the floors).
+  const auto attribution_start = std::chrono::steady_clock::now();
+  if (r.within_floors) {
+    r.verdict = "none";
+  } else {
+    const FitSettings fit_settings = settings.fit;
+    auto make_model = [&capture, fit_settings]() { return ForwardModel::create(capture, fit_settings); };
+    auto attribution = attribute(model, fitted, r.fit, r.floors, settings.attribution, make_model);
+    if (!attribution) return attribution.error();
+    r.attribution = std::move(*attribution);
+    const auto& c = r.attribution.candidates;
+    r.verdict = r.attribution.named ? std::string(effect_name(c[0].effect)) : "unexplained";
+    if (c.size() > 1) r.runner_up = effect_name(c[r.attribution.named ? 1 : 0].effect);
+  }
+  r.seconds_attribution = since(attribution_start);
+  r.simulations = model.simulations();
+  r.seconds = since(start);
+  sim::logger()->info("diagnosis: verdict {} in {:.1f} s", r.verdict, r.seconds);
+  return r;
+}
+
+nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
+  nlohmann::json j;
+  j["capture"] = capture.directory;
+  j["verdict"] = r.verdict;
+  j["runner_up"] = r.runner_up;
+  j["confidence"] = r.attribution.confidence;
+  j["within_floors"] = r.within_floors;
+  j["gap_mm"] = {{"all_views", r.gap_all * 1e3}, {"fit_views", r.gap_fit * 1e3}, {"held_out_view", r.gap_held_out * 1e3}};
+  nlohmann::json floors = {{"all_views_mm", r.floors.all * 1e3},
+                           {"held_out_view_mm", r.floors.held_out * 1e3},
+                           {"margin", r.floors.margin},
+                           {"noise_all_mm", nlohmann::json::array()},
+                           {"noise_held_out_mm", nlohmann::json::array()},
+                           {"multistability_all_mm", nlohmann::json::array()},
+                           {"multistability_held_out_mm", nlohmann::json::array()}};
+  for (double x : r.floors.noise.all) floors["noise_all_mm"].push_back(x * 1e3);
+  for (double x : r.floors.noise.held_out) floors["noise_held_out_mm"].push_back(x * 1e3);
+  for (double x : r.floors.multistability.all) floors["multistability_all_mm"].push_back(x * 1e3);
+  for (double x : r.floors.multistability.held_out) floors["multistability_held_out_mm"].push_back(x * 1e3);
+  j["floors"] = floors;
+  j["baseline"] = {{"initial_guess", bending_json(r.initial_guess)},
+                   {"fitted", bending_json(r.fitted)},
+                   {"fitted_reduced", r.fitted_reduced},
+                   {"evaluations", r.baseline_evaluations},
+                   {"best_state", r.fit.best.state},
+                   {"turn_deg", r.fit.best.angle * 180.0 / M_PI},
+                   {"converged", r.fit.best.converged},
+                   {"hem_spectrum_mm", r.fit.best.hem_spectrum * 1e3},
+                   {"views", view_json(r.fit.best)}};
+  const auto& L = r.localisation;
+  nlohmann::json regions = nlohmann::json::array();
+  for (const auto& s : L.regions) {
+    regions.push_back({{"region", region_name(s.region)},
+                       {"energy_share", s.energy_share},
+                       {"pixel_share", s.pixel_share},
+                       {"enrichment", s.enrichment}});
+  }
+  nlohmann::json harmonics = nlohmann::json::array();
+  for (const auto& h : L.hem_difference) {
+    if (h.order == 0) continue;
+    harmonics.push_back({{"order", h.order}, {"amplitude_mm", h.amplitude * 1e3}, {"phase_rad", h.phase}});
+  }
+  j["localisation"] = {{"region", region_name(L.dominant)},
+                       {"regions", regions},
+                       {"view_share", L.view_share},
+                       {"hem_difference_harmonics", harmonics},
+                       {"folds", {{"capture", L.capture_folds}, {"model", L.model_folds}}},
+                       {"fold_phase_rad", {{"capture", L.capture_fold_phase}, {"model", L.model_fold_phase}}},
+                       {"drape_coefficient",
+                        {{"capture", L.capture_drape_coefficient}, {"model", L.model_drape_coefficient}}}};
+  nlohmann::json candidates = nlohmann::json::array();
+  for (const auto& c : r.attribution.candidates) {
+    nlohmann::json params = nlohmann::json::object();
+    for (std::size_t k = 0; k < c.names.size() && k < c.parameters.size(); ++k) params[c.names[k]] = c.parameters[k];
+    candidates.push_back({{"effect", effect_name(c.effect)},
+                          {"parameters", params},
+                          {"alpha_scale", c.alpha_scale},
+                          {"fit_score_mm", c.fit_score * 1e3},
+                          {"held_out_score_mm", c.held_out_score * 1e3},
+                          {"all_views_score_mm", c.all_score * 1e3},
+                          {"shrinkage", c.shrinkage},
+                          {"raw_shrinkage", c.raw_shrinkage},
+                          {"evaluations", c.evaluations},
+                          {"seconds", c.seconds}});
+  }
+  j["attribution"] = {{"ran", !r.within_floors},
+                      {"named", r.attribution.named},
+                      {"confidence", r.attribution.confidence},
+                      {"candidates", candidates}};
+  j["shrinkage"] = r.attribution.candidates.empty() ? 0.0 : r.attribution.candidates[0].shrinkage;
+  j["runtime"] = {{"seconds", r.seconds},
+                  {"fit_seconds", r.seconds_fit},
+                  {"floors_seconds", r.seconds_floors},
+                  {"attribution_seconds", r.seconds_attribution},
+                  {"simulations_main_thread", r.simulations}};
+  return j;
+}
+
+}  // namespace drapegen::diagnosis

@@ -1,0 +1,33 @@
+#include "drapegen/diagnosis/fabric_space.hpp"
+
+#include <cmath>
+
+namespace drapegen::diagnosis {
+
+BendingParameters from_reduced(const ReducedBending& x) {
+  const double mean = std::exp(x[0]);
+  // geometric mean of (warp, bias, weft) = mean; warp/weft = e^x1; bias / sqrt(warp weft) = e^x2.
+  // With g = sqrt(warp weft): warp = g e^(x1/2), weft = g e^(-x1/2), bias = g e^x2, mean^3 = g^3 e^x2.
+  const double g = mean * std::exp(-x[2] / 3.0);
+  BendingParameters p;
+  p.alpha = {g * std::exp(0.5 * x[1]), g * std::exp(x[2]), g * std::exp(-0.5 * x[1])};
+  const double ratio = -x[3];  // beta = -ratio_mm * alpha (paper units: g mm^3 / (g mm^2) = mm)
+  p.beta = {ratio * p.alpha.warp, ratio * p.alpha.bias, ratio * p.alpha.weft};
+  return p;
+}
+
+ReducedBending to_reduced(const BendingParameters& p) {
+  const auto& a = p.alpha;
+  const double g = std::sqrt(a.warp * a.weft);
+  ReducedBending x;
+  x[0] = std::log(a.warp * a.bias * a.weft) / 3.0;
+  x[1] = std::log(a.warp / a.weft);
+  x[2] = std::log(a.bias / g);
+  x[3] = -(p.beta.warp + p.beta.bias + p.beta.weft) / (a.warp + a.bias + a.weft);
+  return x;
+}
+
+ReducedBending reduced_lower() { return {std::log(200.0), -1.5, -1.5, 0.0}; }
+ReducedBending reduced_upper() { return {std::log(200000.0), 1.5, 1.5, 6.0}; }
+
+}  // namespace drapegen::diagnosis

@@ -1,0 +1,77 @@
+#include "drapegen/diagnosis/floors.hpp"
+
+#include <algorithm>
+#include <limits>
+
+#include "drapegen/renderer/noise.hpp"
+#include "drapegen/renderer/random.hpp"
+
+namespace drapegen::diagnosis {
+namespace {
+
+/// Scores the fit's initial-state drapes against a pseudo-capture (as the capture itself is scored): the state with
+/// the best fit score counts.
+sim::Expected<std::pair<double, double>> score_pseudo(ForwardModel& model, const ModelSetup& fitted,
+                                                      const Evaluation& fit,
+                                                      const std::vector<renderer::DepthImage>& images) {
+  const Target target = model.make_target(images);
+  double best = std::numeric_limits<double>::infinity();
+  std::pair<double, double> out{0.0, 0.0};
+  for (const auto& state : fit.states) {
+    auto s = model.score(state.mesh, fitted, target);
+    if (!s) return s.error();
+    if (s->fit_score < best) {
+      best = s->fit_score;
+      out = {s->all_score, s->held_out_score};
+    }
+  }
+  return out;
+}
+
+std::vector<renderer::DepthImage> with_noise(const std::vector<renderer::DepthImage>& clean, std::uint64_t seed) {
+  const renderer::NoiseModel noise = renderer::NoiseModel::kinect();
+  std::vector<renderer::DepthImage> out;
+  for (std::size_t v = 0; v < clean.size(); ++v) out.push_back(noise.apply(clean[v], renderer::mix_seed(seed, v)));
+  return out;
+}
+
+}  // namespace
+
+sim::Expected<Floors> measure_floors(ForwardModel& model, const ModelSetup& fitted, const Evaluation& fit,
+                                     const FloorSettings& settings) {
+  Floors floors;
+  floors.margin = settings.margin;
+  auto clean = model.render(fit.best.mesh, fit.best.angle, fitted.sensor);
+  if (!clean) return clean.error();
+  for (int k = 0; k < settings.noise_seeds; ++k) {
+    auto s = score_pseudo(model, fitted, fit, with_noise(*clean, 0xF100A + static_cast<std::uint64_t>(k)));
+    if (!s) return s.error();
+    floors.noise.all.push_back(s->first);
+    floors.noise.held_out.push_back(s->second);
+  }
+  // Other stable drapes of the fitted parameters: sine initial states with seeds after the fit's.
+  const auto states = fit_initial_states(settings.extra_states + 1, 1000);
+  for (int j = 1; j <= settings.extra_states; ++j) {
+    sim::InitialStateSpec spec = states[j];
+    auto mesh = model.simulate(fitted, spec);
+    if (!mesh) return mesh.error();
+    const double angle = align(hem_profile_from_mesh(*mesh), model.outline()).angle;
+    auto images = model.render(*mesh, angle, fitted.sensor);
+    if (!images) return images.error();
+    auto s = score_pseudo(model, fitted, fit, with_noise(*images, 0x5EED + static_cast<std::uint64_t>(j)));
+    if (!s) return s.error();
+    floors.multistability.all.push_back(s->first);
+    floors.multistability.held_out.push_back(s->second);
+  }
+  auto top = [](const FloorSamples& a, const FloorSamples& b, bool held_out) {
+    double m = 0.0;
+    for (double x : held_out ? a.held_out : a.all) m = std::max(m, x);
+    for (double x : held_out ? b.held_out : b.all) m = std::max(m, x);
+    return m;
+  };
+  floors.all = settings.margin * top(floors.noise, floors.multistability, false);
+  floors.held_out = settings.margin * top(floors.noise, floors.multistability, true);
+  return floors;
+}
+
+}  // namespace drapegen::diagnosis

@@ -1,0 +1,204 @@
+#include "drapegen/diagnosis/forward_model.hpp"
+
+#include <Eigen/Geometry>
+#include <chrono>
+#include <fmt/format.h>
+#include <limits>
+
+#include "drapegen/renderer/rig.hpp"
+#include "drapegen/renderer/scene.hpp"
+#include "drapegen/sim/drape.hpp"
+
+namespace drapegen::diagnosis {
+
+std::vector<sim::InitialStateSpec> fit_initial_states(int count, std::uint64_t first_seed) {
+  std::vector<sim::InitialStateSpec> states;
+  for (int k = 0; k < count; ++k) {
+    sim::InitialStateSpec s;
+    if (k == 0) {
+      s.shape = sim::InitialShape::kFlat;
+      s.seed = first_seed;
+    } else {
+      s.shape = sim::InitialShape::kSine;
+      s.seed = first_seed + static_cast<std::uint64_t>(k);
+    }
+    states.push_back(s);
+  }
+  return states;
+}
+
+ForwardModel::ForwardModel(const Capture& capture, const FitSettings& settings, renderer::DepthRenderer renderer)
+    : capture_(capture), settings_(settings), renderer_(std::move(renderer)) {}
+
+sim::Expected<std::unique_ptr<ForwardModel>> ForwardModel::create(const Capture& capture, const FitSettings& settings) {
+  if (static_cast<int>(capture.views.size()) != kCaptureViews) {
+    return sim::Error{fmt::format("capture has {} views, need {}", capture.views.size(), kCaptureViews)};
+  }
+  if (settings.resolution < 5 || settings.resolution > 200) return sim::Error{"fit resolution must be 5 .. 200"};
+  if (settings.initial_states < 1) return sim::Error{"need at least one initial state"};
+  for (int v : settings.fit_views) {
+    if (v < 0 || v >= kCaptureViews) return sim::Error{fmt::format("fit view {} out of range", v)};
+  }
+  auto renderer = renderer::DepthRenderer::create();
+  if (!renderer) return renderer.error();
+  FitSettings s = settings;
+  s.weights.cylinder_radius = 0.5 * capture.specimen.cylinder_diameter;
+  std::unique_ptr<ForwardModel> m(new ForwardModel(capture, s, std::move(*renderer)));
+  std::vector<renderer::DepthImage> depth;
+  for (const auto& v : capture.views) depth.push_back(v.depth);
+  m->target_ = m->make_target(depth);
+  m->states_ = fit_initial_states(settings.initial_states);
+  for (auto& s : m->states_) s.platform_radius = 0.5 * capture.specimen.cylinder_diameter;
+  m->is_fit_view_.assign(kCaptureViews, false);
+  for (int v : settings.fit_views) m->is_fit_view_[v] = true;
+  return m;
+}
+
+sim::Expected<sim::ClothMesh> ForwardModel::simulate(const ModelSetup& setup, const sim::InitialStateSpec& state,
+                                                     bool* converged) {
+  const auto start = std::chrono::steady_clock::now();
+  sim::DrapeConfig config;
+  config.fabric = sim::fabric_from_paper_units(setup.bending.alpha, setup.bending.beta, capture_.specimen.density);
+  if (sim::Status s = sim::validate(config.fabric, config.bending_model); !s) return s.error();
+  config.platform.radius = 0.5 * capture_.specimen.cylinder_diameter;
+  config.specimen.size_x = capture_.specimen.size_x;
+  config.specimen.size_y = capture_.specimen.size_y;
+  config.specimen.vertices_x = config.specimen.vertices_y = settings_.resolution;
+  config.specimen.seed = state.seed;
+  config.initial = state;
+  config.initial.platform_radius = config.platform.radius;
+  config.initial.drift += setup.drift;
+  config.effects = setup.effects;
+  config.solver.max_iterations = settings_.max_newton_iterations;
+  config.solver.tolerance = settings_.tolerance;
+  auto result = sim::simulate_drape(config);
+  ++simulations_;
+  simulation_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (!result) return result.error();
+  if (converged != nullptr) *converged = result->report.outcome == sim::SolveOutcome::kConverged;
+  return std::move(result->mesh);
+}
+
+sim::Expected<std::vector<renderer::DepthImage>> ForwardModel::render(const sim::ClothMesh& mesh, double angle,
+                                                                      const renderer::SensorError& sensor) {
+  sim::ClothMesh turned = mesh;
+  turned.positions = Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitZ()).toRotationMatrix() * mesh.positions;
+  auto cloth = renderer::cloth_triangles(turned);
+  if (!cloth) return cloth.error();
+  renderer::RigSpec rig;
+  rig.cylinder.radius = 0.5 * capture_.specimen.cylinder_diameter;
+  if (sim::Status s = renderer_.set_scene(renderer::tester_scene(*cloth, rig)); !s) return s.error();
+  std::vector<renderer::DepthImage> images;
+  for (const auto& view : capture_.views) {
+    const renderer::Camera camera = sensor.true_camera(view.camera);
+    auto image = renderer_.render(camera);
+    if (!image) return image.error();
+    images.push_back(sensor.any() ? sensor.apply(*image, view.camera.intrinsics) : std::move(*image));
+  }
+  return images;
+}
+
+double ForwardModel::fit_mean(const std::vector<ViewComparison>& views) const {
+  double s = 0.0;
+  int n = 0;
+  for (std::size_t v = 0; v < views.size(); ++v)
+    if (is_fit_view_[v]) s += views[v].score, ++n;
+  return n > 0 ? s / n : 0.0;
+}
+
+double ForwardModel::held_out_mean(const std::vector<ViewComparison>& views) const {
+  double s = 0.0;
+  int n = 0;
+  for (std::size_t v = 0; v < views.size(); ++v)
+    if (!is_fit_view_[v]) s += views[v].score, ++n;
+  return n > 0 ? s / n : 0.0;
+}
+
+Target ForwardModel::make_target(const std::vector<renderer::DepthImage>& depth) const {
+  Target t;
+  Capture c = capture_;
+  const double R = 0.5 * capture_.specimen.cylinder_diameter;
+  for (std::size_t v = 0; v < depth.size(); ++v) {
+    c.views[v].depth = depth[v];
+    c.views[v].depth.incidence.clear();
+    t.views.push_back(view_features(c.views[v].depth, c.views[v].camera, settings_.weights));
+    t.radial.push_back(radial_profile(back_project(c.views[v]), R));
+  }
+  t.outline = hem_profile_from_views(c, settings_.fit_views);
+  return t;
+}
+
+sim::Expected<ScoredDrape> ForwardModel::score(const sim::ClothMesh& mesh, const ModelSetup& setup,
+                                               const Target& target) {
+  ScoredDrape d;
+  d.mesh = mesh;
+  d.angle = align(hem_profile_from_mesh(mesh), target.outline).angle;
+  auto images = render(mesh, d.angle, setup.sensor);
+  if (!images) return images.error();
+  const double R = 0.5 * capture_.specimen.cylinder_diameter;
+  const double w = settings_.weights.hem_spectrum;
+  Capture rendered = capture_;
+  for (std::size_t v = 0; v < images->size(); ++v) {
+    d.views.push_back(compare_view(target.views[v], (*images)[v], settings_.weights));
+    rendered.views[v].depth = (*images)[v];
+    d.radial.push_back(radial_distance(target.radial[v], radial_profile(back_project(rendered.views[v]), R)));
+  }
+  d.hem_spectrum = spectrum_distance(hem_profile_from_views(rendered, settings_.fit_views), target.outline);
+  double fit = 0.0, held = 0.0, all = 0.0;
+  int nf = 0, nh = 0;
+  for (std::size_t v = 0; v < d.views.size(); ++v) {
+    const double s = d.views[v].score + settings_.weights.radial * d.radial[v];
+    all += s;
+    if (is_fit_view_[v]) {
+      fit += s, ++nf;
+    } else {
+      held += s, ++nh;
+    }
+  }
+  d.fit_score = (nf > 0 ? fit / nf : 0.0) + w * d.hem_spectrum;
+  d.held_out_score = nh > 0 ? held / nh : 0.0;
+  d.all_score = all / static_cast<double>(d.views.size()) + w * d.hem_spectrum;
+  return d;
+}
+
+sim::Expected<ScoredDrape> ForwardModel::score(const sim::ClothMesh& mesh, const ModelSetup& setup) {
+  return score(mesh, setup, target_);
+}
+
+sim::Expected<Evaluation> ForwardModel::evaluate(const ModelSetup& setup) {
+  Evaluation e;
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t k = 0; k < states_.size(); ++k) {
+    bool converged = true;
+    auto mesh = simulate(setup, states_[k], &converged);
+    if (!mesh) return mesh.error();
+    auto scored = score(*mesh, setup);
+    if (!scored) return scored.error();
+    scored->state = static_cast<int>(k);
+    scored->converged = converged;
+    if (scored->fit_score < best) {
+      best = scored->fit_score;
+      e.best = *scored;
+    }
+    e.states.push_back(std::move(*scored));
+  }
+  return e;
+}
+
+sim::Expected<Evaluation> ForwardModel::rescore(const std::vector<sim::ClothMesh>& meshes, const ModelSetup& setup) {
+  Evaluation e;
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t k = 0; k < meshes.size(); ++k) {
+    auto scored = score(meshes[k], setup);
+    if (!scored) return scored.error();
+    scored->state = static_cast<int>(k);
+    if (scored->fit_score < best) {
+      best = scored->fit_score;
+      e.best = *scored;
+    }
+    e.states.push_back(std::move(*scored));
+  }
+  return e;
+}
+
+}  // namespace drapegen::diagnosis

@@ -1,0 +1,88 @@
+#include "drapegen/diagnosis/localisation.hpp"
+
+#include <cmath>
+
+namespace drapegen::diagnosis {
+namespace {
+
+constexpr Region kRegions[] = {Region::kTop, Region::kRim, Region::kSkirt, Region::kHem, Region::kCylinder};
+constexpr double kMinPixelShare = 0.02;
+constexpr double kMinEnrichment = 1.3;
+
+}  // namespace
+
+Region classify_point(const Eigen::Vector3d& p, const HemProfile& model_outline, double R) {
+  const double r = std::hypot(p.x(), p.y()), z = p.z();
+  if (r < R - 0.005 && z > -0.006) return Region::kTop;
+  if (z < -0.01 && model_outline.bins() > 0) {
+    double a = std::atan2(p.y(), p.x());
+    if (a < 0.0) a += 2.0 * M_PI;
+    const int bin = std::min(model_outline.bins() - 1, static_cast<int>(a / (2.0 * M_PI) * model_outline.bins()));
+    const double hem = model_outline.radius[bin];
+    if (std::isfinite(hem) && r > hem - 0.025) return Region::kHem;
+  }
+  if (r < R + 0.015 && z > -0.03) return Region::kRim;
+  if (r < R + 0.003 && z <= -0.03) return Region::kCylinder;
+  return Region::kSkirt;
+}
+
+Localisation localise(const ForwardModel& model, const ScoredDrape& drape) {
+  Localisation L;
+  const Capture& capture = model.capture();
+  const double R = 0.5 * capture.specimen.cylinder_diameter;
+  const HemProfile model_outline = rotate(hem_profile_from_mesh(drape.mesh), drape.angle);
+  double energy[5] = {0, 0, 0, 0, 0}, pixels[5] = {0, 0, 0, 0, 0};
+  double total_energy = 0.0, total_pixels = 0.0;
+  std::vector<double> view_energy(drape.views.size(), 0.0);
+  for (std::size_t v = 0; v < drape.views.size(); ++v) {
+    const auto& cmp = drape.views[v];
+    const auto& view = capture.views[v];
+    const Eigen::Isometry3d to_specimen = view.camera.world_to_camera.inverse();
+    const int W = view.depth.width;
+    for (std::size_t i = 0; i < cmp.residual.size(); ++i) {
+      const float res = cmp.residual[i];
+      if (!std::isfinite(res) || cmp.depth[i] <= 0.0f) continue;
+      const int u = static_cast<int>(i % W), row = static_cast<int>(i / W);
+      const Eigen::Vector3d p = to_specimen * (static_cast<double>(cmp.depth[i]) * view.camera.ray(u, row));
+      const int k = static_cast<int>(classify_point(p, model_outline, R));
+      const double e = static_cast<double>(res) * res;
+      energy[k] += e;
+      pixels[k] += 1.0;
+      total_energy += e;
+      total_pixels += 1.0;
+      view_energy[v] += e;
+    }
+  }
+  double best = 0.0;
+  for (Region r : kRegions) {
+    const int k = static_cast<int>(r);
+    RegionShare s;
+    s.region = r;
+    s.energy_share = total_energy > 0.0 ? energy[k] / total_energy : 0.0;
+    s.pixel_share = total_pixels > 0.0 ? pixels[k] / total_pixels : 0.0;
+    s.enrichment = s.pixel_share > 0.0 ? s.energy_share / s.pixel_share : 0.0;
+    L.regions.push_back(s);
+    if (s.pixel_share >= kMinPixelShare && s.enrichment > best) {
+      best = s.enrichment;
+      L.dominant = r;
+    }
+  }
+  if (best < kMinEnrichment) L.dominant = Region::kGlobal;
+  for (double e : view_energy) L.view_share.push_back(total_energy > 0.0 ? e / total_energy : 0.0);
+
+  const HemProfile capture_outline = hem_profile_from_capture(capture);
+  HemProfile diff;
+  diff.radius.resize(capture_outline.radius.size());
+  for (std::size_t k = 0; k < diff.radius.size(); ++k) diff.radius[k] = capture_outline.radius[k] - model_outline.radius[k];
+  L.hem_difference = harmonics(diff, 12);
+  L.capture_folds = fold_count(capture_outline);
+  L.model_folds = fold_count(model_outline);
+  const auto hc = harmonics(capture_outline, 16), hm = harmonics(model_outline, 16);
+  if (L.capture_folds > 0 && L.capture_folds <= 16) L.capture_fold_phase = hc[L.capture_folds].phase;
+  if (L.model_folds > 0 && L.model_folds <= 16) L.model_fold_phase = hm[L.model_folds].phase;
+  L.capture_drape_coefficient = drape_coefficient(capture_outline, capture.specimen);
+  L.model_drape_coefficient = drape_coefficient(model_outline, capture.specimen);
+  return L;
+}
+
+}  // namespace drapegen::diagnosis

@@ -1,0 +1,204 @@
+#include "drapegen/diagnosis/reality.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fmt/format.h>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+
+#include "drapegen/diagnosis/candidate_effect.hpp"
+#include "drapegen/renderer/depth_renderer.hpp"
+#include "drapegen/renderer/noise.hpp"
+#include "drapegen/renderer/preview.hpp"
+#include "drapegen/renderer/random.hpp"
+#include "drapegen/renderer/rig.hpp"
+#include "drapegen/renderer/sensor_error.hpp"
+#include "drapegen/sim/drape.hpp"
+
+namespace drapegen::diagnosis {
+namespace fs = std::filesystem;
+namespace {
+
+const std::map<std::string, double>& defaults() {
+  static const std::map<std::string, double> d = {{"yield", 20.0}, {"shear", 1.0},     {"curl", 25.0},
+                                                  {"friction", 0.05}, {"misalign", 15.0}, {"pose", 1.0},
+                                                  {"bias", 5.0},   {"multipath", 15.0}};
+  return d;
+}
+
+Eigen::Vector3d random_unit(renderer::Rng& rng) {
+  Eigen::Vector3d v(rng.gaussian(), rng.gaussian(), rng.gaussian());
+  return v.norm() > 0.0 ? Eigen::Vector3d(v.normalized()) : Eigen::Vector3d::UnitX();
+}
+
+}  // namespace
+
+std::string reality_family(const std::string& name) {
+  if (name == "misalign") return "misalignment";
+  if (name == "pose" || name == "bias" || name == "multipath") return "sensor";
+  return name;
+}
+
+sim::Expected<RealityEffect> parse_reality_effect(const std::string& text) {
+  const auto eq = text.find('=');
+  RealityEffect e;
+  e.name = text.substr(0, eq);
+  if (e.name == "misalignment") e.name = "misalign";
+  const auto it = defaults().find(e.name);
+  if (it == defaults().end()) {
+    return sim::Error{fmt::format("--effect: unknown effect '{}' (yield, shear, curl, friction, misalign, pose, bias, "
+                                  "multipath)", e.name)};
+  }
+  e.strength = it->second;
+  if (eq != std::string::npos) {
+    const std::string v = text.substr(eq + 1);
+    try {
+      std::size_t used = 0;
+      e.strength = std::stod(v, &used);
+      if (used != v.size() || !std::isfinite(e.strength)) throw std::invalid_argument("");
+    } catch (const std::exception&) {
+      return sim::Error{fmt::format("--effect {}: '{}' is not a number", e.name, v)};
+    }
+  }
+  const bool positive = e.name == "yield" || e.name == "shear" || e.name == "friction";
+  if (positive && !(e.strength > 0.0)) return sim::Error{fmt::format("--effect {}: must be positive", e.name)};
+  if ((e.name == "misalign" || e.name == "pose" || e.name == "multipath") && e.strength < 0.0) {
+    return sim::Error{fmt::format("--effect {}: must not be negative", e.name)};
+  }
+  if (e.name == "misalign" && e.strength > 60.0) return sim::Error{"--effect misalign: at most 60 mm"};
+  if (e.name == "pose" && e.strength > 10.0) return sim::Error{"--effect pose: at most 10 degrees"};
+  if (std::abs(e.strength) > 1000.0) return sim::Error{fmt::format("--effect {}: implausibly large", e.name)};
+  return e;
+}
+
+sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std::string& directory) {
+  const auto start = std::chrono::steady_clock::now();
+  if (spec.resolution < 5 || spec.resolution > 200) return sim::Error{"resolution must be 5 .. 200"};
+  renderer::Rng rng(renderer::mix_seed(spec.seed, 0x4EA1));
+  sim::DrapeConfig config;
+  config.fabric = sim::fabric_from_paper_units(spec.bending.alpha, spec.bending.beta, spec.density);
+  if (sim::Status s = sim::validate(config.fabric, config.bending_model); !s) return s.error();
+  config.specimen.vertices_x = config.specimen.vertices_y = spec.resolution;
+  config.specimen.seed = spec.seed;
+  config.initial.shape = sim::InitialShape::kSine;
+  config.initial.seed = spec.seed;
+  config.initial.rotation = 2.0 * M_PI * rng.uniform();
+  const double small = 2e-3 * rng.uniform();  // the data's augmentation range: up to 2 mm off centre
+  const double phi = 2.0 * M_PI * rng.uniform();
+  config.initial.drift = small * Eigen::Vector2d(std::cos(phi), std::sin(phi));
+
+  renderer::SensorError sensor;
+  nlohmann::json effects = nlohmann::json::array();
+  std::string family = "none";
+  std::vector<std::string> regions{"global"};
+  for (const auto& e : spec.effects) {
+    effects.push_back({{"name", e.name}, {"strength", e.strength}});
+    if (family == "none") family = reality_family(e.name);
+    if (e.name == "yield") {
+      config.effects.bending_yield_curvature = e.strength;
+    } else if (e.name == "shear") {
+      config.effects.shear_stiffness = e.strength;
+    } else if (e.name == "curl") {
+      config.effects.edge_curl = sim::EdgeCurl{e.strength, kCurlWidth};
+    } else if (e.name == "friction") {
+      sim::FrictionParameters f;
+      f.coefficient = e.strength;
+      config.effects.friction = f;
+    } else if (e.name == "misalign") {
+      const double a = 2.0 * M_PI * rng.uniform();
+      config.initial.drift += e.strength * 1e-3 * Eigen::Vector2d(std::cos(a), std::sin(a));
+    } else if (e.name == "pose") {
+      sensor.rotation = e.strength * M_PI / 180.0 * random_unit(rng);
+      sensor.translation = 5.0 * e.strength * 1e-3 * random_unit(rng);
+    } else if (e.name == "bias") {
+      sensor.bias_offset = e.strength * 1e-3;
+    } else if (e.name == "multipath") {
+      sensor.multipath_gain = e.strength * 1e-3;
+    }
+  }
+  if (!spec.effects.empty()) {
+    const std::string& first = spec.effects.front().name;
+    if (first == "multipath") {
+      regions = {"cylinder", "rim"};
+    } else if (auto eff = parse_effect(reality_family(first))) {
+      regions.clear();
+      for (Region r : effect_regions(*eff)) regions.emplace_back(region_name(r));
+    }
+  }
+
+  auto drape = sim::simulate_drape(config);
+  if (!drape) return drape.error();
+  const bool converged = drape->report.outcome == sim::SolveOutcome::kConverged;
+
+  auto cloth = renderer::cloth_triangles(drape->mesh);
+  if (!cloth) return cloth.error();
+  renderer::RigSpec rig;
+  renderer::AugmentationSpec augmentation;
+  augmentation.orientations = 1;
+  const auto setups = renderer::plan_data_points(rig, augmentation, spec.seed);
+  auto renderer = renderer::DepthRenderer::create();
+  if (!renderer) return renderer.error();
+  if (sim::Status s = renderer->set_scene(renderer::tester_scene(*cloth, rig)); !s) return s.error();
+  const renderer::NoiseModel noise = spec.noise ? renderer::NoiseModel::kinect() : renderer::NoiseModel::none();
+
+  Capture capture;
+  capture.source = "drapegen reality";
+  capture.specimen.size_x = config.specimen.size_x;
+  capture.specimen.size_y = config.specimen.size_y;
+  capture.specimen.density = spec.density;
+  capture.specimen.cylinder_diameter = 2.0 * rig.cylinder.radius;
+  std::vector<std::vector<renderer::DepthImage>> preview(1);
+  const auto& setup = setups.front();
+  for (int v = 0; v < static_cast<int>(setup.views.size()); ++v) {
+    CaptureView view;
+    view.file = fmt::format("view{}.exr", v);
+    view.camera.intrinsics = setup.views[v].camera.intrinsics;
+    view.camera.world_to_camera = setup.views[v].mesh_to_camera();  // what the calibration says
+    const renderer::Camera truth = sensor.true_camera(view.camera);
+    auto clean = renderer->render(truth);
+    if (!clean) return clean.error();
+    renderer::DepthImage biased = sensor.any() ? sensor.apply(*clean, view.camera.intrinsics) : *clean;
+    view.depth = noise.any() ? noise.apply(biased, setup.noise_seed(v)) : biased;
+    view.depth.incidence.clear();
+    if (sim::Status s = check_view(view); !s) return sim::Error{fmt::format("rendered {}", s.error().message)};
+    preview[0].push_back(view.depth);
+    capture.views.push_back(std::move(view));
+  }
+  if (sim::Status s = write_capture(directory, capture); !s) return s.error();
+  (void)renderer::write_preview_png((fs::path(directory) / "preview.png").string(), preview);
+
+  nlohmann::json truth = {
+      {"warning", "ground truth: the diagnosis never reads this file"},
+      {"family", family},
+      {"effects", effects},
+      {"regions", regions},
+      {"alpha", {spec.bending.alpha.warp, spec.bending.alpha.bias, spec.bending.alpha.weft}},
+      {"beta", {spec.bending.beta.warp, spec.bending.beta.bias, spec.bending.beta.weft}},
+      {"density_g_per_m2", spec.density},
+      {"resolution", spec.resolution},
+      {"seed", spec.seed},
+      {"initial_state", {{"shape", "sine"}, {"seed", spec.seed}, {"rotation_rad", config.initial.rotation}}},
+      {"drift_mm", {config.initial.drift.x() * 1e3, config.initial.drift.y() * 1e3}},
+      {"sensor",
+       {{"rotation_rad", {sensor.rotation.x(), sensor.rotation.y(), sensor.rotation.z()}},
+        {"translation_m", {sensor.translation.x(), sensor.translation.y(), sensor.translation.z()}},
+        {"bias_offset_m", sensor.bias_offset},
+        {"bias_slope", sensor.bias_slope},
+        {"multipath_gain_m", sensor.multipath_gain}}},
+      {"noise", noise.describe()},
+      {"converged", converged},
+      {"drape_coefficient", drape->measures.drape_coefficient},
+      {"folds", drape->measures.folds}};
+  RealityResult result;
+  result.truth_path = (fs::path(directory) / "truth.json").string();
+  std::ofstream out(result.truth_path);
+  out << truth.dump(2) << "\n";
+  if (!out) return sim::Error{result.truth_path + ": cannot write"};
+  result.converged = converged;
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+}  // namespace drapegen::diagnosis

@@ -1,0 +1,159 @@
+#include "drapegen/diagnosis/report.hpp"
+
+#include <png.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fmt/format.h>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "drapegen/renderer/preview.hpp"
+
+namespace drapegen::diagnosis {
+namespace fs = std::filesystem;
+
+sim::Status write_residual_png(const std::string& path, const std::vector<std::vector<float>>& residuals, int width,
+                               int height, double range) {
+  if (residuals.empty() || width <= 0 || height <= 0) return sim::Error{path + ": nothing to draw"};
+  const int gap = 4;
+  const int W = static_cast<int>(residuals.size()) * (width + gap) - gap, H = height;
+  std::vector<unsigned char> rgb(static_cast<std::size_t>(W) * H * 3, 40);
+  for (std::size_t k = 0; k < residuals.size(); ++k) {
+    if (residuals[k].size() != static_cast<std::size_t>(width) * height) return sim::Error{path + ": bad image size"};
+    for (int y = 0; y < height; ++y) {
+      for (int x = 0; x < width; ++x) {
+        const float r = residuals[k][static_cast<std::size_t>(y) * width + x];
+        unsigned char* px = &rgb[(static_cast<std::size_t>(y) * W + k * (width + gap) + x) * 3];
+        if (!std::isfinite(r)) {
+          px[0] = px[1] = px[2] = 0;
+          continue;
+        }
+        const double t = std::clamp(r / range, -1.0, 1.0);
+        const auto fade = static_cast<unsigned char>(std::lround(255.0 * (1.0 - std::abs(t))));
+        if (t >= 0.0) {
+          px[0] = 255, px[1] = fade, px[2] = fade;  // capture farther than the model: red
+        } else {
+          px[0] = fade, px[1] = fade, px[2] = 255;  // capture nearer: blue
+        }
+      }
+    }
+  }
+  FILE* f = std::fopen(path.c_str(), "wb");
+  if (f == nullptr) return sim::Error{path + ": cannot open for writing"};
+  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+  png_infop info = png != nullptr ? png_create_info_struct(png) : nullptr;
+  if (png == nullptr || info == nullptr || setjmp(png_jmpbuf(png))) {
+    png_destroy_write_struct(&png, &info);
+    std::fclose(f);
+    return sim::Error{path + ": PNG encoding failed"};
+  }
+  png_init_io(png, f);
+  png_set_IHDR(png, info, static_cast<png_uint_32>(W), static_cast<png_uint_32>(H), 8, PNG_COLOR_TYPE_RGB,
+               PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+  png_write_info(png, info);
+  for (int y = 0; y < H; ++y) png_write_row(png, &rgb[static_cast<std::size_t>(y) * W * 3]);
+  png_write_end(png, nullptr);
+  png_destroy_write_struct(&png, &info);
+  if (std::fclose(f) != 0) return sim::Error{path + ": write failed"};
+  return {};
+}
+
+sim::Status write_report(const std::string& directory, const DiagnosisResult& r, const Capture& capture,
+                         ForwardModel& model) {
+  const fs::path dir(directory);
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) return sim::Error{fmt::format("{}: cannot create directory: {}", directory, ec.message())};
+  const nlohmann::json j = to_json(r, capture);
+  {
+    std::ofstream out(dir / "report.json");
+    out << j.dump(2) << "\n";
+    if (!out) return sim::Error{(dir / "report.json").string() + ": cannot write"};
+  }
+  const int W = capture.views.front().depth.width, H = capture.views.front().depth.height;
+  const double range = model.settings().weights.truncation;
+  auto residuals = [](const ScoredDrape& d) {
+    std::vector<std::vector<float>> out;
+    for (const auto& v : d.views) out.push_back(v.residual);
+    return out;
+  };
+  if (sim::Status s = write_residual_png((dir / "residual.png").string(), residuals(r.fit.best), W, H, range); !s) return s;
+  const bool after = r.attribution.named && !r.attribution.candidates.empty();
+  if (after) {
+    if (sim::Status s = write_residual_png((dir / "residual_after.png").string(),
+                                           residuals(r.attribution.candidates[0].drape), W, H, range);
+        !s) {
+      return s;
+    }
+  }
+  auto fitted = model.render(r.fit.best.mesh, r.fit.best.angle, {});
+  if (!fitted) return fitted.error();
+  std::vector<std::vector<renderer::DepthImage>> rows(2);
+  for (const auto& v : capture.views) rows[0].push_back(v.depth);
+  rows[1] = *fitted;
+  if (sim::Status s = renderer::write_preview_png((dir / "views.png").string(), rows); !s) return s;
+
+  std::string md;
+  md += fmt::format("# Sim-to-real gap diagnosis of `{}`\n\n", capture.directory);
+  if (r.verdict == "none") {
+    md += "**Verdict: the gap is within the floors** (sensor noise and multiple stable drapes); no effect is named.\n\n";
+  } else if (r.verdict == "unexplained") {
+    md += fmt::format("**Verdict: a gap above the floors that no candidate effect shrinks by {:.0f}% or more** (best: {}).\n\n",
+                      100 * 0.25, r.runner_up);
+  } else {
+    const auto& c = r.attribution.candidates[0];
+    md += fmt::format("**Verdict: {}** (confidence {:.2f} against the runner-up, {}); adding it shrinks the held-out gap "
+                      "above the floor by {:.0f}%.\n\n",
+                      r.verdict, r.attribution.confidence, r.runner_up, 100.0 * c.shrinkage);
+  }
+  md += "## Gap and floors (score in mm: truncated depth RMS + silhouette + fold terms)\n\n";
+  md += "| | all views | held-out view |\n|---|---|---|\n";
+  md += fmt::format("| gap (baseline fit) | {:.2f} | {:.2f} |\n", r.gap_all * 1e3, r.gap_held_out * 1e3);
+  md += fmt::format("| floor (x{:.2f} margin) | {:.2f} | {:.2f} |\n\n", r.floors.margin, r.floors.all * 1e3,
+                    r.floors.held_out * 1e3);
+  md += fmt::format("Fitted baseline: alpha = {:.0f}, {:.0f}, {:.0f} g mm^2/s^2; beta = {:.0f}, {:.0f}, {:.0f} g mm^3/s^2 "
+                    "({} evaluations).\n\n",
+                    r.fitted.alpha.warp, r.fitted.alpha.bias, r.fitted.alpha.weft, r.fitted.beta.warp,
+                    r.fitted.beta.bias, r.fitted.beta.weft, r.baseline_evaluations);
+  md += "## Where the gap sits\n\n| region | energy share | pixel share | enrichment |\n|---|---|---|---|\n";
+  for (const auto& s : r.localisation.regions) {
+    md += fmt::format("| {} | {:.2f} | {:.2f} | {:.2f} |\n", region_name(s.region), s.energy_share, s.pixel_share,
+                      s.enrichment);
+  }
+  md += fmt::format("\nDominant region: **{}**. Per-view share of the residual energy:", region_name(r.localisation.dominant));
+  for (double s : r.localisation.view_share) md += fmt::format(" {:.2f}", s);
+  md += fmt::format(".\nFolds: capture {}, model {}; drape coefficient: capture {:.3f}, model {:.3f}.\n",
+                    r.localisation.capture_folds, r.localisation.model_folds,
+                    r.localisation.capture_drape_coefficient, r.localisation.model_drape_coefficient);
+  md += "Hem radius difference (capture - model), largest harmonics:";
+  auto h = r.localisation.hem_difference;
+  h.erase(h.begin());
+  std::sort(h.begin(), h.end(), [](const Harmonic& a, const Harmonic& b) { return a.amplitude > b.amplitude; });
+  for (std::size_t k = 0; k < std::min<std::size_t>(3, h.size()); ++k)
+    md += fmt::format(" order {} {:.1f} mm;", h[k].order, h[k].amplitude * 1e3);
+  md += "\n\n![residual maps](residual.png)\n\nResidual capture - fitted baseline per view (red: the capture is farther "
+        "from the camera, blue: nearer; saturated at +-" + fmt::format("{:.0f}", range * 1e3) + " mm; black: no return).\n\n"
+        "![views](views.png)\n\nTop: the capture; bottom: the fitted baseline.\n\n";
+  if (!r.attribution.candidates.empty()) {
+    md += "## Candidate effects (refitted on the fit views, judged on the held-out view)\n\n"
+          "| effect | held-out score (mm) | shrinkage above floor | raw shrinkage | parameters |\n|---|---|---|---|---|\n";
+    for (const auto& c : r.attribution.candidates) {
+      std::string params;
+      for (std::size_t k = 0; k < c.names.size(); ++k) params += fmt::format("{}={:.3g} ", c.names[k], c.parameters[k]);
+      md += fmt::format("| {} | {:.2f} | {:.0f}% | {:.0f}% | {}alpha x{:.2f} |\n", effect_name(c.effect),
+                        c.held_out_score * 1e3, 100 * c.shrinkage, 100 * c.raw_shrinkage, params, c.alpha_scale);
+    }
+    if (after) md += "\n![after](residual_after.png)\n\nResidual after adding the named effect.\n";
+  }
+  md += fmt::format("\nRuntime {:.0f} s (fit {:.0f} s, floors {:.0f} s, attribution {:.0f} s).\n", r.seconds,
+                    r.seconds_fit, r.seconds_floors, r.seconds_attribution);
+  std::ofstream out(dir / "report.md");
+  out << md;
+  if (!out) return sim::Error{(dir / "report.md").string() + ": cannot write"};
+  return {};
+}
+
+}  // namespace drapegen::diagnosis

@@ -1,0 +1,120 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <nlohmann/json.hpp>
+
+#include "drapegen/diagnosis/capture.hpp"
+#include "drapegen/diagnosis/depth_exr.hpp"
+#include "drapegen/renderer/rig.hpp"
+
+namespace fs = std::filesystem;
+using namespace drapegen;
+using namespace drapegen::diagnosis;
+
+namespace {
+
+Capture plane_capture() {
+  renderer::RigSpec rig;
+  Capture c;
+  c.specimen.density = 250.0;
+  for (int v = 0; v < kCaptureViews; ++v) {
+    CaptureView view;
+    view.camera = rig.camera();
+    view.camera.world_to_camera = view.camera.world_to_camera * rig.table_pose(0.3, v);
+    view.depth = renderer::DepthImage(rig.width, rig.height);
+    for (int y = 40; y < 150; ++y)
+      for (int x = 30; x < 200; ++x) view.depth.at(x, y) = 0.6f + 0.001f * static_cast<float>(y + v);
+    c.views.push_back(view);
+  }
+  return c;
+}
+
+std::string fresh_dir(const std::string& name) {
+  const fs::path p = fs::temp_directory_path() / ("drapegen_capture_test_" + name);
+  fs::remove_all(p);
+  return p.string();
+}
+
+std::string read_error(const std::string& dir) {
+  const auto r = read_capture(dir);
+  EXPECT_FALSE(r.has_value()) << dir;
+  return r ? std::string() : r.error().message;
+}
+
+}  // namespace
+
+TEST(Capture, RoundTrip) {
+  const std::string dir = fresh_dir("roundtrip");
+  const Capture c = plane_capture();
+  ASSERT_TRUE(write_capture(dir, c).ok());
+  const auto r = read_capture(dir);
+  ASSERT_TRUE(r.has_value()) << r.error().message;
+  EXPECT_NEAR(r->specimen.density, 250.0, 1e-12);
+  EXPECT_NEAR(r->specimen.cylinder_diameter, 0.1, 1e-12);
+  ASSERT_EQ(r->views.size(), 4u);
+  for (int v = 0; v < 4; ++v) {
+    EXPECT_TRUE(r->views[v].camera.world_to_camera.isApprox(c.views[v].camera.world_to_camera, 1e-12));
+    EXPECT_TRUE(r->views[v].camera.intrinsics.K.isApprox(c.views[v].camera.intrinsics.K, 1e-12));
+    EXPECT_EQ(r->views[v].depth.depth, c.views[v].depth.depth);  // float EXR: exact
+  }
+}
+
+TEST(Capture, MissingViewFile) {
+  const std::string dir = fresh_dir("missing");
+  ASSERT_TRUE(write_capture(dir, plane_capture()).ok());
+  fs::remove(fs::path(dir) / "view2.exr");
+  const std::string e = read_error(dir);
+  EXPECT_NE(e.find("view 2"), std::string::npos) << e;
+  EXPECT_NE(e.find("no such file"), std::string::npos) << e;
+}
+
+TEST(Capture, MissingJsonAndWrongViewCount) {
+  const std::string dir = fresh_dir("count");
+  fs::create_directories(dir);
+  EXPECT_NE(read_error(dir).find("capture.json: no such file"), std::string::npos);
+  ASSERT_TRUE(write_capture(dir, plane_capture()).ok());
+  nlohmann::json j = nlohmann::json::parse(std::ifstream(fs::path(dir) / "capture.json"));
+  j["views"].erase(3);
+  std::ofstream(fs::path(dir) / "capture.json") << j.dump();
+  EXPECT_NE(read_error(dir).find("3 views listed"), std::string::npos);
+}
+
+TEST(Capture, WrongSize) {
+  const std::string dir = fresh_dir("size");
+  Capture c = plane_capture();
+  ASSERT_TRUE(write_capture(dir, c).ok());
+  ASSERT_TRUE(write_depth_exr((fs::path(dir) / "view1.exr").string(), renderer::DepthImage(120, 90)).ok());
+  const std::string e = read_error(dir);
+  EXPECT_NE(e.find("depth is 120x90 but the camera is 240x180"), std::string::npos) << e;
+}
+
+TEST(Capture, AllZeroDepth) {
+  const std::string dir = fresh_dir("zero");
+  Capture c = plane_capture();
+  std::fill(c.views[0].depth.depth.begin(), c.views[0].depth.depth.end(), 0.0f);
+  ASSERT_TRUE(write_capture(dir, c).ok());
+  const std::string e = read_error(dir);
+  EXPECT_NE(e.find("all-zero depth"), std::string::npos) << e;
+}
+
+TEST(Capture, NaNDepth) {
+  const std::string dir = fresh_dir("nan");
+  Capture c = plane_capture();
+  c.views[3].depth.at(100, 100) = std::numeric_limits<float>::quiet_NaN();
+  ASSERT_TRUE(write_capture(dir, c).ok());
+  const std::string e = read_error(dir);
+  EXPECT_NE(e.find("view 3"), std::string::npos) << e;
+  EXPECT_NE(e.find("non-finite depth"), std::string::npos) << e;
+}
+
+TEST(Capture, NotAnExrAndBadJson) {
+  const std::string dir = fresh_dir("garbage");
+  ASSERT_TRUE(write_capture(dir, plane_capture()).ok());
+  std::ofstream(fs::path(dir) / "view0.exr") << "not an image";
+  EXPECT_NE(read_error(dir).find("not a readable OpenEXR"), std::string::npos);
+  std::ofstream(fs::path(dir) / "capture.json") << "{ broken";
+  EXPECT_NE(read_error(dir).find("malformed JSON"), std::string::npos);
+}

@@ -1,0 +1,47 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "drapegen/diagnosis/depth_metric.hpp"
+
+using namespace drapegen;
+using namespace drapegen::diagnosis;
+
+namespace {
+renderer::Intrinsics intr() { return renderer::Intrinsics::pinhole(120, 90, 126, 126, 59.5, 44.5); }
+/// A corrugated surface (folds along u) at 0.7 m.
+renderer::DepthImage folds(double offset, int x0 = 20, int x1 = 100) {
+  renderer::DepthImage d(120, 90);
+  for (int v = 10; v < 80; ++v)
+    for (int u = x0; u < x1; ++u) d.at(u, v) = static_cast<float>(0.7 + offset + 0.01 * std::sin(u * 0.4));
+  return d;
+}
+}  // namespace
+
+TEST(DepthMetric, IdenticalIsZero) {
+  const auto f = view_features(folds(0.0), intr());
+  const auto c = compare_view(f, folds(0.0));
+  EXPECT_NEAR(c.score, 0.0, 1e-5);  // float normals: acos near 1 leaves ~0.01 deg
+  EXPECT_GT(c.overlap, 5000);
+}
+
+TEST(DepthMetric, OffsetSilhouetteAndFolds) {
+  const auto f = view_features(folds(0.0), intr());
+  int mask = 0;
+  for (auto m : f.fold_mask) mask += m;
+  EXPECT_GT(mask, 100);  // the corrugation is detected as folds
+  const auto shifted = compare_view(f, folds(0.005));
+  EXPECT_NEAR(shifted.depth_rms, 0.005, 1e-4);
+  EXPECT_NEAR(shifted.silhouette, 0.0, 1e-12);
+  EXPECT_LT(shifted.fold_rms_deg, 1.0);  // a pure offset keeps the normals
+  const auto narrower = compare_view(f, folds(0.0, 20, 80));
+  EXPECT_NEAR(narrower.silhouette, 20.0 / 80.0, 1e-9);
+  // Far off: truncated.
+  const auto far = compare_view(f, folds(0.5));
+  EXPECT_NEAR(far.depth_rms, MetricWeights{}.truncation, 1e-6);
+  // Folds out of phase cost in the fold term.
+  renderer::DepthImage flat(120, 90);
+  for (int v = 10; v < 80; ++v)
+    for (int u = 20; u < 100; ++u) flat.at(u, v) = 0.7f;
+  EXPECT_GT(compare_view(f, flat).fold_rms_deg, 10.0);
+}

@@ -1,0 +1,78 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "drapegen/diagnosis/fabric_space.hpp"
+#include "drapegen/diagnosis/hem_profile.hpp"
+
+using namespace drapegen::diagnosis;
+
+namespace {
+/// A six-fold outline r = 0.14 + 0.02 cos(6 (theta - phase)) sampled as points below the top.
+Eigen::Matrix3Xd lobed_points(double phase, double drift_x = 0.0) {
+  const int n = 20000;
+  Eigen::Matrix3Xd p(3, n);
+  for (int i = 0; i < n; ++i) {
+    const double t = 2 * M_PI * i / n;
+    const double r = 0.14 + 0.02 * std::cos(6 * (t - phase));
+    p.col(i) << r * std::cos(t) + drift_x, r * std::sin(t), -0.1;
+  }
+  return p;
+}
+}  // namespace
+
+TEST(HemProfile, CircleAreaAndDrapeCoefficient) {
+  Eigen::Matrix3Xd p(3, 7200);
+  for (int i = 0; i < 7200; ++i) {
+    const double t = 2 * M_PI * i / 7200;
+    p.col(i) << 0.12 * std::cos(t), 0.12 * std::sin(t), -0.05;
+  }
+  const HemProfile h = hem_profile_from_points(p);
+  for (double r : h.radius) EXPECT_NEAR(r, 0.12, 1e-6);
+  EXPECT_NEAR(enclosed_area(h), M_PI * 0.0144, 1e-6);
+  SpecimenFacts s;
+  EXPECT_NEAR(drape_coefficient(h, s), (M_PI * 0.0144 - M_PI * 0.0025) / (0.09 - M_PI * 0.0025), 1e-5);
+  EXPECT_EQ(fold_count(h), 0);
+}
+
+TEST(HemProfile, FoldsHarmonicsAndAlignment) {
+  const HemProfile a = hem_profile_from_points(lobed_points(0.0));
+  const HemProfile b = hem_profile_from_points(lobed_points(0.2));
+  EXPECT_EQ(fold_count(a), 6);
+  const auto h = harmonics(a, 8);
+  EXPECT_NEAR(h[0].amplitude, 0.14, 3e-3);  // the 98th percentile of a 2.5 deg bin sits above its mean
+  EXPECT_NEAR(h[6].amplitude, 0.02, 1e-3);
+  EXPECT_LT(h[3].amplitude, 1e-3);
+  // b is a turned by 0.2 rad; the six-fold symmetry makes 0.2 - k pi/3 equivalent.
+  const Alignment al = align(a, b);
+  const double period = M_PI / 3;
+  const double wrapped = std::remainder(al.angle - 0.2, period);
+  EXPECT_NEAR(wrapped, 0.0, 0.01);
+  EXPECT_LT(al.rms, 3e-3);
+  const HemProfile turned = rotate(a, 0.2);
+  for (int k = 0; k < b.bins(); ++k) EXPECT_NEAR(turned.radius[k], b.radius[k], 2e-3);
+}
+
+TEST(HemProfile, OffCentreShowsAsFirstHarmonic) {
+  const HemProfile centred = hem_profile_from_points(lobed_points(0.0));
+  const HemProfile shifted = hem_profile_from_points(lobed_points(0.0, 0.015));
+  HemProfile diff;
+  for (int k = 0; k < centred.bins(); ++k) diff.radius.push_back(shifted.radius[k] - centred.radius[k]);
+  const auto h = harmonics(diff, 6);
+  EXPECT_NEAR(h[1].amplitude, 0.015, 0.003);
+  EXPECT_NEAR(std::remainder(h[1].phase, 2 * M_PI), 0.0, 0.1);  // towards +x
+}
+
+TEST(FabricSpace, RoundTrip) {
+  BendingParameters p;
+  p.alpha = {13923, 11455, 8821};
+  p.beta = {-2.5 * 13923, -2.5 * 11455, -2.5 * 8821};
+  const auto x = to_reduced(p);
+  const auto q = from_reduced(x);
+  EXPECT_NEAR(q.alpha.warp, p.alpha.warp, 1e-6);
+  EXPECT_NEAR(q.alpha.bias, p.alpha.bias, 1e-6);
+  EXPECT_NEAR(q.alpha.weft, p.alpha.weft, 1e-6);
+  EXPECT_NEAR(q.beta.bias, p.beta.bias, 1e-6);
+  EXPECT_NEAR(x[3], 2.5, 1e-12);
+  EXPECT_NEAR(std::exp(x[0]), std::cbrt(13923.0 * 11455 * 8821), 1e-6);
+}
