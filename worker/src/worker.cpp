@@ -7,6 +7,9 @@
 #include <mutex>
 #include <optional>
 #include <thread>
+#include <csignal>
+#include <cerrno>
+#include <cstdlib>
 #include <unistd.h>
 #include <zmq.hpp>
 
@@ -95,6 +98,16 @@ sim::Status run_worker(const WorkerOptions& o, const std::atomic<bool>& stop) {
   const std::string name = o.name.empty() ? default_name() : o.name;
   std::string scratch = o.scratch_dir;
   if (scratch.empty()) {
+    // Scratch directories of workers that died without cleaning up (SIGKILL): their process no longer exists.
+    std::error_code ec;
+    for (const auto& entry : std::filesystem::directory_iterator(std::filesystem::temp_directory_path(), ec)) {
+      const std::string name = entry.path().filename().string();
+      if (name.rfind("drapegen-worker-", 0) != 0) continue;
+      const long pid = std::strtol(name.c_str() + 16, nullptr, 10);
+      if (pid > 0 && ::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH) {
+        std::filesystem::remove_all(entry.path(), ec);
+      }
+    }
     scratch = (std::filesystem::temp_directory_path() / fmt::format("drapegen-worker-{}", ::getpid())).string();
   }
   struct RemoveScratch {
