@@ -24,6 +24,8 @@
 #include <string>
 #include <vector>
 
+#include <unistd.h>
+
 #include "drapegen/sim/drape.hpp"
 #include "drapegen/sim/measures.hpp"
 #include "drapegen/sim/ply.hpp"
@@ -118,7 +120,9 @@ void check_k_over_rho(Table& t, int n, const Options& o) {
   const DrapeConfig base = base_config(n, Triangulation::kRandom, 0.2, o);
   const Run r0 = run("a: median fabric", base);
   check_converged(t, n, "a", "base", r0);
-  const std::string path = (std::filesystem::temp_directory_path() / "drapegen_drape_physics_k_rho.ply").string();
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("drapegen_drape_physics_k_rho_" + std::to_string(::getpid()) + ".ply"))
+                               .string();
   if (Status st = write_ply(path, r0.result.mesh); !st) {
     std::cerr << "error: " << st.error().message << "\n";
     std::exit(1);
@@ -201,7 +205,9 @@ Run restart_perturbed(const std::string& label, DrapeConfig config, const DrapeR
       for (int k = 0; k < 3; ++k) mesh.positions(k, v) += noise(rng);
     }
   }
-  const std::string path = (std::filesystem::temp_directory_path() / "drapegen_drape_physics_restart.ply").string();
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("drapegen_drape_physics_restart_" + std::to_string(::getpid()) + ".ply"))
+                               .string();
   if (Status s = write_ply(path, mesh); !s) {
     std::cerr << "error: " << s.error().message << "\n";
     std::exit(1);

@@ -24,6 +24,8 @@
 #include <utility>
 #include <vector>
 
+#include <unistd.h>
+
 #include "drapegen/sim/measures.hpp"
 
 namespace drapegen::sim {
@@ -85,7 +87,9 @@ double mean_distance_mm(const Eigen::Matrix3Xd& a, const Eigen::Matrix3Xd& b) {
 TEST(DrapePhysics, DrapeDependsOnBendingOverDensity) {
   const DrapeConfig base = config(25, false);
   const DrapeResult r0 = drape(base, "k/rho: median fabric");
-  const std::string path = (std::filesystem::temp_directory_path() / "drapegen_k_over_rho_base.ply").string();
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("drapegen_k_over_rho_base_" + std::to_string(::getpid()) + ".ply"))
+                               .string();
   ASSERT_TRUE(write_ply(path, r0.mesh));
   for (const double s : {3.0, 0.5}) {
     DrapeConfig c = base;
