@@ -13,8 +13,6 @@ std::uint64_t splitmix(std::uint64_t& x) {
   return z ^ (z >> 31);
 }
 
-std::uint64_t rotl(std::uint64_t x, int k) { return (x << k) | (x >> (64 - k)); }
-
 /// Inverse of the standard normal CDF by bisection on std::erfc (only used to build the table once).
 double inverse_normal_cdf(double p) {
   double lo = -10.0, hi = 10.0;
@@ -51,25 +49,11 @@ std::uint64_t mix_seed(std::uint64_t seed, std::uint64_t stream) {
   return splitmix(x);
 }
 
-Rng::Rng(std::uint64_t seed) {
-  std::uint64_t x = seed;
-  for (auto& s : s_) s = splitmix(x);
-  (void)gaussian_table();
-}
+Rng::Rng(std::uint64_t seed) : generator_(seed) { (void)gaussian_table(); }
 
-std::uint64_t Rng::next() {
-  const std::uint64_t result = rotl(s_[1] * 5, 7) * 9;
-  const std::uint64_t t = s_[1] << 17;
-  s_[2] ^= s_[0];
-  s_[3] ^= s_[1];
-  s_[1] ^= s_[2];
-  s_[0] ^= s_[3];
-  s_[2] ^= t;
-  s_[3] = rotl(s_[3], 45);
-  return result;
-}
+std::uint64_t Rng::next() { return generator_.next(); }
 
-double Rng::uniform() { return static_cast<double>(next() >> 11) * 0x1.0p-53; }
+double Rng::uniform() { return generator_.uniform(); }
 
 float Rng::gaussian() {
   static const float* table = gaussian_table().data();

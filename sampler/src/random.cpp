@@ -11,28 +11,12 @@ std::uint64_t derive_seed(std::uint64_t seed, std::initializer_list<std::uint64_
   return h;
 }
 
-Random::Random(std::uint64_t seed) {
-  std::uint64_t x = seed;
-  for (std::uint64_t& s : s_) {
-    x += 0x9e3779b97f4a7c15ULL;
-    s = mix64(x);
-  }
-}
+// The state words are SplitMix64 outputs starting one step later than sim::Xoshiro256's own seeding.
+Random::Random(std::uint64_t seed) : generator_(seed + 0x9e3779b97f4a7c15ULL) {}
 
-std::uint64_t Random::next_u64() {
-  auto rotl = [](std::uint64_t v, int k) { return (v << k) | (v >> (64 - k)); };
-  const std::uint64_t result = rotl(s_[1] * 5, 7) * 9;
-  const std::uint64_t t = s_[1] << 17;
-  s_[2] ^= s_[0];
-  s_[3] ^= s_[1];
-  s_[1] ^= s_[2];
-  s_[0] ^= s_[3];
-  s_[2] ^= t;
-  s_[3] = rotl(s_[3], 45);
-  return result;
-}
+std::uint64_t Random::next_u64() { return generator_.next(); }
 
-double Random::uniform() { return static_cast<double>(next_u64() >> 11) * 0x1.0p-53; }
+double Random::uniform() { return generator_.uniform(); }
 
 std::uint64_t Random::below(std::uint64_t n) {
   if (n <= 1) return 0;

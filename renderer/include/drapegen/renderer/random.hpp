@@ -2,8 +2,9 @@
 // Seeded random numbers that are the same on every platform and standard library (std::normal_distribution is
 // not): xoshiro256** seeded through splitmix64, and Gaussians from a normalised inverse-CDF table.
 
-#include <array>
 #include <cstdint>
+
+#include "drapegen/sim/xoshiro.hpp"
 
 namespace drapegen::renderer {
 
@@ -21,7 +22,7 @@ class Rng {
   float gaussian();
 
  private:
-  std::array<std::uint64_t, 4> s_{};
+  sim::Xoshiro256 generator_;
   std::uint64_t pool_ = 0;
   int pooled_ = 0;
 };

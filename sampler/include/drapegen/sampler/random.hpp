@@ -6,6 +6,8 @@
 #include <cstdint>
 #include <initializer_list>
 
+#include "drapegen/sim/xoshiro.hpp"
+
 namespace drapegen::sampler {
 
 /// SplitMix64's finaliser: a bijective 64-bit mix.
@@ -35,7 +37,7 @@ class Random {
   [[nodiscard]] double normal();
 
  private:
-  std::uint64_t s_[4];
+  sim::Xoshiro256 generator_;
   double spare_ = 0.0;
   bool has_spare_ = false;
 };
