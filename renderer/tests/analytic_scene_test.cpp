@@ -6,19 +6,11 @@
 #include <map>
 
 #include "drapegen/renderer/depth_renderer.hpp"
+#include "shared_renderer.hpp"
 #include "drapegen/renderer/ray_caster.hpp"
 
 namespace drapegen::renderer {
 namespace {
-
-DepthRenderer& shared_renderer() {
-  static DepthRenderer renderer = [] {
-    auto r = DepthRenderer::create();
-    if (!r) throw std::runtime_error(r.error().message);
-    return std::move(*r);
-  }();
-  return renderer;
-}
 
 Intrinsics test_intrinsics() { return Intrinsics::pinhole(240, 180, 252.0, 252.0, 119.5, 89.5); }
 

@@ -5,21 +5,13 @@
 #include <cstdio>
 
 #include "drapegen/renderer/depth_renderer.hpp"
+#include "shared_renderer.hpp"
 #include "drapegen/renderer/noise.hpp"
 #include "drapegen/renderer/random.hpp"
 #include "drapegen/renderer/rig.hpp"
 
 namespace drapegen::renderer {
 namespace {
-
-DepthRenderer& shared_renderer() {
-  static DepthRenderer renderer = [] {
-    auto r = DepthRenderer::create();
-    if (!r) throw std::runtime_error(r.error().message);
-    return std::move(*r);
-  }();
-  return renderer;
-}
 
 /// A large plane z = 0 seen from `distance` with its normal at `angle_deg` from the optical axis.
 struct FlatTarget {
