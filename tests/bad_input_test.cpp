@@ -247,7 +247,9 @@ TEST(Service, ExpiredLeasesAreRequeued) {
   EXPECT_EQ(failures[0].worker, "slow");
   for (const auto& j : all(reader->jobs())) {
     EXPECT_EQ(j.state, storage::JobState::kDone);
-    if (j.id == static_cast<std::int64_t>(id)) EXPECT_GE(j.attempts, 2);
+    if (j.id == static_cast<std::int64_t>(id)) {
+      EXPECT_GE(j.attempts, 2);
+    }
   }
   EXPECT_NE(coordinator.err().find("after its lease expired"), std::string::npos) << coordinator.err();
 }

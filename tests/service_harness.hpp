@@ -169,6 +169,15 @@ inline long recorded_jobs(const fs::path& manifest) {
   return n;
 }
 
+/// Polls until at least `target` jobs are recorded or `timeout` passes; whether the target was reached.
+inline bool wait_recorded(const fs::path& manifest, long target, std::chrono::milliseconds timeout) {
+  const auto until = std::chrono::steady_clock::now() + timeout;
+  while (recorded_jobs(manifest) < target && std::chrono::steady_clock::now() < until) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return recorded_jobs(manifest) >= target;
+}
+
 /// The checks every finished run must pass: integrity, each done job exactly one result with its files, every file
 /// present with the recorded checksum and size, no file in data/ the manifest does not list, failed jobs with a
 /// reason and no result.
@@ -185,11 +194,15 @@ inline void check_manifest(const fs::path& manifest, int orientations) {
   for (const auto& j : jobs) {
     if (j.state == storage::JobState::kDone) {
       EXPECT_EQ(result_count[j.id], 1) << "job " << j.id;
-      if (j.mode != "noop") EXPECT_EQ(file_count[j.id], 1 + orientations) << "job " << j.id;
+      if (j.mode != "noop") {
+        EXPECT_EQ(file_count[j.id], 1 + orientations) << "job " << j.id;
+      }
     } else {
       EXPECT_EQ(result_count[j.id], 0) << "job " << j.id;
       EXPECT_EQ(file_count[j.id], 0) << "job " << j.id;
-      if (j.state == storage::JobState::kFailed) EXPECT_FALSE(j.failure_reason.empty()) << "job " << j.id;
+      if (j.state == storage::JobState::kFailed) {
+        EXPECT_FALSE(j.failure_reason.empty()) << "job " << j.id;
+      }
     }
   }
   std::set<std::string> listed;

@@ -76,7 +76,9 @@ TEST(LinearAlgebra, ProductsAndSolvesMatchDenseAlgebra) {
     EXPECT_LE((exact - reference).norm(), 1e-8 * reference.norm()) << n;
     // Single precision (the condition numbers here are 1e4-1e5): a preconditioner needs no more.
     EXPECT_LE((approximate - reference).norm(), 1e-4 * reference.norm()) << n;
-    if (n == 20) EXPECT_GT((approximate - exact).norm(), 0.0) << "expected the supernodal single-precision path";
+    if (n == 20) {
+      EXPECT_GT((approximate - exact).norm(), 0.0) << "expected the supernodal single-precision path";
+    }
   }
 }
 
