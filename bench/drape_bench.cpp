@@ -77,11 +77,16 @@ int main(int argc, char** argv) {
   int max_iterations = drapegen::sim::SolverOptions{}.max_iterations;
   app.add_option("--exact-below", exact_below, "SolverOptions::exact_hessian_below")->capture_default_str();
   app.add_option("--max-iterations", max_iterations, "SolverOptions::max_iterations")->capture_default_str();
+  double tolerance = drapegen::sim::SolverOptions{}.tolerance;
+  app.add_option("--tolerance", tolerance, "SolverOptions::tolerance (residual relative to the largest vertex weight)")
+      ->capture_default_str();
+  std::vector<int> only;
+  app.add_option("--only", only, "run only these of the --fabrics quantiles (0-based)")->delimiter(',');
   app.add_option("--coarse", coarse, "DrapeConfig::coarse_start_resolution (0: off)")->capture_default_str();
   app.add_option("--data", data, "fabrics618.csv")->capture_default_str();
   app.add_option("--resolution", resolution, "vertices per side")->capture_default_str();
   app.add_option("--fabrics", fabrics, "fabrics at evenly spaced quantiles of mean alpha")->capture_default_str();
-  app.add_option("--inits", inits, "initial states")->capture_default_str();
+  app.add_option("--inits", inits, "initial states")->delimiter(',')->capture_default_str();
   app.add_flag("--json", json, "one JSON object per drape");
   bool verbose = false;
   app.add_flag("--verbose", verbose, "print every Newton iteration on stderr");
@@ -96,6 +101,7 @@ int main(int argc, char** argv) {
   for (int f = 0; f < fabrics; ++f) {
     const std::size_t index = fabrics == 1 ? all.size() / 2 : (all.size() - 1) * f / (fabrics - 1);
     const Fabric& fabric = all[index];
+    if (!only.empty() && std::find(only.begin(), only.end(), f) == only.end()) continue;
     for (const std::string& init : inits) {
       drapegen::sim::DrapeConfig config;
       config.fabric = drapegen::sim::fabric_from_paper_units(fabric.alpha, fabric.beta, 300.0);
@@ -108,6 +114,7 @@ int main(int argc, char** argv) {
       config.solver.gauss_newton_above = gn_above;
       config.solver.exact_hessian_below = exact_below;
       config.solver.max_iterations = max_iterations;
+      config.solver.tolerance = tolerance;
       config.coarse_start_resolution = coarse;
       auto initial = drapegen::sim::parse_initial_state(init);
       config.initial = *initial;

@@ -9,6 +9,7 @@
 //
 // Usage: drapegen_drape_physics [--resolution N]... [--checks abcde] [--tolerance T]
 // Each drape's solve is logged on stderr; the table goes to stdout. Exit code 0 when every bounded row passes.
+#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
 #include <Eigen/Geometry>
@@ -44,6 +45,7 @@ struct Options {
   std::vector<int> resolutions;
   std::string checks = "abcde";
   double tolerance = 1e-3;  // the solver's default; the exact checks do not depend on it
+  int mesh_starts = 5;      // initial states per mesh in check d
 };
 
 DrapeConfig base_config(int n, Triangulation triangulation, double jitter, const Options& options) {
@@ -341,12 +343,15 @@ void check_mesh_dependence(Table& t, int n, const Options& o) {
     InitialShape shape;
     unsigned seed;
   };
-  const Start starts[] = {{InitialShape::kFlat, 0}, {InitialShape::kSine, 1}, {InitialShape::kSine, 2},
-                          {InitialShape::kFold, 1}, {InitialShape::kFold, 2}};
+  // flat, then sines and folds in turn with seeds 1, 1, 2, 2, ...
+  std::vector<Start> starts{{InitialShape::kFlat, 0}};
+  for (int i = 1; i < o.mesh_starts; ++i) {
+    starts.push_back({i % 2 == 1 ? InitialShape::kSine : InitialShape::kFold, static_cast<unsigned>((i + 1) / 2)});
+  }
   double difference[3] = {0.0, 0.0, 0.0};
   const char* names[3] = {"isotropic", "curvature rule", "edge rule"};
   for (int k = 0; k < 3; ++k) {
-    double mean[2];
+    double mean[2], standard_error[2];
     for (int perturbed = 0; perturbed < 2; ++perturbed) {
       std::vector<double> dcs;
       for (const Start& start : starts) {
@@ -363,14 +368,21 @@ void check_mesh_dependence(Table& t, int n, const Options& o) {
         check_converged(t, n, "d", label, r);
         dcs.push_back(r.result.measures.drape_coefficient);
       }
-      mean[perturbed] = std::accumulate(dcs.begin(), dcs.end(), 0.0) / static_cast<double>(dcs.size());
+      const double count = static_cast<double>(dcs.size());
+      mean[perturbed] = std::accumulate(dcs.begin(), dcs.end(), 0.0) / count;
+      double square_sum = 0.0;
+      for (double dc : dcs) square_sum += (dc - mean[perturbed]) * (dc - mean[perturbed]);
+      standard_error[perturbed] = count > 1 ? std::sqrt(square_sum / (count - 1) / count) : 0.0;
       const auto [lo, hi] = std::minmax_element(dcs.begin(), dcs.end());
       const char* mesh = perturbed ? "perturbed" : "structured";
       t.row(n, "d", fmt::format("{}: mean DC, {} mesh, {} starts", names[k], mesh, dcs.size()), mean[perturbed]);
       t.row(n, "d", fmt::format("{}: (max - min) / mean DC over the starts, {} mesh", names[k], mesh),
             (*hi - *lo) / mean[perturbed]);
     }
-    difference[k] = std::abs(mean[0] - mean[1]) / (0.5 * (mean[0] + mean[1]));
+    const double scale = 0.5 * (mean[0] + mean[1]);
+    difference[k] = std::abs(mean[0] - mean[1]) / scale;
+    t.row(n, "d", fmt::format("{}: standard error of that difference (from the spread over starts)", names[k]),
+          std::hypot(standard_error[0], standard_error[1]) / scale);
   }
   t.row(n, "d", "isotropic: |d mean DC| / mean DC, structured vs perturbed", difference[0]);
   t.row(n, "d", "curvature rule: |d mean DC| / mean DC, structured vs perturbed", difference[1], "< 0.02",
@@ -422,19 +434,15 @@ void check_initial_states(Table& t, int n, const Options& o) {
 
 int main(int argc, char** argv) {
   Options options;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if ((arg == "--resolution" || arg == "-r") && i + 1 < argc) {
-      options.resolutions.push_back(std::atoi(argv[++i]));
-    } else if (arg == "--checks" && i + 1 < argc) {
-      options.checks = argv[++i];
-    } else if (arg == "--tolerance" && i + 1 < argc) {
-      options.tolerance = std::atof(argv[++i]);
-    } else {
-      std::cerr << "usage: drapegen_drape_physics [--resolution N]... [--checks abcde] [--tolerance T]\n";
-      return arg == "--help" || arg == "-h" ? 0 : 1;
-    }
-  }
+  CLI::App app{"physics checks of the drape (docs/BENCHMARKS.md): k/rho, rotation, sigma, mesh, initial states"};
+  app.add_option("-r,--resolution", options.resolutions, "vertices per side (repeatable; default 60)");
+  app.add_option("--checks", options.checks, "which checks: a k/rho, b rotation, c sigma, d mesh, e initial states")
+      ->capture_default_str();
+  app.add_option("--tolerance", options.tolerance, "solver tolerance")->capture_default_str();
+  app.add_option("--mesh-starts", options.mesh_starts, "initial states per mesh in check d")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
   if (options.resolutions.empty()) options.resolutions = {60};
   Table table;
   const auto start = std::chrono::steady_clock::now();

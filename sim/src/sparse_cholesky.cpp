@@ -4,13 +4,62 @@
 
 #include <algorithm>
 #include <cstring>
+#include <mutex>
 #include <vector>
+
+#ifdef DRAPEGEN_HAVE_OPENMP
+#include <omp.h>
+#endif
 
 #include "drapegen/sim/logging.hpp"
 
 namespace drapegen::sim {
+namespace {
+
+/// While alive, OpenMP parallel regions (CHOLMOD's) run on the encountering thread alone. Concurrent guards share
+/// one saved setting: the first saves and lowers max-active-levels, the last restores it.
+class SerialOpenMp {
+ public:
+  explicit SerialOpenMp(bool active) : active_(active) {
+#ifdef DRAPEGEN_HAVE_OPENMP
+    if (!active_) return;
+    const std::lock_guard lock(mutex());
+    if (users()++ == 0) {
+      saved() = omp_get_max_active_levels();
+      omp_set_max_active_levels(0);
+    }
+#endif
+  }
+  ~SerialOpenMp() {
+#ifdef DRAPEGEN_HAVE_OPENMP
+    if (!active_) return;
+    const std::lock_guard lock(mutex());
+    if (--users() == 0) omp_set_max_active_levels(saved());
+#endif
+  }
+  SerialOpenMp(const SerialOpenMp&) = delete;
+  SerialOpenMp& operator=(const SerialOpenMp&) = delete;
+
+ private:
+  static std::mutex& mutex() {
+    static std::mutex m;
+    return m;
+  }
+  static int& users() {
+    static int n = 0;
+    return n;
+  }
+  static int& saved() {
+    static int levels = 0;
+    return levels;
+  }
+  bool active_;
+};
+
+}  // namespace
 
 struct SparseCholesky::Impl {
+  bool parallel = false;
   cholmod_common common{};
   cholmod_factor* factor = nullptr;
   std::vector<int> colptr, rowind;
@@ -52,7 +101,7 @@ struct SparseCholesky::Impl {
   }
 };
 
-SparseCholesky::SparseCholesky() : impl_(std::make_unique<Impl>()) {}
+SparseCholesky::SparseCholesky(bool parallel) : impl_(std::make_unique<Impl>()) { impl_->parallel = parallel; }
 SparseCholesky::~SparseCholesky() = default;
 
 FactorStatus SparseCholesky::factorize(const HessianAssembler& matrix, double shift) {
@@ -66,6 +115,7 @@ FactorStatus SparseCholesky::factorize(const HessianAssembler& matrix, double sh
     for (int p : matrix.diagonal_positions()) m.values[p] += shift;
   }
   cholmod_sparse a = m.view();
+  const SerialOpenMp serial(!m.parallel);
   if (!m.analysed) {
     m.factor = cholmod_analyze(&a, &m.common);
     if (m.factor == nullptr || m.common.status < CHOLMOD_OK) return FactorStatus::kFailed;

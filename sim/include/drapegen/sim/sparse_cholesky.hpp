@@ -16,7 +16,12 @@ enum class FactorStatus {
 
 class SparseCholesky {
  public:
-  SparseCholesky();
+  /// `parallel`: let CHOLMOD's OpenMP regions (supernodal numeric factorisation) start their thread team. Off by
+  /// default: drapegen runs one solve per core (workers, diagnosis refits), and there the team's hand-offs cost
+  /// more than they save (measured: 390k context switches and 40% more CPU time on a 100x100 drape on a busy
+  /// 2-core machine). Off, factorize() runs CHOLMOD with OpenMP's max-active-levels at 0 for the duration of the
+  /// call (a process-wide setting, restored when the last concurrent factorisation ends).
+  explicit SparseCholesky(bool parallel = false);
   ~SparseCholesky();
   SparseCholesky(const SparseCholesky&) = delete;
   SparseCholesky& operator=(const SparseCholesky&) = delete;
