@@ -80,6 +80,8 @@ int main(int argc, char** argv) {
   double tolerance = drapegen::sim::SolverOptions{}.tolerance;
   app.add_option("--tolerance", tolerance, "SolverOptions::tolerance (residual relative to the largest vertex weight)")
       ->capture_default_str();
+  double extrapolate = drapegen::sim::SolverOptions{}.extrapolate_above;
+  app.add_option("--extrapolate", extrapolate, "SolverOptions::extrapolate_above (0: off)")->capture_default_str();
   std::vector<int> only;
   app.add_option("--only", only, "run only these of the --fabrics quantiles (0-based)")->delimiter(',');
   app.add_option("--coarse", coarse, "DrapeConfig::coarse_start_resolution (0: off)")->capture_default_str();
@@ -115,6 +117,7 @@ int main(int argc, char** argv) {
       config.solver.exact_hessian_below = exact_below;
       config.solver.max_iterations = max_iterations;
       config.solver.tolerance = tolerance;
+      config.solver.extrapolate_above = extrapolate;
       config.coarse_start_resolution = coarse;
       auto initial = drapegen::sim::parse_initial_state(init);
       config.initial = *initial;

@@ -27,6 +27,8 @@
 
 #include <unistd.h>
 
+#include "drapegen/sim/bending.hpp"
+#include "drapegen/sim/dihedral.hpp"
 #include "drapegen/sim/drape.hpp"
 #include "drapegen/sim/measures.hpp"
 #include "drapegen/sim/ply.hpp"
@@ -336,7 +338,72 @@ const char* shape_name(InitialShape shape) {
   return "?";
 }
 
+/// The hinge energy of a constant curvature field K, imposed on the flat specimen as the surface z = p^T K p / 2 with
+/// an infinitesimal amplitude (so the dihedral angles are exactly linear in K), over the continuum energy
+/// (alpha/2)(K_xx^2 + 2 K_xy^2 + K_yy^2) * area, over the vertices away from the border (half of each hinge's energy
+/// to each end vertex; the area is a third of every incident triangle per vertex). K is a cylinder
+/// bent about an axis at `axis_degrees` to the rest x axis, or (axis_degrees < 0) the sphere K = I. Deterministic: it
+/// measures the discretisation without the drape's multistability.
+double hinge_energy_ratio(const ClothMesh& mesh, const Topology& topology, double axis_degrees) {
+  const double angle = axis_degrees * std::numbers::pi / 180.0;
+  Eigen::Matrix2d k = Eigen::Matrix2d::Identity();
+  if (axis_degrees >= 0.0) {
+    const Eigen::Vector2d across(-std::sin(angle), std::cos(angle));
+    k = across * across.transpose();
+  }
+  const double amplitude = 1e-4;
+  Eigen::Matrix3Xd x(3, mesh.rest.cols());
+  for (Eigen::Index v = 0; v < x.cols(); ++v) {
+    const Eigen::Vector2d p = mesh.rest.col(v);
+    x.col(v) << p, amplitude * 0.5 * p.dot(k * p);
+  }
+  const std::vector<HingeRest> rest = hinge_rest_geometry(mesh, topology);
+  std::vector<bool> inner(static_cast<std::size_t>(x.cols()), true);
+  for (Eigen::Index v = 0; v < x.cols(); ++v) {
+    if (topology.on_boundary[static_cast<std::size_t>(v)]) {
+      inner[static_cast<std::size_t>(v)] = false;
+      for (int u : topology.vertex_neighbours[static_cast<std::size_t>(v)]) inner[static_cast<std::size_t>(u)] = false;
+    }
+  }
+  double hinge = 0.0;
+  for (std::size_t h = 0; h < topology.hinges.size(); ++h) {
+    const Hinge& g = topology.hinges[h];
+    const double theta = dihedral_angle(x.col(g.v0), x.col(g.v1), x.col(g.v2), x.col(g.v3)) / amplitude;
+    const double energy = rest[h].edge_length * theta * theta / rest[h].height_sum;  // E_h / alpha, linear law
+    hinge += 0.5 * energy * ((inner[g.v0] ? 1.0 : 0.0) + (inner[g.v1] ? 1.0 : 0.0));  // half to each end
+  }
+  double area = 0.0;
+  for (Eigen::Index t = 0; t < mesh.triangles.cols(); ++t) {
+    const Eigen::Vector2d a = mesh.rest.col(mesh.triangles(0, t)), b = mesh.rest.col(mesh.triangles(1, t)),
+                          c = mesh.rest.col(mesh.triangles(2, t));
+    const double third = std::abs((b - a).x() * (c - a).y() - (b - a).y() * (c - a).x()) / 6.0;
+    for (int i = 0; i < 3; ++i) area += inner[static_cast<std::size_t>(mesh.triangles(i, t))] ? third : 0.0;
+  }
+  return hinge / (0.5 * k.squaredNorm() * area);
+}
+
+void check_hinge_consistency(Table& t, int n) {
+  struct Mesh {
+    const char* name;
+    Triangulation triangulation;
+    double jitter;
+  };
+  const Mesh meshes[] = {{"structured (union jack)", Triangulation::kAlternating, 0.0},
+                         {"random diagonals, no jitter", Triangulation::kRandom, 0.0},
+                         {"perturbed (random diagonals, jitter 0.2)", Triangulation::kRandom, 0.2}};
+  for (const Mesh& m : meshes) {
+    const ClothMesh mesh = make_specimen(SpecimenSpec{0.3, 0.3, n, n, m.jitter, m.triangulation, 1, 0.0});
+    const Topology topology = build_topology(mesh);
+    for (double axis : {0.0, 22.5, 45.0, -1.0}) {
+      const std::string what = axis < 0.0 ? std::string("sphere") : fmt::format("cylinder, axis at {} deg", axis);
+      t.row(n, "d", fmt::format("hinge / continuum energy, {}: {}", what, m.name),
+            hinge_energy_ratio(mesh, topology, axis));
+    }
+  }
+}
+
 void check_mesh_dependence(Table& t, int n, const Options& o) {
+  check_hinge_consistency(t, n);
   const FabricParameters aniso = fabric_from_paper_units({20000, 12500, 5000}, {-50000, -31250, -12500}, 300.0);
   const FabricParameters iso = fabric_from_paper_units({11180, 11180, 11180}, {-27950, -27950, -27950}, 300.0);
   struct Start {

@@ -95,6 +95,25 @@ SolveReport NewtonSolver::solve(const std::vector<EnergyTerm*>& terms, const std
   Eigen::VectorXd g(n), step(n);
   Eigen::Matrix3Xd trial(3, nv);
   double lambda = 0.0;  // diagonal shift relative to the mean diagonal
+  // After a full step accepted into x (= x0 + step): returns the step length kept, 1 or longer (then x moved on).
+  auto extrapolate = [&](double e0, double slope, double e1) {
+    const double ratio = (e1 - e0) / slope;  // 1/2 where the model's curvature along the step is right, near 1 flatter
+    if (!(ratio > options_.extrapolate_above)) return 1.0;
+    double largest = 0.0;
+    for (int f = 0; f < n / 3; ++f) largest = std::max(largest, step.segment<3>(3 * f).norm());
+    const double t = std::min({options_.max_extrapolation, 0.5 / (1.0 - std::min(ratio, 0.99)),
+                               options_.max_step / std::max(largest, 1e-300)});
+    if (t <= 1.0) return 1.0;
+    trial = x;
+    for (int v = 0; v < nv; ++v) {
+      const int f = assembler.free_index(v);
+      if (f >= 0) trial.col(v) += (t - 1.0) * step.segment<3>(3 * f);
+    }
+    const double e_trial = total_energy(terms, trial);
+    if (!(std::isfinite(e_trial) && e_trial < e1)) return 1.0;
+    x.swap(trial);
+    return t;
+  };
 
   auto gather = [&](const Eigen::Matrix3Xd& full, Eigen::VectorXd& reduced) {
     for (int v = 0; v < nv; ++v) {
@@ -238,6 +257,9 @@ SolveReport NewtonSolver::solve(const std::vector<EnergyTerm*>& terms, const std
               accepted = true;
               step_length = t;
               x.swap(trial);
+              if (ls == 0 && t == 1.0 && options_.extrapolate_above > 0.0 && !round_off) {
+                step_length = extrapolate(energy, slope, e_trial);
+              }
               break;
             }
           }

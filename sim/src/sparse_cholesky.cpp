@@ -120,8 +120,8 @@ FactorStatus SparseCholesky::factorize(const HessianAssembler& matrix, double sh
     m.factor = cholmod_analyze(&a, &m.common);
     if (m.factor == nullptr || m.common.status < CHOLMOD_OK) return FactorStatus::kFailed;
     m.analysed = true;
-    logger()->debug("cholmod: n {} nnz(A) {} nnz(L) {:.0f} flops {:.3g} supernodal {} ordering {}", a.nrow, a.nzmax,
-                    m.common.lnz, m.common.fl, m.factor->is_super, m.common.method[m.common.selected].ordering);
+    logger()->debug("cholmod: n {} nnz(A) {} nnz(L) {:.0f} xsize {} nsuper {} flops {:.3g} supernodal {} ordering {}", a.nrow, a.nzmax,
+                    m.common.lnz, m.factor->xsize, m.factor->nsuper, m.common.fl, m.factor->is_super, m.common.method[m.common.selected].ordering);
   }
   m.single.clear();
   const int ok = cholmod_factorize(&a, m.factor, &m.common);

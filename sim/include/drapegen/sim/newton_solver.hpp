@@ -56,6 +56,12 @@ struct SolverOptions {
   /// After a PCG solve that needed more than this fraction of max_pcg_iterations, the next iteration factorises
   /// without trying PCG first (1: always try).
   double pcg_refactor_fraction = 0.5;
+  /// After a full step (t = 1) that lowered the energy by more than `extrapolate_above` of its first-order prediction
+  /// (the energy is flatter along the step than the Hessian says: a fold sliding along a soft valley), try the step
+  /// length where the parabola through E(0), E'(0) and E(1) has its minimum, up to `max_extrapolation` (and the
+  /// max_step limit), and keep it if the energy is lower there. 0 turns it off.
+  double extrapolate_above = 0.75;
+  double max_extrapolation = 8.0;
   /// Outer updates after which the parameters are fixed anyway (directions in nearly flat regions can cycle).
   int max_lagged_outer_updates = 6;
 };
