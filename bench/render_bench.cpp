@@ -204,19 +204,21 @@ int main(int argc, char** argv) {
   CLI::App app{"drapegen renderer benchmark"};
   std::string mesh_path;
   int data_points = 48;
+  bool all_triangles = false;
   bool storage = false, check = false;
   std::string pixel = "half", compression = "zip";
   app.add_option("--mesh", mesh_path, "Draped mesh (PLY) from drapegen simulate --out")->required();
   app.add_option("--data-points", data_points, "Data points (x 4 views) to time")->capture_default_str();
   app.add_option("--pixel", pixel, "EXR pixel type for the timing: half or float")->capture_default_str();
   app.add_option("--compression", compression, "EXR compression for the timing")->capture_default_str();
+  app.add_flag("--all-triangles", all_triangles, "Draw every triangle (RendererOptions::skip_empty_triangles off)");
   app.add_flag("--storage", storage, "Also measure bytes and storage error of every EXR option");
   app.add_flag("--crosscheck", check, "Also compare OSMesa with the CPU ray cast on this drape");
   CLI11_PARSE(app, argc, argv);
 
   const auto mesh = unwrap(sim::read_ply(mesh_path));
   const auto cloth = unwrap(cloth_triangles(mesh));
-  auto renderer = unwrap(DepthRenderer::create());
+  auto renderer = unwrap(DepthRenderer::create(RendererOptions{.skip_empty_triangles = !all_triangles}));
   fmt::print("mesh {}: {} vertices, {} triangles; renderer {}\n", mesh_path, cloth.vertex_count(),
              cloth.triangle_count(), renderer.gl_renderer());
   ExrStorage s;

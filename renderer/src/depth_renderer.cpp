@@ -5,6 +5,9 @@
 #include <GL/gl.h>
 #include <GL/glext.h>
 
+#include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstdlib>
 #include <fmt/format.h>
 #include <vector>
@@ -52,17 +55,78 @@ sim::Expected<GLuint> compile(GLenum type, const char* source) {
   return shader;
 }
 
+/// An inclusive rectangle of pixels (u0..u1, v0..v1); empty when u0 > u1 or v0 > v1.
+struct PixelBox {
+  int u0 = 0, v0 = 0, u1 = -1, v1 = -1;
+  [[nodiscard]] bool empty() const { return u0 > u1 || v0 > v1; }
+  void add(int a0, int b0, int a1, int b1) {
+    if (empty()) {
+      *this = PixelBox{a0, b0, a1, b1};
+      return;
+    }
+    u0 = std::min(u0, a0);
+    v0 = std::min(v0, b0);
+    u1 = std::max(u1, a1);
+    v1 = std::max(v1, b1);
+  }
+};
+
 }  // namespace
 
 struct DepthRenderer::Impl {
   RendererOptions options;
   OSMesaContext context = nullptr;
   std::vector<unsigned char> default_buffer = std::vector<unsigned char>(4 * 4 * 4);
-  GLuint program = 0, vao = 0, vbo = 0, ebo = 0, fbo = 0, color = 0, depth = 0;
+  GLuint program = 0, vao = 0, vbo = 0, ebo = 0, chosen_ebo = 0, fbo = 0, color = 0, depth = 0;
   GLint model_view_location = -1, projection_location = -1;
   int fb_width = 0, fb_height = 0;
   GLsizei index_count = 0;
   std::vector<float> readback;
+  TriangleMesh scene;                         // CPU copy, for skip_empty_triangles
+  std::vector<Eigen::Vector2f> pixel;         // per vertex: image position (u, v) in the current view
+  std::vector<unsigned char> near_clipped;    // per vertex: at or behind the near plane
+  std::vector<std::array<GLuint, 3>> chosen;  // the triangles drawn in the current view
+
+  /// Projects the scene with `P` (= K [R | t], camera pixels) and keeps in `chosen` the triangles that can cover
+  /// the centre of a pixel of the W x H image; returns the pixels they can cover. A triangle covers the centre of
+  /// pixel (c, r) only if (c, r) lies in its bounding box in (u, v): OpenGL samples at pixel centres, which are the
+  /// integer (u, v) here (see gl_projection). The box is widened by kMargin px, far more than llvmpipe's 1/256 px
+  /// vertex snapping and the float rounding between this projection and the vertex shader's, so no triangle that
+  /// covers a centre is dropped. Triangles reaching the near plane are clipped by OpenGL: always kept.
+  PixelBox select_triangles(const Eigen::Matrix<float, 3, 4>& P, int W, int H) {
+    constexpr float kMargin = 1.0f / 64.0f;
+    const float near = static_cast<float>(options.near) * 1.001f;
+    const std::size_t nv = scene.vertices.size();
+    pixel.resize(nv);
+    near_clipped.resize(nv);
+    for (std::size_t i = 0; i < nv; ++i) {
+      const Eigen::Vector3f q = P * scene.vertices[i].homogeneous();
+      near_clipped[i] = !(q.z() > near);
+      pixel[i] = near_clipped[i] ? Eigen::Vector2f::Zero() : Eigen::Vector2f(q.x() / q.z(), q.y() / q.z());
+    }
+    chosen.clear();
+    PixelBox box;
+    for (const auto& t : scene.triangles) {
+      const std::array<GLuint, 3> indices = {static_cast<GLuint>(t[0]), static_cast<GLuint>(t[1]),
+                                             static_cast<GLuint>(t[2])};
+      if (near_clipped[t[0]] || near_clipped[t[1]] || near_clipped[t[2]]) {
+        chosen.push_back(indices);
+        box.add(0, 0, W - 1, H - 1);
+        continue;
+      }
+      const Eigen::Vector2f &a = pixel[t[0]], &b = pixel[t[1]], &c = pixel[t[2]];
+      const Eigen::Vector2f lo = a.cwiseMin(b).cwiseMin(c), hi = a.cwiseMax(b).cwiseMax(c);
+      // The pixel centres in the box, clamped to the image (in float: far-off vertices cannot overflow an int).
+      const float u0 = std::max(std::ceil(lo.x() - kMargin), 0.0f);
+      const float u1 = std::min(std::floor(hi.x() + kMargin), static_cast<float>(W - 1));
+      const float v0 = std::max(std::ceil(lo.y() - kMargin), 0.0f);
+      const float v1 = std::min(std::floor(hi.y() + kMargin), static_cast<float>(H - 1));
+      if (u0 > u1 || v0 > v1) continue;
+      chosen.push_back(indices);
+      box.add(static_cast<int>(u0), static_cast<int>(v0), static_cast<int>(u1), static_cast<int>(v1));
+    }
+    return box;
+  }
 
   bool make_current() {
     if (OSMesaGetCurrentContext() == context) return true;
@@ -100,6 +164,7 @@ struct DepthRenderer::Impl {
       glDeleteRenderbuffers(1, &depth);
       glDeleteBuffers(1, &vbo);
       glDeleteBuffers(1, &ebo);
+      glDeleteBuffers(1, &chosen_ebo);
       glDeleteVertexArrays(1, &vao);
       glDeleteProgram(program);
     }
@@ -143,6 +208,7 @@ sim::Expected<DepthRenderer> DepthRenderer::create(const RendererOptions& option
   glGenVertexArrays(1, &impl->vao);
   glGenBuffers(1, &impl->vbo);
   glGenBuffers(1, &impl->ebo);
+  glGenBuffers(1, &impl->chosen_ebo);
   glBindVertexArray(impl->vao);
   glBindBuffer(GL_ARRAY_BUFFER, impl->vbo);
   glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, impl->ebo);
@@ -161,11 +227,13 @@ sim::Status DepthRenderer::set_scene(const TriangleMesh& mesh) {
   if (!impl_->make_current()) return sim::Error{"OSMesa could not make its context current"};
   glBindVertexArray(impl_->vao);
   glBindBuffer(GL_ARRAY_BUFFER, impl_->vbo);
+  glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, impl_->ebo);
   glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(mesh.vertices.size() * 3 * sizeof(float)),
                mesh.vertices.data(), GL_STATIC_DRAW);
   glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(mesh.triangles.size() * 3 * sizeof(int)),
                mesh.triangles.data(), GL_STATIC_DRAW);
   impl_->index_count = static_cast<GLsizei>(mesh.triangles.size() * 3);
+  impl_->scene = mesh;
   if (glGetError() != GL_NO_ERROR) return sim::Error{"could not upload the mesh"};
   return {};
 }
@@ -192,20 +260,39 @@ sim::Expected<DepthImage> DepthRenderer::render(const Camera& camera, const Eige
   glUniformMatrix4fv(impl_->model_view_location, 1, GL_FALSE, model_view.data());  // Eigen is column-major
   glUniformMatrix4fv(impl_->projection_location, 1, GL_FALSE, projection.data());
   glBindVertexArray(impl_->vao);
-  glDrawElements(GL_TRIANGLES, impl_->index_count, GL_UNSIGNED_INT, nullptr);
-
-  auto& buffer = impl_->readback;
-  buffer.resize(static_cast<std::size_t>(2) * W * H);
-  glPixelStorei(GL_PACK_ALIGNMENT, 4);
-  glReadPixels(0, 0, W, H, GL_RG, GL_FLOAT, buffer.data());
-  if (const GLenum e = glGetError(); e != GL_NO_ERROR) return sim::Error{fmt::format("OpenGL error 0x{:x}", e)};
+  // The pixels that can have a return; the rest of the image stays background (0) and is not read back.
+  PixelBox box{0, 0, W - 1, H - 1};
+  if (impl_->options.skip_empty_triangles) {
+    const Eigen::Matrix<float, 3, 4> P = camera.intrinsics.K.cast<float>() * model_view.topRows<3>();
+    box = impl_->select_triangles(P, W, H);
+    const auto& chosen = impl_->chosen;
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, impl_->chosen_ebo);  // recorded in the VAO
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(chosen.size() * sizeof(chosen[0])), chosen.data(),
+                 GL_STREAM_DRAW);
+    if (!chosen.empty()) glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(3 * chosen.size()), GL_UNSIGNED_INT, nullptr);
+  } else {
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, impl_->ebo);
+    glDrawElements(GL_TRIANGLES, impl_->index_count, GL_UNSIGNED_INT, nullptr);
+  }
 
   DepthImage image(W, H);
   image.incidence.resize(image.depth.size());
-  for (std::size_t i = 0; i < image.depth.size(); ++i) {
-    image.depth[i] = buffer[2 * i];
-    image.incidence[i] = buffer[2 * i + 1];
+  if (!box.empty()) {
+    const int w = box.u1 - box.u0 + 1, h = box.v1 - box.v0 + 1;
+    auto& buffer = impl_->readback;
+    buffer.resize(static_cast<std::size_t>(2) * w * h);
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    glReadPixels(box.u0, box.v0, w, h, GL_RG, GL_FLOAT, buffer.data());
+    for (int r = 0; r < h; ++r) {
+      const float* in = buffer.data() + static_cast<std::size_t>(2) * w * r;
+      const std::size_t out = static_cast<std::size_t>(box.v0 + r) * W + box.u0;
+      for (int c = 0; c < w; ++c) {
+        image.depth[out + c] = in[2 * c];
+        image.incidence[out + c] = in[2 * c + 1];
+      }
+    }
   }
+  if (const GLenum e = glGetError(); e != GL_NO_ERROR) return sim::Error{fmt::format("OpenGL error 0x{:x}", e)};
   return image;
 }
 

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <vector>
 
 #include "drapegen/renderer/depth_renderer.hpp"
 #include "drapegen/renderer/ray_caster.hpp"
@@ -80,6 +81,44 @@ TEST(RayCaster, AgreesWithOsmesaOnARealDrape) {
               foreground, 100.0 * fraction, worst_in_agreement, background_mismatch);
   EXPECT_GT(foreground, 8 * 3000);
   EXPECT_GE(fraction, 0.99);
+}
+
+// RendererOptions::skip_empty_triangles leaves out triangles that cover no pixel centre: the images must be the same
+// bit for bit as drawing every triangle, also when the drape is partly outside the image or reaches the near plane.
+TEST(DepthRenderer, SkippingEmptyTrianglesChangesNoPixel) {
+  auto all = DepthRenderer::create(RendererOptions{.skip_empty_triangles = false});
+  auto skipping = DepthRenderer::create(RendererOptions{.skip_empty_triangles = true});
+  ASSERT_TRUE(all && skipping);
+  const RigSpec rig;
+  const TriangleMesh scene = tester_scene(real_drape(), rig);
+  ASSERT_TRUE(all->set_scene(scene));
+  ASSERT_TRUE(skipping->set_scene(scene));
+  struct View {
+    Camera camera;
+    Eigen::Isometry3d model;
+  };
+  std::vector<View> views;
+  for (const auto& setup : plan_data_points(rig, AugmentationSpec{.orientations = 2}, 5)) {
+    for (const auto& view : setup.views) views.push_back({view.camera, view.model});
+  }
+  Camera shifted = rig.camera();  // half the drape beyond the right edge of the image
+  shifted.intrinsics.K(0, 2) += 120.0;
+  views.push_back({shifted, Eigen::Isometry3d::Identity()});
+  // The camera 30 mm above the cloth on the platform, looking down: the near plane (50 mm) cuts the cloth.
+  views.push_back({Camera::look_at(rig.intrinsics(), {0.0, 0.0, 0.03}, {0.0, 0.0, -0.1}, {0, 1, 0}),
+                   Eigen::Isometry3d::Identity()});
+  int differing = 0, foreground = 0;
+  for (const View& view : views) {
+    auto a = all->render(view.camera, view.model);
+    auto b = skipping->render(view.camera, view.model);
+    ASSERT_TRUE(a && b);
+    foreground += a->foreground_count();
+    for (std::size_t i = 0; i < a->depth.size(); ++i) {
+      differing += a->depth[i] != b->depth[i] || a->incidence[i] != b->incidence[i];
+    }
+  }
+  EXPECT_GT(foreground, 8 * 3000);
+  EXPECT_EQ(differing, 0);
 }
 
 }  // namespace

@@ -20,6 +20,10 @@ struct RendererOptions {
   /// the first context is made; set here only if the environment does not set it). 0 renders in the calling
   /// thread, the right choice for one worker process per core. Negative: leave Mesa's default (one per CPU).
   int threads = 0;
+  /// Before each draw, project the scene on the CPU and leave out the triangles whose screen bounding box contains
+  /// no pixel centre of the image: under OpenGL's rasterisation rules they produce no fragment, so the image is the
+  /// same bit for bit (tested) and llvmpipe skips their setup. false: draw every triangle.
+  bool skip_empty_triangles = true;
 };
 
 /// One OpenGL 3.3 core context with a float framebuffer, reused across renders: upload a scene once with
