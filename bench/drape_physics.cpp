@@ -48,6 +48,7 @@ struct Options {
   std::string checks = "abcde";
   double tolerance = 1e-3;  // the solver's default; the exact checks do not depend on it
   int mesh_starts = 5;      // initial states per mesh in check d
+  BendingModel model = BendingModel::kNonlinearDihedral;  // for everything but the edge rule (a hinge concept)
 };
 
 DrapeConfig base_config(int n, Triangulation triangulation, double jitter, const Options& options) {
@@ -55,6 +56,7 @@ DrapeConfig base_config(int n, Triangulation triangulation, double jitter, const
   c.fabric = fabric_from_paper_units(kMedianAlpha, kMedianBeta, 300.0);
   c.specimen = SpecimenSpec{0.3, 0.3, n, n, jitter, triangulation, 0, 0.0};
   c.solver.tolerance = options.tolerance;
+  c.bending_model = options.model;
   return c;
 }
 
@@ -426,6 +428,7 @@ void check_mesh_dependence(Table& t, int n, const Options& o) {
                                   : base_config(n, Triangulation::kAlternating, 0.0, o);
         c.fabric = k == 0 ? iso : aniso;
         c.anisotropy = k == 2 ? AnisotropyRule::kEdge : AnisotropyRule::kCurvature;
+        if (k == 2) c.bending_model = BendingModel::kNonlinearDihedral;
         c.initial.shape = start.shape;
         c.initial.seed = start.seed;
         if (perturbed) c.specimen.seed = start.seed + 10 * static_cast<unsigned>(start.shape);
@@ -464,6 +467,7 @@ void check_mesh_dependence(Table& t, int n, const Options& o) {
       DrapeConfig c = base_config(n, Triangulation::kEquilateral, 0.0, o);
       c.fabric = aniso;
       c.anisotropy = edge ? AnisotropyRule::kEdge : AnisotropyRule::kCurvature;
+      if (edge) c.bending_model = BendingModel::kNonlinearDihedral;
       c.specimen.material_angle = turned ? std::numbers::pi / 2.0 : 0.0;
       const std::string label =
           fmt::format("{}, equilateral mesh, warp at {} deg", edge ? "edge rule" : "curvature rule", turned ? 90 : 0);
@@ -509,7 +513,14 @@ int main(int argc, char** argv) {
   app.add_option("--mesh-starts", options.mesh_starts, "initial states per mesh in check d")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  std::string model = "dihedral";
+  app.add_option("--bending-model", model,
+                 "dihedral: hinge curvature (paper Eq. 3); triangle: per-triangle curvature tensors (the edge rule "
+                 "always uses the hinge model)")
+      ->check(CLI::IsMember({"dihedral", "triangle"}))
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
+  options.model = model == "triangle" ? BendingModel::kNonlinearTriangle : BendingModel::kNonlinearDihedral;
   if (options.resolutions.empty()) options.resolutions = {60};
   Table table;
   const auto start = std::chrono::steady_clock::now();

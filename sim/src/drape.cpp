@@ -8,24 +8,37 @@
 #include "drapegen/sim/gravity.hpp"
 #include "drapegen/sim/measures.hpp"
 #include "drapegen/sim/mesh_transfer.hpp"
+#include "drapegen/sim/triangle_bending.hpp"
 
 namespace drapegen::sim {
 namespace {
 
-std::unique_ptr<EnergyTerm> make_bending(const ClothMesh& mesh, const Topology& topology, const FabricParameters& fabric,
-                                         const DrapeConfig& config) {
+/// The bending terms: one model, or for kNonlinearTriangle the triangles plus the hinge model at the border.
+std::vector<std::unique_ptr<EnergyTerm>> make_bending(const ClothMesh& mesh, const Topology& topology,
+                                                      const FabricParameters& fabric, const DrapeConfig& config) {
   const PhysicalEffects& fx = config.effects;
+  std::vector<std::unique_ptr<EnergyTerm>> terms;
   if (config.bending_model == BendingModel::kQuadratic) {
     if (fx.edge_curl || fx.bending_yield_curvature) {
       throw std::invalid_argument("edge curl and bending plasticity need the dihedral bending model");
     }
-    return std::make_unique<QuadraticBending>(mesh, topology, fabric.gamma, config.anisotropy);
+    terms.push_back(std::make_unique<QuadraticBending>(mesh, topology, fabric.gamma, config.anisotropy));
+    return terms;
   }
-  auto bending =
-      std::make_unique<DihedralBending>(mesh, topology, DihedralModuli{fabric.alpha, fabric.beta}, config.anisotropy);
-  if (fx.edge_curl) bending->set_rest_angles(edge_curl_rest_angles(mesh, topology, *fx.edge_curl));
-  if (fx.bending_yield_curvature) bending->set_yield_curvature(*fx.bending_yield_curvature);
-  return bending;
+  const DihedralModuli moduli{fabric.alpha, fabric.beta};
+  auto hinges = std::make_unique<DihedralBending>(mesh, topology, moduli, config.anisotropy);
+  if (config.bending_model == BendingModel::kNonlinearTriangle) {
+    if (fx.edge_curl || fx.bending_yield_curvature) {
+      throw std::invalid_argument("edge curl and bending plasticity need the dihedral bending model");
+    }
+    auto triangles = std::make_unique<TriangleCurvatureBending>(mesh, topology, moduli, config.anisotropy);
+    hinges->set_hinge_weights(triangles->border_hinge_weights());
+    terms.push_back(std::move(triangles));
+  }
+  if (fx.edge_curl) hinges->set_rest_angles(edge_curl_rest_angles(mesh, topology, *fx.edge_curl));
+  if (fx.bending_yield_curvature) hinges->set_yield_curvature(*fx.bending_yield_curvature);
+  terms.push_back(std::move(hinges));
+  return terms;
 }
 
 std::unique_ptr<EnergyTerm> make_membrane(const ClothMesh& mesh, const DrapeConfig& config) {
@@ -55,7 +68,7 @@ Expected<DrapeResult> simulate_drape(const DrapeConfig& config,
   try {
     const Topology topology = build_topology(mesh);
     const std::unique_ptr<EnergyTerm> membrane = make_membrane(mesh, config);
-    const std::unique_ptr<EnergyTerm> bending = make_bending(mesh, topology, fabric, config);
+    const std::vector<std::unique_ptr<EnergyTerm>> bending = make_bending(mesh, topology, fabric, config);
     Gravity gravity(mesh, fabric.density, config.gravity);
     PlatformContact contact(mesh, config.platform);
 
@@ -75,7 +88,10 @@ Expected<DrapeResult> simulate_drape(const DrapeConfig& config,
 
     NewtonSolver solver(config.solver);
     if (progress) solver.set_progress(progress);
-    std::vector<EnergyTerm*> terms{membrane.get(), bending.get(), &gravity, &contact};
+    std::vector<EnergyTerm*> terms{membrane.get()};
+    for (const auto& term : bending) terms.push_back(term.get());
+    terms.push_back(&gravity);
+    terms.push_back(&contact);
     if (friction) terms.push_back(friction.get());
     Eigen::Matrix3Xd x = mesh.positions;
     const int coarse = config.coarse_start_resolution;

@@ -12,6 +12,7 @@ constexpr double kStandardDensity = 0.3;  // kg/m^2
 enum class BendingModel {
   kNonlinearDihedral,  // paper Eq. 1-3 (default)
   kQuadratic,          // Bergou et al. 2006, paper Eq. 4
+  kNonlinearTriangle,  // the Eq. 1-3 torque law on per-triangle curvature tensors (triangle_bending.hpp)
 };
 
 /// Bending parameters in SI units: alpha in N*m (= 1e9 g*mm^2/s^2), beta in N*m^2 (= 1e12 g*mm^3/s^2),

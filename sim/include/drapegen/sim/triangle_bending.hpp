@@ -1,0 +1,73 @@
+#pragma once
+// The paper's nonlinear anisotropic bending law (Eq. 1-3, 8) on per-triangle curvature tensors, a discretisation
+// that is exact for quadratic surfaces on any triangulation.
+//
+// To first order the three dihedral angles around a triangle are linear in a constant curvature tensor K:
+// theta_i = b_i . (K_xx, K_xy, K_yy), with b_i from the rest geometry of hinge i. Solving that 3 x 3 system gives
+// the triangle's K_T, and the triangle stores the energy density
+//   W = psi_phi(kappa_d) + psi_phi+90(kappa_p) + alpha_t kappa_t^2,
+// kappa_d = d.K d along its bending direction d (curvature rule: the greater principal directions of its three
+// vertices, Meyer et al. 2003, as the hinge model), kappa_p across it, kappa_t = d.K p the twist, psi the work of
+// the torque law alpha kappa + beta kappa^2 in that direction (Eq. 8 interpolation) and alpha_t the mean of the two
+// directions' alpha. For isotropic linear bending W = (alpha/2)|K|^2. The hinge model (DihedralBending) measures
+// curvature per hinge instead, and on right-triangle grids picks up twist that depends on the diagonals
+// (docs/PHYSICS.md). Triangles at the border (fewer than three hinges) leave their hinges to the hinge model:
+// border_sides() gives the weights (DihedralBending::set_hinge_weights).
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "drapegen/sim/anisotropy.hpp"
+#include "drapegen/sim/bending.hpp"
+#include "drapegen/sim/energy.hpp"
+#include "drapegen/sim/mesh.hpp"
+
+namespace drapegen::sim {
+
+class TriangleCurvatureBending final : public EnergyTerm {
+ public:
+  /// Throws std::invalid_argument on invalid moduli, the edge rule (a hinge concept) with anisotropic moduli, or a
+  /// degenerate curvature system.
+  TriangleCurvatureBending(const ClothMesh& mesh, const Topology& topology, const DihedralModuli& moduli,
+                           AnisotropyRule rule);
+
+  [[nodiscard]] std::string_view name() const override { return "triangle bending"; }
+  [[nodiscard]] int arity() const override { return 6; }
+  [[nodiscard]] int element_count() const override { return static_cast<int>(elements_.size()); }
+  void element_vertices(int element, int* out) const override;
+  /// Recomputes each triangle's bending direction (curvature rule) and its torque laws.
+  double update_lagged(const Eigen::Matrix3Xd& x) override;
+  [[nodiscard]] double energy(const Eigen::Matrix3Xd& x) const override { return evaluate(x, nullptr, nullptr); }
+  double evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd* gradient, HessianSink* hessian) const override;
+
+  /// Per hinge: how many of its two triangles are border triangles (0, 1 or 2). The hinge model keeps half of a
+  /// hinge's energy per border side.
+  [[nodiscard]] const std::vector<int>& border_sides() const { return border_sides_; }
+  /// Twice the weights DihedralBending::set_hinge_weights needs, as a vector.
+  [[nodiscard]] Eigen::VectorXd border_hinge_weights() const;
+
+ private:
+  struct Element {
+    int vertices[6];             // triangle (0-2), then the wing across each edge (3-5)
+    Hinge hinge[3];              // each hinge in the topology's vertex order
+    int slot[3][4];              // hinge vertex -> element slot
+    Eigen::Matrix3d to_tensor;   // (K_xx, K_xy, K_yy) = to_tensor * theta
+    double area = 0.0;
+    Eigen::Matrix3d measure;     // rows: d kappa_d, d kappa_p, d kappa_t / d theta
+    TorqueLaw along, across;     // laws in the bending direction and across it
+    double twist = 0.0;          // alpha_t
+  };
+  /// Sets the laws and curvature measures of element e for bending direction d (rest frame, unit); returns the
+  /// relative change of its moduli.
+  double assign(Element& e, const Eigen::Vector2d& d) const;
+
+  const ClothMesh* mesh_;
+  const Topology* topology_;
+  DihedralModuli moduli_;
+  AnisotropyRule rule_;
+  std::vector<Element> elements_;
+  std::vector<int> border_sides_;
+  AnisotropyWorkspace workspace_;
+};
+
+}  // namespace drapegen::sim

@@ -1,0 +1,205 @@
+#include "drapegen/sim/triangle_bending.hpp"
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <map>
+#include <stdexcept>
+
+#include "drapegen/sim/dihedral.hpp"
+
+namespace drapegen::sim {
+
+TriangleCurvatureBending::TriangleCurvatureBending(const ClothMesh& mesh, const Topology& topology,
+                                                   const DihedralModuli& moduli, AnisotropyRule rule)
+    : mesh_(&mesh), topology_(&topology), moduli_(moduli), rule_(rule) {
+  for (const DirectionalValues* v : {&moduli.alpha, &moduli.beta}) {
+    for (double k : {v->warp, v->bias, v->weft}) {
+      if (!std::isfinite(k)) throw std::invalid_argument("triangle bending: moduli must be finite");
+    }
+  }
+  if (!(moduli.alpha.warp > 0.0 && moduli.alpha.bias > 0.0 && moduli.alpha.weft > 0.0)) {
+    throw std::invalid_argument("triangle bending: alpha must be positive");
+  }
+  if (rule == AnisotropyRule::kEdge && !moduli.isotropic()) {
+    throw std::invalid_argument("triangle bending: the edge rule belongs to the hinge model");
+  }
+  std::map<std::pair<int, int>, int> hinge_of;
+  for (std::size_t h = 0; h < topology.hinges.size(); ++h) {
+    const Hinge& g = topology.hinges[h];
+    hinge_of[{std::min(g.v0, g.v1), std::max(g.v0, g.v1)}] = static_cast<int>(h);
+  }
+  border_sides_.assign(topology.hinges.size(), 0);
+  const Eigen::Vector2d warp(std::cos(mesh.material_angle), std::sin(mesh.material_angle));
+  for (Eigen::Index t = 0; t < mesh.triangles.cols(); ++t) {
+    const int tri[3] = {mesh.triangles(0, t), mesh.triangles(1, t), mesh.triangles(2, t)};
+    int hinge_index[3];
+    int found = 0;
+    for (int i = 0; i < 3; ++i) {
+      const int a = tri[(i + 1) % 3], b = tri[(i + 2) % 3];
+      const auto it = hinge_of.find({std::min(a, b), std::max(a, b)});
+      hinge_index[i] = it == hinge_of.end() ? -1 : it->second;
+      found += it == hinge_of.end() ? 0 : 1;
+    }
+    if (found < 3) {
+      for (int i = 0; i < 3; ++i) {
+        if (hinge_index[i] >= 0) ++border_sides_[static_cast<std::size_t>(hinge_index[i])];
+      }
+      continue;
+    }
+    Element e{};
+    for (int i = 0; i < 3; ++i) e.vertices[i] = tri[i];
+    const Eigen::Vector2d centre = (mesh.rest.col(tri[0]) + mesh.rest.col(tri[1]) + mesh.rest.col(tri[2])) / 3.0;
+    Eigen::Matrix3d b;  // row i: d theta_i / d (K_xx, K_xy, K_yy)
+    for (int i = 0; i < 3; ++i) {
+      const Hinge& g = topology.hinges[static_cast<std::size_t>(hinge_index[i])];
+      e.hinge[i] = g;
+      const int* hv = &g.v0;
+      for (int k = 0; k < 4; ++k) {
+        int slot = 3 + i;  // the wing
+        for (int s = 0; s < 3; ++s) slot = hv[k] == tri[s] ? s : slot;
+        e.slot[i][k] = slot;
+        if (slot == 3 + i) e.vertices[3 + i] = hv[k];
+      }
+      // The angles of the surface z = amplitude * q^T K q / 2 (q from the centroid) for the three unit tensors; at
+      // this amplitude (angles ~1e-5) the map is linear to ~1e-10.
+      const double amplitude = 1e-3;
+      for (int j = 0; j < 3; ++j) {
+        Eigen::Vector3d p[4];
+        for (int k = 0; k < 4; ++k) {
+          const Eigen::Vector2d q = mesh.rest.col(hv[k]) - centre;
+          const double z = j == 0 ? 0.5 * q.x() * q.x() : j == 1 ? q.x() * q.y() : 0.5 * q.y() * q.y();
+          p[k] = Eigen::Vector3d(q.x(), q.y(), amplitude * z);
+        }
+        b(i, j) = dihedral_angle(p[0], p[1], p[2], p[3]) / amplitude;
+      }
+    }
+    const Eigen::FullPivLU<Eigen::Matrix3d> lu(b);
+    if (!lu.isInvertible() || !(lu.rcond() > 1e-8)) {
+      throw std::invalid_argument("triangle bending: degenerate curvature system");
+    }
+    e.to_tensor = lu.inverse();
+    const Eigen::Vector2d u = mesh.rest.col(tri[1]) - mesh.rest.col(tri[0]),
+                          w = mesh.rest.col(tri[2]) - mesh.rest.col(tri[0]);
+    e.area = 0.5 * std::abs(u.x() * w.y() - u.y() * w.x());
+    assign(e, warp);
+    elements_.push_back(e);
+  }
+}
+
+Eigen::VectorXd TriangleCurvatureBending::border_hinge_weights() const {
+  Eigen::VectorXd w(static_cast<Eigen::Index>(border_sides_.size()));
+  for (Eigen::Index h = 0; h < w.size(); ++h) w[h] = 0.5 * border_sides_[static_cast<std::size_t>(h)];
+  return w;
+}
+
+double TriangleCurvatureBending::assign(Element& e, const Eigen::Vector2d& d) const {
+  const Eigen::Vector2d p(-d.y(), d.x());
+  // kappa = a^T K a = (a_x^2, 2 a_x a_y, a_y^2) . (K_xx, K_xy, K_yy); twist d^T K p likewise.
+  const Eigen::RowVector3d along(d.x() * d.x(), 2.0 * d.x() * d.y(), d.y() * d.y());
+  const Eigen::RowVector3d across(p.x() * p.x(), 2.0 * p.x() * p.y(), p.y() * p.y());
+  const Eigen::RowVector3d twist(d.x() * p.x(), d.x() * p.y() + d.y() * p.x(), d.y() * p.y());
+  e.measure.row(0) = along * e.to_tensor;
+  e.measure.row(1) = across * e.to_tensor;
+  e.measure.row(2) = twist * e.to_tensor;
+  const TorqueLaw old = e.along;
+  if (moduli_.isotropic()) {
+    e.along = e.across = TorqueLaw{moduli_.alpha.warp, moduli_.beta.warp};
+  } else {
+    const double c = std::cos(mesh_->material_angle), s = std::sin(mesh_->material_angle);
+    const double phi = std::atan2(d.y() * c - d.x() * s, d.x() * c + d.y() * s);  // from the warp direction
+    const double floor = 1e-3 * std::min({moduli_.alpha.warp, moduli_.alpha.bias, moduli_.alpha.weft});
+    auto law = [&](double angle) {
+      return TorqueLaw{std::max(interpolate_directional(moduli_.alpha, angle), floor),
+                       interpolate_directional(moduli_.beta, angle)};
+    };
+    e.along = law(phi);
+    e.across = law(phi + 0.5 * std::acos(-1.0));
+  }
+  e.twist = 0.5 * (e.along.alpha + e.across.alpha);
+  if (!(old.alpha > 0.0)) return 0.0;
+  return std::max(std::abs(e.along.alpha - old.alpha) / old.alpha,
+                  std::abs(e.along.beta - old.beta) / std::max(std::abs(old.beta), old.alpha * std::sqrt(e.area)));
+}
+
+double TriangleCurvatureBending::update_lagged(const Eigen::Matrix3Xd& x) {
+  if (moduli_.isotropic()) return 0.0;
+  ClothMesh current = *mesh_;  // the curvature estimate reads positions from a mesh
+  current.positions = x;
+  principal_curvatures(current, *topology_, workspace_.curvature, workspace_.field);
+  const CurvatureField& field = workspace_.field;
+  double change = 0.0;
+  for (Element& e : elements_) {
+    // Mean of the vertices' greater principal directions, signs aligned, weighted by their anisotropy.
+    Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+    const Eigen::Vector2d first = field.direction.col(e.vertices[0]);
+    for (int k = 0; k < 3; ++k) {
+      const int v = e.vertices[k];
+      const double weight = std::abs(field.max_curvature[v]) - std::abs(field.min_curvature[v]) + 1e-9;
+      const Eigen::Vector2d dv = field.direction.col(v);
+      sum += weight * (dv.dot(first) < 0.0 ? -dv : dv);
+    }
+    if (!(sum.norm() > 0.0) || !sum.allFinite()) continue;
+    const double delta = assign(e, sum.normalized());
+    change = std::max(change, std::min(delta, 1.0));
+  }
+  return change;
+}
+
+void TriangleCurvatureBending::element_vertices(int element, int* out) const {
+  for (int k = 0; k < 6; ++k) out[k] = elements_[static_cast<std::size_t>(element)].vertices[k];
+}
+
+double TriangleCurvatureBending::evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd* gradient,
+                                          HessianSink* hessian) const {
+  using Matrix18d = Eigen::Matrix<double, 18, 18>;
+  double total = 0.0;
+  Vector12d g;
+  Matrix12d h2[3];
+  Eigen::Matrix<double, 18, 3> jacobian;  // d theta_i / d x
+  Matrix18d element;
+  const bool exact = hessian != nullptr && hessian->mode() == HessianMode::kExact;
+  for (std::size_t t = 0; t < elements_.size(); ++t) {
+    const Element& e = elements_[t];
+    Eigen::Vector3d theta;
+    jacobian.setZero();
+    for (int i = 0; i < 3; ++i) {
+      const Hinge& h = e.hinge[i];
+      const bool need_gradient = gradient != nullptr || hessian != nullptr;
+      theta(i) = exact ? dihedral_angle_hessian(x.col(h.v0), x.col(h.v1), x.col(h.v2), x.col(h.v3), g, h2[i])
+                 : need_gradient ? dihedral_angle_gradient(x.col(h.v0), x.col(h.v1), x.col(h.v2), x.col(h.v3), g)
+                                 : dihedral_angle(x.col(h.v0), x.col(h.v1), x.col(h.v2), x.col(h.v3));
+      if (!need_gradient) continue;
+      for (int k = 0; k < 4; ++k) jacobian.block<3, 1>(3 * e.slot[i][k], i) += g.segment<3>(3 * k);
+    }
+    const Eigen::Vector3d kappa = e.measure * theta;  // along, across, twist
+    const double k0 = std::abs(kappa(0)), k1 = std::abs(kappa(1));
+    total += e.area * (e.along.work(k0) + e.across.work(k1) + e.twist * kappa(2) * kappa(2));
+    if (gradient == nullptr && hessian == nullptr) continue;
+    const Eigen::Vector3d moment(std::copysign(e.along.torque(k0), kappa(0)),
+                                 std::copysign(e.across.torque(k1), kappa(1)), 2.0 * e.twist * kappa(2));
+    const Eigen::Vector3d torque = e.area * e.measure.transpose() * moment;  // dE / dtheta
+    if (gradient != nullptr) {
+      const Eigen::Matrix<double, 18, 1> ge = jacobian * torque;
+      for (int k = 0; k < 6; ++k) gradient->col(e.vertices[k]) += ge.segment<3>(3 * k);
+    }
+    if (hessian == nullptr) continue;
+    const Eigen::Vector3d stiffness(e.along.stiffness(k0), e.across.stiffness(k1), 2.0 * e.twist);
+    const Eigen::Matrix3d d2e = e.area * e.measure.transpose() * stiffness.asDiagonal() * e.measure;  // PSD
+    element.noalias() = jacobian * d2e * jacobian.transpose();
+    if (exact) {
+      for (int i = 0; i < 3; ++i) {
+        for (int a = 0; a < 4; ++a) {
+          for (int c = 0; c < 4; ++c) {
+            element.block<3, 3>(3 * e.slot[i][a], 3 * e.slot[i][c]) += torque(i) * h2[i].block<3, 3>(3 * a, 3 * c);
+          }
+        }
+      }
+    }
+    // kProjected and kGaussNewton: the Gauss-Newton matrix, positive semi-definite by construction (an 18 x 18
+    // eigen-projection per triangle would cost more than the whole assembly).
+    hessian->add(static_cast<int>(t), element.data());
+  }
+  return total;
+}
+
+}  // namespace drapegen::sim
