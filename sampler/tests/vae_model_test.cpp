@@ -128,7 +128,7 @@ TEST_F(ModelFileTest, StudentTModelRoundTripsAsVersion2) {
   const std::string p = (dir_ / "student.dgvae").string();
   ASSERT_TRUE(save_vae_model(m, p));
   const std::vector<char> bytes = read_all(p);
-  EXPECT_EQ(bytes[8], 2);                         // version
+  EXPECT_EQ(bytes[8], 2);  // version
   EXPECT_EQ(bytes.size(), bytes_.size() + 4 + 8 * 6);  // observation code and the degrees of freedom
   auto loaded = load_vae_model(p);
   ASSERT_TRUE(loaded) << loaded.error().message;
@@ -180,6 +180,7 @@ TEST(VaeModel, CommittedModelLoads) {
   ASSERT_TRUE(loaded) << loaded.error().message;
   EXPECT_EQ(loaded->latent_dim, 8);
   EXPECT_EQ(loaded->hidden, (std::vector<int>{128, 32, 16}));
+  EXPECT_EQ(loaded->observation, Observation::student_t);  // docs/SAMPLER.md, "Models"
 }
 
 }  // namespace

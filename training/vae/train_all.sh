@@ -2,7 +2,7 @@
 # Trains and evaluates every candidate of the paper's Table 1 (GMM K = 3..7, VAE-1..4), exports the chosen VAE-3 to
 # sampler/models/vae3.dgvae (and its PyTorch state to training/vae/models/vae3.pt, the reference of the decoder test),
 # and writes training/vae/results/metrics.json and the table in docs/SAMPLER.md (between its TABLE markers).
-# Two processes in parallel, one thread each; about 25 minutes on the 2-core development machine (shared).
+# Two processes in parallel, one thread each; about 33 minutes on the 2-core development machine (shared).
 # VAEs: Student-t observation model (docs/SAMPLER.md), otherwise the paper's settings; at most the given epochs,
 # early-stopped on a tenth of the training fabrics (checks every --check-every epochs). The paper does not state
 # epochs; the large VAE-1 and VAE-2 get fewer, for time.
