@@ -43,11 +43,8 @@ double mean_log_likelihood(const VaeModel& model, const std::vector<Features>& d
   if (data.empty() || samples < 3) throw std::invalid_argument("mean_log_likelihood: needs data and samples >= 3");
   const int latent = model.latent_dim;
   const double log_2pi = std::log(2.0 * std::numbers::pi);
-  double log_std_sum = 0.0, log_sigma_sum = 0.0;
-  for (int i = 0; i < kFeatureCount; ++i) {
-    log_std_sum += std::log(model.feature_std[i]);
-    log_sigma_sum += model.log_sigma[i];
-  }
+  double log_std_sum = 0.0;
+  for (int i = 0; i < kFeatureCount; ++i) log_std_sum += std::log(model.feature_std[i]);
   // log N(z; centre, diag(sd^2)) for every column of z.
   auto log_normal = [&](const Eigen::MatrixXd& z, const Eigen::VectorXd& centre, const Eigen::VectorXd& sd) {
     const Eigen::ArrayXd r2 = ((z.colwise() - centre).array().colwise() / sd.array()).square().colwise().sum();
@@ -83,14 +80,7 @@ double mean_log_likelihood(const VaeModel& model, const std::vector<Features>& d
     const Eigen::ArrayXd log_q = top + ((a - top).exp() + (b - top).exp() + (prior - top).exp()).log() - std::log(3.0);
     const Eigen::MatrixXd mean = model.decode_standardised(z);
     Eigen::ArrayXd w(samples);
-    for (int k = 0; k < samples; ++k) {
-      double log_obs = -0.5 * kFeatureCount * log_2pi - log_sigma_sum;
-      for (int i = 0; i < kFeatureCount; ++i) {
-        const double r = (s(i) - mean(i, k)) * std::exp(-model.log_sigma[i]);
-        log_obs -= 0.5 * r * r;
-      }
-      w(k) = log_obs + prior(k) - log_q(k);
-    }
+    for (int k = 0; k < samples; ++k) w(k) = model.log_observation(s, mean.col(k)) + prior(k) - log_q(k);
     const double best = w.maxCoeff();
     total += best + std::log((w - best).exp().sum() / samples) - log_std_sum;
   }

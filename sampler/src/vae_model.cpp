@@ -4,12 +4,14 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <numbers>
 
 namespace drapegen::sampler {
 namespace {
 
 constexpr char kMagic[8] = {'D', 'G', 'V', 'A', 'E', '\0', '\0', '\1'};
-constexpr std::uint32_t kVersion = 1;
+constexpr std::uint32_t kGaussianVersion = 1;  // Gaussian observation, no observation code
+constexpr std::uint32_t kVersion = 2;          // observation code in the header, Student-t degrees of freedom
 constexpr std::uint32_t kActivationElu = 1;
 
 std::uint64_t fnv1a(const unsigned char* data, std::size_t size) {
@@ -139,6 +141,17 @@ sim::Status VaeModel::validate() const {
                         " is not finite or not ordered (std > 0, low <= high)"};
     }
   }
+  if (observation != Observation::gaussian && observation != Observation::student_t) {
+    return sim::Error{"unknown observation model"};
+  }
+  if (observation == Observation::student_t) {
+    for (int i = 0; i < kFeatureCount; ++i) {
+      if (!(degrees_of_freedom[i] > 1.0) || !std::isfinite(degrees_of_freedom[i])) {
+        return sim::Error{std::string("Student-t degrees of freedom of feature ") + kFeatureNames[i] +
+                          " must be finite and > 1"};
+      }
+    }
+  }
   if (static_cast<int>(encoder.size()) != h || static_cast<int>(decoder.size()) != h + 1) {
     return sim::Error{"layer counts do not match the hidden widths"};
   }
@@ -157,6 +170,21 @@ sim::Status VaeModel::validate() const {
     in = out;
   }
   return {};
+}
+
+double VaeModel::log_observation(const Eigen::VectorXd& standardised, const Eigen::VectorXd& mean) const {
+  double total = 0.0;
+  for (int i = 0; i < kFeatureCount; ++i) {
+    const double r = (standardised(i) - mean(i)) * std::exp(-log_sigma[i]);
+    if (observation == Observation::gaussian) {
+      total += -0.5 * r * r - log_sigma[i] - 0.5 * std::log(2.0 * std::numbers::pi);
+    } else {
+      const double nu = degrees_of_freedom[i];
+      total += std::lgamma(0.5 * (nu + 1.0)) - std::lgamma(0.5 * nu) - 0.5 * std::log(nu * std::numbers::pi) -
+               log_sigma[i] - 0.5 * (nu + 1.0) * std::log1p(r * r / nu);
+    }
+  }
+  return total;
 }
 
 Eigen::MatrixXd VaeModel::decode_standardised(const Eigen::MatrixXd& latents) const {
@@ -200,18 +228,21 @@ sim::Expected<VaeModel> load_vae_model(const std::string& path) {
   r.skip(sizeof kMagic);
   const std::uint32_t version = r.u32();
   if (r.truncated()) return sim::Error{where + " is truncated in its header"};
-  if (version != kVersion) {
-    return sim::Error{where + " has format version " + std::to_string(version) + "; this program reads version " +
-                      std::to_string(kVersion)};
+  if (version != kGaussianVersion && version != kVersion) {
+    return sim::Error{where + " has format version " + std::to_string(version) + "; this program reads versions " +
+                      std::to_string(kGaussianVersion) + " and " + std::to_string(kVersion)};
   }
   const std::uint32_t dim = r.u32(), latent = r.u32(), layers = r.u32(), activation = r.u32();
+  const std::uint32_t observation = version == kGaussianVersion ? 0 : r.u32();
   if (r.truncated()) return sim::Error{where + " is truncated in its header"};
   if (dim != kFeatureCount) return sim::Error{where + " has " + std::to_string(dim) + " features, expected 6"};
   if (latent < 1 || latent > 1024 || layers < 1 || layers > 16) {
     return sim::Error{where + " has an implausible latent dimension or layer count (corrupt header?)"};
   }
   if (activation != kActivationElu) return sim::Error{where + " uses an unknown activation code"};
+  if (observation > 1) return sim::Error{where + " uses an unknown observation model code"};
   VaeModel m;
+  m.observation = static_cast<Observation>(observation);
   m.latent_dim = static_cast<int>(latent);
   for (std::uint32_t i = 0; i < layers; ++i) {
     const std::uint32_t w = r.u32();
@@ -220,7 +251,7 @@ sim::Expected<VaeModel> load_vae_model(const std::string& path) {
   }
   if (r.truncated()) return sim::Error{where + " is truncated in its header"};
   // The size the header implies, checked before reading any array.
-  std::uint64_t reals = 5ULL * kFeatureCount;
+  std::uint64_t reals = (m.observation == Observation::student_t ? 6ULL : 5ULL) * kFeatureCount;
   std::uint64_t in_w = kFeatureCount;
   for (int w : m.hidden) reals += (in_w + 1) * w, in_w = w;
   reals += 2 * (in_w + 1) * latent;
@@ -245,6 +276,7 @@ sim::Expected<VaeModel> load_vae_model(const std::string& path) {
   r.features(m.range_low);
   r.features(m.range_high);
   r.features(m.log_sigma);
+  if (m.observation == Observation::student_t) r.features(m.degrees_of_freedom);
   int in_width = kFeatureCount;
   for (int w : m.hidden) {
     m.encoder.push_back(r.dense(in_width, w));
@@ -267,17 +299,20 @@ sim::Status save_vae_model(const VaeModel& model, const std::string& path) {
   if (sim::Status s = model.validate(); !s) return s;
   Writer w;
   w.bytes.assign(kMagic, kMagic + sizeof kMagic);
-  w.u32(kVersion);
+  const bool gaussian = model.observation == Observation::gaussian;
+  w.u32(gaussian ? kGaussianVersion : kVersion);
   w.u32(kFeatureCount);
   w.u32(static_cast<std::uint32_t>(model.latent_dim));
   w.u32(static_cast<std::uint32_t>(model.hidden.size()));
   w.u32(kActivationElu);
+  if (!gaussian) w.u32(static_cast<std::uint32_t>(model.observation));
   for (int h : model.hidden) w.u32(static_cast<std::uint32_t>(h));
   w.features(model.feature_mean);
   w.features(model.feature_std);
   w.features(model.range_low);
   w.features(model.range_high);
   w.features(model.log_sigma);
+  if (!gaussian) w.features(model.degrees_of_freedom);
   for (const DenseLayer& l : model.encoder) w.dense(l);
   w.dense(model.encoder_mu);
   w.dense(model.encoder_logvar);

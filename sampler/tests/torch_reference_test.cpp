@@ -73,18 +73,19 @@ TEST(TorchReference, CommittedDecoderMatchesPyTorch) {
 }
 
 TEST(TorchReference, FreshlyTrainedDecoderMatchesPyTorch) {
-  // A tiny training run end to end: train.py exports the model file and the PyTorch state; both decode the same
-  // latents.
+  // A tiny training run end to end (Student-t observation, format version 2): train.py exports the model file and the
+  // PyTorch state; both decode the same latents.
   if (!torch_available()) GTEST_SKIP() << kPython << " cannot import torch/numpy/scipy: apt-get install python3-torch";
   const fs::path dir = fs::temp_directory_path() / ("drapegen_torch_test_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   std::string out;
   ASSERT_TRUE(run(kPython + " " + kSource + "/training/vae/train.py --models VAE-4 --epochs 3 --iw-samples 10" +
-                      " --generated 300 --seed 5 --export VAE-4=" + (dir / "m.dgvae").string() + " --checkpoint " +
-                      (dir / "m.pt").string() + " 2>/dev/null",
+                      " --observation student --generated 300 --seed 5 --export VAE-4=" + (dir / "m.dgvae").string() +
+                      " --checkpoint " + (dir / "m.pt").string() + " 2>/dev/null",
                   out));
   auto model = load_vae_model((dir / "m.dgvae").string());
   ASSERT_TRUE(model) << model.error().message;
+  EXPECT_EQ(model->observation, Observation::student_t);
   std::string reference;
   ASSERT_TRUE(run(kPython + " " + kSource + "/training/vae/reference_decode.py --checkpoint " + (dir / "m.pt").string() +
                       " --count 64 --seed 3",
@@ -107,7 +108,8 @@ TEST(TorchReference, TrainingIsReproducibleFromASeed) {
   auto train = [&](int seed, const std::string& name) {
     std::string out;
     EXPECT_TRUE(run(kPython + " " + kSource + "/training/vae/train.py --models VAE-4 --epochs 4 --check-every 2" +
-                        " --iw-samples 9 --generated 300 --seed " + std::to_string(seed) + " --export VAE-4=" +
+                        " --observation student --kl-warmup 2 --lr-final 1e-5 --iw-samples 9 --generated 300" +
+                        " --seed " + std::to_string(seed) + " --export VAE-4=" +
                         (dir / name).string() + " 2>/dev/null",
                     out));
     return file_bytes(dir / name);

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <numbers>
 
 #include "test_models.hpp"
 
@@ -101,8 +102,8 @@ TEST_F(ModelFileTest, EveryFlippedBodyByteIsRejected) {
 
 TEST_F(ModelFileTest, HeaderErrorsAreNamed) {
   std::vector<char> bad = bytes_;
-  bad[8] = 2;  // version
-  EXPECT_NE(error_of(bad).find("version 2"), std::string::npos);
+  bad[8] = 3;  // version
+  EXPECT_NE(error_of(bad).find("version 3"), std::string::npos);
   bad = bytes_;
   bad[12] = 7;  // features
   EXPECT_NE(error_of(bad).find("7 features"), std::string::npos);
@@ -118,6 +119,48 @@ TEST_F(ModelFileTest, NonFiniteWeightsAreRejectedOnSave) {
   m = model_;
   m.feature_std[2] = 0.0;
   EXPECT_FALSE(m.validate());
+}
+
+TEST_F(ModelFileTest, StudentTModelRoundTripsAsVersion2) {
+  VaeModel m = model_;
+  m.observation = Observation::student_t;
+  m.degrees_of_freedom = {1.5, 2.0, 3.25, 4.0, 7.5, 30.0};
+  const std::string p = (dir_ / "student.dgvae").string();
+  ASSERT_TRUE(save_vae_model(m, p));
+  const std::vector<char> bytes = read_all(p);
+  EXPECT_EQ(bytes[8], 2);  // version
+  EXPECT_EQ(bytes.size(), bytes_.size() + 4 + 8 * 6);  // observation code and the degrees of freedom
+  auto loaded = load_vae_model(p);
+  ASSERT_TRUE(loaded) << loaded.error().message;
+  EXPECT_EQ(loaded->observation, Observation::student_t);
+  EXPECT_EQ(loaded->degrees_of_freedom, m.degrees_of_freedom);
+  EXPECT_EQ(loaded->log_sigma, m.log_sigma);
+  // Unknown observation codes and degrees of freedom <= 1 are rejected.
+  std::vector<char> bad = bytes;
+  bad[28] = 5;
+  EXPECT_NE(error_of(bad).find("observation"), std::string::npos) << error_of(bad);
+  m.degrees_of_freedom[3] = 1.0;
+  EXPECT_FALSE(m.validate());
+  EXPECT_FALSE(save_vae_model(m, p));
+}
+
+TEST(VaeModel, ObservationLogDensities) {
+  VaeModel m = testing::random_model();
+  Eigen::VectorXd s(6), mean(6);
+  s << 0.3, -1.0, 2.0, 0.0, 0.5, -0.25;
+  mean << 0.1, -0.5, 1.0, 0.2, 0.5, 0.75;
+  double gauss = 0.0, student = 0.0;
+  const double nu = 3.0;
+  for (int i = 0; i < 6; ++i) {
+    const double sigma = std::exp(m.log_sigma[i]), r = (s(i) - mean(i)) / sigma;
+    gauss += -0.5 * r * r - std::log(sigma * std::sqrt(2.0 * std::numbers::pi));
+    // Student-t with 3 degrees of freedom: 2 / (pi sqrt(3) sigma (1 + r^2/3)^2).
+    student += std::log(2.0 / (std::numbers::pi * std::sqrt(3.0) * sigma)) - 2.0 * std::log1p(r * r / nu);
+  }
+  EXPECT_NEAR(m.log_observation(s, mean), gauss, 1e-12);
+  m.observation = Observation::student_t;
+  m.degrees_of_freedom.fill(nu);
+  EXPECT_NEAR(m.log_observation(s, mean), student, 1e-12);
 }
 
 TEST(VaeModel, DecoderIsTheMlpWithElu) {
@@ -137,6 +180,7 @@ TEST(VaeModel, CommittedModelLoads) {
   ASSERT_TRUE(loaded) << loaded.error().message;
   EXPECT_EQ(loaded->latent_dim, 8);
   EXPECT_EQ(loaded->hidden, (std::vector<int>{128, 32, 16}));
+  EXPECT_EQ(loaded->observation, Observation::student_t);  // docs/SAMPLER.md, "Models"
 }
 
 }  // namespace

@@ -25,7 +25,7 @@ def main():
     args = ap.parse_args()
     torch.set_num_threads(1)
     state = torch.load(args.checkpoint)
-    model = vae.VAE(state["hidden"], state["latent"])
+    model = vae.VAE(state["hidden"], state["latent"], observation=state.get("observation", "gaussian"))
     model.load_state_dict(state["state_dict"])
     model.eval()
     x = fabrics.distinct_fabrics(args.data)

@@ -1,12 +1,15 @@
-"""Writes a trained VAE in the drapegen model format (version 1; specified in
-sampler/include/drapegen/sampler/vae_model.hpp and docs/SAMPLER.md)."""
+"""Writes a trained VAE in the drapegen model format (specified in sampler/include/drapegen/sampler/vae_model.hpp and
+docs/SAMPLER.md): version 1 for a Gaussian observation model, version 2 (observation code and Student-t degrees of
+freedom) otherwise."""
 import struct
 
 import numpy as np
 
 MAGIC = b"DGVAE\x00\x00\x01"
-VERSION = 1
+VERSION_GAUSSIAN = 1
+VERSION = 2
 ACTIVATION_ELU = 1
+OBSERVATION_CODES = {"gaussian": 0, "student": 1}
 
 
 def fnv1a64(data):
@@ -23,7 +26,11 @@ def _linear_layers(seq):
 
 def model_bytes(model, range_low, range_high):
     out = bytearray(MAGIC)
-    out += struct.pack("<5I", VERSION, model.dim, model.latent, len(model.hidden), ACTIVATION_ELU)
+    gaussian = model.observation == "gaussian"
+    out += struct.pack("<5I", VERSION_GAUSSIAN if gaussian else VERSION, model.dim, model.latent, len(model.hidden),
+                       ACTIVATION_ELU)
+    if not gaussian:
+        out += struct.pack("<I", OBSERVATION_CODES[model.observation])
     out += struct.pack(f"<{len(model.hidden)}I", *model.hidden)
 
     def reals(values):
@@ -35,6 +42,8 @@ def model_bytes(model, range_low, range_high):
     out += reals(range_low)
     out += reals(range_high)
     out += reals(model.log_sigma.detach().numpy())
+    if not gaussian:
+        out += reals(model.degrees_of_freedom().detach().numpy())
     layers = _linear_layers(model.encoder) + [model.to_mu, model.to_logvar] + _linear_layers(model.decoder)
     for layer in layers:
         out += reals(layer.weight.detach().numpy())  # out x in, row-major

@@ -16,8 +16,17 @@ def describe(name, res):
     if name.startswith("GMM"):
         return f"K = {name[4:]}, full covariances, EM 200 it."
     hidden, latent = vae.ARCHITECTURES[name]
-    return (f"FC {'-'.join(map(str, hidden))}, latent {latent}; epoch {res['chosen_epoch']} of "
-            f"{res['epochs']} (early stop)")
+    training = res.get("training", {})
+    observation = {"gaussian": "Gaussian", "student": "Student-t"}[training.get("observation", "gaussian")]
+    schedule = ""
+    if training.get("kl_warmup"):
+        schedule += f", KL warm-up {training['kl_warmup']}"
+    if training.get("lr_final") is not None:
+        schedule += f", lr {training['lr']:g} -> {training['lr_final']:g} (cosine)"
+    elif training.get("lr", 1e-4) != 1e-4:
+        schedule += f", lr {training['lr']:g}"
+    return (f"FC {'-'.join(map(str, hidden))}, latent {latent}, {observation} obs.{schedule}; epoch "
+            f"{res['chosen_epoch']} of {res['epochs']} (early stop)")
 
 
 def main():

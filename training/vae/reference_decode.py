@@ -20,7 +20,7 @@ def main():
     ap.add_argument("--seed", type=int, default=0)
     args = ap.parse_args()
     state = torch.load(args.checkpoint)
-    model = vae.VAE(state["hidden"], state["latent"])
+    model = vae.VAE(state["hidden"], state["latent"], observation=state.get("observation", "gaussian"))
     model.load_state_dict(state["state_dict"])
     model.eval()
     rng = np.random.default_rng(args.seed)

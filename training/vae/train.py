@@ -68,6 +68,13 @@ def main():
     ap.add_argument("--checkpoint", default=None, help="save the exported VAE's PyTorch state here")
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--check-every", type=int, default=500, help="epochs between early-stopping checks")
+    ap.add_argument("--observation", choices=vae.OBSERVATIONS, default="gaussian",
+                    help="VAE observation model: Gaussian or Student-t (per-feature scale and degrees of freedom)")
+    ap.add_argument("--lr", type=float, default=1e-4, help="Adam learning rate (the paper's 1e-4)")
+    ap.add_argument("--lr-final", type=float, default=None, help="cosine decay of the learning rate to this value")
+    ap.add_argument("--kl-warmup", type=int, default=0, help="epochs of linear KL weight warm-up from 0 to 1")
+    ap.add_argument("--criterion", choices=("median", "mean"), default="median",
+                    help="early-stopping statistic of the stop set's log-likelihoods")
     args = ap.parse_args()
     torch.set_num_threads(args.threads)
 
@@ -99,26 +106,30 @@ def main():
         else:
             hidden, latent = vae.ARCHITECTURES[name]
             torch.manual_seed(args.seed)
-            model = vae.VAE(hidden, latent)
+            model = vae.VAE(hidden, latent, observation=args.observation)
             model.feature_mean[:] = torch.as_tensor(m)
             model.feature_std[:] = torch.as_tensor(s)
             # Early stopping on a tenth of the training fabrics (the validation fabrics stay unseen).
             fit, stop = fabrics.split(len(tr), args.seed + 1, validation_fraction=0.1)
             chosen = vae.train(model, (x[tr[fit]] - m) / s, args.epochs, args.seed, stop_s=(x[tr[stop]] - m) / s,
-                               check_every=args.check_every, log=log)
+                               check_every=args.check_every, log=log, lr=args.lr, lr_final=args.lr_final,
+                               kl_warmup=args.kl_warmup, criterion=args.criterion)
             model.eval()
             res = evaluate_vae(model, x, tr, va, m, s, args.iw_samples, args.seed, args.generated)
             if name == export_name:
                 export.write_model(model, x.min(0), x.max(0), export_path)
                 log(f"  exported {name} to {export_path}")
                 if args.checkpoint:
-                    torch.save({"name": name, "hidden": hidden, "latent": latent, "state_dict": model.state_dict()},
+                    torch.save({"name": name, "hidden": hidden, "latent": latent, "observation": args.observation,
+                                "state_dict": model.state_dict()},
                                args.checkpoint)
         res["seconds"] = round(time.time() - t0, 1)
         if not name.startswith("GMM-"):
             res["epochs"] = args.epochs
             res["chosen_epoch"] = chosen
             res["fit_fabrics"], res["stop_fabrics"] = len(fit), len(stop)
+            res["training"] = {"observation": args.observation, "lr": args.lr, "lr_final": args.lr_final,
+                               "kl_warmup": args.kl_warmup, "criterion": args.criterion}
         results["models"][name] = res
         log(f"{name}: " + ", ".join(f"{k} {v:.3f}" if isinstance(v, float) else f"{k} {v}" for k, v in res.items()))
         if args.results:  # after every model, so a long run keeps what it has

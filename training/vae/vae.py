@@ -14,6 +14,7 @@ ARCHITECTURES = {
     "VAE-3": ([128, 32, 16], 8),
     "VAE-4": ([32, 16, 8], 4),
 }
+OBSERVATIONS = ("gaussian", "student")
 ACTIVATION = "elu"  # the C++ decoder implements the same function (sampler/src/mlp.cpp)
 
 
@@ -27,15 +28,20 @@ def mlp(widths):
 
 
 class VAE(nn.Module):
-    def __init__(self, hidden, latent, dim=6):
+    def __init__(self, hidden, latent, dim=6, observation="gaussian"):
         super().__init__()
-        self.hidden, self.latent, self.dim = list(hidden), latent, dim
+        if observation not in OBSERVATIONS:
+            raise ValueError(f"unknown observation model '{observation}'")
+        self.hidden, self.latent, self.dim, self.observation = list(hidden), latent, dim, observation
         self.encoder = mlp([dim] + self.hidden)
         self.encoder_act = nn.ELU()
         self.to_mu = nn.Linear(self.hidden[-1], latent)
         self.to_logvar = nn.Linear(self.hidden[-1], latent)
         self.decoder = mlp([latent] + self.hidden[::-1] + [dim])
         self.log_sigma = nn.Parameter(torch.zeros(dim, dtype=torch.float64))
+        if observation == "student":
+            # degrees of freedom nu = 1 + exp(log_nu_minus_1) > 1 (so the decoder output is the mean), start at 5
+            self.log_nu_minus_1 = nn.Parameter(torch.full((dim,), math.log(4.0), dtype=torch.float64))
         self.register_buffer("feature_mean", torch.zeros(dim, dtype=torch.float64))
         self.register_buffer("feature_std", torch.ones(dim, dtype=torch.float64))
         self.double()
@@ -55,12 +61,24 @@ class VAE(nn.Module):
         var = torch.exp(2 * self.log_sigma)
         return -0.5 * (((s - mean) ** 2) / var + 2 * self.log_sigma + math.log(2 * math.pi)).sum(-1)
 
-    def elbo(self, s):
+    def degrees_of_freedom(self):
+        return 1 + torch.exp(self.log_nu_minus_1)
+
+    def log_obs(self, s, mean):
+        """log p(s | decoder mean) of the observation model, summed over features."""
+        if self.observation == "gaussian":
+            return self.log_gaussian_obs(s, mean)
+        nu = self.degrees_of_freedom()
+        r = (s - mean) * torch.exp(-self.log_sigma)
+        return (torch.lgamma((nu + 1) / 2) - torch.lgamma(nu / 2) - 0.5 * torch.log(nu * math.pi) - self.log_sigma
+                - (nu + 1) / 2 * torch.log1p(r * r / nu)).sum(-1)
+
+    def elbo(self, s, kl_weight=1.0):
         mu, logvar = self.encode(s)
         z = mu + torch.exp(0.5 * logvar) * torch.randn_like(mu)
-        rec = self.log_gaussian_obs(s, self.decoder(z))
+        rec = self.log_obs(s, self.decoder(z))
         kl = 0.5 * (mu ** 2 + torch.exp(logvar) - 1 - logvar).sum(-1)
-        return rec - kl
+        return rec - kl_weight * kl
 
     @torch.no_grad()
     def iw_log_likelihood(self, s, samples, generator):
@@ -93,14 +111,14 @@ class VAE(nn.Module):
             else:
                 z = mu[i] + std[i] * eps
                 log_q = log_n(z, mu[i], std[i])
-            log_obs = self.log_gaussian_obs(s[i].expand(samples, -1), self.decoder(z))
+            log_obs = self.log_obs(s[i].expand(samples, -1), self.decoder(z))
             w = log_obs + log_prior_of(z) - log_q
             out.append(torch.logsumexp(w, 0) - math.log(samples))
         return torch.stack(out)
 
 
 def train(model, train_s, epochs, seed, stop_s=None, check_every=500, stop_samples=300, lr=1e-4,
-          weight_decay=1e-5, batch=16, log=None):
+          weight_decay=1e-5, batch=16, log=None, kl_warmup=0, lr_final=None, criterion="median"):
     """Adam, lr 1e-4, weight decay 1e-5, batch 16 (paper Section 5.1.3); maximises the ELBO. With `stop_s`, every
     `check_every` epochs (and at the end) the log-likelihood of those held-out fabrics is estimated (log_likelihood,
     `stop_samples` draws) and the state with the best *median* is kept (early stopping). The median, because the
@@ -114,9 +132,13 @@ def train(model, train_s, epochs, seed, stop_s=None, check_every=500, stop_sampl
     for epoch in range(epochs):
         order = torch.randperm(len(data), generator=g)
         total = 0.0
+        kl_weight = min(1.0, (epoch + 1) / kl_warmup) if kl_warmup else 1.0
+        if lr_final is not None:  # cosine decay from lr to lr_final over the epochs
+            for group in opt.param_groups:
+                group["lr"] = lr_final + 0.5 * (lr - lr_final) * (1 + math.cos(math.pi * epoch / epochs))
         for start in range(0, len(data), batch):
             x = data[order[start:start + batch]]
-            loss = -model.elbo(x).mean()
+            loss = -model.elbo(x, kl_weight).mean()
             opt.zero_grad()
             loss.backward()
             opt.step()
@@ -125,11 +147,11 @@ def train(model, train_s, epochs, seed, stop_s=None, check_every=500, stop_sampl
         message = ""
         if stop_s is not None and (done % check_every == 0 or done == epochs):
             lls = model.log_likelihood(torch.as_tensor(stop_s), stop_samples, torch.Generator().manual_seed(seed + 7))
-            ll = float(lls.median())
+            ll = float(lls.median()) if criterion == "median" else float(lls.mean())
             if ll > best[0]:
                 best = (ll, done, {k: v.clone() for k, v in model.state_dict().items()})
-            message = (f"  stop-set LL median {ll:.4f} mean {float(lls.mean()):.4f} "
-                       f"(best median {best[0]:.4f} at {best[1]})")
+            message = (f"  stop-set LL median {float(lls.median()):.4f} mean {float(lls.mean()):.4f} "
+                       f"(best {criterion} {best[0]:.4f} at {best[1]})")
         if log and (epoch % max(1, epochs // 10) == 0 or done == epochs or message):
             log(f"  epoch {done:6d}  -ELBO {total / len(data):.4f}{message}")
     if best[2] is not None:

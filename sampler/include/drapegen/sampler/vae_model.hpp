@@ -2,19 +2,25 @@
 // The trained subspace model (paper Section 5.1.3): a VAE's decoder (and encoder, for the log-likelihood of the
 // coverage report), loaded from the binary file that training/vae/export.py writes.
 //
-// File format (version 1), all integers unsigned 32-bit and all reals IEEE-754 float64, little-endian:
+// File format (versions 1 and 2), all integers unsigned 32-bit and all reals IEEE-754 float64, little-endian:
 //   magic      8 bytes "DGVAE\0\0\1"
-//   header     u32 version (= 1), u32 D (features, = 6), u32 L (latent dimension, 1..1024),
-//              u32 H (hidden layers, 1..16), u32 activation (1 = ELU with alpha 1), u32 widths[H] (1..8192, encoder
-//              order: D -> widths[0] -> ... -> widths[H-1])
+//   header     u32 version (1 or 2), u32 D (features, = 6), u32 L (latent dimension, 1..1024),
+//              u32 H (hidden layers, 1..16), u32 activation (1 = ELU with alpha 1),
+//              version 2 only: u32 observation (0 = Gaussian, 1 = Student-t),
+//              u32 widths[H] (1..8192, encoder order: D -> widths[0] -> ... -> widths[H-1])
 //   f64[D] x 5 feature mean, feature std (> 0), data range low, data range high (features of the measured
-//              fabrics, low <= high), observation log-sigma (standardised units)
+//              fabrics, low <= high), observation log-scale (log sigma, standardised units)
+//   f64[D]     version 2 with a Student-t observation only: degrees of freedom nu (> 1)
 //   encoder    H dense layers, then the mean head (widths[H-1] -> L) and the log-variance head (same shape)
 //   decoder    H + 1 dense layers: L -> widths[H-1] -> ... -> widths[0] -> D
 //              each dense layer: weights f64[out][in] (row-major, as torch.nn.Linear stores them), bias f64[out];
 //              the activation follows every layer except the last of each network (and the encoder's output
 //              feeds both heads after its activation)
 //   checksum   u64 FNV-1a (64-bit) of every preceding byte
+// Version 1 is a Gaussian observation model; writers use version 1 for Gaussian models, version 2 otherwise.
+// The observation model p(s | z) is per feature, independent: N(decoder(z), sigma^2) or Student-t with location
+// decoder(z), scale sigma and nu degrees of freedom; either way its mean is the decoder output (nu > 1), which is what
+// the sampler uses.
 // The decoder maps a latent vector z to standardised features s; features = s * std + mean (sign(k) ln|k|).
 
 #include <Eigen/Core>
@@ -32,6 +38,8 @@ struct DenseLayer {
   Eigen::VectorXd bias;    // out
 };
 
+enum class Observation : std::uint32_t { gaussian = 0, student_t = 1 };
+
 struct VaeModel {
   int latent_dim = 0;
   std::vector<int> hidden;  // encoder order
@@ -39,7 +47,9 @@ struct VaeModel {
   Features feature_std{};
   Features range_low{};   // of the measured fabrics' features
   Features range_high{};
-  Features log_sigma{};   // observation noise, standardised units
+  Observation observation = Observation::gaussian;
+  Features log_sigma{};   // observation scale, standardised units
+  Features degrees_of_freedom{};  // Student-t only (> 1)
   std::vector<DenseLayer> encoder;  // H layers
   DenseLayer encoder_mu, encoder_logvar;
   std::vector<DenseLayer> decoder;  // H + 1 layers
@@ -50,6 +60,8 @@ struct VaeModel {
   [[nodiscard]] Eigen::MatrixXd decode_standardised(const Eigen::MatrixXd& latents) const;
   /// Posterior mean and log-variance of q(z | features) for standardised inputs, one per column.
   void encode_standardised(const Eigen::MatrixXd& standardised, Eigen::MatrixXd& mu, Eigen::MatrixXd& logvar) const;
+  /// log p(s | decoder mean) of the observation model, summed over the features (standardised units).
+  [[nodiscard]] double log_observation(const Eigen::VectorXd& standardised, const Eigen::VectorXd& mean) const;
   /// Checks shapes and finiteness (the loader calls it).
   [[nodiscard]] sim::Status validate() const;
 };
