@@ -46,6 +46,7 @@ struct Options {
   double tolerance = 1e-3;
   bool master = true;
   bool eq8 = true;
+  BendingModel model = BendingModel::kNonlinearDihedral;
   std::string json_path;
   std::string csv_path;
 };
@@ -53,7 +54,8 @@ struct Options {
 [[noreturn]] void usage(const char* program, int code) {
   std::fprintf(code == 0 ? stdout : stderr,
                "usage: %s [--segments N] [--points N] [--gamma-min G] [--gamma-max G] [--length m] [--width m]\n"
-               "          [--eq8-segments N] [--tolerance t] [--skip-master] [--skip-eq8] [--json FILE] [--csv FILE]\n",
+               "          [--eq8-segments N] [--tolerance t] [--model dihedral|triangle] [--skip-master] [--skip-eq8]\n"
+               "          [--json FILE] [--csv FILE]\n",
                program);
   std::exit(code);
 }
@@ -75,7 +77,11 @@ Options parse(int argc, char** argv) {
       else if (a == "--width") o.width = std::stod(value());
       else if (a == "--eq8-segments") o.eq8_segments = std::stoi(value());
       else if (a == "--tolerance") o.tolerance = std::stod(value());
-      else if (a == "--skip-master") o.master = false;
+      else if (a == "--model") {
+        const std::string m = value();
+        if (m != "dihedral" && m != "triangle") usage(argv[0], 2);
+        o.model = m == "triangle" ? BendingModel::kNonlinearTriangle : BendingModel::kNonlinearDihedral;
+      } else if (a == "--skip-master") o.master = false;
       else if (a == "--skip-eq8") o.eq8 = false;
       else if (a == "--json") o.json_path = value();
       else if (a == "--csv") o.csv_path = value();
@@ -136,6 +142,7 @@ int main(int argc, char** argv) {
       spec.length = o.length;
       spec.width = width;
       spec.segments = o.segments;
+      spec.bending_model = o.model;
       spec.fabric.alpha = {alpha, alpha, alpha};
       spec.fabric.density = o.density;
       spec.solver.tolerance = o.tolerance;
@@ -178,6 +185,7 @@ int main(int argc, char** argv) {
       spec.length = length;
       spec.width = eq8_width;
       spec.segments = o.eq8_segments;
+      spec.bending_model = o.model;
       spec.fabric.alpha = alpha;
       spec.fabric.density = o.density;
       spec.cut_angle = phi;

@@ -86,6 +86,7 @@ int run_simulate(const SimulateOptions& o) {
 
   sim::DrapeConfig config;
   config.fabric = sim::fabric_from_paper_units(*alpha, *beta, o.density);
+  if (o.model == "triangle") config.bending_model = sim::BendingModel::kNonlinearTriangle;
   if (o.model == "quadratic") {
     config.bending_model = sim::BendingModel::kQuadratic;
     // The quadratic model's gamma equals alpha / 3 for identical small-angle behaviour (paper Section 4.2.1).
@@ -93,7 +94,7 @@ int run_simulate(const SimulateOptions& o) {
   }
   config.anisotropy = o.anisotropy == "edge" ? sim::AnisotropyRule::kEdge : sim::AnisotropyRule::kCurvature;
   config.effects = *effects;
-  if (config.bending_model == sim::BendingModel::kQuadratic &&
+  if (config.bending_model != sim::BendingModel::kNonlinearDihedral &&
       (config.effects.edge_curl || config.effects.bending_yield_curvature)) {
     return fail("--effect curl and yield need --model dihedral");
   }
@@ -187,8 +188,10 @@ Runner add_simulate_command(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--out", o->out, "Write the draped mesh to this PLY file");
   app.add_flag("--json", o->json, "Print the summary as JSON");
-  app.add_option("--model", o->model, "Bending model: dihedral (paper Eq. 1-3) or quadratic (Eq. 4, gamma = alpha/3)")
-      ->check(CLI::IsMember({"dihedral", "quadratic"}))
+  app.add_option("--model", o->model,
+                 "Bending model: dihedral (paper Eq. 1-3, curvature per hinge), triangle (the same law on per-triangle "
+                 "curvature tensors, exact for quadratic surfaces on any mesh) or quadratic (Eq. 4, gamma = alpha/3)")
+      ->check(CLI::IsMember({"dihedral", "triangle", "quadratic"}))
       ->capture_default_str();
   app.add_option("--anisotropy", o->anisotropy, "Bending direction rule: curvature (paper) or edge (naive)")
       ->check(CLI::IsMember({"curvature", "edge"}))

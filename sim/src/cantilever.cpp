@@ -13,6 +13,7 @@
 #include "drapegen/sim/gravity.hpp"
 #include "drapegen/sim/membrane.hpp"
 #include "drapegen/sim/specimen.hpp"
+#include "drapegen/sim/triangle_bending.hpp"
 
 namespace drapegen::sim {
 
@@ -122,12 +123,18 @@ Expected<CantileverResult> simulate_cantilever(const CantileverSpec& spec) {
   try {
     const Topology topology = build_topology(mesh);
     CorotationalMembrane membrane(mesh, MembraneParameters{spec.membrane_stiffness, 0.99, 1.01});
-    std::unique_ptr<EnergyTerm> bending;
+    std::unique_ptr<EnergyTerm> bending, triangles;
     if (spec.bending_model == BendingModel::kQuadratic) {
       bending = std::make_unique<QuadraticBending>(mesh, topology, spec.fabric.gamma, spec.anisotropy);
     } else {
-      bending = std::make_unique<DihedralBending>(mesh, topology, DihedralModuli{spec.fabric.alpha, spec.fabric.beta},
-                                                  spec.anisotropy);
+      const DihedralModuli moduli{spec.fabric.alpha, spec.fabric.beta};
+      auto hinges = std::make_unique<DihedralBending>(mesh, topology, moduli, spec.anisotropy);
+      if (spec.bending_model == BendingModel::kNonlinearTriangle) {
+        auto t = std::make_unique<TriangleCurvatureBending>(mesh, topology, moduli, spec.anisotropy);
+        hinges->set_hinge_weights(t->border_hinge_weights());
+        triangles = std::move(t);
+      }
+      bending = std::move(hinges);
     }
     NewtonSolver solver(spec.solver);
     Eigen::Matrix3Xd x = mesh.positions;
@@ -137,6 +144,7 @@ Expected<CantileverResult> simulate_cantilever(const CantileverSpec& spec) {
     for (int k = 1; k <= steps; ++k) {
       Gravity gravity(mesh, spec.fabric.density, spec.gravity * k / steps);
       std::vector<EnergyTerm*> terms{&membrane, bending.get(), &gravity};
+      if (triangles) terms.push_back(triangles.get());
       const SolveReport r = solver.solve(terms, strip.fixed, reference, x);
       result.report.add_work(r);
       result.report.lagged_change = r.lagged_change;
