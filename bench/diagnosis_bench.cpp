@@ -59,8 +59,8 @@ struct Case {
   Fabric fabric;
 };
 
-/// Strengths per effect, drawn uniformly in [lo, hi].
-const std::map<std::string, std::pair<double, double>> kStrength = {
+/// Strengths per effect, drawn uniformly in [lo, hi] (--strength NAME=LO:HI overrides).
+const std::map<std::string, std::pair<double, double>> kDefaultStrength = {
     {"yield", {10.0, 25.0}}, {"shear", {0.3, 1.0}},       {"curl", {30.0, 50.0}}, {"friction", {0.02, 0.1}},
     {"misalign", {15.0, 30.0}}, {"pose", {1.0, 2.0}},     {"bias", {5.0, 10.0}},  {"multipath", {15.0, 30.0}}};
 
@@ -83,11 +83,28 @@ int main(int argc, char** argv) {
   app.add_option("--diagnose-jobs", diagnose_jobs, "--jobs of each diagnosis (refit threads)")->capture_default_str();
   app.add_option("--resolution", resolution, "Reality mesh resolution")->capture_default_str();
   app.add_option("--seed", seed, "Seed of fabrics, strengths and captures")->capture_default_str();
+  std::vector<std::string> strength_overrides;
+  app.add_option("--strength", strength_overrides, "NAME=LO:HI: draw that effect's strength in [LO, HI]");
   app.add_flag("--quick", quick, "Diagnose with --quick");
   app.add_flag("--generate-only", generate_only, "Only generate the captures");
   app.add_flag("--score-only", score_only, "Only score existing diagnoses");
   CLI11_PARSE(app, argc, argv);
   if (drapegen.empty()) drapegen = (fs::path(argv[0]).parent_path() / "drapegen").string();
+  auto strength_range = kDefaultStrength;
+  for (const auto& o : strength_overrides) {
+    const auto eq = o.find('='), colon = o.find(':');
+    const std::string name = o.substr(0, eq);
+    if (eq == std::string::npos || colon == std::string::npos || colon < eq || !strength_range.contains(name)) {
+      std::cerr << "diagnosis_bench: error: --strength " << o << ": expected NAME=LO:HI with a known effect\n";
+      return 1;
+    }
+    try {
+      strength_range[name] = {std::stod(o.substr(eq + 1, colon - eq - 1)), std::stod(o.substr(colon + 1))};
+    } catch (const std::exception&) {
+      std::cerr << "diagnosis_bench: error: --strength " << o << ": LO and HI must be numbers\n";
+      return 1;
+    }
+  }
 
   const auto fabrics = read_fabrics(fabrics_path);
   if (fabrics.empty()) {
@@ -113,7 +130,7 @@ int main(int argc, char** argv) {
       c.effect = family;
     }
     if (!c.effect.empty()) {
-      const auto [lo, hi] = kStrength.at(c.effect);
+      const auto [lo, hi] = strength_range.at(c.effect);
       c.strength = lo + (hi - lo) * rng.uniform();
     }
     c.name = fmt::format("{}_{:02d}", family, index);

@@ -65,7 +65,6 @@ nlohmann::json view_json(const ScoredDrape& d) {
     views.push_back({{"score_mm", v.score * 1e3},
                      {"stable_rms_mm", v.stable_rms * 1e3},
                      {"stable_px", v.stable_pixels},
-                     {"radial_mm", k < d.radial.size() ? d.radial[k] * 1e3 : 0.0},
                      {"depth_rms_mm", v.depth_rms * 1e3},
                      {"silhouette_mismatch", v.silhouette},
                      {"fold_rms_deg", v.fold_rms_deg},
@@ -84,7 +83,7 @@ DiagnosisSettings DiagnosisSettings::quick() {
   s.baseline_optimiser.max_evaluations = 20;
   s.guess_levels = 3;
   s.floors.noise_seeds = 2;
-  s.floors.extra_states = 2;
+  s.floors.extra_states = 3;
   s.attribution.optimiser.max_evaluations = 8;
   s.attribution.sensor_evaluations = 100;
   s.attribution.bootstrap_samples = 400;
@@ -142,6 +141,8 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
 
   // 3. Where the gap sits.
   r.localisation = localise(model, r.fit.best);
+  r.fit_target = model.target().shape;
+  localise_features(r.localisation, r.fit.best, model.target(), r.floors.group_floor(), r.floors.stable_floor());
 
   // 4. Which effect explains it (not when the gap is within the floors).
   const auto attribution_start = std::chrono::steady_clock::now();
@@ -191,7 +192,12 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                    {"best_state", r.fit.best.state},
                    {"turn_deg", r.fit.best.angle * 180.0 / M_PI},
                    {"converged", r.fit.best.converged},
-                   {"hem_spectrum_mm", r.fit.best.hem_spectrum * 1e3},
+                   {"stable_mm", {{"fit_views", r.fit.best.stable_fit * 1e3},
+                                  {"held_out_view", r.fit.best.stable_held_out * 1e3},
+                                  {"all_views", r.fit.best.stable_all * 1e3}}},
+                   {"shape_distance", {{"fit_views", r.fit.best.shape_fit},
+                                       {"held_out_view", r.fit.best.shape_held_out},
+                                       {"all_views", r.fit.best.shape_all}}},
                    {"views", view_json(r.fit.best)}};
   const auto& L = r.localisation;
   nlohmann::json regions = nlohmann::json::array();
@@ -206,7 +212,17 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
     if (h.order == 0) continue;
     harmonics.push_back({{"order", h.order}, {"amplitude_mm", h.amplitude * 1e3}, {"phase_rad", h.phase}});
   }
+  nlohmann::json groups = nlohmann::json::object();
+  const auto diff = group_differences(r.fit_target.all, r.fit.best.shape.all);
+  const auto floor = r.floors.group_floor();
+  for (std::size_t k = 0; k < L.group_ratio.size(); ++k) {
+    groups[std::string(feature_group_name(kFeatureGroups[k]))] = {
+        {"difference_mm", diff[k] * 1e3}, {"floor_mm", floor[k] * 1e3}, {"ratio", L.group_ratio[k]}};
+  }
   j["localisation"] = {{"region", region_name(L.dominant)},
+                       {"feature_groups", groups},
+                       {"stable_ratio", L.stable_ratio},
+                       {"pixel_region", region_name(L.pixel_region)},
                        {"regions", regions},
                        {"view_share", L.view_share},
                        {"hem_difference_harmonics", harmonics},

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <optional>
 
 #include "drapegen/renderer/noise.hpp"
 #include "drapegen/renderer/random.hpp"
@@ -11,21 +12,25 @@ namespace {
 
 /// Scores the fit's initial-state drapes against a pseudo-capture (as the capture itself is scored): the state with
 /// the best fit score counts.
-sim::Expected<std::pair<double, double>> score_pseudo(ForwardModel& model, const ModelSetup& fitted,
-                                                      const Evaluation& fit,
-                                                      const std::vector<renderer::DepthImage>& images) {
+sim::Status score_pseudo(ForwardModel& model, const ModelSetup& fitted, const Evaluation& fit,
+                         const std::vector<renderer::DepthImage>& images, FloorSamples& samples) {
   const Target target = model.make_target(images);
   double best = std::numeric_limits<double>::infinity();
-  std::pair<double, double> out{0.0, 0.0};
+  std::optional<ScoredDrape> chosen;
   for (const auto& state : fit.states) {
     auto s = model.score(state.mesh, fitted, target);
     if (!s) return s.error();
     if (s->fit_score < best) {
       best = s->fit_score;
-      out = {s->all_score, s->held_out_score};
+      chosen = std::move(*s);
     }
   }
-  return out;
+  if (!chosen) return sim::Error{"no fitted drape to score the floor samples against"};
+  samples.all.push_back(chosen->all_score);
+  samples.held_out.push_back(chosen->held_out_score);
+  samples.stable.push_back(chosen->stable_all);
+  samples.groups.push_back(group_differences(target.shape.all, chosen->shape.all));
+  return {};
 }
 
 std::vector<renderer::DepthImage> with_noise(const std::vector<renderer::DepthImage>& clean, std::uint64_t seed) {
@@ -37,6 +42,21 @@ std::vector<renderer::DepthImage> with_noise(const std::vector<renderer::DepthIm
 
 }  // namespace
 
+std::vector<double> Floors::group_floor() const {
+  std::vector<double> top(kFeatureGroupCount, 0.0);
+  for (const auto* samples : {&noise, &multistability})
+    for (const auto& g : samples->groups)
+      for (std::size_t k = 0; k < g.size() && k < top.size(); ++k) top[k] = std::max(top[k], g[k]);
+  return top;
+}
+
+double Floors::stable_floor() const {
+  double top = 0.0;
+  for (double x : noise.stable) top = std::max(top, x);
+  for (double x : multistability.stable) top = std::max(top, x);
+  return top;
+}
+
 sim::Expected<Floors> measure_floors(ForwardModel& model, const ModelSetup& fitted, const Evaluation& fit,
                                      const FloorSettings& settings) {
   Floors floors;
@@ -44,10 +64,8 @@ sim::Expected<Floors> measure_floors(ForwardModel& model, const ModelSetup& fitt
   auto clean = model.render(fit.best.mesh, fit.best.angle, fitted.sensor);
   if (!clean) return clean.error();
   for (int k = 0; k < settings.noise_seeds; ++k) {
-    auto s = score_pseudo(model, fitted, fit, with_noise(*clean, 0xF100A + static_cast<std::uint64_t>(k)));
-    if (!s) return s.error();
-    floors.noise.all.push_back(s->first);
-    floors.noise.held_out.push_back(s->second);
+    const auto images = with_noise(*clean, 0xF100A + static_cast<std::uint64_t>(k));
+    if (sim::Status s = score_pseudo(model, fitted, fit, images, floors.noise); !s) return s.error();
   }
   // Other stable drapes of the fitted parameters: sine initial states with seeds after the fit's.
   const auto states = fit_initial_states(settings.extra_states + 1, 1000);
@@ -58,10 +76,8 @@ sim::Expected<Floors> measure_floors(ForwardModel& model, const ModelSetup& fitt
     const double angle = align(hem_profile_from_mesh(*mesh), model.outline()).angle;
     auto images = model.render(*mesh, angle, fitted.sensor);
     if (!images) return images.error();
-    auto s = score_pseudo(model, fitted, fit, with_noise(*images, 0x5EED + static_cast<std::uint64_t>(j)));
-    if (!s) return s.error();
-    floors.multistability.all.push_back(s->first);
-    floors.multistability.held_out.push_back(s->second);
+    const auto noisy = with_noise(*images, 0x5EED + static_cast<std::uint64_t>(j));
+    if (sim::Status s = score_pseudo(model, fitted, fit, noisy, floors.multistability); !s) return s.error();
   }
   auto top = [](const FloorSamples& a, const FloorSamples& b, bool held_out) {
     double m = 0.0;

@@ -109,7 +109,7 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
                       "above the floor by {:.0f}%.\n\n",
                       r.verdict, r.attribution.confidence, r.runner_up, 100.0 * c.shrinkage);
   }
-  md += "## Gap and floors (score in mm: truncated depth RMS + silhouette + fold terms)\n\n";
+  md += "## Gap and floors (score in mm: stable-region RMS + 4 mm x shape-feature distance)\n\n";
   md += "| | all views | held-out view |\n|---|---|---|\n";
   md += fmt::format("| gap (baseline fit) | {:.2f} | {:.2f} |\n", r.gap_all * 1e3, r.gap_held_out * 1e3);
   md += fmt::format("| floor (x{:.2f} margin) | {:.2f} | {:.2f} |\n\n", r.floors.margin, r.floors.all * 1e3,
@@ -118,7 +118,15 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
                     "({} evaluations).\n\n",
                     r.fitted.alpha.warp, r.fitted.alpha.bias, r.fitted.alpha.weft, r.fitted.beta.warp,
                     r.fitted.beta.bias, r.fitted.beta.weft, r.baseline_evaluations);
-  md += "## Where the gap sits\n\n| region | energy share | pixel share | enrichment |\n|---|---|---|---|\n";
+  md += "## Where the gap sits\n\nShape features, capture against the fitted baseline, over the largest floor sample:\n\n"
+        "| feature group | region | ratio to floor |\n|---|---|---|\n";
+  for (std::size_t k = 0; k < r.localisation.group_ratio.size(); ++k) {
+    md += fmt::format("| {} | {} | {:.2f} |\n", feature_group_name(kFeatureGroups[k]),
+                      region_name(feature_region(kFeatureGroups[k])), r.localisation.group_ratio[k]);
+  }
+  md += fmt::format("| stable term (platform top, bare cylinder) | global | {:.2f} |\n\n", r.localisation.stable_ratio);
+  md += fmt::format("Pixel residuals by region (most enriched: {}):\n\n", region_name(r.localisation.pixel_region));
+  md += "| region | energy share | pixel share | enrichment |\n|---|---|---|---|\n";
   for (const auto& s : r.localisation.regions) {
     md += fmt::format("| {} | {:.2f} | {:.2f} | {:.2f} |\n", region_name(s.region), s.energy_share, s.pixel_share,
                       s.enrichment);

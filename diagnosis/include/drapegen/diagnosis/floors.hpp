@@ -13,6 +13,8 @@ namespace drapegen::diagnosis {
 struct FloorSamples {
   std::vector<double> all;       // score over all views
   std::vector<double> held_out;  // score over the held-out views
+  std::vector<double> stable;    // the stable-region term over all views (m)
+  std::vector<std::vector<double>> groups;  // per sample: group_differences over all views (m)
 };
 
 struct Floors {
@@ -22,6 +24,10 @@ struct Floors {
   double all = 0.0;
   double held_out = 0.0;
   double margin = 1.15;
+
+  /// The largest sample of either kind, per feature group / of the stable term (no margin).
+  [[nodiscard]] std::vector<double> group_floor() const;
+  [[nodiscard]] double stable_floor() const;
 };
 
 struct FloorSettings {
