@@ -46,13 +46,13 @@ sim::Expected<std::unique_ptr<ForwardModel>> ForwardModel::create(const Capture&
   FitSettings s = settings;
   s.weights.cylinder_radius = 0.5 * capture.specimen.cylinder_diameter;
   std::unique_ptr<ForwardModel> m(new ForwardModel(capture, s, std::move(*renderer)));
+  m->is_fit_view_.assign(kCaptureViews, false);
+  for (int v : settings.fit_views) m->is_fit_view_[v] = true;
   std::vector<renderer::DepthImage> depth;
   for (const auto& v : capture.views) depth.push_back(v.depth);
   m->target_ = m->make_target(depth);
   m->states_ = fit_initial_states(settings.initial_states);
   for (auto& s : m->states_) s.platform_radius = 0.5 * capture.specimen.cylinder_diameter;
-  m->is_fit_view_.assign(kCaptureViews, false);
-  for (int v : settings.fit_views) m->is_fit_view_[v] = true;
   return m;
 }
 
