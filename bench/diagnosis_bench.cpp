@@ -235,6 +235,7 @@ int main(int argc, char** argv) {
                         {"verdict", verdict}, {"runner_up", d.value("runner_up", "")},
                         {"confidence", d.value("confidence", 0.0)}, {"region", region}, {"region_ok", region_ok},
                         {"gap_mm", d["gap_mm"]["all_views"]}, {"floor_mm", d["floors"]["all_views_mm"]},
+                        {"tests", d.value("gap_tests", nlohmann::json::object())},
                         {"shrinkage", family == "none" ? nlohmann::json(nullptr) : nlohmann::json(shrink)},
                         {"seconds", d["runtime"]["seconds"]}});
   }
@@ -264,6 +265,18 @@ int main(int argc, char** argv) {
   md += fmt::format("- localised region matches the effect's region: {}/{}\n", region_match, region_total);
   md += fmt::format("- runtime per capture: median {:.0f} s, max {:.0f} s\n", median(seconds),
                     seconds.empty() ? 0.0 : *std::max_element(seconds.begin(), seconds.end()));
+  md += "\n| case | effect | strength | verdict | stable / floor (mm) | shape / floor | region | region ok | "
+        "shrinkage | s |\n|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const auto& c : per_case) {
+    const auto& t = c["tests"];
+    const std::string shrink = c["shrinkage"].is_null() ? "-" : fmt::format("{:.0f}%", 100.0 * c["shrinkage"].get<double>());
+    md += fmt::format("| {} | {} | {:.3g} | {} | {:.1f} / {:.1f} | {:.2f} / {:.2f} | {} | {} | {} | {:.0f} |\n",
+                      c["case"].get<std::string>(), c["effect"].get<std::string>().empty() ? "-" : c["effect"].get<std::string>(),
+                      c["strength"].get<double>(), c["verdict"].get<std::string>(), t.value("stable_mm", 0.0),
+                      t.value("stable_floor_mm", 0.0), t.value("shape", 0.0), t.value("shape_floor", 0.0),
+                      c["region"].get<std::string>(), c["region_ok"].get<bool>() ? "yes" : "no", shrink,
+                      c["seconds"].get<double>());
+  }
   std::ofstream(fs::path(out) / "summary.md") << md;
   std::ofstream(fs::path(out) / "cases.json") << per_case.dump(2) << "\n";
   std::cout << md;

@@ -137,7 +137,9 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
   r.gap_all = r.fit.best.all_score;
   r.gap_fit = r.fit.best.fit_score;
   r.gap_held_out = r.fit.best.held_out_score;
-  r.within_floors = r.gap_all <= r.floors.all;
+  // Within the floors: neither the stable-region term (sensor errors) nor the shape distance (physical effects)
+  // exceeds what sensor noise and other stable drapes of the fitted fabric produce.
+  r.within_floors = r.fit.best.stable_all <= r.floors.stable && r.fit.best.shape_all <= r.floors.shape;
 
   // 3. Where the gap sits.
   r.localisation = localise(model, r.fit.best);
@@ -173,9 +175,20 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
   j["confidence"] = r.attribution.confidence;
   j["within_floors"] = r.within_floors;
   j["gap_mm"] = {{"all_views", r.gap_all * 1e3}, {"fit_views", r.gap_fit * 1e3}, {"held_out_view", r.gap_held_out * 1e3}};
+  j["gap_tests"] = {{"stable_mm", r.fit.best.stable_all * 1e3},
+                    {"stable_floor_mm", r.floors.stable * 1e3},
+                    {"shape", r.fit.best.shape_all},
+                    {"shape_floor", r.floors.shape}};
   nlohmann::json floors = {{"all_views_mm", r.floors.all * 1e3},
                            {"held_out_view_mm", r.floors.held_out * 1e3},
                            {"margin", r.floors.margin},
+                           {"stable_mm", r.floors.stable * 1e3},
+                           {"shape", r.floors.shape},
+                           {"shape_margin", r.floors.shape_margin},
+                           {"typical_all_views_mm", r.floors.typical_all * 1e3},
+                           {"typical_held_out_view_mm", r.floors.typical_held_out * 1e3},
+                           {"noise_shape", r.floors.noise.shape},
+                           {"multistability_shape", r.floors.multistability.shape},
                            {"noise_all_mm", nlohmann::json::array()},
                            {"noise_held_out_mm", nlohmann::json::array()},
                            {"multistability_all_mm", nlohmann::json::array()},
@@ -241,7 +254,8 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                           {"held_out_score_mm", c.held_out_score * 1e3},
                           {"all_views_score_mm", c.all_score * 1e3},
                           {"shrinkage", c.shrinkage},
-                          {"raw_shrinkage", c.raw_shrinkage},
+                          {"held_out_shrinkage", c.held_out_shrinkage},
+                          {"confirmed", c.confirmed},
                           {"evaluations", c.evaluations},
                           {"seconds", c.seconds}});
   }

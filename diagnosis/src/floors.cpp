@@ -29,6 +29,7 @@ sim::Status score_pseudo(ForwardModel& model, const ModelSetup& fitted, const Ev
   samples.all.push_back(chosen->all_score);
   samples.held_out.push_back(chosen->held_out_score);
   samples.stable.push_back(chosen->stable_all);
+  samples.shape.push_back(chosen->shape_all);
   samples.groups.push_back(group_differences(target.shape.all, chosen->shape.all));
   return {};
 }
@@ -87,6 +88,24 @@ sim::Expected<Floors> measure_floors(ForwardModel& model, const ModelSetup& fitt
   };
   floors.all = settings.margin * top(floors.noise, floors.multistability, false);
   floors.held_out = settings.margin * top(floors.noise, floors.multistability, true);
+  floors.stable = settings.margin * floors.stable_floor();
+  floors.shape_margin = settings.shape_margin;
+  double shape = 0.0;
+  for (const auto* samples : {&floors.noise, &floors.multistability})
+    for (double x : samples->shape) shape = std::max(shape, x);
+  floors.shape = settings.shape_margin * shape;
+  auto median = [](std::vector<double> v) {
+    if (v.empty()) return 0.0;
+    std::sort(v.begin(), v.end());
+    return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+  };
+  auto pooled = [](const std::vector<double>& a, const std::vector<double>& b) {
+    std::vector<double> v = a;
+    v.insert(v.end(), b.begin(), b.end());
+    return v;
+  };
+  floors.typical_all = median(pooled(floors.noise.all, floors.multistability.all));
+  floors.typical_held_out = median(pooled(floors.noise.held_out, floors.multistability.held_out));
   return floors;
 }
 
