@@ -93,7 +93,7 @@ sim::Expected<Floors> measure_floors(ForwardModel& model, const ModelSetup& fitt
   double shape = 0.0;
   for (const auto* samples : {&floors.noise, &floors.multistability})
     for (double x : samples->shape) shape = std::max(shape, x);
-  floors.shape = settings.shape_margin * shape;
+  floors.shape = settings.shape_threshold > 0.0 ? settings.shape_threshold : settings.shape_margin * shape;
   auto median = [](std::vector<double> v) {
     if (v.empty()) return 0.0;
     std::sort(v.begin(), v.end());
