@@ -16,11 +16,11 @@
 #include <map>
 #include <mutex>
 #include <nlohmann/json.hpp>
-#include <sstream>
 #include <thread>
 
 #include "drapegen/diagnosis/reality.hpp"
 #include "drapegen/renderer/random.hpp"
+#include "drapegen/sampler/fabric_data.hpp"
 
 namespace fs = std::filesystem;
 using namespace drapegen;
@@ -31,26 +31,6 @@ struct Fabric {
   diagnosis::BendingParameters bending;
   double density = 300.0;
 };
-
-std::vector<Fabric> read_fabrics(const std::string& path) {
-  std::vector<Fabric> out;
-  std::ifstream in(path);
-  std::string line;
-  std::getline(in, line);  // header
-  while (std::getline(in, line)) {
-    std::stringstream ss(line);
-    std::vector<double> v;
-    std::string cell;
-    while (std::getline(ss, cell, ',')) v.push_back(std::stod(cell));
-    if (v.size() < 7) continue;
-    Fabric f;
-    f.density = v[0] * 1000.0;  // kg/m^2 -> g/m^2
-    f.bending.alpha = {v[1], v[3], v[2]};  // warp, diag (bias), weft
-    f.bending.beta = {v[4], v[6], v[5]};
-    out.push_back(f);
-  }
-  return out;
-}
 
 struct Case {
   std::string name, family, effect;
@@ -108,7 +88,13 @@ int main(int argc, char** argv) {
     }
   }
 
-  const auto fabrics = read_fabrics(fabrics_path);
+  std::vector<Fabric> fabrics;
+  if (auto measured = sampler::read_fabric_csv(fabrics_path); !measured) {
+    std::cerr << "diagnosis_bench: error: " << measured.error().message << "\n";
+    return 1;
+  } else {
+    for (const auto& f : *measured) fabrics.push_back({{f.moduli.alpha, f.moduli.beta}, f.density_g_per_m2});
+  }
   if (fabrics.empty()) {
     std::cerr << "diagnosis_bench: error: no fabrics in " << fabrics_path << "\n";
     return 1;
@@ -179,9 +165,10 @@ int main(int argc, char** argv) {
           const fs::path result = fs::path(out) / "diagnoses" / (c.name + ".json");
           if (fs::exists(result) && fs::file_size(result) > 0) continue;
           fs::create_directories(result.parent_path());
-          const std::string cmd = fmt::format("'{}' diagnose --capture '{}' --json{} --jobs {} {} > '{}.tmp' 2> '{}.err'",
-                                              drapegen, dir.string(), quick ? " --quick" : "", diagnose_jobs, diagnose_args,
-                                              result.string(), result.string());
+          const std::string cmd =
+              fmt::format("'{}' diagnose --capture '{}' --json{} --jobs {} {} > '{}.tmp' 2> '{}.err'", drapegen,
+                          dir.string(), quick ? " --quick" : "", diagnose_jobs, diagnose_args, result.string(),
+                          result.string());
           const auto t0 = std::chrono::steady_clock::now();
           const int rc = std::system(cmd.c_str());
           const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -273,9 +260,11 @@ int main(int argc, char** argv) {
         "shrinkage | s |\n|---|---|---|---|---|---|---|---|---|---|\n";
   for (const auto& c : per_case) {
     const auto& t = c["tests"];
-    const std::string shrink = c["shrinkage"].is_null() ? "-" : fmt::format("{:.0f}%", 100.0 * c["shrinkage"].get<double>());
+    const std::string shrink =
+        c["shrinkage"].is_null() ? "-" : fmt::format("{:.0f}%", 100.0 * c["shrinkage"].get<double>());
+    const std::string effect = c["effect"].get<std::string>();
     md += fmt::format("| {} | {} | {:.3g} | {} | {:.1f} / {:.1f} | {:.2f} / {:.2f} | {} | {} | {} | {:.0f} |\n",
-                      c["case"].get<std::string>(), c["effect"].get<std::string>().empty() ? "-" : c["effect"].get<std::string>(),
+                      c["case"].get<std::string>(), effect.empty() ? "-" : effect,
                       c["strength"].get<double>(), c["verdict"].get<std::string>(), t.value("stable_mm", 0.0),
                       t.value("stable_floor_mm", 0.0), t.value("shape", 0.0), t.value("shape_floor", 0.0),
                       c["region"].get<std::string>(), c["region_ok"].get<bool>() ? "yes" : "no", shrink,

@@ -7,36 +7,16 @@
 #include <algorithm>
 #include <filesystem>
 #include <fmt/format.h>
-#include <fstream>
 #include <iostream>
-#include <sstream>
 
 #include "drapegen/diagnosis/reality.hpp"
 #include "drapegen/diagnosis/shape_features.hpp"
+#include "drapegen/sampler/fabric_data.hpp"
 
 namespace fs = std::filesystem;
 using namespace drapegen;
 
 namespace {
-
-std::vector<std::pair<diagnosis::BendingParameters, double>> read_fabrics(const std::string& path) {
-  std::vector<std::pair<diagnosis::BendingParameters, double>> out;
-  std::ifstream in(path);
-  std::string line;
-  std::getline(in, line);
-  while (std::getline(in, line)) {
-    std::stringstream ss(line);
-    std::vector<double> v;
-    std::string cell;
-    while (std::getline(ss, cell, ',')) v.push_back(std::stod(cell));
-    if (v.size() < 7) continue;
-    diagnosis::BendingParameters b;
-    b.alpha = {v[1], v[3], v[2]};
-    b.beta = {v[4], v[6], v[5]};
-    out.emplace_back(b, v[0] * 1000.0);
-  }
-  return out;
-}
 
 double median(std::vector<double> v) {
   if (v.empty()) return -1.0;
@@ -60,7 +40,11 @@ int main(int argc, char** argv) {
   app.add_option("--resolution", resolution)->capture_default_str();
   app.add_option("--work", work)->capture_default_str();
   CLI11_PARSE(app, argc, argv);
-  const auto fabrics = read_fabrics(fabrics_path);
+  const auto fabrics = sampler::read_fabric_csv(fabrics_path);
+  if (!fabrics) {
+    std::cerr << "effect_probe: error: " << fabrics.error().message << "\n";
+    return 1;
+  }
 
   std::cout << "group differences in mm (folds: count); control: median over control pairs, effect: median over "
                "(effect, control) pairs\n";
@@ -68,7 +52,13 @@ int main(int argc, char** argv) {
   for (auto g : diagnosis::kFeatureGroups) std::cout << fmt::format(" {:>12}", diagnosis::feature_group_name(g));
   std::cout << "\n";
   for (int row : fabric_rows) {
-    const auto& [bending, density] = fabrics.at(static_cast<std::size_t>(row));
+    if (row < 0 || row >= static_cast<int>(fabrics->size())) {
+      std::cerr << "effect_probe: error: no fabric row " << row << "\n";
+      return 1;
+    }
+    const auto& fabric = (*fabrics)[static_cast<std::size_t>(row)];
+    const diagnosis::BendingParameters bending{fabric.moduli.alpha, fabric.moduli.beta};
+    const double density = fabric.density_g_per_m2;
     auto features_of = [&](const std::string& effect, int seed) -> diagnosis::ShapeFeatures {
       diagnosis::RealitySpec spec;
       spec.bending = bending;

@@ -97,7 +97,8 @@ Runner add_diagnose_command(CLI::App& app) {
   app.add_option("--resolution", o->resolution, "Fitting mesh vertices per side (default 20; quick 16)");
   app.add_option("--states", o->states, "Initial states per evaluation (default 3; quick 2)");
   app.add_option("--evaluations", o->evaluations, "Baseline fit evaluations (default 40; quick 20)");
-  app.add_option("--refit-evaluations", o->refit_evaluations, "Evaluations per candidate refit (default 14; quick 8)");
+  app.add_option("--refit-evaluations", o->refit_evaluations,
+                 "Evaluations per candidate refit (default 14, also with --quick)");
   app.add_option("--jobs", o->jobs, "Candidate refits in parallel threads")->capture_default_str();
   app.add_option("--shape-floor", o->shape_floor,
                  "Shape-distance floor (default: calibrated 1.15; 0: the largest floor sample)");

@@ -84,7 +84,7 @@ DiagnosisSettings DiagnosisSettings::quick() {
   s.guess_levels = 3;
   s.floors.noise_seeds = 2;
   s.floors.extra_states = 3;
-  s.attribution.optimiser.max_evaluations = 8;
+  s.attribution.optimiser.max_evaluations = 14;
   s.attribution.sensor_evaluations = 100;
   s.attribution.bootstrap_samples = 400;
   return s;

@@ -1,8 +1,8 @@
 #pragma once
 // Which effect explains the gap: each candidate is added to the model with its own parameters, refitted on the fit
 // views (with the bending scale free as well), and judged by how much it shrinks the gap above the typical floor,
-// confirmed on the held-out view (which must not get worse). Confidence: a block bootstrap over the held-out view's residual tiles of the named effect against
-// the runner-up.
+// confirmed on the held-out view (which must not get worse). Confidence: a block bootstrap over the held-out view's
+// residual tiles of the named effect against the runner-up.
 
 #include <string>
 #include <vector>
