@@ -24,8 +24,19 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, Effect effect, const M
   if (sim) {  // the bending scale stays free: an effect may trade off against stiffness
     x0.push_back(0.0), step.push_back(0.25), lo.push_back(-1.5), hi.push_back(1.5);
   }
+  const std::size_t first = x0.size();
   x0.insert(x0.end(), space.start.begin(), space.start.end());
   step.insert(step.end(), space.step.begin(), space.step.end());
+  if (effect == Effect::kMisalignment) {
+    // Start from the outline's centre offset that the baseline lacks (the fit views' first hem-radius harmonic, mm;
+    // only its size: the turn makes the direction arbitrary). The extra cloth of an off-centre specimen partly hangs
+    // down instead of out, so this underestimates the drift: a start, not an estimate.
+    const auto& captured = model.target().shape.fit.off_centre;
+    const auto& modelled = fit.best.shape.fit.off_centre;
+    if (!captured.empty() && !modelled.empty()) {
+      x0[first] = std::clamp((captured[0] - modelled[0]) * 1e3, 0.0, space.upper[0]);
+    }
+  }
   lo.insert(lo.end(), space.lower.begin(), space.lower.end());
   hi.insert(hi.end(), space.upper.begin(), space.upper.end());
 
