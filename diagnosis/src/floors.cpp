@@ -41,6 +41,22 @@ std::vector<renderer::DepthImage> with_noise(const std::vector<renderer::DepthIm
   return out;
 }
 
+/// Both kinds of samples of one field, pooled.
+std::vector<double> pooled(const Floors& floors, std::vector<double> FloorSamples::*field) {
+  std::vector<double> v = floors.noise.*field;
+  const auto& more = floors.multistability.*field;
+  v.insert(v.end(), more.begin(), more.end());
+  return v;
+}
+
+double largest(const std::vector<double>& v) { return v.empty() ? 0.0 : *std::max_element(v.begin(), v.end()); }
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+}
+
 }  // namespace
 
 std::vector<double> Floors::group_floor() const {
@@ -51,12 +67,7 @@ std::vector<double> Floors::group_floor() const {
   return top;
 }
 
-double Floors::stable_floor() const {
-  double top = 0.0;
-  for (double x : noise.stable) top = std::max(top, x);
-  for (double x : multistability.stable) top = std::max(top, x);
-  return top;
-}
+double Floors::stable_floor() const { return largest(pooled(*this, &FloorSamples::stable)); }
 
 sim::Expected<Floors> measure_floors(ForwardModel& model, const ModelSetup& fitted, const Evaluation& fit,
                                      const FloorSettings& settings) {
@@ -80,32 +91,14 @@ sim::Expected<Floors> measure_floors(ForwardModel& model, const ModelSetup& fitt
     const auto noisy = with_noise(*images, 0x5EED + static_cast<std::uint64_t>(j));
     if (sim::Status s = score_pseudo(model, fitted, fit, noisy, floors.multistability); !s) return s.error();
   }
-  auto top = [](const FloorSamples& a, const FloorSamples& b, bool held_out) {
-    double m = 0.0;
-    for (double x : held_out ? a.held_out : a.all) m = std::max(m, x);
-    for (double x : held_out ? b.held_out : b.all) m = std::max(m, x);
-    return m;
-  };
-  floors.all = settings.margin * top(floors.noise, floors.multistability, false);
-  floors.held_out = settings.margin * top(floors.noise, floors.multistability, true);
+  floors.all = settings.margin * largest(pooled(floors, &FloorSamples::all));
+  floors.held_out = settings.margin * largest(pooled(floors, &FloorSamples::held_out));
   floors.stable = settings.margin * floors.stable_floor();
   floors.shape_margin = settings.shape_margin;
-  double shape = 0.0;
-  for (const auto* samples : {&floors.noise, &floors.multistability})
-    for (double x : samples->shape) shape = std::max(shape, x);
-  floors.shape = settings.shape_threshold > 0.0 ? settings.shape_threshold : settings.shape_margin * shape;
-  auto median = [](std::vector<double> v) {
-    if (v.empty()) return 0.0;
-    std::sort(v.begin(), v.end());
-    return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
-  };
-  auto pooled = [](const std::vector<double>& a, const std::vector<double>& b) {
-    std::vector<double> v = a;
-    v.insert(v.end(), b.begin(), b.end());
-    return v;
-  };
-  floors.typical_all = median(pooled(floors.noise.all, floors.multistability.all));
-  floors.typical_held_out = median(pooled(floors.noise.held_out, floors.multistability.held_out));
+  floors.shape = settings.shape_threshold > 0.0 ? settings.shape_threshold
+                                                : settings.shape_margin * largest(pooled(floors, &FloorSamples::shape));
+  floors.typical_all = median(pooled(floors, &FloorSamples::all));
+  floors.typical_held_out = median(pooled(floors, &FloorSamples::held_out));
   return floors;
 }
 
