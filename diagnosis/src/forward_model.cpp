@@ -52,8 +52,9 @@ sim::Expected<std::unique_ptr<ForwardModel>> ForwardModel::create(const Capture&
   for (const auto& v : capture.views) depth.push_back(v.depth);
   m->target_ = m->make_target(depth);
   if (!m->target_.shape.all.valid) {
-    return sim::Error{"the capture shows no skirt hanging below the platform top (too few points below it in the "
-                      "views): not a drape capture, or the camera poses do not match the depth"};
+    return sim::Error{fmt::format("{}: the capture shows no skirt hanging below the platform top (too few points below "
+                                  "it in the views): not a drape capture, or the camera poses do not match the depth",
+                                  capture.directory.empty() ? "capture" : capture.directory)};
   }
   m->states_ = fit_initial_states(settings.initial_states);
   for (auto& s : m->states_) s.platform_radius = 0.5 * capture.specimen.cylinder_diameter;
