@@ -25,6 +25,7 @@ struct DiagnoseOptions {
   int evaluations = 0;
   int refit_evaluations = 0;
   int jobs = 1;
+  double shape_floor = -1.0;  // < 0: the settings' calibrated value
   bool verbose = false;
 };
 
@@ -40,6 +41,7 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (o.evaluations < 0 || o.evaluations > 10000 || o.refit_evaluations < 0 || o.refit_evaluations > 10000) {
     return fail("--evaluations and --refit-evaluations must be 1 .. 10000");
   }
+  if (o.shape_floor > 100.0) return fail("--shape-floor must be 0 (from the floor samples) .. 100");
   if (o.verbose) sim::logger()->set_level(spdlog::level::info);
   auto capture = diagnosis::read_capture(o.capture);
   if (!capture) return fail(capture.error().message);
@@ -52,6 +54,7 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (o.evaluations > 0) settings.baseline_optimiser.max_evaluations = o.evaluations;
   if (o.refit_evaluations > 0) settings.attribution.optimiser.max_evaluations = o.refit_evaluations;
   settings.attribution.jobs = o.jobs;
+  if (o.shape_floor >= 0.0) settings.floors.shape_threshold = o.shape_floor;
   auto result = diagnosis::diagnose(*capture, settings);
   if (!result) return fail(result.error().message);
   if (!o.report.empty()) {
@@ -94,8 +97,11 @@ Runner add_diagnose_command(CLI::App& app) {
   app.add_option("--resolution", o->resolution, "Fitting mesh vertices per side (default 20; quick 16)");
   app.add_option("--states", o->states, "Initial states per evaluation (default 3; quick 2)");
   app.add_option("--evaluations", o->evaluations, "Baseline fit evaluations (default 40; quick 20)");
-  app.add_option("--refit-evaluations", o->refit_evaluations, "Evaluations per candidate refit (default 14; quick 8)");
+  app.add_option("--refit-evaluations", o->refit_evaluations,
+                 "Evaluations per candidate refit (default 14, also with --quick)");
   app.add_option("--jobs", o->jobs, "Candidate refits in parallel threads")->capture_default_str();
+  app.add_option("--shape-floor", o->shape_floor,
+                 "Shape-distance floor (default: calibrated 1.15; 0: the largest floor sample)");
   app.add_flag("-v,--verbose", o->verbose, "Log progress on stderr");
   return [o] { return run_diagnose(*o); };
 }

@@ -65,7 +65,6 @@ nlohmann::json view_json(const ScoredDrape& d) {
     views.push_back({{"score_mm", v.score * 1e3},
                      {"stable_rms_mm", v.stable_rms * 1e3},
                      {"stable_px", v.stable_pixels},
-                     {"radial_mm", k < d.radial.size() ? d.radial[k] * 1e3 : 0.0},
                      {"depth_rms_mm", v.depth_rms * 1e3},
                      {"silhouette_mismatch", v.silhouette},
                      {"fold_rms_deg", v.fold_rms_deg},
@@ -84,8 +83,8 @@ DiagnosisSettings DiagnosisSettings::quick() {
   s.baseline_optimiser.max_evaluations = 20;
   s.guess_levels = 3;
   s.floors.noise_seeds = 2;
-  s.floors.extra_states = 2;
-  s.attribution.optimiser.max_evaluations = 8;
+  s.floors.extra_states = 3;
+  s.attribution.optimiser.max_evaluations = 14;
   s.attribution.sensor_evaluations = 100;
   s.attribution.bootstrap_samples = 400;
   return s;
@@ -138,10 +137,14 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
   r.gap_all = r.fit.best.all_score;
   r.gap_fit = r.fit.best.fit_score;
   r.gap_held_out = r.fit.best.held_out_score;
-  r.within_floors = r.gap_all <= r.floors.all;
+  // Within the floors: neither the stable-region term (sensor errors) nor the shape distance (physical effects)
+  // exceeds what sensor noise and other stable drapes of the fitted fabric produce.
+  r.within_floors = r.fit.best.stable_all <= r.floors.stable && r.fit.best.shape_all <= r.floors.shape;
 
   // 3. Where the gap sits.
   r.localisation = localise(model, r.fit.best);
+  r.fit_target = model.target().shape;
+  localise_features(r.localisation, r.fit.best, model.target(), r.floors.group_floor(), r.floors.stable_floor());
 
   // 4. Which effect explains it (not when the gap is within the floors).
   const auto attribution_start = std::chrono::steady_clock::now();
@@ -172,9 +175,20 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
   j["confidence"] = r.attribution.confidence;
   j["within_floors"] = r.within_floors;
   j["gap_mm"] = {{"all_views", r.gap_all * 1e3}, {"fit_views", r.gap_fit * 1e3}, {"held_out_view", r.gap_held_out * 1e3}};
+  j["gap_tests"] = {{"stable_mm", r.fit.best.stable_all * 1e3},
+                    {"stable_floor_mm", r.floors.stable * 1e3},
+                    {"shape", r.fit.best.shape_all},
+                    {"shape_floor", r.floors.shape}};
   nlohmann::json floors = {{"all_views_mm", r.floors.all * 1e3},
                            {"held_out_view_mm", r.floors.held_out * 1e3},
                            {"margin", r.floors.margin},
+                           {"stable_mm", r.floors.stable * 1e3},
+                           {"shape", r.floors.shape},
+                           {"shape_margin", r.floors.shape_margin},
+                           {"typical_all_views_mm", r.floors.typical_all * 1e3},
+                           {"typical_held_out_view_mm", r.floors.typical_held_out * 1e3},
+                           {"noise_shape", r.floors.noise.shape},
+                           {"multistability_shape", r.floors.multistability.shape},
                            {"noise_all_mm", nlohmann::json::array()},
                            {"noise_held_out_mm", nlohmann::json::array()},
                            {"multistability_all_mm", nlohmann::json::array()},
@@ -191,7 +205,12 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                    {"best_state", r.fit.best.state},
                    {"turn_deg", r.fit.best.angle * 180.0 / M_PI},
                    {"converged", r.fit.best.converged},
-                   {"hem_spectrum_mm", r.fit.best.hem_spectrum * 1e3},
+                   {"stable_mm", {{"fit_views", r.fit.best.stable_fit * 1e3},
+                                  {"held_out_view", r.fit.best.stable_held_out * 1e3},
+                                  {"all_views", r.fit.best.stable_all * 1e3}}},
+                   {"shape_distance", {{"fit_views", r.fit.best.shape_fit},
+                                       {"held_out_view", r.fit.best.shape_held_out},
+                                       {"all_views", r.fit.best.shape_all}}},
                    {"views", view_json(r.fit.best)}};
   const auto& L = r.localisation;
   nlohmann::json regions = nlohmann::json::array();
@@ -206,7 +225,17 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
     if (h.order == 0) continue;
     harmonics.push_back({{"order", h.order}, {"amplitude_mm", h.amplitude * 1e3}, {"phase_rad", h.phase}});
   }
+  nlohmann::json groups = nlohmann::json::object();
+  const auto diff = group_differences(r.fit_target.all, r.fit.best.shape.all);
+  const auto floor = r.floors.group_floor();
+  for (std::size_t k = 0; k < L.group_ratio.size(); ++k) {
+    groups[std::string(feature_group_name(kFeatureGroups[k]))] = {
+        {"difference_mm", diff[k] * 1e3}, {"floor_mm", floor[k] * 1e3}, {"ratio", L.group_ratio[k]}};
+  }
   j["localisation"] = {{"region", region_name(L.dominant)},
+                       {"feature_groups", groups},
+                       {"stable_ratio", L.stable_ratio},
+                       {"pixel_region", region_name(L.pixel_region)},
                        {"regions", regions},
                        {"view_share", L.view_share},
                        {"hem_difference_harmonics", harmonics},
@@ -225,7 +254,8 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                           {"held_out_score_mm", c.held_out_score * 1e3},
                           {"all_views_score_mm", c.all_score * 1e3},
                           {"shrinkage", c.shrinkage},
-                          {"raw_shrinkage", c.raw_shrinkage},
+                          {"held_out_shrinkage", c.held_out_shrinkage},
+                          {"confirmed", c.confirmed},
                           {"evaluations", c.evaluations},
                           {"seconds", c.seconds}});
   }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <optional>
 
 #include "drapegen/renderer/noise.hpp"
 #include "drapegen/renderer/random.hpp"
@@ -11,21 +12,26 @@ namespace {
 
 /// Scores the fit's initial-state drapes against a pseudo-capture (as the capture itself is scored): the state with
 /// the best fit score counts.
-sim::Expected<std::pair<double, double>> score_pseudo(ForwardModel& model, const ModelSetup& fitted,
-                                                      const Evaluation& fit,
-                                                      const std::vector<renderer::DepthImage>& images) {
+sim::Status score_pseudo(ForwardModel& model, const ModelSetup& fitted, const Evaluation& fit,
+                         const std::vector<renderer::DepthImage>& images, FloorSamples& samples) {
   const Target target = model.make_target(images);
   double best = std::numeric_limits<double>::infinity();
-  std::pair<double, double> out{0.0, 0.0};
+  std::optional<ScoredDrape> chosen;
   for (const auto& state : fit.states) {
     auto s = model.score(state.mesh, fitted, target);
     if (!s) return s.error();
     if (s->fit_score < best) {
       best = s->fit_score;
-      out = {s->all_score, s->held_out_score};
+      chosen = std::move(*s);
     }
   }
-  return out;
+  if (!chosen) return sim::Error{"no fitted drape to score the floor samples against"};
+  samples.all.push_back(chosen->all_score);
+  samples.held_out.push_back(chosen->held_out_score);
+  samples.stable.push_back(chosen->stable_all);
+  samples.shape.push_back(chosen->shape_all);
+  samples.groups.push_back(group_differences(target.shape.all, chosen->shape.all));
+  return {};
 }
 
 std::vector<renderer::DepthImage> with_noise(const std::vector<renderer::DepthImage>& clean, std::uint64_t seed) {
@@ -35,7 +41,33 @@ std::vector<renderer::DepthImage> with_noise(const std::vector<renderer::DepthIm
   return out;
 }
 
+/// Both kinds of samples of one field, pooled.
+std::vector<double> pooled(const Floors& floors, std::vector<double> FloorSamples::*field) {
+  std::vector<double> v = floors.noise.*field;
+  const auto& more = floors.multistability.*field;
+  v.insert(v.end(), more.begin(), more.end());
+  return v;
+}
+
+double largest(const std::vector<double>& v) { return v.empty() ? 0.0 : *std::max_element(v.begin(), v.end()); }
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+}
+
 }  // namespace
+
+std::vector<double> Floors::group_floor() const {
+  std::vector<double> top(kFeatureGroupCount, 0.0);
+  for (const auto* samples : {&noise, &multistability})
+    for (const auto& g : samples->groups)
+      for (std::size_t k = 0; k < g.size() && k < top.size(); ++k) top[k] = std::max(top[k], g[k]);
+  return top;
+}
+
+double Floors::stable_floor() const { return largest(pooled(*this, &FloorSamples::stable)); }
 
 sim::Expected<Floors> measure_floors(ForwardModel& model, const ModelSetup& fitted, const Evaluation& fit,
                                      const FloorSettings& settings) {
@@ -44,10 +76,8 @@ sim::Expected<Floors> measure_floors(ForwardModel& model, const ModelSetup& fitt
   auto clean = model.render(fit.best.mesh, fit.best.angle, fitted.sensor);
   if (!clean) return clean.error();
   for (int k = 0; k < settings.noise_seeds; ++k) {
-    auto s = score_pseudo(model, fitted, fit, with_noise(*clean, 0xF100A + static_cast<std::uint64_t>(k)));
-    if (!s) return s.error();
-    floors.noise.all.push_back(s->first);
-    floors.noise.held_out.push_back(s->second);
+    const auto images = with_noise(*clean, 0xF100A + static_cast<std::uint64_t>(k));
+    if (sim::Status s = score_pseudo(model, fitted, fit, images, floors.noise); !s) return s.error();
   }
   // Other stable drapes of the fitted parameters: sine initial states with seeds after the fit's.
   const auto states = fit_initial_states(settings.extra_states + 1, 1000);
@@ -58,19 +88,17 @@ sim::Expected<Floors> measure_floors(ForwardModel& model, const ModelSetup& fitt
     const double angle = align(hem_profile_from_mesh(*mesh), model.outline()).angle;
     auto images = model.render(*mesh, angle, fitted.sensor);
     if (!images) return images.error();
-    auto s = score_pseudo(model, fitted, fit, with_noise(*images, 0x5EED + static_cast<std::uint64_t>(j)));
-    if (!s) return s.error();
-    floors.multistability.all.push_back(s->first);
-    floors.multistability.held_out.push_back(s->second);
+    const auto noisy = with_noise(*images, 0x5EED + static_cast<std::uint64_t>(j));
+    if (sim::Status s = score_pseudo(model, fitted, fit, noisy, floors.multistability); !s) return s.error();
   }
-  auto top = [](const FloorSamples& a, const FloorSamples& b, bool held_out) {
-    double m = 0.0;
-    for (double x : held_out ? a.held_out : a.all) m = std::max(m, x);
-    for (double x : held_out ? b.held_out : b.all) m = std::max(m, x);
-    return m;
-  };
-  floors.all = settings.margin * top(floors.noise, floors.multistability, false);
-  floors.held_out = settings.margin * top(floors.noise, floors.multistability, true);
+  floors.all = settings.margin * largest(pooled(floors, &FloorSamples::all));
+  floors.held_out = settings.margin * largest(pooled(floors, &FloorSamples::held_out));
+  floors.stable = settings.margin * floors.stable_floor();
+  floors.shape_margin = settings.shape_margin;
+  floors.shape = settings.shape_threshold > 0.0 ? settings.shape_threshold
+                                                : settings.shape_margin * largest(pooled(floors, &FloorSamples::shape));
+  floors.typical_all = median(pooled(floors, &FloorSamples::all));
+  floors.typical_held_out = median(pooled(floors, &FloorSamples::held_out));
   return floors;
 }
 

@@ -5,6 +5,8 @@
 #include <fmt/format.h>
 #include <limits>
 
+#include "drapegen/renderer/noise.hpp"
+#include "drapegen/renderer/random.hpp"
 #include "drapegen/renderer/rig.hpp"
 #include "drapegen/renderer/scene.hpp"
 #include "drapegen/sim/drape.hpp"
@@ -44,13 +46,18 @@ sim::Expected<std::unique_ptr<ForwardModel>> ForwardModel::create(const Capture&
   FitSettings s = settings;
   s.weights.cylinder_radius = 0.5 * capture.specimen.cylinder_diameter;
   std::unique_ptr<ForwardModel> m(new ForwardModel(capture, s, std::move(*renderer)));
+  m->is_fit_view_.assign(kCaptureViews, false);
+  for (int v : settings.fit_views) m->is_fit_view_[v] = true;
   std::vector<renderer::DepthImage> depth;
   for (const auto& v : capture.views) depth.push_back(v.depth);
   m->target_ = m->make_target(depth);
+  if (!m->target_.shape.all.valid) {
+    return sim::Error{fmt::format("{}: the capture shows no skirt hanging below the platform top (too few points below "
+                                  "it in the views): not a drape capture, or the camera poses do not match the depth",
+                                  capture.directory.empty() ? "capture" : capture.directory)};
+  }
   m->states_ = fit_initial_states(settings.initial_states);
   for (auto& s : m->states_) s.platform_radius = 0.5 * capture.specimen.cylinder_diameter;
-  m->is_fit_view_.assign(kCaptureViews, false);
-  for (int v : settings.fit_views) m->is_fit_view_[v] = true;
   return m;
 }
 
@@ -114,17 +121,31 @@ double ForwardModel::held_out_mean(const std::vector<ViewComparison>& views) con
   return n > 0 ? s / n : 0.0;
 }
 
+ShapeSet ForwardModel::shape_set(const std::vector<renderer::DepthImage>& depth) const {
+  Capture c = capture_;
+  for (std::size_t v = 0; v < depth.size(); ++v) c.views[v].depth = depth[v];
+  std::vector<int> held, all;
+  for (int v = 0; v < kCaptureViews; ++v) {
+    all.push_back(v);
+    if (!is_fit_view_[v]) held.push_back(v);
+  }
+  ShapeSet s;
+  s.fit = shape_features(c, settings_.fit_views);
+  s.held_out = held.empty() ? ShapeFeatures{} : shape_features(c, held);
+  s.all = shape_features(c, all);
+  return s;
+}
+
 Target ForwardModel::make_target(const std::vector<renderer::DepthImage>& depth) const {
   Target t;
   Capture c = capture_;
-  const double R = 0.5 * capture_.specimen.cylinder_diameter;
   for (std::size_t v = 0; v < depth.size(); ++v) {
     c.views[v].depth = depth[v];
     c.views[v].depth.incidence.clear();
     t.views.push_back(view_features(c.views[v].depth, c.views[v].camera, settings_.weights));
-    t.radial.push_back(radial_profile(back_project(c.views[v]), R));
   }
   t.outline = hem_profile_from_views(c, settings_.fit_views);
+  t.shape = shape_set(depth);
   return t;
 }
 
@@ -135,19 +156,23 @@ sim::Expected<ScoredDrape> ForwardModel::score(const sim::ClothMesh& mesh, const
   d.angle = align(hem_profile_from_mesh(mesh), target.outline).angle;
   auto images = render(mesh, d.angle, setup.sensor);
   if (!images) return images.error();
-  const double R = 0.5 * capture_.specimen.cylinder_diameter;
-  const double w = settings_.weights.hem_spectrum;
-  Capture rendered = capture_;
+  // The shape features of the model are taken from renders with the capture's kind of noise (a fixed seed), so
+  // that noise-sensitive features (the hem's 98th percentile, the skirt's spread) compare like with like.
+  const renderer::NoiseModel noise = renderer::NoiseModel::kinect();
+  std::vector<renderer::DepthImage> noisy;
   for (std::size_t v = 0; v < images->size(); ++v) {
     d.views.push_back(compare_view(target.views[v], (*images)[v], settings_.weights));
-    rendered.views[v].depth = (*images)[v];
-    d.radial.push_back(radial_distance(target.radial[v], radial_profile(back_project(rendered.views[v]), R)));
+    noisy.push_back(noise.apply((*images)[v], renderer::mix_seed(kModelNoiseSeed, v)));
   }
-  d.hem_spectrum = spectrum_distance(hem_profile_from_views(rendered, settings_.fit_views), target.outline);
+  d.shape = shape_set(noisy);
+  const std::vector<double> scales = default_feature_scales();
+  d.shape_fit = feature_distance(target.shape.fit, d.shape.fit, scales);
+  d.shape_held_out = feature_distance(target.shape.held_out, d.shape.held_out, scales);
+  d.shape_all = feature_distance(target.shape.all, d.shape.all, scales);
   double fit = 0.0, held = 0.0, all = 0.0;
   int nf = 0, nh = 0;
   for (std::size_t v = 0; v < d.views.size(); ++v) {
-    const double s = d.views[v].score + settings_.weights.radial * d.radial[v];
+    const double s = d.views[v].stable_rms;
     all += s;
     if (is_fit_view_[v]) {
       fit += s, ++nf;
@@ -155,9 +180,13 @@ sim::Expected<ScoredDrape> ForwardModel::score(const sim::ClothMesh& mesh, const
       held += s, ++nh;
     }
   }
-  d.fit_score = (nf > 0 ? fit / nf : 0.0) + w * d.hem_spectrum;
-  d.held_out_score = nh > 0 ? held / nh : 0.0;
-  d.all_score = all / static_cast<double>(d.views.size()) + w * d.hem_spectrum;
+  d.stable_fit = nf > 0 ? fit / nf : 0.0;
+  d.stable_held_out = nh > 0 ? held / nh : 0.0;
+  d.stable_all = d.views.empty() ? 0.0 : all / static_cast<double>(d.views.size());
+  const double w = settings_.weights.shape;
+  d.fit_score = d.stable_fit + w * d.shape_fit;
+  d.held_out_score = d.stable_held_out + w * d.shape_held_out;
+  d.all_score = d.stable_all + w * d.shape_all;
   return d;
 }
 

@@ -1,5 +1,6 @@
 #include "drapegen/diagnosis/localisation.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace drapegen::diagnosis {
@@ -24,6 +25,40 @@ Region classify_point(const Eigen::Vector3d& p, const HemProfile& model_outline,
   if (r < R + 0.015 && z > -0.03) return Region::kRim;
   if (r < R + 0.003 && z <= -0.03) return Region::kCylinder;
   return Region::kSkirt;
+}
+
+Region feature_region(FeatureGroup group) {
+  switch (group) {
+    case FeatureGroup::kHarmonics:
+    case FeatureGroup::kOffCentre:
+    case FeatureGroup::kSortedRadii:
+    case FeatureGroup::kHemHeight: return Region::kHem;
+    case FeatureGroup::kSkirtHeight:
+    case FeatureGroup::kSkirtSpread:
+    case FeatureGroup::kFolds: return Region::kSkirt;
+  }
+  return Region::kGlobal;
+}
+
+void localise_features(Localisation& L, const ScoredDrape& drape, const Target& capture,
+                       const std::vector<double>& group_floor, double stable_floor) {
+  const auto diff = group_differences(capture.shape.all, drape.shape.all);
+  const auto scale = default_feature_scales();
+  L.group_ratio.assign(diff.size(), 0.0);
+  double best = 1.0;
+  L.dominant = Region::kGlobal;
+  for (std::size_t k = 0; k < diff.size(); ++k) {
+    if (diff[k] < 0.0) continue;
+    const double floor = std::max(k < group_floor.size() ? group_floor[k] : 0.0, 0.5 * scale[k]);
+    L.group_ratio[k] = diff[k] / floor;
+    if (L.group_ratio[k] > best) {
+      best = L.group_ratio[k];
+      L.dominant = feature_region(kFeatureGroups[k]);
+    }
+  }
+  // The stable term (platform top, bare cylinder) is where sensor errors show: everywhere at once.
+  L.stable_ratio = drape.stable_all / std::max(stable_floor, 1e-4);
+  if (L.stable_ratio > best) L.dominant = Region::kGlobal;
 }
 
 Localisation localise(const ForwardModel& model, const ScoredDrape& drape) {
@@ -64,10 +99,10 @@ Localisation localise(const ForwardModel& model, const ScoredDrape& drape) {
     L.regions.push_back(s);
     if (s.pixel_share >= kMinPixelShare && s.enrichment > best) {
       best = s.enrichment;
-      L.dominant = r;
+      L.pixel_region = r;
     }
   }
-  if (best < kMinEnrichment) L.dominant = Region::kGlobal;
+  if (best < kMinEnrichment) L.pixel_region = Region::kGlobal;
   for (double e : view_energy) L.view_share.push_back(total_energy > 0.0 ? e / total_energy : 0.0);
 
   const HemProfile capture_outline = hem_profile_from_capture(capture);

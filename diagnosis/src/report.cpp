@@ -109,16 +109,27 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
                       "above the floor by {:.0f}%.\n\n",
                       r.verdict, r.attribution.confidence, r.runner_up, 100.0 * c.shrinkage);
   }
-  md += "## Gap and floors (score in mm: truncated depth RMS + silhouette + fold terms)\n\n";
+  md += "## Gap and floors (score in mm: stable-region RMS + 4 mm x shape-feature distance)\n\n";
   md += "| | all views | held-out view |\n|---|---|---|\n";
   md += fmt::format("| gap (baseline fit) | {:.2f} | {:.2f} |\n", r.gap_all * 1e3, r.gap_held_out * 1e3);
   md += fmt::format("| floor (x{:.2f} margin) | {:.2f} | {:.2f} |\n\n", r.floors.margin, r.floors.all * 1e3,
                     r.floors.held_out * 1e3);
+  md += fmt::format("Tests (all views): stable-region term {:.2f} mm against its floor {:.2f} mm; shape distance {:.2f} "
+                    "against its floor {:.2f}.\n\n",
+                    r.fit.best.stable_all * 1e3, r.floors.stable * 1e3, r.fit.best.shape_all, r.floors.shape);
   md += fmt::format("Fitted baseline: alpha = {:.0f}, {:.0f}, {:.0f} g mm^2/s^2; beta = {:.0f}, {:.0f}, {:.0f} g mm^3/s^2 "
                     "({} evaluations).\n\n",
                     r.fitted.alpha.warp, r.fitted.alpha.bias, r.fitted.alpha.weft, r.fitted.beta.warp,
                     r.fitted.beta.bias, r.fitted.beta.weft, r.baseline_evaluations);
-  md += "## Where the gap sits\n\n| region | energy share | pixel share | enrichment |\n|---|---|---|---|\n";
+  md += "## Where the gap sits\n\nShape features, capture against the fitted baseline, over the largest floor sample:\n\n"
+        "| feature group | region | ratio to floor |\n|---|---|---|\n";
+  for (std::size_t k = 0; k < r.localisation.group_ratio.size(); ++k) {
+    md += fmt::format("| {} | {} | {:.2f} |\n", feature_group_name(kFeatureGroups[k]),
+                      region_name(feature_region(kFeatureGroups[k])), r.localisation.group_ratio[k]);
+  }
+  md += fmt::format("| stable term (platform top, bare cylinder) | global | {:.2f} |\n\n", r.localisation.stable_ratio);
+  md += fmt::format("Pixel residuals by region (most enriched: {}):\n\n", region_name(r.localisation.pixel_region));
+  md += "| region | energy share | pixel share | enrichment |\n|---|---|---|---|\n";
   for (const auto& s : r.localisation.regions) {
     md += fmt::format("| {} | {:.2f} | {:.2f} | {:.2f} |\n", region_name(s.region), s.energy_share, s.pixel_share,
                       s.enrichment);
@@ -138,13 +149,15 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
         "from the camera, blue: nearer; saturated at +-" + fmt::format("{:.0f}", range * 1e3) + " mm; black: no return).\n\n"
         "![views](views.png)\n\nTop: the capture; bottom: the fitted baseline.\n\n";
   if (!r.attribution.candidates.empty()) {
-    md += "## Candidate effects (refitted on the fit views, judged on the held-out view)\n\n"
-          "| effect | held-out score (mm) | shrinkage above floor | raw shrinkage | parameters |\n|---|---|---|---|---|\n";
+    md += "## Candidate effects (refitted on the fit views, confirmed on the held-out view)\n\n"
+          "| effect | all-view score (mm) | shrinkage above the typical floor | held-out score (mm) | held-out "
+          "shrinkage | confirmed | parameters |\n|---|---|---|---|---|---|---|\n";
     for (const auto& c : r.attribution.candidates) {
       std::string params;
       for (std::size_t k = 0; k < c.names.size(); ++k) params += fmt::format("{}={:.3g} ", c.names[k], c.parameters[k]);
-      md += fmt::format("| {} | {:.2f} | {:.0f}% | {:.0f}% | {}alpha x{:.2f} |\n", effect_name(c.effect),
-                        c.held_out_score * 1e3, 100 * c.shrinkage, 100 * c.raw_shrinkage, params, c.alpha_scale);
+      md += fmt::format("| {} | {:.2f} | {:.0f}% | {:.2f} | {:.0f}% | {} | {}alpha x{:.2f} |\n", effect_name(c.effect),
+                        c.all_score * 1e3, 100 * c.shrinkage, c.held_out_score * 1e3, 100 * c.held_out_shrinkage,
+                        c.confirmed ? "yes" : "no", params, c.alpha_scale);
     }
     if (after) md += "\n![after](residual_after.png)\n\nResidual after adding the named effect.\n";
   }

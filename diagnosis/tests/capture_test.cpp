@@ -8,6 +8,7 @@
 
 #include "drapegen/diagnosis/capture.hpp"
 #include "drapegen/diagnosis/depth_exr.hpp"
+#include "drapegen/diagnosis/forward_model.hpp"
 #include "drapegen/renderer/rig.hpp"
 
 namespace fs = std::filesystem;
@@ -117,4 +118,22 @@ TEST(Capture, NotAnExrAndBadJson) {
   EXPECT_NE(read_error(dir).find("not a readable OpenEXR"), std::string::npos);
   std::ofstream(fs::path(dir) / "capture.json") << "{ broken";
   EXPECT_NE(read_error(dir).find("malformed JSON"), std::string::npos);
+}
+
+TEST(Capture, NoSkirtIsAClearError) {
+  // A capture whose every return lies above the platform top (a plane far above the tester): no drape to diagnose.
+  Capture c = plane_capture();
+  for (auto& view : c.views) {
+    const Eigen::Isometry3d to_specimen = view.camera.world_to_camera.inverse();
+    for (int y = 0; y < view.depth.height; ++y) {
+      for (int x = 0; x < view.depth.width; ++x) {
+        if (view.depth.at(x, y) <= 0.0f) continue;
+        const Eigen::Vector3d p = to_specimen * (static_cast<double>(view.depth.at(x, y)) * view.camera.ray(x, y));
+        if (p.z() < 0.0) view.depth.at(x, y) = 0.0f;  // keep only what lies above the top
+      }
+    }
+  }
+  auto model = ForwardModel::create(c, FitSettings{});
+  ASSERT_FALSE(model);
+  EXPECT_NE(model.error().message.find("no skirt"), std::string::npos) << model.error().message;
 }

@@ -1,8 +1,8 @@
 #pragma once
 // Which effect explains the gap: each candidate is added to the model with its own parameters, refitted on the fit
-// views (with the bending scale free as well), and judged by how much it shrinks the gap above the floor on the
-// held-out view. Confidence: a block bootstrap over the held-out view's residual tiles of the named effect against
-// the runner-up.
+// views (with the bending scale free as well), and judged by how much it shrinks the gap above the typical floor,
+// confirmed on the held-out view (which must not get worse). Confidence: a block bootstrap over the held-out view's
+// residual tiles of the named effect against the runner-up.
 
 #include <string>
 #include <vector>
@@ -20,8 +20,10 @@ struct CandidateResult {
   std::vector<double> parameters;   // as in effect_space
   double alpha_scale = 1.0;         // the refitted bending scale relative to the baseline fit
   double fit_score = 0.0, held_out_score = 0.0, all_score = 0.0;
-  double shrinkage = 0.0;           // held-out gap above the floor: 1 - excess_after / excess_before
-  double raw_shrinkage = 0.0;       // 1 - held_out_after / held_out_before
+  /// All-view gap above the typical floor sample (Floors::typical_all): 1 - excess_after / excess_before.
+  double shrinkage = 0.0;
+  double held_out_shrinkage = 0.0;  // 1 - held_out_after / held_out_before (the view not in the refit)
+  bool confirmed = false;           // the held-out view does not get worse
   int evaluations = 0;
   double seconds = 0.0;
   ScoredDrape drape;
@@ -39,7 +41,7 @@ struct AttributionSettings {
 
 struct Attribution {
   std::vector<CandidateResult> candidates;  // sorted by shrinkage, best first
-  bool named = false;                       // the best shrinks the gap significantly
+  bool named = false;                       // the best is confirmed and shrinks the gap significantly
   double confidence = 0.0;                  // bootstrap P(best beats runner-up on the held-out view)
 };
 

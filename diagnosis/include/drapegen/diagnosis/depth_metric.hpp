@@ -26,10 +26,8 @@ struct MetricWeights {
   /// The view score: stable * stable_rms + pixel * (depth_rms + silhouette + fold terms).
   double stable = 1.0;
   double pixel = 0.25;
-  /// m per m of the distance between the hem outlines' rotation-invariant spectra (ForwardModel).
-  double hem_spectrum = 1.0;
-  /// m per m of the radial-profile difference per view (ForwardModel).
-  double radial = 0.25;
+  /// m per unit of the shape-feature distance (ForwardModel): a difference of one group scale counts this much.
+  double shape = 0.004;
 };
 
 /// What is precomputed once per captured (or pseudo-captured) view: depth, smoothed normals, fold mask.

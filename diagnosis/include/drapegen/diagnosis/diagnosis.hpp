@@ -32,6 +32,7 @@ struct DiagnosisResult {
   double gap_all = 0.0, gap_fit = 0.0, gap_held_out = 0.0;
   bool within_floors = false;
   Localisation localisation;
+  ShapeSet fit_target;  // the capture's shape features
   Attribution attribution;
   /// The verdict: the named effect ("none" within the floors, "unexplained" if no candidate shrinks it enough).
   std::string verdict;

@@ -13,6 +13,9 @@ namespace drapegen::diagnosis {
 struct FloorSamples {
   std::vector<double> all;       // score over all views
   std::vector<double> held_out;  // score over the held-out views
+  std::vector<double> stable;    // the stable-region term over all views (m)
+  std::vector<double> shape;     // the shape-feature distance over all views (dimensionless)
+  std::vector<std::vector<double>> groups;  // per sample: group_differences over all views (m)
 };
 
 struct Floors {
@@ -22,12 +25,31 @@ struct Floors {
   double all = 0.0;
   double held_out = 0.0;
   double margin = 1.15;
+  /// The two tests of "within the floors": the stable-region term (m, largest sample x margin) and the shape
+  /// distance (FloorSettings::shape_threshold, or the largest sample x shape_margin).
+  double stable = 0.0;
+  double shape = 0.0;
+  double shape_margin = 1.0;
+  /// The median sample score over all views / the held-out view: what a correct model typically leaves (the
+  /// reference the attribution's shrinkage is measured above).
+  double typical_all = 0.0;
+  double typical_held_out = 0.0;
+
+  /// The largest sample of either kind, per feature group / of the stable term (no margin).
+  [[nodiscard]] std::vector<double> group_floor() const;
+  [[nodiscard]] double stable_floor() const;
 };
 
 struct FloorSettings {
   int noise_seeds = 3;
   int extra_states = 3;      // sine seeds after the fit's
   double margin = 1.15;
+  double shape_margin = 1.0;
+  /// If positive, the shape test's floor instead of shape_margin x the largest sample: a value calibrated on controls
+  /// that are not part of the benchmark (docs/DIAGNOSIS.md, "Floors"). The fitted capture's own shape distance is
+  /// smaller than a floor sample's (the fit was optimised for the capture, not for the sample), so the samples
+  /// overstate the floor.
+  double shape_threshold = 1.15;
 };
 
 [[nodiscard]] sim::Expected<Floors> measure_floors(ForwardModel& model, const ModelSetup& fitted,

@@ -10,6 +10,7 @@
 #include "drapegen/diagnosis/depth_metric.hpp"
 #include "drapegen/diagnosis/hem_profile.hpp"
 #include "drapegen/diagnosis/model_setup.hpp"
+#include "drapegen/diagnosis/shape_features.hpp"
 #include "drapegen/renderer/depth_renderer.hpp"
 #include "drapegen/sim/expected.hpp"
 #include "drapegen/sim/initial_state.hpp"
@@ -29,11 +30,16 @@ struct FitSettings {
 /// The initial states of the fit: flat, then sine seeds 1.. (count in total).
 [[nodiscard]] std::vector<sim::InitialStateSpec> fit_initial_states(int count, std::uint64_t first_seed = 1);
 
-/// What a model drape is compared with: per view features and radial profiles, and the outline of the fit views.
+/// The shape features of one set of views (capture or model render) over the fit views, the held-out views and all.
+struct ShapeSet {
+  ShapeFeatures fit, held_out, all;
+};
+
+/// What a model drape is compared with: per view pixel features, the outline of the fit views, the shape features.
 struct Target {
   std::vector<ViewFeatures> views;
-  std::vector<RadialProfile> radial;  // per view
   HemProfile outline;                 // from the fit views
+  ShapeSet shape;
 };
 
 /// One drape of the model, turned to best match an outline, and how it compares with each view.
@@ -42,11 +48,14 @@ struct ScoredDrape {
   double angle = 0.0;         // radians: the turn applied before rendering
   int state = 0;              // index of the initial state
   bool converged = true;
-  std::vector<ViewComparison> views;  // every view of the capture
-  double hem_spectrum = 0.0;  // m, spectrum_distance of the fit views' outlines (capture, model render)
-  std::vector<double> radial; // m, per view: radial_distance of capture and model render
-  /// Each a mean over its views of (view score + radial weight * radial), plus hem weight * hem_spectrum for the
-  /// fit and all-view scores (the held-out score uses the held-out view alone).
+  std::vector<ViewComparison> views;  // every view of the capture (pixel residuals: localisation, report)
+  ShapeSet shape;                     // the model render's shape features (rendered with sensor noise)
+  /// m: the mean stable-region RMS (platform top, bare cylinder) over the fit / held-out / all views.
+  double stable_fit = 0.0, stable_held_out = 0.0, stable_all = 0.0;
+  /// feature_distance of the capture's and the model's shape features (dimensionless, per group scale).
+  double shape_fit = 0.0, shape_held_out = 0.0, shape_all = 0.0;
+  /// Each: stable term + MetricWeights::shape x shape distance over the fit / held-out / all views (m). The pixel
+  /// terms (where the folds fall) do not enter: two stable drapes of one fabric differ there the most.
   double fit_score = 0.0;
   double held_out_score = 0.0;
   double all_score = 0.0;
@@ -71,6 +80,10 @@ class ForwardModel {
   /// The target of a capture with these views (same cameras as the capture).
   [[nodiscard]] Target make_target(const std::vector<renderer::DepthImage>& depth) const;
   [[nodiscard]] sim::Expected<ScoredDrape> score(const sim::ClothMesh& mesh, const ModelSetup& setup);
+  /// The shape features of a set of views (one image per capture view) over the fit / held-out / all views.
+  [[nodiscard]] ShapeSet shape_set(const std::vector<renderer::DepthImage>& depth) const;
+  /// The noise seed of the model renders' shape features.
+  static constexpr std::uint64_t kModelNoiseSeed = 0x5FEA;
   /// Every initial state simulated and scored; the best by fit score.
   [[nodiscard]] sim::Expected<Evaluation> evaluate(const ModelSetup& setup);
   /// Re-scores given meshes (no simulation): the sensor candidate's refit.
@@ -84,6 +97,7 @@ class ForwardModel {
   [[nodiscard]] const FitSettings& settings() const { return settings_; }
   [[nodiscard]] const std::vector<ViewFeatures>& features() const { return target_.views; }
   [[nodiscard]] const HemProfile& outline() const { return target_.outline; }
+  [[nodiscard]] const Target& target() const { return target_; }
   [[nodiscard]] const std::vector<sim::InitialStateSpec>& initial_states() const { return states_; }
   [[nodiscard]] int simulations() const { return simulations_; }
   [[nodiscard]] double simulation_seconds() const { return simulation_seconds_; }

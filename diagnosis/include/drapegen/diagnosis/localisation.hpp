@@ -7,6 +7,7 @@
 
 #include "drapegen/diagnosis/candidate_effect.hpp"
 #include "drapegen/diagnosis/forward_model.hpp"
+#include "drapegen/diagnosis/shape_features.hpp"
 
 namespace drapegen::diagnosis {
 
@@ -18,8 +19,16 @@ struct RegionShare {
 };
 
 struct Localisation {
+  /// Where the gap sits: the region of the shape-feature group (or the stable term) that exceeds its floor the most
+  /// (localise_features), kGlobal for the stable term or if nothing exceeds its floor.
+  Region dominant = Region::kGlobal;
+  /// Per feature group (kFeatureGroups order) and for the stable term: the capture's difference from the fitted
+  /// drape over the largest floor sample's (at least half the group's scale).
+  std::vector<double> group_ratio;
+  double stable_ratio = 0.0;
+  /// The residual maps' most enriched region, kGlobal if none stands out (pixel residuals: fold placement shows).
+  Region pixel_region = Region::kGlobal;
   std::vector<RegionShare> regions;
-  Region dominant = Region::kGlobal;  // the most enriched region, kGlobal if none stands out
   std::vector<double> view_share;     // fraction of the residual energy per view
   std::vector<Harmonic> hem_difference;  // harmonics of (capture - model) hem radius
   int capture_folds = 0, model_folds = 0;
@@ -32,5 +41,12 @@ struct Localisation {
 
 /// `drape` is the fitted drape scored against the capture (its residual maps).
 [[nodiscard]] Localisation localise(const ForwardModel& model, const ScoredDrape& drape);
+
+/// The region a feature group describes: the outline groups the hem, the skirt groups the skirt.
+[[nodiscard]] Region feature_region(FeatureGroup group);
+/// Sets group_ratio, stable_ratio and dominant from the fitted drape's shape features against the capture's and the
+/// floors (floors.hpp) of each group.
+void localise_features(Localisation& localisation, const ScoredDrape& drape, const Target& capture,
+                       const std::vector<double>& group_floor, double stable_floor);
 
 }  // namespace drapegen::diagnosis
