@@ -7,7 +7,6 @@ import os
 import sys
 
 import numpy as np
-import torch
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import vae  # noqa: E402
@@ -19,10 +18,7 @@ def main():
     ap.add_argument("--count", type=int, default=64)
     ap.add_argument("--seed", type=int, default=0)
     args = ap.parse_args()
-    state = torch.load(args.checkpoint)
-    model = vae.VAE(state["hidden"], state["latent"], observation=state.get("observation", "gaussian"))
-    model.load_state_dict(state["state_dict"])
-    model.eval()
+    model, _ = vae.load_checkpoint(args.checkpoint)
     rng = np.random.default_rng(args.seed)
     z = rng.standard_normal((args.count, model.latent)) * 1.5  # wider than the prior, to exercise the decoder
     out = vae.decode_numpy(model, z)

@@ -160,6 +160,15 @@ def train(model, train_s, epochs, seed, stop_s=None, check_every=500, stop_sampl
     return epochs
 
 
+def load_checkpoint(path):
+    """A model saved by train.py --checkpoint, in eval mode, and the saved state (name, hidden, latent, ...)."""
+    state = torch.load(path)
+    model = VAE(state["hidden"], state["latent"], observation=state.get("observation", "gaussian"))
+    model.load_state_dict(state["state_dict"])
+    model.eval()
+    return model, state
+
+
 def prior_latents(n, latent, rng):
     return rng.standard_normal((n, latent))
 
