@@ -82,6 +82,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   double extrapolate = drapegen::sim::SolverOptions{}.extrapolate_above;
   app.add_option("--extrapolate", extrapolate, "SolverOptions::extrapolate_above (0: off)")->capture_default_str();
+  std::string model = "dihedral";
+  app.add_option("--bending-model", model, "dihedral (paper, per hinge) or triangle (per-triangle curvature tensors)")
+      ->check(CLI::IsMember({"dihedral", "triangle"}))
+      ->capture_default_str();
   std::vector<int> only;
   app.add_option("--only", only, "run only these of the --fabrics quantiles (0-based)")->delimiter(',');
   app.add_option("--coarse", coarse, "DrapeConfig::coarse_start_resolution (0: off)")->capture_default_str();
@@ -117,6 +121,7 @@ int main(int argc, char** argv) {
       config.solver.exact_hessian_below = exact_below;
       config.solver.max_iterations = max_iterations;
       config.solver.tolerance = tolerance;
+      if (model == "triangle") config.bending_model = drapegen::sim::BendingModel::kNonlinearTriangle;
       config.solver.extrapolate_above = extrapolate;
       config.coarse_start_resolution = coarse;
       auto initial = drapegen::sim::parse_initial_state(init);
