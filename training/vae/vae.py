@@ -2,6 +2,7 @@
 observation model with one learned standard deviation per feature, standard normal prior. Works in float64 on
 standardised features (feature - mean) / std with the training set's mean and std."""
 import math
+import os
 
 import numpy as np
 import torch
@@ -158,6 +159,13 @@ def train(model, train_s, epochs, seed, stop_s=None, check_every=500, stop_sampl
         model.load_state_dict(best[2])
         return best[1]
     return epochs
+
+
+def add_checkpoint_arguments(parser, repo):
+    """--checkpoint, --data and --seed as the evaluation scripts take them."""
+    parser.add_argument("--checkpoint", default=os.path.join(repo, "training", "vae", "models", "vae3.pt"))
+    parser.add_argument("--data", default=os.path.join(repo, "sampler", "data", "fabrics618.csv"))
+    parser.add_argument("--seed", type=int, default=0, help="the split seed of the training run")
 
 
 def load_checkpoint(path):

@@ -20,9 +20,7 @@ REPO = os.path.abspath(os.path.join(os.path.dirname(os.path.abspath(__file__)), 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--checkpoint", default=os.path.join(REPO, "training", "vae", "models", "vae3.pt"))
-    ap.add_argument("--data", default=os.path.join(REPO, "sampler", "data", "fabrics618.csv"))
-    ap.add_argument("--seed", type=int, default=0, help="the split seed of the training run")
+    vae.add_checkpoint_arguments(ap, REPO)
     ap.add_argument("--worst", type=int, default=6)
     args = ap.parse_args()
     torch.set_num_threads(1)
