@@ -130,9 +130,7 @@ Expected<CantileverResult> simulate_cantilever(const CantileverSpec& spec) {
       const DihedralModuli moduli{spec.fabric.alpha, spec.fabric.beta};
       auto hinges = std::make_unique<DihedralBending>(mesh, topology, moduli, spec.anisotropy);
       if (spec.bending_model == BendingModel::kNonlinearTriangle) {
-        auto t = std::make_unique<TriangleCurvatureBending>(mesh, topology, moduli, spec.anisotropy);
-        hinges->set_hinge_weights(t->border_hinge_weights());
-        triangles = std::move(t);
+        triangles = add_triangle_curvature(*hinges, mesh, topology, moduli, spec.anisotropy);
       }
       bending = std::move(hinges);
     }

@@ -31,9 +31,7 @@ std::vector<std::unique_ptr<EnergyTerm>> make_bending(const ClothMesh& mesh, con
     if (fx.edge_curl || fx.bending_yield_curvature) {
       throw std::invalid_argument("edge curl and bending plasticity need the dihedral bending model");
     }
-    auto triangles = std::make_unique<TriangleCurvatureBending>(mesh, topology, moduli, config.anisotropy);
-    hinges->set_hinge_weights(triangles->border_hinge_weights());
-    terms.push_back(std::move(triangles));
+    terms.push_back(add_triangle_curvature(*hinges, mesh, topology, moduli, config.anisotropy));
   }
   if (fx.edge_curl) hinges->set_rest_angles(edge_curl_rest_angles(mesh, topology, *fx.edge_curl));
   if (fx.bending_yield_curvature) hinges->set_yield_curvature(*fx.bending_yield_curvature);

@@ -202,4 +202,12 @@ double TriangleCurvatureBending::evaluate(const Eigen::Matrix3Xd& x, Eigen::Matr
   return total;
 }
 
+std::unique_ptr<TriangleCurvatureBending> add_triangle_curvature(DihedralBending& hinges, const ClothMesh& mesh,
+                                                                 const Topology& topology,
+                                                                 const DihedralModuli& moduli, AnisotropyRule rule) {
+  auto triangles = std::make_unique<TriangleCurvatureBending>(mesh, topology, moduli, rule);
+  hinges.set_hinge_weights(triangles->border_hinge_weights());
+  return triangles;
+}
+
 }  // namespace drapegen::sim

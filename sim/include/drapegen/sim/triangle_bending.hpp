@@ -15,6 +15,7 @@
 // border_sides() gives the weights (DihedralBending::set_hinge_weights).
 
 #include <Eigen/Core>
+#include <memory>
 #include <vector>
 
 #include "drapegen/sim/anisotropy.hpp"
@@ -69,5 +70,13 @@ class TriangleCurvatureBending final : public EnergyTerm {
   std::vector<int> border_sides_;
   AnisotropyWorkspace workspace_;
 };
+
+/// The kNonlinearTriangle model over the hinge model: builds the triangle term and leaves `hinges` only the border
+/// triangles' share (DihedralBending::set_hinge_weights). Both terms go into the energy.
+[[nodiscard]] std::unique_ptr<TriangleCurvatureBending> add_triangle_curvature(DihedralBending& hinges,
+                                                                              const ClothMesh& mesh,
+                                                                              const Topology& topology,
+                                                                              const DihedralModuli& moduli,
+                                                                              AnisotropyRule rule);
 
 }  // namespace drapegen::sim
