@@ -156,7 +156,7 @@ double DihedralBending::energy(const Eigen::Matrix3Xd& x) const {
     const Hinge& h = hinges_[i];
     const double theta = dihedral_angle(x.col(h.v0), x.col(h.v1), x.col(h.v2), x.col(h.v3)) - rest_angle_[i];
     const double c = 2.0 / rest_[i].height_sum;
-    const double w = weight_.size() == 0 ? 1.0 : weight_[static_cast<Eigen::Index>(i)];
+    const double w = hinge_weight(i);
     total += w * rest_[i].edge_length / c * laws_[i].work(c * std::abs(theta));
   }
   return total;
@@ -179,7 +179,7 @@ double DihedralBending::evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd* gr
                          rest_angle_[i];
     const double kappa = c * std::abs(theta);
     const TorqueLaw& law = laws_[i];
-    const double w = weight_.size() == 0 ? 1.0 : weight_[static_cast<Eigen::Index>(i)];
+    const double w = hinge_weight(i);
     total += w * e / c * law.work(kappa);
     const double de = std::copysign(w * e * law.torque(kappa), theta);  // dE / dtheta
     const double d2e = w * e * c * law.stiffness(kappa);                 // d^2E / dtheta^2

@@ -95,12 +95,11 @@ SolveReport NewtonSolver::solve(const std::vector<EnergyTerm*>& terms, const std
   Eigen::VectorXd g(n), step(n);
   Eigen::Matrix3Xd trial(3, nv);
   double lambda = 0.0;  // diagonal shift relative to the mean diagonal
-  // After a full step accepted into x (= x0 + step): returns the step length kept, 1 or longer (then x moved on).
-  auto extrapolate = [&](double e0, double slope, double e1) {
+  // After a full step accepted into x (= x0 + step), `largest` its largest vertex displacement: returns the step
+  // length kept, 1 or longer (then x moved on).
+  auto extrapolate = [&](double e0, double slope, double e1, double largest) {
     const double ratio = (e1 - e0) / slope;  // 1/2 where the model's curvature along the step is right, near 1 flatter
     if (!(ratio > options_.extrapolate_above)) return 1.0;
-    double largest = 0.0;
-    for (int f = 0; f < n / 3; ++f) largest = std::max(largest, step.segment<3>(3 * f).norm());
     const double t = std::min({options_.max_extrapolation, 0.5 / (1.0 - std::min(ratio, 0.99)),
                                options_.max_step / std::max(largest, 1e-300)});
     if (t <= 1.0) return 1.0;
@@ -258,7 +257,7 @@ SolveReport NewtonSolver::solve(const std::vector<EnergyTerm*>& terms, const std
               step_length = t;
               x.swap(trial);
               if (ls == 0 && t == 1.0 && options_.extrapolate_above > 0.0 && !round_off) {
-                step_length = extrapolate(energy, slope, e_trial);
+                step_length = extrapolate(energy, slope, e_trial, largest);
               }
               break;
             }

@@ -23,9 +23,10 @@ class SerialOpenMp {
   explicit SerialOpenMp(bool active) : active_(active) {
 #ifdef DRAPEGEN_HAVE_OPENMP
     if (!active_) return;
-    const std::lock_guard lock(mutex());
-    if (users()++ == 0) {
-      saved() = omp_get_max_active_levels();
+    Shared& s = shared();
+    const std::lock_guard lock(s.mutex);
+    if (s.users++ == 0) {
+      s.saved_levels = omp_get_max_active_levels();
       omp_set_max_active_levels(0);
     }
 #endif
@@ -33,25 +34,23 @@ class SerialOpenMp {
   ~SerialOpenMp() {
 #ifdef DRAPEGEN_HAVE_OPENMP
     if (!active_) return;
-    const std::lock_guard lock(mutex());
-    if (--users() == 0) omp_set_max_active_levels(saved());
+    Shared& s = shared();
+    const std::lock_guard lock(s.mutex);
+    if (--s.users == 0) omp_set_max_active_levels(s.saved_levels);
 #endif
   }
   SerialOpenMp(const SerialOpenMp&) = delete;
   SerialOpenMp& operator=(const SerialOpenMp&) = delete;
 
  private:
-  static std::mutex& mutex() {
-    static std::mutex m;
-    return m;
-  }
-  static int& users() {
-    static int n = 0;
-    return n;
-  }
-  static int& saved() {
-    static int levels = 0;
-    return levels;
+  struct Shared {
+    std::mutex mutex;
+    int users = 0;
+    int saved_levels = 0;
+  };
+  static Shared& shared() {
+    static Shared s;
+    return s;
   }
   bool active_;
 };

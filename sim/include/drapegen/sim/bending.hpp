@@ -78,6 +78,9 @@ class DihedralBending final : public EnergyTerm {
  private:
   /// Sets every hinge's torque law from its bending angle; returns the largest relative change of alpha or beta.
   double assign_laws();
+  [[nodiscard]] double hinge_weight(std::size_t i) const {
+    return weight_.size() == 0 ? 1.0 : weight_[static_cast<Eigen::Index>(i)];
+  }
 
   const ClothMesh* mesh_;
   const Topology* topology_;
