@@ -152,10 +152,38 @@ inline std::string wait_endpoint(const fs::path& output, Process& coordinator, s
   return "";
 }
 
+/// `drapegen run ARGS` that has announced its endpoint; `endpoint` is empty if it did not within 30 s.
+struct Coordinator {
+  Process process;
+  std::string endpoint;
+};
+inline Coordinator start_coordinator(const std::vector<std::string>& args, const fs::path& output,
+                                     const fs::path& log_prefix) {
+  std::vector<std::string> command{"run"};
+  command.insert(command.end(), args.begin(), args.end());
+  Coordinator c{Process(command, log_prefix.string()), ""};
+  c.endpoint = wait_endpoint(output, c.process, 30s);
+  return c;
+}
+
+/// Worker w`k` (log under DIR/worker`k`).
 inline Process start_worker(const std::string& endpoint, const fs::path& dir, int k) {
-  return Process({"worker", "--connect", endpoint, "--name", "w" + std::to_string(k), "--heartbeat-ms", "100",
+  const std::string number = std::to_string(k);
+  return Process({"worker", "--connect", endpoint, "--name", std::string("w").append(number), "--heartbeat-ms", "100",
                   "--liveness", "4", "--backoff-max-ms", "500", "--give-up", "60"},
-                 (dir / ("worker" + std::to_string(k))).string());
+                 (dir / std::string("worker").append(number)).string());
+}
+
+/// `drapegen run --resume MANIFEST` with one worker (w`k`), run to the end: success if it exits 0.
+inline ::testing::AssertionResult resume_to_completion(const fs::path& manifest, const fs::path& output,
+                                                       const fs::path& dir, int k) {
+  Coordinator resumed = start_coordinator({"--resume", manifest.string()}, output, dir / "resumed");
+  if (resumed.endpoint.empty()) return ::testing::AssertionFailure() << "no endpoint: " << resumed.process.err();
+  Process worker = start_worker(resumed.endpoint, dir, k);
+  if (const int code = resumed.process.wait(120s); code != 0) {
+    return ::testing::AssertionFailure() << "resume exited " << code << ": " << resumed.process.err();
+  }
+  return ::testing::AssertionSuccess();
 }
 
 /// Jobs recorded (done or failed), read through the stable reader; -1 if the manifest cannot be read yet.

@@ -12,8 +12,7 @@ TEST(Service, EndToEndWithTwoWorkers) {
   const fs::path dir = test_dir("end_to_end");
   const fs::path out = dir / "run";
   write_text(dir / "run.toml", small_config(out, 4, 2));
-  Process coordinator({"run", "--config", (dir / "run.toml").string()}, (dir / "coordinator").string());
-  const std::string endpoint = wait_endpoint(out, coordinator, 30s);
+  auto [coordinator, endpoint] = start_coordinator({"--config", (dir / "run.toml").string()}, out, dir / "coordinator");
   ASSERT_FALSE(endpoint.empty()) << coordinator.err();
   EXPECT_EQ(endpoint.rfind("tcp://127.0.0.1:", 0), 0u);
   Process w1 = start_worker(endpoint, dir, 1), w2 = start_worker(endpoint, dir, 2);
@@ -54,8 +53,7 @@ TEST(Service, SurvivesWorkerKills) {
   const fs::path dir = test_dir("worker_kills");
   const fs::path out = dir / "run";
   write_text(dir / "run.toml", small_config(out, 12, 2, "[retry]\nmax_attempts = 20\n"));
-  Process coordinator({"run", "--config", (dir / "run.toml").string()}, (dir / "coordinator").string());
-  const std::string endpoint = wait_endpoint(out, coordinator, 30s);
+  auto [coordinator, endpoint] = start_coordinator({"--config", (dir / "run.toml").string()}, out, dir / "coordinator");
   ASSERT_FALSE(endpoint.empty()) << coordinator.err();
   std::mt19937 rng(42);
   std::vector<Process> workers;
@@ -237,8 +235,7 @@ TEST(Service, StopsOnAnUnwritableOutputAndResumes) {
   const fs::path out = dir / "run";
   write_text(dir / "run.toml", small_config(out, 8, 2));
   const fs::path manifest = out / "manifest.sqlite";
-  Process coordinator({"run", "--config", (dir / "run.toml").string()}, (dir / "coordinator").string());
-  const std::string endpoint = wait_endpoint(out, coordinator, 30s);
+  auto [coordinator, endpoint] = start_coordinator({"--config", (dir / "run.toml").string()}, out, dir / "coordinator");
   ASSERT_FALSE(endpoint.empty()) << coordinator.err();
   Process worker = start_worker(endpoint, dir, 1);
   ASSERT_TRUE(wait_recorded(manifest, 3, 60s));
@@ -257,11 +254,7 @@ TEST(Service, StopsOnAnUnwritableOutputAndResumes) {
   // Fix it and resume.
   fs::remove(out / "data");
   fs::rename(dir / "data.saved", out / "data");
-  Process resumed({"run", "--resume", manifest.string()}, (dir / "resumed").string());
-  const std::string endpoint2 = wait_endpoint(out, resumed, 30s);
-  ASSERT_FALSE(endpoint2.empty()) << resumed.err();
-  Process worker2 = start_worker(endpoint2, dir, 2);
-  ASSERT_EQ(resumed.wait(120s), 0) << resumed.err();
+  ASSERT_TRUE(resume_to_completion(manifest, out, dir, 2));
   check_manifest(manifest, 2);
   auto reader = storage::ManifestReader::open(manifest.string());
   ASSERT_TRUE(reader);
@@ -286,8 +279,7 @@ TEST(Service, StopsOnAFullDiskAndResumes) {
   } unmount{out.string()};
   write_text(dir / "run.toml", small_config(out, 8, 2));
   const fs::path manifest = out / "manifest.sqlite";
-  Process coordinator({"run", "--config", (dir / "run.toml").string()}, (dir / "coordinator").string());
-  const std::string endpoint = wait_endpoint(out, coordinator, 30s);
+  auto [coordinator, endpoint] = start_coordinator({"--config", (dir / "run.toml").string()}, out, dir / "coordinator");
   ASSERT_FALSE(endpoint.empty()) << coordinator.err();
   Process worker = start_worker(endpoint, dir, 1);
   ASSERT_EQ(coordinator.wait(120s), 3) << coordinator.err();
@@ -304,11 +296,7 @@ TEST(Service, StopsOnAFullDiskAndResumes) {
   EXPECT_EQ(worker.wait(10s), 0) << worker.err();
   // More space, then resume.
   ASSERT_EQ(std::system(("mount -o remount,size=64m " + out.string()).c_str()), 0);
-  Process resumed({"run", "--resume", manifest.string()}, (dir / "resumed").string());
-  const std::string endpoint2 = wait_endpoint(out, resumed, 30s);
-  ASSERT_FALSE(endpoint2.empty()) << resumed.err();
-  Process worker2 = start_worker(endpoint2, dir, 2);
-  ASSERT_EQ(resumed.wait(120s), 0) << resumed.err();
+  ASSERT_TRUE(resume_to_completion(manifest, out, dir, 2));
   check_manifest(manifest, 2);
   EXPECT_EQ(recorded_jobs(manifest), 16);
 }
@@ -320,8 +308,7 @@ TEST(Service, StopsCleanlyOnSigterm) {
   const fs::path out = dir / "run";
   write_text(dir / "run.toml", small_config(out, 8, 2));
   const fs::path manifest = out / "manifest.sqlite";
-  Process coordinator({"run", "--config", (dir / "run.toml").string()}, (dir / "coordinator").string());
-  const std::string endpoint = wait_endpoint(out, coordinator, 30s);
+  auto [coordinator, endpoint] = start_coordinator({"--config", (dir / "run.toml").string()}, out, dir / "coordinator");
   ASSERT_FALSE(endpoint.empty()) << coordinator.err();
   Process worker = start_worker(endpoint, dir, 1);
   wait_recorded(manifest, 2, 60s);  // SIGTERM mid-run; the test holds whether or not two were recorded by then
@@ -335,11 +322,7 @@ TEST(Service, StopsCleanlyOnSigterm) {
     EXPECT_EQ(reader->run()->state, "stopped");
   }
   check_manifest(manifest, 2);
-  Process resumed({"run", "--resume", manifest.string()}, (dir / "resumed").string());
-  const std::string endpoint2 = wait_endpoint(out, resumed, 30s);
-  ASSERT_FALSE(endpoint2.empty()) << resumed.err();
-  Process worker2 = start_worker(endpoint2, dir, 2);
-  ASSERT_EQ(resumed.wait(120s), 0) << resumed.err();
+  ASSERT_TRUE(resume_to_completion(manifest, out, dir, 2));
   check_manifest(manifest, 2);
   EXPECT_EQ(recorded_jobs(manifest), 16);
 }

@@ -156,8 +156,7 @@ double DihedralBending::energy(const Eigen::Matrix3Xd& x) const {
     const Hinge& h = hinges_[i];
     const double theta = dihedral_angle(x.col(h.v0), x.col(h.v1), x.col(h.v2), x.col(h.v3)) - rest_angle_[i];
     const double c = 2.0 / rest_[i].height_sum;
-    const double w = hinge_weight(i);
-    total += w * rest_[i].edge_length / c * laws_[i].work(c * std::abs(theta));
+    total += rest_[i].edge_length / c * laws_[i].work(c * std::abs(theta));
   }
   return total;
 }
@@ -179,10 +178,9 @@ double DihedralBending::evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd* gr
                          rest_angle_[i];
     const double kappa = c * std::abs(theta);
     const TorqueLaw& law = laws_[i];
-    const double w = hinge_weight(i);
-    total += w * e / c * law.work(kappa);
-    const double de = std::copysign(w * e * law.torque(kappa), theta);  // dE / dtheta
-    const double d2e = w * e * c * law.stiffness(kappa);                 // d^2E / dtheta^2
+    total += e / c * law.work(kappa);
+    const double de = std::copysign(e * law.torque(kappa), theta);  // dE / dtheta
+    const double d2e = e * c * law.stiffness(kappa);                 // d^2E / dtheta^2
     if (gradient != nullptr) {
       for (int v = 0; v < 4; ++v) gradient->col((&h.v0)[v]) += de * g.segment<3>(3 * v);
     }
@@ -195,13 +193,6 @@ double DihedralBending::evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd* gr
     hessian->add(static_cast<int>(i), element.data());
   }
   return total;
-}
-
-void DihedralBending::set_hinge_weights(Eigen::VectorXd weights) {
-  if (weights.size() != static_cast<Eigen::Index>(hinges_.size()) || !weights.allFinite() || weights.minCoeff() < 0.0) {
-    throw std::invalid_argument("bending: one finite non-negative weight per hinge expected");
-  }
-  weight_ = std::move(weights);
 }
 
 // ---------------------------------------------------------------------------------------------------------------

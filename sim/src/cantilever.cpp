@@ -123,16 +123,18 @@ Expected<CantileverResult> simulate_cantilever(const CantileverSpec& spec) {
   try {
     const Topology topology = build_topology(mesh);
     CorotationalMembrane membrane(mesh, MembraneParameters{spec.membrane_stiffness, 0.99, 1.01});
-    std::unique_ptr<EnergyTerm> bending, triangles;
-    if (spec.bending_model == BendingModel::kQuadratic) {
-      bending = std::make_unique<QuadraticBending>(mesh, topology, spec.fabric.gamma, spec.anisotropy);
-    } else {
-      const DihedralModuli moduli{spec.fabric.alpha, spec.fabric.beta};
-      auto hinges = std::make_unique<DihedralBending>(mesh, topology, moduli, spec.anisotropy);
-      if (spec.bending_model == BendingModel::kNonlinearTriangle) {
-        triangles = add_triangle_curvature(*hinges, mesh, topology, moduli, spec.anisotropy);
-      }
-      bending = std::move(hinges);
+    std::unique_ptr<EnergyTerm> bending;
+    const DihedralModuli moduli{spec.fabric.alpha, spec.fabric.beta};
+    switch (spec.bending_model) {
+      case BendingModel::kQuadratic:
+        bending = std::make_unique<QuadraticBending>(mesh, topology, spec.fabric.gamma, spec.anisotropy);
+        break;
+      case BendingModel::kNonlinearTriangle:
+        bending = std::make_unique<TriangleCurvatureBending>(mesh, topology, moduli, spec.anisotropy);
+        break;
+      case BendingModel::kNonlinearDihedral:
+        bending = std::make_unique<DihedralBending>(mesh, topology, moduli, spec.anisotropy);
+        break;
     }
     NewtonSolver solver(spec.solver);
     Eigen::Matrix3Xd x = mesh.positions;
@@ -142,7 +144,6 @@ Expected<CantileverResult> simulate_cantilever(const CantileverSpec& spec) {
     for (int k = 1; k <= steps; ++k) {
       Gravity gravity(mesh, spec.fabric.density, spec.gravity * k / steps);
       std::vector<EnergyTerm*> terms{&membrane, bending.get(), &gravity};
-      if (triangles) terms.push_back(triangles.get());
       const SolveReport r = solver.solve(terms, strip.fixed, reference, x);
       result.report.add_work(r);
       result.report.lagged_change = r.lagged_change;

@@ -13,7 +13,7 @@
 namespace drapegen::sim {
 namespace {
 
-/// The bending terms: one model, or for kNonlinearTriangle the triangles plus the hinge model at the border.
+/// The bending term of the configured model, with its effects.
 std::vector<std::unique_ptr<EnergyTerm>> make_bending(const ClothMesh& mesh, const Topology& topology,
                                                       const FabricParameters& fabric, const DrapeConfig& config) {
   const PhysicalEffects& fx = config.effects;
@@ -26,13 +26,14 @@ std::vector<std::unique_ptr<EnergyTerm>> make_bending(const ClothMesh& mesh, con
     return terms;
   }
   const DihedralModuli moduli{fabric.alpha, fabric.beta};
-  auto hinges = std::make_unique<DihedralBending>(mesh, topology, moduli, config.anisotropy);
   if (config.bending_model == BendingModel::kNonlinearTriangle) {
     if (fx.edge_curl || fx.bending_yield_curvature) {
       throw std::invalid_argument("edge curl and bending plasticity need the dihedral bending model");
     }
-    terms.push_back(add_triangle_curvature(*hinges, mesh, topology, moduli, config.anisotropy));
+    terms.push_back(std::make_unique<TriangleCurvatureBending>(mesh, topology, moduli, config.anisotropy));
+    return terms;
   }
+  auto hinges = std::make_unique<DihedralBending>(mesh, topology, moduli, config.anisotropy);
   if (fx.edge_curl) hinges->set_rest_angles(edge_curl_rest_angles(mesh, topology, *fx.edge_curl));
   if (fx.bending_yield_curvature) hinges->set_yield_curvature(*fx.bending_yield_curvature);
   terms.push_back(std::move(hinges));

@@ -50,7 +50,7 @@ HessianAssembler::HessianAssembler(int vertex_count, const std::vector<bool>& fi
       term->element_vertices(e, verts.data());
       for (int a = 0; a < n; ++a) {
         for (int b = 0; b < n; ++b) {
-          const int i = free_index_[verts[a]], j = free_index_[verts[b]];
+          const int i = free_or_absent(verts[a]), j = free_or_absent(verts[b]);
           if (i > j && j >= 0) lower[j].push_back(i);
         }
       }
@@ -94,7 +94,7 @@ HessianAssembler::HessianAssembler(int vertex_count, const std::vector<bool>& fi
       term->element_vertices(e, verts.data());
       for (int a = 0; a < n; ++a) {
         for (int b = 0; b < n; ++b) {
-          const int i = free_index_[verts[a]], j = free_index_[verts[b]];
+          const int i = free_or_absent(verts[a]), j = free_or_absent(verts[b]);
           if (i < 0 || j < 0 || i < j) continue;
           int* out = map.offsets.data() + ((static_cast<std::size_t>(e) * n + a) * n + b) * 3;
           if (i == j) {

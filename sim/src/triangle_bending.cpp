@@ -28,30 +28,20 @@ TriangleCurvatureBending::TriangleCurvatureBending(const ClothMesh& mesh, const 
     const Hinge& g = topology.hinges[h];
     hinge_of[{std::min(g.v0, g.v1), std::max(g.v0, g.v1)}] = static_cast<int>(h);
   }
-  border_sides_.assign(topology.hinges.size(), 0);
   const Eigen::Vector2d warp(std::cos(mesh.material_angle), std::sin(mesh.material_angle));
   for (Eigen::Index t = 0; t < mesh.triangles.cols(); ++t) {
     const int tri[3] = {mesh.triangles(0, t), mesh.triangles(1, t), mesh.triangles(2, t)};
-    int hinge_index[3];
-    int found = 0;
-    for (int i = 0; i < 3; ++i) {
-      const int a = tri[(i + 1) % 3], b = tri[(i + 2) % 3];
-      const auto it = hinge_of.find({std::min(a, b), std::max(a, b)});
-      hinge_index[i] = it == hinge_of.end() ? -1 : it->second;
-      found += it == hinge_of.end() ? 0 : 1;
-    }
-    if (found < 3) {
-      for (int i = 0; i < 3; ++i) {
-        if (hinge_index[i] >= 0) ++border_sides_[static_cast<std::size_t>(hinge_index[i])];
-      }
-      continue;
-    }
     Element e{};
     for (int i = 0; i < 3; ++i) e.vertices[i] = tri[i];
+    for (int i = 3; i < 6; ++i) e.vertices[i] = -1;
     const Eigen::Vector2d centre = (mesh.rest.col(tri[0]) + mesh.rest.col(tri[1]) + mesh.rest.col(tri[2])) / 3.0;
-    Eigen::Matrix3d b;  // row i: d theta_i / d (K_xx, K_xy, K_yy)
-    for (int i = 0; i < 3; ++i) {
-      const Hinge& g = topology.hinges[static_cast<std::size_t>(hinge_index[i])];
+    e.constraint.setZero();
+    for (int edge = 0; edge < 3; ++edge) {
+      const int a = tri[(edge + 1) % 3], b = tri[(edge + 2) % 3];
+      const auto it = hinge_of.find({std::min(a, b), std::max(a, b)});
+      if (it == hinge_of.end()) continue;  // a free edge
+      const int i = e.hinge_count++;
+      const Hinge& g = topology.hinges[static_cast<std::size_t>(it->second)];
       e.hinge[i] = g;
       const int* hv = &g.v0;
       for (int k = 0; k < 4; ++k) {
@@ -70,14 +60,17 @@ TriangleCurvatureBending::TriangleCurvatureBending(const ClothMesh& mesh, const 
           const double z = j == 0 ? 0.5 * q.x() * q.x() : j == 1 ? q.x() * q.y() : 0.5 * q.y() * q.y();
           p[k] = Eigen::Vector3d(q.x(), q.y(), amplitude * z);
         }
-        b(i, j) = dihedral_angle(p[0], p[1], p[2], p[3]) / amplitude;
+        e.constraint(i, j) = dihedral_angle(p[0], p[1], p[2], p[3]) / amplitude;
       }
     }
-    const Eigen::FullPivLU<Eigen::Matrix3d> lu(b);
-    if (!lu.isInvertible() || !(lu.rcond() > 1e-8)) {
-      throw std::invalid_argument("triangle bending: degenerate curvature system");
+    if (e.hinge_count == 0) continue;  // a lone triangle: nothing to bend
+    if (e.hinge_count == 3) {
+      const Eigen::FullPivLU<Eigen::Matrix3d> lu(e.constraint);
+      if (!lu.isInvertible() || !(lu.rcond() > 1e-8)) {
+        throw std::invalid_argument("triangle bending: degenerate curvature system");
+      }
+      e.to_tensor = lu.inverse();
     }
-    e.to_tensor = lu.inverse();
     const Eigen::Vector2d u = mesh.rest.col(tri[1]) - mesh.rest.col(tri[0]),
                           w = mesh.rest.col(tri[2]) - mesh.rest.col(tri[0]);
     e.area = 0.5 * std::abs(u.x() * w.y() - u.y() * w.x());
@@ -86,21 +79,8 @@ TriangleCurvatureBending::TriangleCurvatureBending(const ClothMesh& mesh, const 
   }
 }
 
-Eigen::VectorXd TriangleCurvatureBending::border_hinge_weights() const {
-  Eigen::VectorXd w(static_cast<Eigen::Index>(border_sides_.size()));
-  for (Eigen::Index h = 0; h < w.size(); ++h) w[h] = 0.5 * border_sides_[static_cast<std::size_t>(h)];
-  return w;
-}
-
 double TriangleCurvatureBending::assign(Element& e, const Eigen::Vector2d& d) const {
   const Eigen::Vector2d p(-d.y(), d.x());
-  // kappa = a^T K a = (a_x^2, 2 a_x a_y, a_y^2) . (K_xx, K_xy, K_yy); twist d^T K p likewise.
-  const Eigen::RowVector3d along(d.x() * d.x(), 2.0 * d.x() * d.y(), d.y() * d.y());
-  const Eigen::RowVector3d across(p.x() * p.x(), 2.0 * p.x() * p.y(), p.y() * p.y());
-  const Eigen::RowVector3d twist(d.x() * p.x(), d.x() * p.y() + d.y() * p.x(), d.y() * p.y());
-  e.measure.row(0) = along * e.to_tensor;
-  e.measure.row(1) = across * e.to_tensor;
-  e.measure.row(2) = twist * e.to_tensor;
   const TorqueLaw old = e.along;
   if (moduli_.isotropic()) {
     e.along = e.across = TorqueLaw{moduli_.alpha.warp, moduli_.beta.warp};
@@ -116,6 +96,26 @@ double TriangleCurvatureBending::assign(Element& e, const Eigen::Vector2d& d) co
     e.across = law(phi + 0.5 * std::acos(-1.0));
   }
   e.twist = 0.5 * (e.along.alpha + e.across.alpha);
+  // kappa = a^T K a = (a_x^2, 2 a_x a_y, a_y^2) . (K_xx, K_xy, K_yy); twist d^T K p likewise.
+  const Eigen::RowVector3d along(d.x() * d.x(), 2.0 * d.x() * d.y(), d.y() * d.y());
+  const Eigen::RowVector3d across(p.x() * p.x(), 2.0 * p.x() * p.y(), p.y() * p.y());
+  const Eigen::RowVector3d twist(d.x() * p.x(), d.x() * p.y() + d.y() * p.x(), d.y() * p.y());
+  if (e.hinge_count < 3) {
+    // A border triangle measures only some components of K: the rest takes the value of least linear bending
+    // energy 1/2 k^T A k under the measured angles, B k = theta (the free edge's natural boundary condition, zero
+    // moment across it, for the linear part of the laws): k = A^-1 B^T (B A^-1 B^T)^-1 theta.
+    const Eigen::Matrix3d stiffness = e.along.alpha * along.transpose() * along +
+                                      e.across.alpha * across.transpose() * across +
+                                      2.0 * e.twist * twist.transpose() * twist;
+    const int m = e.hinge_count;
+    const Eigen::MatrixXd b = e.constraint.topRows(m);
+    const Eigen::MatrixXd a_inv_bt = stiffness.ldlt().solve(b.transpose());  // 3 x m
+    e.to_tensor.setZero();
+    e.to_tensor.leftCols(m) = a_inv_bt * (b * a_inv_bt).inverse();
+  }
+  e.measure.row(0) = along * e.to_tensor;
+  e.measure.row(1) = across * e.to_tensor;
+  e.measure.row(2) = twist * e.to_tensor;
   if (!(old.alpha > 0.0)) return 0.0;
   return std::max(std::abs(e.along.alpha - old.alpha) / old.alpha,
                   std::abs(e.along.beta - old.beta) / std::max(std::abs(old.beta), old.alpha * std::sqrt(e.area)));
@@ -162,7 +162,8 @@ double TriangleCurvatureBending::evaluate(const Eigen::Matrix3Xd& x, Eigen::Matr
     const Element& e = elements_[t];
     Eigen::Vector3d theta;
     jacobian.setZero();
-    for (int i = 0; i < 3; ++i) {
+    theta.setZero();
+    for (int i = 0; i < e.hinge_count; ++i) {
       const Hinge& h = e.hinge[i];
       const bool need_gradient = gradient != nullptr || hessian != nullptr;
       theta(i) = exact ? dihedral_angle_hessian(x.col(h.v0), x.col(h.v1), x.col(h.v2), x.col(h.v3), g, h2[i])
@@ -180,14 +181,16 @@ double TriangleCurvatureBending::evaluate(const Eigen::Matrix3Xd& x, Eigen::Matr
     const Eigen::Vector3d torque = e.area * e.measure.transpose() * moment;  // dE / dtheta
     if (gradient != nullptr) {
       const Eigen::Matrix<double, 18, 1> ge = jacobian * torque;
-      for (int k = 0; k < 6; ++k) gradient->col(e.vertices[k]) += ge.segment<3>(3 * k);
+      for (int k = 0; k < 6; ++k) {
+        if (e.vertices[k] >= 0) gradient->col(e.vertices[k]) += ge.segment<3>(3 * k);
+      }
     }
     if (hessian == nullptr) continue;
     const Eigen::Vector3d stiffness(e.along.stiffness(k0), e.across.stiffness(k1), 2.0 * e.twist);
     const Eigen::Matrix3d d2e = e.area * e.measure.transpose() * stiffness.asDiagonal() * e.measure;  // PSD
     element.noalias() = jacobian * d2e * jacobian.transpose();
     if (exact) {
-      for (int i = 0; i < 3; ++i) {
+      for (int i = 0; i < e.hinge_count; ++i) {
         for (int a = 0; a < 4; ++a) {
           for (int c = 0; c < 4; ++c) {
             element.block<3, 3>(3 * e.slot[i][a], 3 * e.slot[i][c]) += torque(i) * h2[i].block<3, 3>(3 * a, 3 * c);
@@ -200,14 +203,6 @@ double TriangleCurvatureBending::evaluate(const Eigen::Matrix3Xd& x, Eigen::Matr
     hessian->add(static_cast<int>(t), element.data());
   }
   return total;
-}
-
-std::unique_ptr<TriangleCurvatureBending> add_triangle_curvature(DihedralBending& hinges, const ClothMesh& mesh,
-                                                                 const Topology& topology,
-                                                                 const DihedralModuli& moduli, AnisotropyRule rule) {
-  auto triangles = std::make_unique<TriangleCurvatureBending>(mesh, topology, moduli, rule);
-  hinges.set_hinge_weights(triangles->border_hinge_weights());
-  return triangles;
 }
 
 }  // namespace drapegen::sim

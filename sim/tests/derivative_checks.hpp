@@ -26,7 +26,9 @@ class DenseSink final : public HessianSink {
     term_.element_vertices(element, v.data());
     const Eigen::Map<const Eigen::MatrixXd> m(local, 3 * n, 3 * n);
     for (int a = 0; a < n; ++a)
-      for (int b = 0; b < n; ++b) h_.block<3, 3>(3 * v[a], 3 * v[b]) += m.block<3, 3>(3 * a, 3 * b);
+      for (int b = 0; b < n; ++b) {
+        if (v[a] >= 0 && v[b] >= 0) h_.block<3, 3>(3 * v[a], 3 * v[b]) += m.block<3, 3>(3 * a, 3 * b);
+      }
   }
   [[nodiscard]] const Eigen::MatrixXd& matrix() const { return h_; }
 

@@ -1,6 +1,7 @@
 // Bending on per-triangle curvature tensors: derivatives, and exactness for constant curvature on any mesh.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <set>
@@ -34,34 +35,47 @@ TEST(TriangleCurvatureBending, DerivativesAnisotropicSofteningAndStiffening) {
   }
 }
 
-TEST(TriangleCurvatureBending, BorderTrianglesLeaveTheirHingesToTheHingeModel) {
+TEST(TriangleCurvatureBending, EveryTriangleIsAnElementBorderWingsAbsent) {
   const ClothMesh mesh = make_specimen(SpecimenSpec{0.1, 0.1, 6, 6, 0.1, Triangulation::kRandom, 2, 0.0});
   const Topology topology = build_topology(mesh);
   const TriangleCurvatureBending bending(mesh, topology, DihedralModuli{{1e-5, 1e-5, 1e-5}, {0, 0, 0}},
                                          AnisotropyRule::kCurvature);
+  ASSERT_EQ(bending.element_count(), mesh.triangle_count());
   std::set<std::pair<int, int>> hinge_edges;
   for (const Hinge& h : topology.hinges) hinge_edges.insert({std::min(h.v0, h.v1), std::max(h.v0, h.v1)});
-  int full = 0, border_incidences = 0;
+  std::vector<int> vertices(6);
+  int absent = 0;
   for (int t = 0; t < mesh.triangle_count(); ++t) {
+    bending.element_vertices(t, vertices.data());
     int hinges = 0;
     for (int i = 0; i < 3; ++i) {
-      const int a = mesh.triangles((i + 1) % 3, t), b = mesh.triangles((i + 2) % 3, t);
+      const int a = vertices[(i + 1) % 3], b = vertices[(i + 2) % 3];
       hinges += hinge_edges.count({std::min(a, b), std::max(a, b)}) > 0 ? 1 : 0;
     }
-    if (hinges == 3) ++full;
-    else border_incidences += hinges;
+    const int wings = static_cast<int>(std::count_if(vertices.begin() + 3, vertices.end(), [](int v) { return v >= 0; }));
+    EXPECT_EQ(wings, hinges) << t;
+    absent += 3 - wings;
   }
-  EXPECT_EQ(bending.element_count(), full);
-  int sides = 0;
-  for (int s : bending.border_sides()) sides += s;
-  EXPECT_EQ(sides, border_incidences);
-  EXPECT_GT(sides, 0);
-  const Eigen::VectorXd w = bending.border_hinge_weights();
-  ASSERT_EQ(w.size(), static_cast<Eigen::Index>(topology.hinges.size()));
-  EXPECT_NEAR(w.sum(), 0.5 * sides, 1e-12);
+  EXPECT_EQ(absent, static_cast<int>(topology.boundary_edges.size()));
 }
 
-/// E over (alpha/2) |K|^2 A for the surface z = p^T K p / 2 (tiny amplitude), summed over the elements.
+/// The continuum energy density, over alpha/2, that a triangle should carry for the constant curvature K: |K|^2
+/// inside; at the border the least |K - S|^2 over the tensors S spanned by n n^T of its free edges' normals n (the
+/// components its hinges do not see, relaxed to zero moment: the free edge's natural boundary condition).
+double expected_density(const Eigen::Matrix2d& k, const std::vector<Eigen::Vector2d>& free_normals) {
+  if (free_normals.empty()) return k.squaredNorm();
+  Eigen::MatrixXd basis(4, static_cast<Eigen::Index>(free_normals.size()));  // vec(n n^T) per free edge
+  for (std::size_t i = 0; i < free_normals.size(); ++i) {
+    const Eigen::Matrix2d nn = free_normals[i] * free_normals[i].transpose();
+    basis.col(static_cast<Eigen::Index>(i)) = Eigen::Map<const Eigen::Vector4d>(nn.data());
+  }
+  const Eigen::Vector4d v = Eigen::Map<const Eigen::Vector4d>(k.data());
+  const Eigen::VectorXd c = basis.colPivHouseholderQr().solve(v);
+  return (v - basis * c).squaredNorm();
+}
+
+/// E over the continuum energy (alpha/2) sum_T density_T area_T for the surface z = p^T K p / 2 (tiny amplitude),
+/// K a cylinder bent about an axis at `axis_degrees`.
 double energy_ratio(Triangulation triangulation, double jitter, double axis_degrees) {
   const ClothMesh mesh = make_specimen(SpecimenSpec{0.1, 0.1, 21, 21, jitter, triangulation, 5, 0.0});
   const Topology topology = build_topology(mesh);
@@ -76,23 +90,34 @@ double energy_ratio(Triangulation triangulation, double jitter, double axis_degr
     const Eigen::Vector2d p = mesh.rest.col(v);
     x.col(v) << p, amplitude * 0.5 * p.dot(k * p);
   }
-  double area = 0.0;  // of the elements
-  std::vector<int> vertices(6);
-  for (int e = 0; e < bending.element_count(); ++e) {
-    bending.element_vertices(e, vertices.data());
-    const Eigen::Vector2d u = mesh.rest.col(vertices[1]) - mesh.rest.col(vertices[0]),
-                          w = mesh.rest.col(vertices[2]) - mesh.rest.col(vertices[0]);
-    area += 0.5 * std::abs(u.x() * w.y() - u.y() * w.x());
+  std::set<std::pair<int, int>> free_edges;
+  for (const Eigen::Vector2i& e : topology.boundary_edges) free_edges.insert({std::min(e.x(), e.y()), std::max(e.x(), e.y())});
+  double continuum = 0.0;
+  for (int t = 0; t < mesh.triangle_count(); ++t) {
+    const Eigen::Vector2d p[3] = {mesh.rest.col(mesh.triangles(0, t)), mesh.rest.col(mesh.triangles(1, t)),
+                                  mesh.rest.col(mesh.triangles(2, t))};
+    std::vector<Eigen::Vector2d> normals;
+    for (int i = 0; i < 3; ++i) {
+      const int u = mesh.triangles((i + 1) % 3, t), w = mesh.triangles((i + 2) % 3, t);
+      if (free_edges.count({std::min(u, w), std::max(u, w)}) == 0) continue;
+      const Eigen::Vector2d edge = (p[(i + 2) % 3] - p[(i + 1) % 3]).normalized();
+      normals.emplace_back(-edge.y(), edge.x());
+    }
+    const Eigen::Vector2d u = p[1] - p[0], w = p[2] - p[0];
+    continuum += 0.5 * std::abs(u.x() * w.y() - u.y() * w.x()) * expected_density(k, normals);
   }
-  return bending.energy(x) / (0.5 * alpha * amplitude * amplitude * k.squaredNorm() * area);
+  return bending.energy(x) / (0.5 * alpha * amplitude * amplitude * continuum);
 }
 
 TEST(TriangleCurvatureBending, ExactForConstantCurvatureOnAnyTriangulation) {
-  // The hinge model gives 1.0 to 2.0 here depending on mesh and axis (bench/drape_physics.cpp, check d).
+  // Inside, the continuum energy; at the border, the continuum energy without the curvature normal to the free
+  // edge: exact where the border triangles' hinges are symmetric about that normal (union jack), within 0.1% of the
+  // whole where they are not (their hinges see a little of it). The hinge model gives 1.0 to 2.0 here depending on
+  // mesh and axis (bench/drape_physics.cpp, check d).
   for (double axis : {0.0, 22.5, 45.0}) {
     EXPECT_NEAR(energy_ratio(Triangulation::kAlternating, 0.0, axis), 1.0, 1e-4) << axis;
-    EXPECT_NEAR(energy_ratio(Triangulation::kRandom, 0.2, axis), 1.0, 1e-4) << axis;
-    EXPECT_NEAR(energy_ratio(Triangulation::kEquilateral, 0.0, axis), 1.0, 1e-4) << axis;
+    EXPECT_NEAR(energy_ratio(Triangulation::kRandom, 0.2, axis), 1.0, 1.5e-3) << axis;
+    EXPECT_NEAR(energy_ratio(Triangulation::kEquilateral, 0.0, axis), 1.0, 1.5e-3) << axis;
   }
 }
 

@@ -72,15 +72,9 @@ class DihedralBending final : public EnergyTerm {
   /// moves until the torque equals the yield torque (return mapping). Infinity (the default) is elastic.
   void set_yield_curvature(double yield_curvature);
 
-  /// Scales each hinge's energy (1 by default); TriangleCurvatureBending leaves border hinges to this model.
-  void set_hinge_weights(Eigen::VectorXd weights);
-
  private:
   /// Sets every hinge's torque law from its bending angle; returns the largest relative change of alpha or beta.
   double assign_laws();
-  [[nodiscard]] double hinge_weight(std::size_t i) const {
-    return weight_.size() == 0 ? 1.0 : weight_[static_cast<Eigen::Index>(i)];
-  }
 
   const ClothMesh* mesh_;
   const Topology* topology_;
@@ -92,7 +86,6 @@ class DihedralBending final : public EnergyTerm {
   AnisotropyRule rule_;
   Eigen::VectorXd rest_angle_;
   double yield_curvature_ = std::numeric_limits<double>::infinity();
-  Eigen::VectorXd weight_;  // empty: all 1
 };
 
 /// Bergou et al. 2006 (paper Eq. 4): E_h = 3 gamma / ((H0 + H1) e) * |K x|^2 with the hinge's cotangent weights K.

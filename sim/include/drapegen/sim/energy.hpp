@@ -31,7 +31,8 @@ class EnergyTerm {
   /// Vertices per element (1: per-vertex terms, 3: triangles, 4: hinges).
   [[nodiscard]] virtual int arity() const = 0;
   [[nodiscard]] virtual int element_count() const = 0;
-  /// Writes the element's `arity()` vertex indices to `out`.
+  /// Writes the element's `arity()` vertex indices to `out`; -1 marks an unused slot (an element with fewer
+  /// vertices than the arity, e.g. a border triangle's missing wing).
   virtual void element_vertices(int element, int* out) const = 0;
   /// Whether the term has a non-zero Hessian at all (gravity does not).
   [[nodiscard]] virtual bool has_hessian() const { return true; }

@@ -39,9 +39,12 @@ class HessianAssembler {
     const EnergyTerm* term;
     int arity;
     // Per element, per ordered local pair (a, b), per column c of the block: the value index of row 0 of that
-    // block column (-1 where the pair is not stored: a fixed vertex, or the block lies above the diagonal).
+    // block column (-1 where the pair is not stored: a fixed or absent vertex, or the block lies above the diagonal).
     std::vector<int> offsets;
   };
+
+  /// free_index, and -1 for an element's unused slot (vertex -1).
+  [[nodiscard]] int free_or_absent(int vertex) const { return vertex < 0 ? -1 : free_index_[vertex]; }
 
   int free_count_ = 0;
   std::vector<int> free_index_;

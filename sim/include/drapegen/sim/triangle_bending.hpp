@@ -11,8 +11,9 @@
 // the torque law alpha kappa + beta kappa^2 in that direction (Eq. 8 interpolation) and alpha_t the mean of the two
 // directions' alpha. For isotropic linear bending W = (alpha/2)|K|^2. The hinge model (DihedralBending) measures
 // curvature per hinge instead, and on right-triangle grids picks up twist that depends on the diagonals
-// (docs/PHYSICS.md). Triangles at the border (fewer than three hinges) leave their hinges to the hinge model:
-// border_sides() gives the weights (DihedralBending::set_hinge_weights).
+// (docs/PHYSICS.md). A triangle at the border has only one or two hinges: the components of K they do not measure
+// take the values of least linear bending energy (zero moment across the free edge, its natural boundary
+// condition), so the whole specimen is one model and no hinge energy remains.
 
 #include <Eigen/Core>
 #include <memory>
@@ -35,31 +36,29 @@ class TriangleCurvatureBending final : public EnergyTerm {
   [[nodiscard]] std::string_view name() const override { return "triangle bending"; }
   [[nodiscard]] int arity() const override { return 6; }
   [[nodiscard]] int element_count() const override { return static_cast<int>(elements_.size()); }
+  /// The triangle, then its wings; -1 for a border triangle's missing wings.
   void element_vertices(int element, int* out) const override;
   /// Recomputes each triangle's bending direction (curvature rule) and its torque laws.
   double update_lagged(const Eigen::Matrix3Xd& x) override;
   [[nodiscard]] double energy(const Eigen::Matrix3Xd& x) const override { return evaluate(x, nullptr, nullptr); }
   double evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd* gradient, HessianSink* hessian) const override;
 
-  /// Per hinge: how many of its two triangles are border triangles (0, 1 or 2). The hinge model keeps half of a
-  /// hinge's energy per border side.
-  [[nodiscard]] const std::vector<int>& border_sides() const { return border_sides_; }
-  /// Twice the weights DihedralBending::set_hinge_weights needs, as a vector.
-  [[nodiscard]] Eigen::VectorXd border_hinge_weights() const;
 
  private:
   struct Element {
-    int vertices[6];             // triangle (0-2), then the wing across each edge (3-5)
+    int vertices[6];             // triangle (0-2), then the wing across each hinge (3-5; -1 where none)
+    int hinge_count = 0;         // 3 inside, 1 or 2 at the border
     Hinge hinge[3];              // each hinge in the topology's vertex order
     int slot[3][4];              // hinge vertex -> element slot
+    Eigen::Matrix3d constraint;  // row i: d theta_i / d (K_xx, K_xy, K_yy) (rows past hinge_count: zero)
     Eigen::Matrix3d to_tensor;   // (K_xx, K_xy, K_yy) = to_tensor * theta
     double area = 0.0;
     Eigen::Matrix3d measure;     // rows: d kappa_d, d kappa_p, d kappa_t / d theta
     TorqueLaw along, across;     // laws in the bending direction and across it
     double twist = 0.0;          // alpha_t
   };
-  /// Sets the laws and curvature measures of element e for bending direction d (rest frame, unit); returns the
-  /// relative change of its moduli.
+  /// Sets the laws and curvature measures of element e (and a border triangle's tensor map) for bending direction
+  /// d (rest frame, unit); returns the relative change of its moduli.
   double assign(Element& e, const Eigen::Vector2d& d) const;
 
   const ClothMesh* mesh_;
@@ -67,16 +66,7 @@ class TriangleCurvatureBending final : public EnergyTerm {
   DihedralModuli moduli_;
   AnisotropyRule rule_;
   std::vector<Element> elements_;
-  std::vector<int> border_sides_;
   AnisotropyWorkspace workspace_;
 };
-
-/// The kNonlinearTriangle model over the hinge model: builds the triangle term and leaves `hinges` only the border
-/// triangles' share (DihedralBending::set_hinge_weights). Both terms go into the energy.
-[[nodiscard]] std::unique_ptr<TriangleCurvatureBending> add_triangle_curvature(DihedralBending& hinges,
-                                                                              const ClothMesh& mesh,
-                                                                              const Topology& topology,
-                                                                              const DihedralModuli& moduli,
-                                                                              AnisotropyRule rule);
 
 }  // namespace drapegen::sim
