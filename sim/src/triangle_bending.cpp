@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "drapegen/sim/dihedral.hpp"
+#include "drapegen/sim/psd_projection.hpp"
 
 namespace drapegen::sim {
 
@@ -158,6 +159,9 @@ double TriangleCurvatureBending::evaluate(const Eigen::Matrix3Xd& x, Eigen::Matr
   Eigen::Matrix<double, 18, 3> jacobian;  // d theta_i / d x
   Matrix18d element;
   const bool exact = hessian != nullptr && hessian->mode() == HessianMode::kExact;
+  // The angles' own second derivatives (torque x Hessian of theta_i): exact, or per hinge projected to positive
+  // semi-definite (kProjected); the Gauss-Newton mode leaves them out.
+  const bool angle_hessians = hessian != nullptr && hessian->mode() != HessianMode::kGaussNewton;
   for (std::size_t t = 0; t < elements_.size(); ++t) {
     const Element& e = elements_[t];
     Eigen::Vector3d theta;
@@ -166,7 +170,7 @@ double TriangleCurvatureBending::evaluate(const Eigen::Matrix3Xd& x, Eigen::Matr
     for (int i = 0; i < e.hinge_count; ++i) {
       const Hinge& h = e.hinge[i];
       const bool need_gradient = gradient != nullptr || hessian != nullptr;
-      theta(i) = exact ? dihedral_angle_hessian(x.col(h.v0), x.col(h.v1), x.col(h.v2), x.col(h.v3), g, h2[i])
+      theta(i) = angle_hessians ? dihedral_angle_hessian(x.col(h.v0), x.col(h.v1), x.col(h.v2), x.col(h.v3), g, h2[i])
                  : need_gradient ? dihedral_angle_gradient(x.col(h.v0), x.col(h.v1), x.col(h.v2), x.col(h.v3), g)
                                  : dihedral_angle(x.col(h.v0), x.col(h.v1), x.col(h.v2), x.col(h.v3));
       if (!need_gradient) continue;
@@ -189,17 +193,17 @@ double TriangleCurvatureBending::evaluate(const Eigen::Matrix3Xd& x, Eigen::Matr
     const Eigen::Vector3d stiffness(e.along.stiffness(k0), e.across.stiffness(k1), 2.0 * e.twist);
     const Eigen::Matrix3d d2e = e.area * e.measure.transpose() * stiffness.asDiagonal() * e.measure;  // PSD
     element.noalias() = jacobian * d2e * jacobian.transpose();
-    if (exact) {
+    if (angle_hessians) {
       for (int i = 0; i < e.hinge_count; ++i) {
+        Matrix12d term = torque(i) * h2[i];
+        if (!exact) project_to_psd<12>(term);
         for (int a = 0; a < 4; ++a) {
           for (int c = 0; c < 4; ++c) {
-            element.block<3, 3>(3 * e.slot[i][a], 3 * e.slot[i][c]) += torque(i) * h2[i].block<3, 3>(3 * a, 3 * c);
+            element.block<3, 3>(3 * e.slot[i][a], 3 * e.slot[i][c]) += term.block<3, 3>(3 * a, 3 * c);
           }
         }
       }
     }
-    // kProjected and kGaussNewton: the Gauss-Newton matrix, positive semi-definite by construction (an 18 x 18
-    // eigen-projection per triangle would cost more than the whole assembly).
     hessian->add(static_cast<int>(t), element.data());
   }
   return total;
