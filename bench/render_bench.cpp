@@ -82,9 +82,9 @@ void timing(Renderer& renderer, const TriangleMesh& cloth, int data_points, cons
   }
   const double wall = now() - wall0, cpu = cpu_now() - cpu0;
   const int views = data_points * request.rig.views;
-  fmt::print("timing: {} data points x {} views, {} triangles (cloth + cylinder), storage {} {}\n", data_points,
-             request.rig.views, tester_scene(cloth, request.rig).triangle_count(),
-             storage.pixel == ExrStorage::Pixel::kHalf ? "half" : "float", storage.compression);
+  fmt::print("timing: {} data points x {} views, {} triangles (cloth + cylinder), storage {} {} (zip level {})\n",
+             data_points, request.rig.views, tester_scene(cloth, request.rig).triangle_count(),
+             storage.pixel == ExrStorage::Pixel::kHalf ? "half" : "float", storage.compression, storage.zip_level);
   fmt::print("  CPU time: render {:.3f} ms/view, noise {:.3f} ms/view, EXR encode {:.3f} ms/view\n", 1e3 * t_render / views,
              1e3 * t_noise / views, 1e3 * t_encode / views);
   // Per core = per CPU-second of this (single-threaded) process; wall time also counts waiting for a shared core.
@@ -106,7 +106,8 @@ void storage_table(Renderer& renderer, const TriangleMesh& cloth, int data_point
   for (const std::string c : {"zip", "zips", "piz", "rle", "b44a", "dwaa", "dwab"}) {
     options.push_back({ExrStorage{.pixel = ExrStorage::Pixel::kHalf, .compression = c}, "half " + c});
   }
-  for (int level : {1, 9}) {
+  for (int level : {1, 2, 3, 4, 9}) {
+    if (level == ExrStorage{}.zip_level) continue;  // the "half zip" row
     options.push_back({ExrStorage{.pixel = ExrStorage::Pixel::kHalf, .compression = "zip", .zip_level = level},
                        fmt::format("half zip level {}", level)});
   }
@@ -210,6 +211,7 @@ int main(int argc, char** argv) {
   bool all_triangles = false;
   bool storage = false, check = false;
   std::string pixel = "half", compression = "zip", renderer_name = "software";
+  int zip_level = ExrStorage{}.zip_level;
   app.add_option("--mesh", mesh_path, "Draped mesh (PLY) from drapegen simulate --out")->required();
   app.add_option("--data-points", data_points, "Data points (x 4 views) to time")->capture_default_str();
   app.add_option("--renderer", renderer_name, "software (SoftwareRenderer) or osmesa (DepthRenderer)")
@@ -217,6 +219,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--pixel", pixel, "EXR pixel type for the timing: half or float")->capture_default_str();
   app.add_option("--compression", compression, "EXR compression for the timing")->capture_default_str();
+  app.add_option("--zip-level", zip_level, "zlib level of zip/zips for the timing")->capture_default_str();
   app.add_flag("--all-triangles", all_triangles,
                "osmesa: draw every triangle (RendererOptions::skip_empty_triangles off)");
   app.add_flag("--storage", storage, "Also measure bytes and storage error of every EXR option");
@@ -233,6 +236,7 @@ int main(int argc, char** argv) {
   ExrStorage s;
   s.pixel = pixel == "float" ? ExrStorage::Pixel::kFloat : ExrStorage::Pixel::kHalf;
   s.compression = compression;
+  s.zip_level = zip_level;
   timing(*renderer, cloth, data_points, s);
   if (storage) storage_table(*renderer, cloth, std::min(data_points, 12));
   if (check) crosscheck(*renderer, cloth, 3);

@@ -2,7 +2,6 @@
 // One job, computed: the drape simulated from its (parameters, recipe, seeds), its data points rendered and encoded
 // as OpenEXR in memory, and the answer to the coordinator (a Result or a Failure with its reason).
 
-#include <memory>
 #include <optional>
 #include <string>
 
