@@ -198,8 +198,19 @@ sim::Expected<DepthImage> SoftwareRenderer::render(const Camera& camera, const E
   Target target{image, triangle_of_, range_, {}};
   const auto volume = clip_volume(K, range_.near);
   std::array<Eigen::Vector3d, 8> polygon;
+  // Back faces of closed surfaces are hidden unless the near plane cuts them open (then none is skipped).
+  int closed_from = scene_.closed_from >= 0 ? scene_.closed_from : scene_.triangle_count();
+  for (int id = closed_from; id < scene_.triangle_count(); ++id) {
+    for (int k : scene_.triangles[id]) {
+      if (!(eye_[k].z() >= range_.near)) closed_from = scene_.triangle_count();
+    }
+  }
   for (int id = 0; id < scene_.triangle_count(); ++id) {
     const std::array<int, 3>& tri = scene_.triangles[id];
+    if (id >= closed_from) {  // a back face (its normal points away from the camera)
+      const Eigen::Vector3d& p = eye_[tri[0]];
+      if ((eye_[tri[1]] - p).cross(eye_[tri[2]] - p).dot(p) >= 0.0) continue;
+    }
     const Point &a = points_[tri[0]], &b = points_[tri[1]], &c = points_[tri[2]];
     if (!(a.clipped || b.clipped || c.clipped)) {
       target.triangle(a, b, c, id);

@@ -138,6 +138,35 @@ TEST(SoftwareRenderer, AgreesWithOsmesaWhereClipped) {
   EXPECT_LT(worst_incidence, 1e-2);
 }
 
+// The software rasteriser skips the platform's back faces (TriangleMesh::closed_from): the images are those of the
+// whole scene but for pixel centres exactly on the platform's silhouette edges (the back face's under the top-left
+// rule).
+TEST(SoftwareRenderer, SkippingThePlatformsBackFacesChangesAlmostNothing) {
+  const RigSpec rig;
+  const TriangleMesh scene = tester_scene(real_drape(), rig);
+  ASSERT_EQ(scene.closed_from, real_drape().triangle_count());
+  TriangleMesh all_open = scene;
+  all_open.closed_from = -1;
+  SoftwareRenderer culling, drawing_all;
+  ASSERT_TRUE(culling.set_scene(scene));
+  ASSERT_TRUE(drawing_all.set_scene(all_open));
+  long foreground = 0, differing = 0;
+  for (const auto& setup : plan_data_points(rig, AugmentationSpec{.orientations = 3}, 7)) {
+    for (const auto& view : setup.views) {
+      auto a = culling.render(view.camera, view.model);
+      auto b = drawing_all.render(view.camera, view.model);
+      ASSERT_TRUE(a && b);
+      foreground += b->foreground_count();
+      for (std::size_t i = 0; i < a->depth.size(); ++i) {
+        differing += a->depth[i] != b->depth[i] || a->incidence[i] != b->incidence[i];
+      }
+    }
+  }
+  std::printf("platform back faces skipped: %ld of %ld foreground pixels differ\n", differing, foreground);
+  EXPECT_GT(foreground, 12 * 3000);
+  EXPECT_LE(differing, 12);  // at most about one silhouette pixel per view
+}
+
 // RendererOptions::skip_empty_triangles leaves out triangles that cover no pixel centre: the images must be the same
 // bit for bit as drawing every triangle, also when the drape is partly outside the image or reaches the near plane.
 TEST(DepthRenderer, SkippingEmptyTrianglesChangesNoPixel) {
