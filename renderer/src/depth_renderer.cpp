@@ -162,7 +162,8 @@ DepthRenderer& DepthRenderer::operator=(DepthRenderer&&) noexcept = default;
 DepthRenderer::~DepthRenderer() = default;
 
 sim::Expected<DepthRenderer> DepthRenderer::create(const RendererOptions& options) {
-  if (!(options.range.near > 0.0 && options.range.far > options.range.near)) return sim::Error{"renderer: need 0 < near < far"};
+  const DepthRange& range = options.range;
+  if (!(range.near > 0.0 && range.far > range.near)) return sim::Error{"renderer: need 0 < near < far"};
   if (options.threads >= 0) setenv("LP_NUM_THREADS", std::to_string(options.threads).c_str(), /*overwrite=*/0);
   auto impl = std::make_unique<Impl>();
   impl->options = options;
@@ -230,8 +231,8 @@ sim::Expected<DepthImage> DepthRenderer::render(const Camera& camera, const Eige
   if (sim::Status s = impl_->resize(W, H); !s) return s.error();
 
   const Eigen::Matrix4f model_view = (camera.world_to_camera * model).matrix().cast<float>();
-  const Eigen::Matrix4f projection = gl_projection(camera.intrinsics, impl_->options.range.near, impl_->options.range.far)
-                                         .cast<float>();
+  const DepthRange& range = impl_->options.range;
+  const Eigen::Matrix4f projection = gl_projection(camera.intrinsics, range.near, range.far).cast<float>();
   glBindFramebuffer(GL_FRAMEBUFFER, impl_->fbo);
   glViewport(0, 0, W, H);
   glClearColor(0.0f, 0.0f, 0.0f, 0.0f);

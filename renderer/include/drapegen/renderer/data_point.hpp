@@ -6,9 +6,9 @@
 #include <string>
 #include <vector>
 
-#include "drapegen/renderer/renderer.hpp"
 #include "drapegen/renderer/exr.hpp"
 #include "drapegen/renderer/noise.hpp"
+#include "drapegen/renderer/renderer.hpp"
 #include "drapegen/renderer/rig.hpp"
 
 namespace drapegen::renderer {

@@ -33,7 +33,8 @@ class Renderer {
   [[nodiscard]] virtual sim::Expected<DepthImage> render(
       const Camera& camera, const Eigen::Isometry3d& model = Eigen::Isometry3d::Identity()) = 0;
 
-  /// What renders, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)" (stored in run summaries).
+  /// What renders: "drapegen software rasteriser", or OpenGL's renderer string such as "llvmpipe (LLVM 15.0.6, 256
+  /// bits)" (in drapegen render's JSON summary).
   [[nodiscard]] virtual std::string name() const = 0;
 
  protected:

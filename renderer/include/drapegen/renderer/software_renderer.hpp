@@ -15,7 +15,8 @@ namespace drapegen::renderer {
 /// Coverage follows OpenGL's rules: a pixel is drawn where its centre is inside a triangle, a centre on an edge
 /// shared by two triangles belongs to exactly one of them (top-left rule), zero-area triangles cover nothing,
 /// triangles crossing the near plane are clipped to it. Depth is the perspective-correct interpolation of camera z
-/// in double precision, the incidence cosine that of the triangle's plane. Not thread-safe; one per thread.
+/// in double precision, the incidence cosine that of the triangle's plane. Back faces of closed surfaces
+/// (TriangleMesh::closed_from) are skipped. Not thread-safe; one per thread.
 class SoftwareRenderer final : public Renderer {
  public:
   explicit SoftwareRenderer(DepthRange range = {});
@@ -38,7 +39,7 @@ class SoftwareRenderer final : public Renderer {
  private:
   DepthRange range_;
   TriangleMesh scene_;
-  // Per vertex, in the current view: camera-space position, and image position and 1/z if in front of the near plane.
+  // Per vertex, in the current view: camera-space position, and its image point.
   std::vector<Eigen::Vector3d> eye_;
   std::vector<ImagePoint> points_;
   std::vector<int> triangle_of_;  // per pixel: the triangle seen
