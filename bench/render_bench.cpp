@@ -1,8 +1,9 @@
 // Renderer benchmark (docs/BENCHMARKS.md, docs/RENDERER.md): views per second on one core for a drape, split into
-// render / noise / EXR encode; bytes per view and storage error for every EXR storage option; the OSMesa vs CPU
-// ray-cast cross-check.
+// render / noise / EXR encode; bytes per view and storage error for every EXR storage option; the cross-check of
+// the renderer against the CPU ray cast.
 //
-//   drapegen_render_bench --mesh drape100.ply [--data-points 48] [--storage] [--crosscheck]
+//   drapegen_render_bench --mesh drape100.ply [--renderer software|osmesa] [--data-points 48] [--storage]
+//                         [--crosscheck]
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
@@ -10,11 +11,13 @@
 #include <chrono>
 #include <cmath>
 #include <ctime>
+#include <memory>
 #include <time.h>
 #include <string>
 #include <vector>
 
 #include "drapegen/renderer/data_point.hpp"
+#include "drapegen/renderer/make_renderer.hpp"
 #include "drapegen/renderer/exr.hpp"
 #include "drapegen/renderer/ray_caster.hpp"
 #include "drapegen/sim/ply.hpp"
@@ -41,14 +44,14 @@ T unwrap(sim::Expected<T> e) {
   return std::move(*e);
 }
 
-void timing(DepthRenderer& renderer, const TriangleMesh& cloth, int data_points, const ExrStorage& storage) {
+void timing(Renderer& renderer, const TriangleMesh& cloth, int data_points, const ExrStorage& storage) {
   RenderRequest request;
   request.augmentation.orientations = data_points;
   request.seed = 1;
   const auto setups = plan_data_points(request.rig, request.augmentation, request.seed);
   if (sim::Status s = renderer.set_scene(tester_scene(cloth, request.rig)); !s) std::exit(1);
   const ExrWriter writer(storage);
-  // Warm-up (shader compilation, first framebuffer).
+  // Warm-up (OSMesa: shader compilation, first framebuffer).
   (void)unwrap(renderer.render(setups[0].views[0].camera, setups[0].views[0].model));
 
   double t_render = 0, t_noise = 0, t_encode = 0;
@@ -79,9 +82,9 @@ void timing(DepthRenderer& renderer, const TriangleMesh& cloth, int data_points,
   }
   const double wall = now() - wall0, cpu = cpu_now() - cpu0;
   const int views = data_points * request.rig.views;
-  fmt::print("timing: {} data points x {} views, {} triangles (cloth + cylinder), storage {} {}\n", data_points,
-             request.rig.views, tester_scene(cloth, request.rig).triangle_count(),
-             storage.pixel == ExrStorage::Pixel::kHalf ? "half" : "float", storage.compression);
+  fmt::print("timing: {} data points x {} views, {} triangles (cloth + cylinder), storage {} {} (zip level {})\n",
+             data_points, request.rig.views, tester_scene(cloth, request.rig).triangle_count(),
+             storage.pixel == ExrStorage::Pixel::kHalf ? "half" : "float", storage.compression, storage.zip_level);
   fmt::print("  CPU time: render {:.3f} ms/view, noise {:.3f} ms/view, EXR encode {:.3f} ms/view\n", 1e3 * t_render / views,
              1e3 * t_noise / views, 1e3 * t_encode / views);
   // Per core = per CPU-second of this (single-threaded) process; wall time also counts waiting for a shared core.
@@ -95,7 +98,7 @@ struct StorageOption {
   std::string label;
 };
 
-void storage_table(DepthRenderer& renderer, const TriangleMesh& cloth, int data_points) {
+void storage_table(Renderer& renderer, const TriangleMesh& cloth, int data_points) {
   std::vector<StorageOption> options;
   for (const std::string c : {"zip", "zips", "piz", "pxr24", "rle", "b44a", "dwaa", "dwab"}) {
     options.push_back({ExrStorage{.pixel = ExrStorage::Pixel::kFloat, .compression = c}, "float " + c});
@@ -103,7 +106,8 @@ void storage_table(DepthRenderer& renderer, const TriangleMesh& cloth, int data_
   for (const std::string c : {"zip", "zips", "piz", "rle", "b44a", "dwaa", "dwab"}) {
     options.push_back({ExrStorage{.pixel = ExrStorage::Pixel::kHalf, .compression = c}, "half " + c});
   }
-  for (int level : {1, 9}) {
+  for (int level : {1, 2, 3, 4, 9}) {
+    if (level == ExrStorage{}.zip_level) continue;  // the "half zip" row
     options.push_back({ExrStorage{.pixel = ExrStorage::Pixel::kHalf, .compression = "zip", .zip_level = level},
                        fmt::format("half zip level {}", level)});
   }
@@ -168,7 +172,7 @@ void storage_table(DepthRenderer& renderer, const TriangleMesh& cloth, int data_
   }
 }
 
-void crosscheck(DepthRenderer& renderer, const TriangleMesh& cloth, int data_points) {
+void crosscheck(Renderer& renderer, const TriangleMesh& cloth, int data_points) {
   const RigSpec rig;
   const TriangleMesh scene = tester_scene(cloth, rig);
   if (sim::Status s = renderer.set_scene(scene); !s) std::exit(1);
@@ -178,16 +182,16 @@ void crosscheck(DepthRenderer& renderer, const TriangleMesh& cloth, int data_poi
   const double t0 = now();
   for (const auto& setup : plan_data_points(rig, AugmentationSpec{.orientations = data_points}, 3)) {
     for (const auto& view : setup.views) {
-      const DepthImage gl = unwrap(renderer.render(view.camera, view.model));
-      const DepthImage cpu = caster.render(view.camera, view.model);
-      for (std::size_t i = 0; i < gl.depth.size(); ++i) {
-        if (gl.depth[i] == 0.0f && cpu.depth[i] == 0.0f) continue;
+      const DepthImage image = unwrap(renderer.render(view.camera, view.model));
+      const DepthImage reference = caster.render(view.camera, view.model);
+      for (std::size_t i = 0; i < image.depth.size(); ++i) {
+        if (image.depth[i] == 0.0f && reference.depth[i] == 0.0f) continue;
         ++foreground;
-        if ((gl.depth[i] == 0.0f) != (cpu.depth[i] == 0.0f)) {
+        if ((image.depth[i] == 0.0f) != (reference.depth[i] == 0.0f)) {
           ++one_only;
           continue;
         }
-        const double e = std::abs(static_cast<double>(gl.depth[i]) - cpu.depth[i]);
+        const double e = std::abs(static_cast<double>(image.depth[i]) - reference.depth[i]);
         if (e <= 5e-4) ++agree;
         worst = std::max(worst, e);
       }
@@ -206,26 +210,35 @@ int main(int argc, char** argv) {
   int data_points = 48;
   bool all_triangles = false;
   bool storage = false, check = false;
-  std::string pixel = "half", compression = "zip";
+  std::string pixel = "half", compression = "zip", renderer_name = "software";
+  int zip_level = ExrStorage{}.zip_level;
   app.add_option("--mesh", mesh_path, "Draped mesh (PLY) from drapegen simulate --out")->required();
   app.add_option("--data-points", data_points, "Data points (x 4 views) to time")->capture_default_str();
+  app.add_option("--renderer", renderer_name, "software (SoftwareRenderer) or osmesa (DepthRenderer)")
+      ->check(CLI::IsMember(kRendererNames))
+      ->capture_default_str();
   app.add_option("--pixel", pixel, "EXR pixel type for the timing: half or float")->capture_default_str();
   app.add_option("--compression", compression, "EXR compression for the timing")->capture_default_str();
-  app.add_flag("--all-triangles", all_triangles, "Draw every triangle (RendererOptions::skip_empty_triangles off)");
+  app.add_option("--zip-level", zip_level, "zlib level of zip/zips for the timing")->capture_default_str();
+  app.add_flag("--all-triangles", all_triangles,
+               "osmesa: draw every triangle (RendererOptions::skip_empty_triangles off)");
   app.add_flag("--storage", storage, "Also measure bytes and storage error of every EXR option");
-  app.add_flag("--crosscheck", check, "Also compare OSMesa with the CPU ray cast on this drape");
+  app.add_flag("--crosscheck", check, "Also compare the renderer with the CPU ray cast on this drape");
   CLI11_PARSE(app, argc, argv);
 
   const auto mesh = unwrap(sim::read_ply(mesh_path));
   const auto cloth = unwrap(cloth_triangles(mesh));
-  auto renderer = unwrap(DepthRenderer::create(RendererOptions{.skip_empty_triangles = !all_triangles}));
+  RendererOptions osmesa;
+  osmesa.skip_empty_triangles = !all_triangles;
+  const auto renderer = unwrap(make_renderer(renderer_name, osmesa));
   fmt::print("mesh {}: {} vertices, {} triangles; renderer {}\n", mesh_path, cloth.vertex_count(),
-             cloth.triangle_count(), renderer.gl_renderer());
+             cloth.triangle_count(), renderer->name());
   ExrStorage s;
   s.pixel = pixel == "float" ? ExrStorage::Pixel::kFloat : ExrStorage::Pixel::kHalf;
   s.compression = compression;
-  timing(renderer, cloth, data_points, s);
-  if (storage) storage_table(renderer, cloth, std::min(data_points, 12));
-  if (check) crosscheck(renderer, cloth, 3);
+  s.zip_level = zip_level;
+  timing(*renderer, cloth, data_points, s);
+  if (storage) storage_table(*renderer, cloth, std::min(data_points, 12));
+  if (check) crosscheck(*renderer, cloth, 3);
   return 0;
 }

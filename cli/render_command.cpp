@@ -10,6 +10,7 @@
 
 #include "commands.hpp"
 #include "drapegen/renderer/data_point.hpp"
+#include "drapegen/renderer/make_renderer.hpp"
 #include "drapegen/renderer/preview.hpp"
 #include "drapegen/sim/ply.hpp"
 #include "parse.hpp"
@@ -22,6 +23,7 @@ struct RenderOptions {
   std::string out;
   int orientations = 12;
   std::string noise = "kinect";
+  std::string renderer_name = renderer::kRendererNames.front();
   std::uint64_t seed = 0;
   std::string preview;
   bool json = false;
@@ -77,10 +79,10 @@ int run_render(const RenderOptions& o) {
   const auto cloth = cloth_triangles(*mesh);
   if (!cloth) return fail(fmt::format("{}: {}", o.mesh, cloth.error().message));
 
-  auto renderer = DepthRenderer::create();
+  auto renderer = make_renderer(o.renderer_name);
   if (!renderer) return fail(renderer.error().message);
   const auto render_start = std::chrono::steady_clock::now();
-  auto points = render_data_points(*renderer, *cloth, request);
+  auto points = render_data_points(**renderer, *cloth, request);
   if (!points) return fail(fmt::format("{}: {}", o.mesh, points.error().message));
   // A view with no return at all is a broken setup, never a data point.
   for (const auto& p : *points) {
@@ -118,7 +120,7 @@ int run_render(const RenderOptions& o) {
   const int views = o.orientations * request.rig.views;
   if (o.json) {
     nlohmann::json summary = {{"mesh", o.mesh},
-                              {"renderer", renderer->gl_renderer()},
+                              {"renderer", (*renderer)->name()},
                               {"noise", request.noise.describe()},
                               {"seed", o.seed},
                               {"storage", fmt::format("{} {} quantum={} m", o.pixel, o.compression, o.quantum)},
@@ -151,6 +153,9 @@ Runner add_render_command(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--noise", o->noise, "Depth noise model: kinect or none (clean depth)")
       ->check(CLI::IsMember({"kinect", "none"}))
+      ->capture_default_str();
+  app.add_option("--renderer", o->renderer_name, "Depth renderer: software (CPU rasteriser) or osmesa (OpenGL)")
+      ->check(CLI::IsMember(renderer::kRendererNames))
       ->capture_default_str();
   app.add_option("--seed", o->seed, "Seed of orientations, perturbations and noise")->capture_default_str();
   app.add_option("--preview", o->preview, "Also write a PNG: one row per data point, its views side by side");

@@ -74,6 +74,13 @@ foreach(k 00 01 02)
   endif()
 endforeach()
 
+# The OpenGL renderer instead of the default software rasteriser.
+run(${DRAPEGEN} render --mesh ${WORK}/drape.ply --out ${WORK}/gl.exr --orientations 1 --renderer osmesa --json)
+string(JSON renderer GET "${out}" renderer)
+if(NOT renderer MATCHES "llvmpipe|softpipe")
+  message(FATAL_ERROR "--renderer osmesa rendered with '${renderer}'")
+endif()
+
 # One data point: exactly the --out path; clean depth.
 run(${DRAPEGEN} render --mesh ${WORK}/drape.ply --out ${WORK}/clean.exr --orientations 1 --noise none)
 if(NOT EXISTS ${WORK}/clean.exr)

@@ -25,7 +25,7 @@ sim::Status check_in_view(const TriangleMesh& cloth, const RigSpec& rig, const s
   return {};
 }
 
-sim::Expected<std::vector<DataPointRecord>> render_data_points(DepthRenderer& renderer, const TriangleMesh& cloth,
+sim::Expected<std::vector<DataPointRecord>> render_data_points(Renderer& renderer, const TriangleMesh& cloth,
                                                                const RenderRequest& request,
                                                                std::vector<std::vector<DepthImage>>* clean) {
   if (sim::Status s = validate(cloth); !s) return s.error();

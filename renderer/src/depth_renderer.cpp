@@ -55,22 +55,6 @@ sim::Expected<GLuint> compile(GLenum type, const char* source) {
   return shader;
 }
 
-/// An inclusive rectangle of pixels (u0..u1, v0..v1); empty when u0 > u1 or v0 > v1.
-struct PixelBox {
-  int u0 = 0, v0 = 0, u1 = -1, v1 = -1;
-  [[nodiscard]] bool empty() const { return u0 > u1 || v0 > v1; }
-  void add(int a0, int b0, int a1, int b1) {
-    if (empty()) {
-      *this = PixelBox{a0, b0, a1, b1};
-      return;
-    }
-    u0 = std::min(u0, a0);
-    v0 = std::min(v0, b0);
-    u1 = std::max(u1, a1);
-    v1 = std::max(v1, b1);
-  }
-};
-
 }  // namespace
 
 struct DepthRenderer::Impl {
@@ -95,7 +79,7 @@ struct DepthRenderer::Impl {
   /// covers a centre is dropped. Triangles reaching the near plane are clipped by OpenGL: always kept.
   PixelBox select_triangles(const Eigen::Matrix<float, 3, 4>& P, int W, int H) {
     constexpr float kMargin = 1.0f / 64.0f;
-    const float near = static_cast<float>(options.near) * 1.001f;
+    const float near = static_cast<float>(options.range.near) * 1.001f;
     const std::size_t nv = scene.vertices.size();
     pixel.resize(nv);
     near_clipped.resize(nv);
@@ -178,7 +162,8 @@ DepthRenderer& DepthRenderer::operator=(DepthRenderer&&) noexcept = default;
 DepthRenderer::~DepthRenderer() = default;
 
 sim::Expected<DepthRenderer> DepthRenderer::create(const RendererOptions& options) {
-  if (!(options.near > 0.0 && options.far > options.near)) return sim::Error{"renderer: need 0 < near < far"};
+  const DepthRange& range = options.range;
+  if (!(range.near > 0.0 && range.far > range.near)) return sim::Error{"renderer: need 0 < near < far"};
   if (options.threads >= 0) setenv("LP_NUM_THREADS", std::to_string(options.threads).c_str(), /*overwrite=*/0);
   auto impl = std::make_unique<Impl>();
   impl->options = options;
@@ -239,18 +224,15 @@ sim::Status DepthRenderer::set_scene(const TriangleMesh& mesh) {
 }
 
 sim::Expected<DepthImage> DepthRenderer::render(const Camera& camera, const Eigen::Isometry3d& model) {
+  if (sim::Status s = check_view(camera, model); !s) return s.error();
   const int W = camera.intrinsics.width, H = camera.intrinsics.height;
-  if (W <= 0 || H <= 0 || W > 8192 || H > 8192) return sim::Error{fmt::format("bad image size {}x{}", W, H)};
-  if (!camera.intrinsics.K.allFinite() || !camera.world_to_camera.matrix().allFinite() || !model.matrix().allFinite()) {
-    return sim::Error{"camera or model pose is not finite"};
-  }
   if (impl_->index_count == 0) return sim::Error{"no scene to render (call set_scene first)"};
   if (!impl_->make_current()) return sim::Error{"OSMesa could not make its context current"};
   if (sim::Status s = impl_->resize(W, H); !s) return s.error();
 
   const Eigen::Matrix4f model_view = (camera.world_to_camera * model).matrix().cast<float>();
-  const Eigen::Matrix4f projection = gl_projection(camera.intrinsics, impl_->options.near, impl_->options.far)
-                                         .cast<float>();
+  const DepthRange& range = impl_->options.range;
+  const Eigen::Matrix4f projection = gl_projection(camera.intrinsics, range.near, range.far).cast<float>();
   glBindFramebuffer(GL_FRAMEBUFFER, impl_->fbo);
   glViewport(0, 0, W, H);
   glClearColor(0.0f, 0.0f, 0.0f, 0.0f);
@@ -296,7 +278,7 @@ sim::Expected<DepthImage> DepthRenderer::render(const Camera& camera, const Eige
   return image;
 }
 
-std::string DepthRenderer::gl_renderer() const {
+std::string DepthRenderer::name() const {
   if (!impl_->make_current()) return "unknown";
   const auto* name = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
   return name != nullptr ? name : "unknown";

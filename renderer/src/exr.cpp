@@ -180,20 +180,10 @@ sim::Expected<std::vector<char>> ExrWriter::encode(const DataPointRecord& point)
   }
   // The data window is the bounding box of the pixels with a return in any view (OpenEXR readers fill the rest of
   // the display window with 0, which is what no return means here).
-  int x0 = W, y0 = H, x1 = -1, y1 = -1;
-  for (const auto& v : point.views) {
-    for (int y = 0; y < H; ++y) {
-      for (int x = 0; x < W; ++x) {
-        if (v.depth.at(x, y) > 0.0f) {
-          x0 = std::min(x0, x);
-          x1 = std::max(x1, x);
-          y0 = std::min(y0, y);
-          y1 = std::max(y1, y);
-        }
-      }
-    }
-  }
-  if (x1 < 0) x0 = y0 = x1 = y1 = 0;  // nothing anywhere: one pixel of 0
+  PixelBox returns;
+  for (const auto& v : point.views) returns.add(v.depth.foreground_box());
+  if (returns.empty()) returns = PixelBox{0, 0, 0, 0};  // nothing anywhere: one pixel of 0
+  const int x0 = returns.u0, y0 = returns.v0, x1 = returns.u1, y1 = returns.v1;
   const int dw = x1 - x0 + 1, dh = y1 - y0 + 1;
   try {
     Imf::Header header(Imath::Box2i({0, 0}, {W - 1, H - 1}), Imath::Box2i({x0, y0}, {x1, y1}));

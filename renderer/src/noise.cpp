@@ -73,28 +73,21 @@ DepthImage NoiseModel::apply(const DepthImage& clean, std::uint64_t seed) const 
   // The box of pixels with a return, grown by `reach` pixels: outside it nothing can change (a lateral offset beyond
   // `reach` has probability < 1e-9 for sigma_L < 0.8 px), so the noise neither visits nor draws numbers there.
   constexpr int reach = 5;
-  int bx0 = W, by0 = H, bx1 = -1, by1 = -1;
-  for (int v = 0; v < H; ++v) {
-    const float* row = clean.depth.data() + static_cast<std::size_t>(v) * W;
-    for (int u = 0; u < W; ++u) {
-      if (row[u] > 0.0f) {
-        bx0 = std::min(bx0, u);
-        bx1 = std::max(bx1, u);
-        by0 = std::min(by0, v);
-        by1 = std::max(by1, v);
-      }
-    }
-  }
+  const PixelBox returns = clean.foreground_box();
   DepthImage out(W, H);
-  if (bx1 < 0) return out;
-  bx0 = std::max(0, bx0 - reach);
-  by0 = std::max(0, by0 - reach);
-  bx1 = std::min(W - 1, bx1 + reach);
-  by1 = std::min(H - 1, by1 + reach);
+  if (returns.empty()) return out;
+  const int bx0 = std::max(0, returns.u0 - reach), by0 = std::max(0, returns.v0 - reach);
+  const int bx1 = std::min(W - 1, returns.u1 + reach), by1 = std::min(H - 1, returns.v1 + reach);
 
-  // Lateral jitter: each pixel copies the clean pixel at a rounded Gaussian offset.
-  std::vector<float> z0 = clean.depth;
-  std::vector<float> c0 = have_incidence ? clean.incidence : std::vector<float>(n, 1.0f);
+  // Lateral jitter: each pixel copies the clean pixel at a rounded Gaussian offset. The jittered images are scratch
+  // reused by every call on this thread (no allocation per view).
+  thread_local std::vector<float> z0, c0;
+  z0.assign(clean.depth.begin(), clean.depth.end());
+  if (have_incidence) {
+    c0.assign(clean.incidence.begin(), clean.incidence.end());
+  } else {
+    c0.assign(n, 1.0f);
+  }
   if (lateral) {
     Rng rng(mix_seed(seed, 1));
     const float background_sigma = static_cast<float>(lateral_sigma_px(0.0));

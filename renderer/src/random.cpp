@@ -49,22 +49,6 @@ std::uint64_t mix_seed(std::uint64_t seed, std::uint64_t stream) {
   return splitmix(x);
 }
 
-Rng::Rng(std::uint64_t seed) : generator_(seed) { (void)gaussian_table(); }
-
-std::uint64_t Rng::next() { return generator_.next(); }
-
-double Rng::uniform() { return generator_.uniform(); }
-
-float Rng::gaussian() {
-  static const float* table = gaussian_table().data();
-  if (pooled_ == 0) {
-    pool_ = next();
-    pooled_ = 4;
-  }
-  const auto index = static_cast<std::uint16_t>(pool_);
-  pool_ >>= 16;
-  --pooled_;
-  return table[index];
-}
+Rng::Rng(std::uint64_t seed) : generator_(seed), gaussian_table_(gaussian_table().data()) {}
 
 }  // namespace drapegen::renderer

@@ -9,7 +9,9 @@ void TriangleMesh::append(const TriangleMesh& other) {
   const int offset = vertex_count();
   vertices.insert(vertices.end(), other.vertices.begin(), other.vertices.end());
   triangles.reserve(triangles.size() + other.triangles.size());
+  const int first = triangle_count();
   for (const auto& t : other.triangles) triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+  closed_from = other.closed_from >= 0 ? first + other.closed_from : -1;
 }
 
 TriangleMesh make_cylinder(const CylinderSpec& spec) {
@@ -33,11 +35,15 @@ TriangleMesh make_cylinder(const CylinderSpec& spec) {
     m.triangles.push_back({2 * n, i, j});
     m.triangles.push_back({2 * n + 1, n + j, n + i});
   }
+  m.closed_from = 0;
   return m;
 }
 
 sim::Status validate(const TriangleMesh& mesh) {
   if (mesh.triangles.empty()) return sim::Error{"mesh has no triangles"};
+  if (mesh.closed_from < -1 || mesh.closed_from > mesh.triangle_count()) {
+    return sim::Error{fmt::format("closed triangles from {} of {}", mesh.closed_from, mesh.triangle_count())};
+  }
   for (int i = 0; i < mesh.vertex_count(); ++i) {
     if (!mesh.vertices[i].allFinite()) return sim::Error{fmt::format("mesh vertex {} is not finite", i)};
   }

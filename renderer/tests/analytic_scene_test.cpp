@@ -1,16 +1,21 @@
-// Acceptance 1: analytic scenes render to the exact depth (noise off); background pixels are exactly 0.
+// Acceptance 1: analytic scenes render to the exact depth (noise off); background pixels are exactly 0. Every test
+// runs with each renderer (OSMesa and the software rasteriser).
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
 #include <map>
 
-#include "drapegen/renderer/depth_renderer.hpp"
-#include "shared_renderer.hpp"
 #include "drapegen/renderer/ray_caster.hpp"
+#include "shared_renderer.hpp"
 
 namespace drapegen::renderer {
 namespace {
+
+class AnalyticScene : public ::testing::TestWithParam<const char*> {
+ protected:
+  Renderer& renderer = shared_renderer(GetParam());
+};
 
 Intrinsics test_intrinsics() { return Intrinsics::pinhole(240, 180, 252.0, 252.0, 119.5, 89.5); }
 
@@ -57,8 +62,7 @@ TriangleMesh icosphere(const Eigen::Vector3d& c, double r, int levels) {
   return m;
 }
 
-TEST(AnalyticScene, FrontoParallelPlaneHasExactDepthAndZeroBackground) {
-  DepthRenderer& renderer = shared_renderer();
+TEST_P(AnalyticScene, FrontoParallelPlaneHasExactDepthAndZeroBackground) {
   ASSERT_TRUE(renderer.set_scene(square(0.2)));
   for (double d : {0.5, 0.8, 1.3, 2.7}) {
     Camera camera = Camera::look_at(test_intrinsics(), {0, 0, d}, {0, 0, 0}, {0, 1, 0});
@@ -82,8 +86,8 @@ TEST(AnalyticScene, FrontoParallelPlaneHasExactDepthAndZeroBackground) {
         }
       }
     }
-    std::printf("plane at %.1f m: %d pixels, worst depth error %.3g m; %d background pixels\n", d, plane, worst,
-                background);
+    std::printf("%s: plane at %.1f m: %d pixels, worst depth error %.3g m; %d background pixels\n", GetParam(), d,
+                plane, worst, background);
     EXPECT_GT(plane, 1000);
     if (d > 0.6) {
       EXPECT_GT(background, 1000);
@@ -91,8 +95,7 @@ TEST(AnalyticScene, FrontoParallelPlaneHasExactDepthAndZeroBackground) {
   }
 }
 
-TEST(AnalyticScene, TiltedPlaneDepthFollowsThePlaneEquation) {
-  DepthRenderer& renderer = shared_renderer();
+TEST_P(AnalyticScene, TiltedPlaneDepthFollowsThePlaneEquation) {
   ASSERT_TRUE(renderer.set_scene(square(2.0)));
   // Plane z = 0 in the world, seen from 1 m at 50 degrees from its normal: depth along each pixel ray is
   // h / (n . ray) in camera coordinates.
@@ -113,12 +116,24 @@ TEST(AnalyticScene, TiltedPlaneDepthFollowsThePlaneEquation) {
       EXPECT_NEAR(image->incidence[v * 240 + u], std::abs(r.dot(n_cam)), 1e-3);
     }
   }
-  std::printf("tilted plane: worst depth error %.3g m\n", worst);
+  std::printf("%s: tilted plane: worst depth error %.3g m\n", GetParam(), worst);
   EXPECT_LT(worst, 1e-4);
 }
 
-TEST(AnalyticScene, SphereHasExactDepthAndZeroBackground) {
-  DepthRenderer& renderer = shared_renderer();
+// A plane 200 km wide seen from 1 m: its corners project millions of pixels outside the image (beyond the software
+// rasteriser's guard band, so its triangles are clipped first) and the plane must still fill the image exactly.
+TEST_P(AnalyticScene, HugePlaneFillsTheImage) {
+  ASSERT_TRUE(renderer.set_scene(square(1e5)));
+  const Camera camera = Camera::look_at(test_intrinsics(), {0.1, 0.2, 1.0}, {0.1, 0.2, 0}, {0, 1, 0});
+  auto image = renderer.render(camera);
+  ASSERT_TRUE(image);
+  double worst = 0.0;
+  for (float z : image->depth) worst = std::max(worst, std::abs(z - 1.0));
+  EXPECT_EQ(image->foreground_count(), 240 * 180);
+  EXPECT_LT(worst, 1e-4);
+}
+
+TEST_P(AnalyticScene, SphereHasExactDepthAndZeroBackground) {
   const Eigen::Vector3d centre(0.02, -0.01, 0.0);
   const double radius = 0.12;
   // Level 6: 81920 facets, at most ~6 um inside the sphere (the depth error of a facet grows as 1 / cos(incidence)).
@@ -152,14 +167,14 @@ TEST(AnalyticScene, SphereHasExactDepthAndZeroBackground) {
       }
     }
   }
-  std::printf("sphere: %d pixels compared, worst depth error %.3g m; %d background pixels\n", inside, worst, outside);
+  std::printf("%s: sphere: %d pixels compared, worst depth error %.3g m; %d background pixels\n", GetParam(), inside,
+              worst, outside);
   EXPECT_GT(inside, 2000);
   EXPECT_GT(outside, 10000);
   EXPECT_LT(worst, 1e-4) << "worst depth error on the sphere";
 }
 
-TEST(AnalyticScene, ModelPoseTurnsTheScene) {
-  DepthRenderer& renderer = shared_renderer();
+TEST_P(AnalyticScene, ModelPoseTurnsTheScene) {
   // A square standing at x = 0.3 facing -x; turned by 90 degrees about z it stands at y = 0.3.
   TriangleMesh wall;
   wall.vertices = {{0.3f, -0.1f, -0.1f}, {0.3f, 0.1f, -0.1f}, {0.3f, 0.1f, 0.1f}, {0.3f, -0.1f, 0.1f}};
@@ -176,8 +191,7 @@ TEST(AnalyticScene, ModelPoseTurnsTheScene) {
   EXPECT_EQ(unseen->foreground_count(), 0);
 }
 
-TEST(AnalyticScene, RejectsBadInput) {
-  DepthRenderer& renderer = shared_renderer();
+TEST_P(AnalyticScene, RejectsBadInput) {
   TriangleMesh bad = square(0.1);
   bad.vertices[2].x() = std::nanf("");
   EXPECT_FALSE(renderer.set_scene(bad));
@@ -191,7 +205,9 @@ TEST(AnalyticScene, RejectsBadInput) {
   EXPECT_FALSE(renderer.render(camera));
 }
 
-TEST(AnalyticScene, ProjectionRoundTripsWithRays) {
+INSTANTIATE_TEST_SUITE_P(Renderers, AnalyticScene, ::testing::ValuesIn(kRendererKinds));
+
+TEST(Camera, ProjectionRoundTripsWithRays) {
   const Camera camera = Camera::look_at(test_intrinsics(), {0.3, -0.6, 0.4}, {0, 0, 0}, {0, 0, 1});
   const Eigen::Vector3d p(0.05, 0.02, -0.03);
   const auto uvz = camera.project(p);

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
 
 #include "drapegen/renderer/data_point.hpp"
 #include "drapegen/renderer/rig.hpp"
@@ -101,6 +102,26 @@ TEST(Rig, CylinderIsClosedAndOnThePlatform) {
   EXPECT_FLOAT_EQ(top, 0.0f);
   EXPECT_FLOAT_EQ(bottom, -0.25f);
   EXPECT_NEAR(r, 0.05f, 1e-7);
+  // Closed and wound counter-clockwise seen from outside (TriangleMesh::closed_from): every directed edge appears
+  // once and its reverse once, and every normal points away from the axis or along it out of the caps.
+  EXPECT_EQ(c.closed_from, 0);
+  std::map<std::pair<int, int>, int> edges;
+  for (const auto& t : c.triangles) {
+    for (int k = 0; k < 3; ++k) ++edges[{t[k], t[(k + 1) % 3]}];
+    const Eigen::Vector3f a = c.vertices[t[0]], b = c.vertices[t[1]], d = c.vertices[t[2]];
+    const Eigen::Vector3f centroid = (a + b + d) / 3.0f;
+    const Eigen::Vector3f outward(centroid.x(), centroid.y(), centroid.z() + 0.125f);  // from the cylinder's middle
+    EXPECT_GT((b - a).cross(d - a).dot(outward), 0.0f);
+  }
+  for (const auto& [edge, count] : edges) {
+    EXPECT_EQ(count, 1);
+    EXPECT_EQ(edges.count({edge.second, edge.first}), 1u);
+  }
+  // In the tester's scene the platform's triangles stay marked closed after the cloth's.
+  TriangleMesh cloth;
+  cloth.vertices = {{0, 0, 0.01f}, {0.1f, 0, 0.01f}, {0, 0.1f, 0.01f}};
+  cloth.triangles = {{0, 1, 2}};
+  EXPECT_EQ(tester_scene(cloth, RigSpec{}).closed_from, 1);
 }
 
 }  // namespace

@@ -1,9 +1,12 @@
 #pragma once
-// One OSMesa renderer per test program, created on first use (a context is costly; tests reuse it).
+// One renderer of each kind per test program, created on first use (an OSMesa context is costly; tests reuse it),
+// and the names of the kinds for tests run with every renderer.
 #include <stdexcept>
+#include <string>
 #include <utility>
 
 #include "drapegen/renderer/depth_renderer.hpp"
+#include "drapegen/renderer/software_renderer.hpp"
 
 namespace drapegen::renderer {
 
@@ -15,5 +18,15 @@ inline DepthRenderer& shared_renderer() {
   }();
   return renderer;
 }
+
+/// "osmesa" (shared_renderer()) or "software" (a SoftwareRenderer).
+inline Renderer& shared_renderer(const std::string& kind) {
+  static SoftwareRenderer software;
+  if (kind == "software") return software;
+  if (kind == "osmesa") return shared_renderer();
+  throw std::invalid_argument("unknown renderer " + kind);
+}
+
+inline const char* const kRendererKinds[] = {"osmesa", "software"};
 
 }  // namespace drapegen::renderer

@@ -161,11 +161,6 @@ v1::Envelope JobRunner::compute(const v1::Job& job) {
   if (!mesh_bytes) return failure(job, v1::FAILURE_REASON_INVALID_JOB, mesh_bytes.error().message, &metrics);
 
   const auto render_start = std::chrono::steady_clock::now();
-  if (!renderer_) {
-    auto created = renderer::DepthRenderer::create();
-    if (!created) return failure(job, v1::FAILURE_REASON_RENDER_ERROR, created.error().message, &metrics);
-    renderer_ = std::make_unique<renderer::DepthRenderer>(std::move(created).value());
-  }
   const auto cloth = renderer::cloth_triangles(drape->mesh);
   if (!cloth) return failure(job, v1::FAILURE_REASON_RENDER_ERROR, cloth.error().message, &metrics);
   renderer::RenderRequest request;
@@ -173,7 +168,7 @@ v1::Envelope JobRunner::compute(const v1::Job& job) {
   request.noise = spec.noise() == "none" ? renderer::NoiseModel::none() : renderer::NoiseModel::kinect();
   request.seed = spec.render_seed();
   request.source = fmt::format("sample {} slot {}", spec.recipe().sample(), spec.recipe().slot());
-  auto points = renderer::render_data_points(*renderer_, *cloth, request);
+  auto points = renderer::render_data_points(renderer_, *cloth, request);
   if (!points) return failure(job, v1::FAILURE_REASON_RENDER_ERROR, points.error().message, &metrics);
   const renderer::ExrWriter writer;
   v1::Envelope e;

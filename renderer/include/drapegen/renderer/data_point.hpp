@@ -6,9 +6,9 @@
 #include <string>
 #include <vector>
 
-#include "drapegen/renderer/depth_renderer.hpp"
 #include "drapegen/renderer/exr.hpp"
 #include "drapegen/renderer/noise.hpp"
+#include "drapegen/renderer/renderer.hpp"
 #include "drapegen/renderer/rig.hpp"
 
 namespace drapegen::renderer {
@@ -29,7 +29,7 @@ struct RenderRequest {
 /// Renders `cloth` (plus the cylinder) for every data point of `request`. If `clean` is given it receives the
 /// noise-free images (one vector of views per data point).
 [[nodiscard]] sim::Expected<std::vector<DataPointRecord>> render_data_points(
-    DepthRenderer& renderer, const TriangleMesh& cloth, const RenderRequest& request,
+    Renderer& renderer, const TriangleMesh& cloth, const RenderRequest& request,
     std::vector<std::vector<DepthImage>>* clean = nullptr);
 
 }  // namespace drapegen::renderer

@@ -5,17 +5,13 @@
 #include <memory>
 #include <string>
 
-#include "drapegen/renderer/camera.hpp"
-#include "drapegen/renderer/depth_image.hpp"
-#include "drapegen/renderer/scene.hpp"
-#include "drapegen/sim/expected.hpp"
+#include "drapegen/renderer/renderer.hpp"
 
 namespace drapegen::renderer {
 
 struct RendererOptions {
   /// Clipping planes, metres from the camera. Geometry outside [near, far] is not drawn.
-  double near = 0.05;
-  double far = 10.0;
+  DepthRange range;
   /// llvmpipe rasteriser threads (the LP_NUM_THREADS environment variable, which Mesa reads once per process when
   /// the first context is made; set here only if the environment does not set it). 0 renders in the calling
   /// thread, the right choice for one worker process per core. Negative: leave Mesa's default (one per CPU).
@@ -29,7 +25,7 @@ struct RendererOptions {
 /// One OpenGL 3.3 core context with a float framebuffer, reused across renders: upload a scene once with
 /// set_scene, then render it from any number of cameras and model poses. Not thread-safe; one renderer per thread
 /// (it makes its context current on the calling thread at every call).
-class DepthRenderer {
+class DepthRenderer final : public Renderer {
  public:
   /// Creates the context and compiles the shaders. Fails with a message when OSMesa cannot give a 3.3 context.
   [[nodiscard]] static sim::Expected<DepthRenderer> create(const RendererOptions& options = {});
@@ -38,17 +34,11 @@ class DepthRenderer {
   DepthRenderer& operator=(DepthRenderer&&) noexcept;
   ~DepthRenderer();
 
-  /// Uploads the triangles to draw (replacing any earlier scene). Fails on an invalid mesh (see validate()).
-  [[nodiscard]] sim::Status set_scene(const TriangleMesh& mesh);
-
-  /// Renders the scene, placed in the world by `model` (e.g. the rotary table's turn), seen by `camera`: linear
-  /// camera-space z per pixel (0 where nothing is hit) and the cosine of the incidence angle. Pixel (u, v) samples
-  /// the scene at its centre, as Camera::ray(u, v) does.
-  [[nodiscard]] sim::Expected<DepthImage> render(const Camera& camera,
-                                                 const Eigen::Isometry3d& model = Eigen::Isometry3d::Identity());
-
+  [[nodiscard]] sim::Status set_scene(const TriangleMesh& mesh) override;
+  [[nodiscard]] sim::Expected<DepthImage> render(
+      const Camera& camera, const Eigen::Isometry3d& model = Eigen::Isometry3d::Identity()) override;
   /// GL_RENDERER of the context, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)".
-  [[nodiscard]] std::string gl_renderer() const;
+  [[nodiscard]] std::string name() const override;
 
  private:
   struct Impl;

@@ -11,18 +11,29 @@ namespace drapegen::renderer {
 /// splitmix64: a good 64-bit mix, used to derive independent seeds (e.g. one per view) from a parent seed.
 [[nodiscard]] std::uint64_t mix_seed(std::uint64_t seed, std::uint64_t stream);
 
+/// Defined here so that the noise model's per-pixel loops inline them.
 class Rng {
  public:
   explicit Rng(std::uint64_t seed);
-  std::uint64_t next();
+  std::uint64_t next() { return generator_.next(); }
   /// Uniform in [0, 1) with 53 random bits.
-  double uniform();
+  double uniform() { return generator_.uniform(); }
   /// Standard normal from 16 random bits: the inverse normal CDF at the midpoints of 65536 equal-probability cells,
   /// rescaled to unit variance (range about +-4.3). Four per call of next().
-  float gaussian();
+  float gaussian() {
+    if (pooled_ == 0) {
+      pool_ = next();
+      pooled_ = 4;
+    }
+    const auto index = static_cast<std::uint16_t>(pool_);
+    pool_ >>= 16;
+    --pooled_;
+    return gaussian_table_[index];
+  }
 
  private:
   sim::Xoshiro256 generator_;
+  const float* gaussian_table_;  // 65536 entries, built once per process
   std::uint64_t pool_ = 0;
   int pooled_ = 0;
 };

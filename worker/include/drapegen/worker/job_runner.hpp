@@ -2,12 +2,11 @@
 // One job, computed: the drape simulated from its (parameters, recipe, seeds), its data points rendered and encoded
 // as OpenEXR in memory, and the answer to the coordinator (a Result or a Failure with its reason).
 
-#include <memory>
 #include <optional>
 #include <string>
 
 #include "drapegen/proto/codec.hpp"
-#include "drapegen/renderer/depth_renderer.hpp"
+#include "drapegen/renderer/software_renderer.hpp"
 #include "drapegen/sim/drape.hpp"
 
 namespace drapegen::worker {
@@ -32,7 +31,7 @@ class JobRunner {
  private:
   proto::v1::Envelope compute(const proto::v1::Job& job);
   std::string scratch_;
-  std::unique_ptr<renderer::DepthRenderer> renderer_;  // created on the first drape job, in the computing thread
+  renderer::SoftwareRenderer renderer_;
 };
 
 }  // namespace drapegen::worker

@@ -1,0 +1,21 @@
+#pragma once
+// Choosing a renderer by name (the --renderer option of drapegen render and the renderer benchmark).
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "drapegen/renderer/depth_renderer.hpp"
+#include "drapegen/renderer/renderer.hpp"
+
+namespace drapegen::renderer {
+
+/// "software": SoftwareRenderer, the default (docs/RENDERER.md, "Software rasteriser"); "osmesa": DepthRenderer
+/// with `osmesa` options. Fails on another name or when OSMesa gives no context.
+[[nodiscard]] sim::Expected<std::unique_ptr<Renderer>> make_renderer(const std::string& name,
+                                                                     const RendererOptions& osmesa = {});
+
+/// The names make_renderer() accepts, the default first.
+inline const std::vector<std::string> kRendererNames = {"software", "osmesa"};
+
+}  // namespace drapegen::renderer
