@@ -2,7 +2,7 @@
 // render / noise / EXR encode; bytes per view and storage error for every EXR storage option; the cross-check of
 // the renderer against the CPU ray cast.
 //
-//   drapegen_render_bench --mesh drape100.ply [--renderer software|osmesa] [--data-points 48] [--storage]
+//   drapegen_render_bench --mesh drape100.ply [--renderer osmesa|software] [--data-points 48] [--storage]
 //                         [--crosscheck]
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
@@ -210,11 +210,11 @@ int main(int argc, char** argv) {
   int data_points = 48;
   bool all_triangles = false;
   bool storage = false, check = false;
-  std::string pixel = "half", compression = "zip", renderer_name = "software";
+  std::string pixel = "half", compression = "zip", renderer_name = kRendererNames.front();
   int zip_level = ExrStorage{}.zip_level;
   app.add_option("--mesh", mesh_path, "Draped mesh (PLY) from drapegen simulate --out")->required();
   app.add_option("--data-points", data_points, "Data points (x 4 views) to time")->capture_default_str();
-  app.add_option("--renderer", renderer_name, "software (SoftwareRenderer) or osmesa (DepthRenderer)")
+  app.add_option("--renderer", renderer_name, "osmesa (DepthRenderer) or software (SoftwareRenderer)")
       ->check(CLI::IsMember(kRendererNames))
       ->capture_default_str();
   app.add_option("--pixel", pixel, "EXR pixel type for the timing: half or float")->capture_default_str();

@@ -154,7 +154,8 @@ Runner add_render_command(CLI::App& app) {
   app.add_option("--noise", o->noise, "Depth noise model: kinect or none (clean depth)")
       ->check(CLI::IsMember({"kinect", "none"}))
       ->capture_default_str();
-  app.add_option("--renderer", o->renderer_name, "Depth renderer: software (CPU rasteriser) or osmesa (OpenGL)")
+  app.add_option("--renderer", o->renderer_name,
+                 "Depth renderer: osmesa (OpenGL through OSMesa) or software (the faster CPU rasteriser)")
       ->check(CLI::IsMember(renderer::kRendererNames))
       ->capture_default_str();
   app.add_option("--seed", o->seed, "Seed of orientations, perturbations and noise")->capture_default_str();

@@ -104,8 +104,8 @@ sim::Expected<RunConfig> parse_run_config(const std::string& toml_text, const st
   RunConfig c;
   Reader r(root, source_name);
   r.only_keys(&root, "",
-              {"seed", "samples", "states_per_sample", "orientations", "resolution", "noise", "density", "output",
-               "model", "recipes", "solver", "network", "security", "retry", "progress", "testing"});
+              {"seed", "samples", "states_per_sample", "orientations", "resolution", "noise", "renderer", "density",
+               "output", "model", "recipes", "solver", "network", "security", "retry", "progress", "testing"});
   if (const toml::node* seed = root.get("seed")) {
     if (!seed->is_integer() || seed->as_integer()->get() < 0) {
       r.fail("seed", "must be a non-negative integer");
@@ -118,6 +118,7 @@ sim::Expected<RunConfig> parse_run_config(const std::string& toml_text, const st
   r.integer(&root, "", "orientations", c.orientations, 1, 360);
   r.integer(&root, "", "resolution", c.resolution, 5, 400);
   r.text(&root, "", "noise", c.noise, {"kinect", "none"});
+  r.text(&root, "", "renderer", c.renderer, {"osmesa", "software"});
   r.real(&root, "", "density", c.density, 1.0, 1e5);
   r.text(&root, "", "output", c.output);
   r.text(&root, "", "model", c.model);

@@ -19,6 +19,7 @@ states_per_sample = 2
 orientations = 2
 resolution = 15
 noise = "none"
+renderer = "software"
 density = 250
 output = "x"
 model = ""
@@ -50,6 +51,7 @@ poison_samples = [1, 2]
   EXPECT_EQ(c->seed, 7u);
   EXPECT_EQ(c->resolution, 15);
   EXPECT_EQ(c->noise, "none");
+  EXPECT_EQ(c->renderer, "software");
   EXPECT_EQ(c->density, 250.0);
   EXPECT_EQ(c->weight_fold, 0.5);
   EXPECT_EQ(c->max_self_intersections, 3);
@@ -64,6 +66,7 @@ TEST(RunConfig, NamesTheKeyOfEveryError) {
   EXPECT_EQ(error_of("samples = 0"), "run.toml: samples: must be between 1 and 10000000");
   EXPECT_EQ(error_of("sampels = 3"), "run.toml: sampels: unknown key");
   EXPECT_EQ(error_of("noise = \"loud\""), "run.toml: noise: 'loud' is not one of kinect, none");
+  EXPECT_EQ(error_of("renderer = \"gpu\""), "run.toml: renderer: 'gpu' is not one of osmesa, software");
   EXPECT_EQ(error_of("[solver]\ntolerance = \"small\""), "run.toml: solver.tolerance: must be a number");
   EXPECT_EQ(error_of("[network]\nbind = \"http://x\""),
             "run.toml: network.bind: must be a tcp:// or ipc:// endpoint, e.g. tcp://127.0.0.1:5555");

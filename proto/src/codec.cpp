@@ -27,6 +27,9 @@ sim::Status check_spec(const v1::JobSpec& s) {
   if (s.resolution() < 3 || s.resolution() > 1000) return sim::Error{"job: resolution outside 3..1000"};
   if (s.orientations() < 1 || s.orientations() > 360) return sim::Error{"job: orientations outside 1..360"};
   if (s.noise() != "kinect" && s.noise() != "none") return sim::Error{"job: noise must be kinect or none"};
+  if (!s.renderer().empty() && s.renderer() != "osmesa" && s.renderer() != "software") {
+    return sim::Error{"job: renderer must be osmesa or software"};
+  }
   if (s.max_iterations() < 1) return sim::Error{"job: max_iterations must be >= 1"};
   if (!(s.tolerance() > 0) || !std::isfinite(s.tolerance())) return sim::Error{"job: tolerance must be > 0"};
   if (s.max_self_intersections() < 0) return sim::Error{"job: max_self_intersections must be >= 0"};

@@ -72,6 +72,13 @@ TEST(Codec, ChecksFieldRules) {
   e = valid_job();
   e.mutable_job()->set_attempt(0);
   EXPECT_FALSE(decode(encode(e)));
+  e = valid_job();
+  e.mutable_job()->mutable_spec()->set_renderer("vulkan");
+  EXPECT_FALSE(decode(encode(e)));
+  for (const char* renderer : {"", "osmesa", "software"}) {  // empty: a job from before the field, OSMesa
+    e.mutable_job()->mutable_spec()->set_renderer(renderer);
+    EXPECT_TRUE(decode(encode(e))) << renderer;
+  }
   v1::Envelope f;
   f.mutable_failure()->set_job_id(3);
   f.mutable_failure()->set_attempt(1);

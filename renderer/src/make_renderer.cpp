@@ -13,7 +13,7 @@ sim::Expected<std::unique_ptr<Renderer>> make_renderer(const std::string& name, 
     if (!created) return created.error();
     return std::unique_ptr<Renderer>(std::make_unique<DepthRenderer>(std::move(created).value()));
   }
-  return sim::Error{fmt::format("unknown renderer '{}' (software or osmesa)", name)};
+  return sim::Error{fmt::format("unknown renderer '{}' (osmesa or software)", name)};
 }
 
 }  // namespace drapegen::renderer

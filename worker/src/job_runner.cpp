@@ -10,6 +10,7 @@
 
 #include "drapegen/proto/recipe.hpp"
 #include "drapegen/renderer/data_point.hpp"
+#include "drapegen/renderer/make_renderer.hpp"
 #include "drapegen/renderer/scene.hpp"
 #include "drapegen/sampler/initial_state_recipe.hpp"
 #include "drapegen/sim/ply.hpp"
@@ -168,7 +169,14 @@ v1::Envelope JobRunner::compute(const v1::Job& job) {
   request.noise = spec.noise() == "none" ? renderer::NoiseModel::none() : renderer::NoiseModel::kinect();
   request.seed = spec.render_seed();
   request.source = fmt::format("sample {} slot {}", spec.recipe().sample(), spec.recipe().slot());
-  auto points = renderer::render_data_points(renderer_, *cloth, request);
+  const std::string renderer_name = spec.renderer().empty() ? "osmesa" : spec.renderer();
+  std::unique_ptr<renderer::Renderer>& renderer = renderers_[renderer_name];
+  if (!renderer) {
+    auto created = renderer::make_renderer(renderer_name);
+    if (!created) return failure(job, v1::FAILURE_REASON_RENDER_ERROR, created.error().message, &metrics);
+    renderer = std::move(created).value();
+  }
+  auto points = renderer::render_data_points(*renderer, *cloth, request);
   if (!points) return failure(job, v1::FAILURE_REASON_RENDER_ERROR, points.error().message, &metrics);
   const renderer::ExrWriter writer;
   v1::Envelope e;

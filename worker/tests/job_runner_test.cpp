@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <unistd.h>
 
@@ -75,6 +76,41 @@ TEST(JobRunner, ComputesADrapeWithItsFilesInMemory) {
   ASSERT_EQ(again.body_case(), v1::Envelope::kResult);
   EXPECT_EQ(again.result().mesh_ply(), r.mesh_ply());
   EXPECT_EQ(again.result().exr(0), r.exr(0));
+}
+
+// The job names its renderer: both draw the same drape (the mesh bytes are equal) into nearly the same depth, each
+// deterministically.
+TEST(JobRunner, RendersWithTheJobsRenderer) {
+  JobRunner runner(scratch());
+  std::vector<v1::Envelope> answers;
+  for (const char* name : {"osmesa", "software", "software"}) {
+    v1::Job job = tiny_job(v1::JOB_MODE_DRAPE);
+    job.mutable_spec()->set_renderer(name);
+    job.mutable_spec()->set_noise("none");
+    answers.push_back(runner.run(job));
+    ASSERT_EQ(answers.back().body_case(), v1::Envelope::kResult) << name << ": " << answers.back().failure().message();
+  }
+  EXPECT_EQ(answers[0].result().mesh_ply(), answers[1].result().mesh_ply());
+  EXPECT_EQ(answers[1].result().exr(0), answers[2].result().exr(0));
+  const auto decode = [](const v1::Envelope& e) {
+    return renderer::read_exr(std::vector<char>(e.result().exr(0).begin(), e.result().exr(0).end()));
+  };
+  const auto a = decode(answers[0]), b = decode(answers[1]);
+  ASSERT_TRUE(a && b);
+  int compared = 0, agree = 0;
+  for (std::size_t v = 0; v < a->views.size(); ++v) {
+    const auto& da = a->views[v].depth;
+    const auto& db = b->views[v].depth;
+    for (int y = 0; y < da.height; ++y) {
+      for (int x = 0; x < da.width; ++x) {
+        if (da.at(x, y) == 0.0f && db.at(x, y) == 0.0f) continue;
+        ++compared;
+        agree += std::abs(da.at(x, y) - db.at(x, y)) < 5e-4f ? 1 : 0;
+      }
+    }
+  }
+  ASSERT_GT(compared, 1000);
+  EXPECT_GT(agree, 0.99 * compared) << agree << " of " << compared;
 }
 
 TEST(JobRunner, PoisonDiverges) {

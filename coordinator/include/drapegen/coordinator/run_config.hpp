@@ -17,6 +17,7 @@ struct RunConfig {
   int orientations = 12;         // data points (specimen orientations, 4 views each) per drape
   int resolution = 100;          // vertices per side of the 300 mm specimen
   std::string noise = "kinect";  // kinect | none
+  std::string renderer = "osmesa";  // osmesa | software (docs/RENDERER.md)
   double density = 300.0;        // g/m^2 the sampled moduli are simulated at
   std::string output = "drapegen-run";  // output directory (manifest.sqlite, data/)
   std::string model;             // VAE model file; empty: the one committed with the source

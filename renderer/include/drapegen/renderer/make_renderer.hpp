@@ -10,12 +10,13 @@
 
 namespace drapegen::renderer {
 
-/// "software": SoftwareRenderer, the default (docs/RENDERER.md, "Software rasteriser"); "osmesa": DepthRenderer
-/// with `osmesa` options. Fails on another name or when OSMesa gives no context.
+/// "osmesa": DepthRenderer with `osmesa` options, the default (OpenGL through OSMesa); "software": SoftwareRenderer,
+/// the faster CPU rasteriser (docs/RENDERER.md, "Software rasteriser"). Fails on another name or when OSMesa gives no
+/// context.
 [[nodiscard]] sim::Expected<std::unique_ptr<Renderer>> make_renderer(const std::string& name,
                                                                      const RendererOptions& osmesa = {});
 
 /// The names make_renderer() accepts, the default first.
-inline const std::vector<std::string> kRendererNames = {"software", "osmesa"};
+inline const std::vector<std::string> kRendererNames = {"osmesa", "software"};
 
 }  // namespace drapegen::renderer

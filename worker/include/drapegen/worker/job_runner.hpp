@@ -2,11 +2,13 @@
 // One job, computed: the drape simulated from its (parameters, recipe, seeds), its data points rendered and encoded
 // as OpenEXR in memory, and the answer to the coordinator (a Result or a Failure with its reason).
 
+#include <map>
+#include <memory>
 #include <optional>
 #include <string>
 
 #include "drapegen/proto/codec.hpp"
-#include "drapegen/renderer/software_renderer.hpp"
+#include "drapegen/renderer/renderer.hpp"
 #include "drapegen/sim/drape.hpp"
 
 namespace drapegen::worker {
@@ -31,7 +33,8 @@ class JobRunner {
  private:
   proto::v1::Envelope compute(const proto::v1::Job& job);
   std::string scratch_;
-  renderer::SoftwareRenderer renderer_;
+  /// By JobSpec.renderer name, created on first use in the computing thread (an OSMesa context belongs to it).
+  std::map<std::string, std::unique_ptr<renderer::Renderer>> renderers_;
 };
 
 }  // namespace drapegen::worker
