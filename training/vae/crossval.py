@@ -291,8 +291,10 @@ def main():
     ap.add_argument("--seed", type=int, default=0, help="split, initialisation, batches and evaluation")
     ap.add_argument("--dir", default=os.path.join(REPO, "training", "vae", "results", "crossval"),
                     help="where the fold files and the summary go")
-    ap.add_argument("--vae", default="VAE-3", help="the VAE of the paper's Table 1 to cross-validate")
-    ap.add_argument("--observation", default="student", help="VAE observation model (gaussian or student)")
+    ap.add_argument("--vae", default="VAE-3", choices=("VAE-1", "VAE-2", "VAE-3", "VAE-4"),
+                    help="the VAE of the paper's Table 1 to cross-validate")
+    ap.add_argument("--observation", default="student", choices=("gaussian", "student"),
+                    help="VAE observation model")
     ap.add_argument("--epochs", type=int, default=10000, help="VAE epochs (the committed VAE-3: 10000)")
     ap.add_argument("--check-every", type=int, default=250, help="epochs between early-stopping checks (250)")
     ap.add_argument("--iw-samples", type=int, default=1000)
