@@ -10,6 +10,8 @@
 #include <iterator>
 #include <sstream>
 
+#include <nlohmann/json.hpp>
+
 #include "drapegen/sampler/vae_model.hpp"
 
 namespace drapegen::sampler {
@@ -118,6 +120,43 @@ TEST(TorchReference, TrainingIsReproducibleFromASeed) {
   ASSERT_FALSE(a.empty());
   EXPECT_EQ(a, b) << "two trainings with seed 5 exported different weights";
   EXPECT_NE(a, c) << "seeds 5 and 6 exported the same weights";
+  fs::remove_all(dir);
+}
+
+TEST(TorchReference, CrossValidationValidatesEveryFabricOnce) {
+  // training/vae/crossval.py on two folds with a tiny VAE-4: the folds partition the 251 distinct fabrics, the pooled
+  // figures are those of the per-fabric ones, the best GMM is the rule's, and bad fold numbers are refused.
+  if (!torch_available()) GTEST_SKIP() << kPython << " cannot import torch/numpy/scipy: apt-get install python3-torch";
+  const fs::path dir = fs::temp_directory_path() / ("drapegen_crossval_test_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const std::string script = kPython + " " + kSource + "/training/vae/crossval.py --folds 2 --dir " + dir.string();
+  std::string out;
+  for (int fold = 0; fold < 2; ++fold)
+    ASSERT_TRUE(run(script + " --fold " + std::to_string(fold) +
+                        " --vae VAE-4 --epochs 2 --check-every 1 --iw-samples 9 --generated 300 2>/dev/null",
+                    out));
+  ASSERT_TRUE(run(script + " --summarise", out));
+  EXPECT_NE(out.find("2-fold cross-validation over 251 distinct fabrics (fold sizes 125, 126"), std::string::npos)
+      << out;
+  std::ifstream in(dir / "summary.json");
+  const auto summary = nlohmann::json::parse(in);
+  const auto& models = summary.at("models");
+  ASSERT_EQ(models.size(), 6u);
+  std::string best;
+  for (int k = 3; k <= 7; ++k) {
+    const std::string name = "GMM-" + std::to_string(k);
+    if (best.empty() || models.at(name).at("ll_mean") > models.at(best).at("ll_mean")) best = name;
+    // The mean of the paired per-fabric differences is the difference of the pooled means.
+    const auto& d = summary.at("ll_vae_minus").at(name);
+    EXPECT_NEAR(d.at("mean").get<double>(),
+                models.at("VAE-4").at("ll_mean").get<double>() - models.at(name).at("ll_mean").get<double>(), 1e-9);
+    EXPECT_EQ(d.at("n").get<int>(), 251);
+    const auto& e = summary.at("energy_gmm_minus_vae").at(name);
+    EXPECT_NEAR(e.at("mean").get<double>(),
+                models.at(name).at("energy").get<double>() - models.at("VAE-4").at("energy").get<double>(), 1e-9);
+  }
+  EXPECT_EQ(summary.at("best_gmm_ll").get<std::string>(), best);
+  EXPECT_FALSE(run(script + " --fold 2 2>/dev/null", out)) << "fold 2 of 2 accepted";
   fs::remove_all(dir);
 }
 
