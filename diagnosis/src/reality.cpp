@@ -52,7 +52,6 @@ sim::Expected<RealityEffect> parse_reality_effect(const std::string& text) {
                                   "multipath)", e.name)};
   }
   e.strength = it->second;
-  if (e.name == "curl") e.width_mm = kCurlWidth * 1e3;
   if (eq != std::string::npos) {
     std::string v = text.substr(eq + 1);
     const auto comma = v.find(',');
@@ -111,7 +110,8 @@ sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std
   std::vector<std::string> regions{"global"};
   for (const auto& e : spec.effects) {
     effects.push_back({{"name", e.name}, {"strength", e.strength}});
-    if (e.name == "curl") effects.back()["width_mm"] = e.width_mm;
+    const double curl_width_mm = e.width_mm > 0.0 ? e.width_mm : kCurlWidth * 1e3;
+    if (e.name == "curl") effects.back()["width_mm"] = curl_width_mm;
     if (family == "none") family = reality_family(e.name);
     if (e.name == "yield") {
       config.effects.bending_yield_curvature = e.strength;
@@ -120,14 +120,14 @@ sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std
     } else if (e.name == "curl") {
       // The band needs two vertex spacings at least, or the mesh cannot bend within it.
       const double spacing_mm = config.specimen.size_x * 1e3 / (spec.resolution - 1);
-      if (e.width_mm < 2.0 * spacing_mm) {
+      if (curl_width_mm < 2.0 * spacing_mm) {
         return sim::Error{fmt::format("--effect curl: a band of {:g} mm spans fewer than two vertex spacings of the "
                                       "{}x{} specimen ({:.1f} mm): raise --resolution to at least {}",
-                                      e.width_mm, spec.resolution, spec.resolution, spacing_mm,
-                                      static_cast<int>(std::ceil(2.0 * config.specimen.size_x * 1e3 / e.width_mm)) +
+                                      curl_width_mm, spec.resolution, spec.resolution, spacing_mm,
+                                      static_cast<int>(std::ceil(2.0 * config.specimen.size_x * 1e3 / curl_width_mm)) +
                                           1)};
       }
-      config.effects.edge_curl = sim::EdgeCurl{e.strength, e.width_mm * 1e-3};
+      config.effects.edge_curl = sim::EdgeCurl{e.strength, curl_width_mm * 1e-3};
     } else if (e.name == "friction") {
       sim::FrictionParameters f;
       f.coefficient = e.strength;

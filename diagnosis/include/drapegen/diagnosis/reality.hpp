@@ -25,7 +25,7 @@ namespace drapegen::diagnosis {
 struct RealityEffect {
   std::string name;
   double strength = 0.0;
-  double width_mm = 0.0;  // curl only: the band's width (set by parse_reality_effect; 0 elsewhere)
+  double width_mm = 0.0;  // curl only: the band's width (0: kCurlWidth)
 };
 [[nodiscard]] sim::Expected<RealityEffect> parse_reality_effect(const std::string& text);
 /// The family the diagnosis should name: yield, shear, curl, friction, misalignment or sensor (pose, bias,
