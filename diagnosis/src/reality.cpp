@@ -53,7 +53,7 @@ sim::Expected<RealityEffect> parse_reality_effect(const std::string& text) {
   }
   e.strength = it->second;
   if (eq != std::string::npos) {
-    std::string v = text.substr(eq + 1);
+    const std::string v = text.substr(eq + 1);
     const auto comma = v.find(',');
     if (comma != std::string::npos && e.name != "curl") {
       return sim::Error{fmt::format("--effect {}: one value expected (only curl=K,W takes two)", e.name)};
@@ -110,14 +110,14 @@ sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std
   std::vector<std::string> regions{"global"};
   for (const auto& e : spec.effects) {
     effects.push_back({{"name", e.name}, {"strength", e.strength}});
-    const double curl_width_mm = e.width_mm > 0.0 ? e.width_mm : kCurlWidth * 1e3;
-    if (e.name == "curl") effects.back()["width_mm"] = curl_width_mm;
     if (family == "none") family = reality_family(e.name);
     if (e.name == "yield") {
       config.effects.bending_yield_curvature = e.strength;
     } else if (e.name == "shear") {
       config.effects.shear_stiffness = e.strength;
     } else if (e.name == "curl") {
+      const double curl_width_mm = e.width_mm > 0.0 ? e.width_mm : kCurlWidth * 1e3;
+      effects.back()["width_mm"] = curl_width_mm;
       // The band needs two vertex spacings at least, or the mesh cannot bend within it.
       const double spacing_mm = config.specimen.size_x * 1e3 / (spec.resolution - 1);
       if (curl_width_mm < 2.0 * spacing_mm) {

@@ -1,5 +1,6 @@
 #include "drapegen/sim/edge_curl.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
@@ -35,8 +36,7 @@ class RollProfile {
     const double x = s / curl_.width * kSteps;
     const int i = std::min(kSteps - 1, static_cast<int>(x));
     const double t = x - i;
-    const Eigen::Vector2d p = (1.0 - t) * table_[i] + t * table_[i + 1];
-    // Measured from the band's start (d = width), towards the edge.
+    const Eigen::Vector2d p = (1.0 - t) * table_[i] + t * table_[i + 1];  // from the band's start towards the edge
     return {curl_.width - p.x(), p.y()};
   }
 
