@@ -41,7 +41,7 @@ struct Case {
 
 /// Strengths per effect, drawn uniformly in [lo, hi] (--strength NAME=LO:HI overrides).
 const std::map<std::string, std::pair<double, double>> kDefaultStrength = {
-    {"yield", {10.0, 25.0}}, {"shear", {0.3, 1.0}},       {"curl", {30.0, 50.0}}, {"friction", {0.02, 0.1}},
+    {"yield", {10.0, 25.0}}, {"shear", {0.3, 1.0}},       {"curl", {100.0, 300.0}}, {"friction", {0.02, 0.1}},
     {"misalign", {15.0, 30.0}}, {"pose", {1.0, 2.0}},     {"bias", {5.0, 10.0}},  {"multipath", {15.0, 30.0}}};
 
 }  // namespace

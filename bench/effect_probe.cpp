@@ -35,7 +35,7 @@ int main(int argc, char** argv) {
   int seeds = 4, resolution = 30;
   app.add_option("--fabrics", fabrics_path)->capture_default_str();
   app.add_option("--rows", fabric_rows, "Fabric rows of the CSV")->capture_default_str();
-  app.add_option("--effects", effects, "NAME=STRENGTH (stiff=S: no effect, bending scaled by S)")->capture_default_str();
+  app.add_option("--effects", effects, "NAME=STRENGTH, A+B for several in one capture (stiff=S: no effect, bending scaled by S)")->capture_default_str();
   app.add_option("--seeds", seeds)->capture_default_str();
   app.add_option("--resolution", resolution)->capture_default_str();
   app.add_option("--work", work)->capture_default_str();
@@ -71,10 +71,15 @@ int main(int argc, char** argv) {
         auto& b = spec.bending.beta;
         a = {a.warp * s, a.bias * s, a.weft * s};
         b = {b.warp * s, b.bias * s, b.weft * s};
-      } else if (!effect.empty()) {
-        auto e = diagnosis::parse_reality_effect(effect);
-        if (!e) throw std::runtime_error(e.error().message);
-        spec.effects.push_back(*e);
+      } else {
+        // A+B: several effects in one capture (e.g. friction=0.02+misalign=10: friction with a placement drift).
+        for (std::size_t from = 0; from < effect.size();) {
+          const std::size_t plus = std::min(effect.find('+', from), effect.size());
+          auto e = diagnosis::parse_reality_effect(effect.substr(from, plus - from));
+          if (!e) throw std::runtime_error(e.error().message);
+          spec.effects.push_back(*e);
+          from = plus + 1;
+        }
       }
       const std::string dir = fmt::format("{}/f{}_{}_{}", work, row, effect.empty() ? "none" : effect, seed);
       auto r = diagnosis::generate_reality(spec, dir);

@@ -31,7 +31,9 @@ EffectSpace effect_space(Effect effect) {
     case Effect::kShear:
       return {{"ln_shear_stiffness_kg_per_s2"}, {std::log(3.0)}, {-1.2}, {std::log(0.05)}, {std::log(200.0)}};
     case Effect::kCurl:
-      return {{"edge_curvature_per_m"}, {0.0}, {20.0}, {-80.0}, {80.0}};
+      // A hanging hem flattens a gentle curl (gravity against the bending law's peak torque): the drape
+      // changes little below ~100 /m and much above (docs/DIAGNOSIS.md, "Detectability"), so the search starts there.
+      return {{"edge_curvature_per_m"}, {100.0}, {100.0}, {-300.0}, {300.0}};
     case Effect::kFriction:
       return {{"ln_friction_coefficient"}, {std::log(0.3)}, {-1.5}, {std::log(0.003)}, {std::log(5.0)}};
     case Effect::kMisalignment:

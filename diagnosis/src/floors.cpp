@@ -85,7 +85,7 @@ sim::Expected<Floors> measure_floors(ForwardModel& model, const ModelSetup& fitt
     sim::InitialStateSpec spec = states[j];
     auto mesh = model.simulate(fitted, spec);
     if (!mesh) return mesh.error();
-    const double angle = align(hem_profile_from_mesh(*mesh), model.outline()).angle;
+    const double angle = align_orientation(hem_profile_from_mesh(*mesh), model.outline()).angle;
     auto images = model.render(*mesh, angle, fitted.sensor);
     if (!images) return images.error();
     const auto noisy = with_noise(*images, 0x5EED + static_cast<std::uint64_t>(j));

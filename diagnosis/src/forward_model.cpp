@@ -153,7 +153,7 @@ sim::Expected<ScoredDrape> ForwardModel::score(const sim::ClothMesh& mesh, const
                                                const Target& target) {
   ScoredDrape d;
   d.mesh = mesh;
-  d.angle = align(hem_profile_from_mesh(mesh), target.outline).angle;
+  d.angle = align_orientation(hem_profile_from_mesh(mesh), target.outline).angle;
   auto images = render(mesh, d.angle, setup.sensor);
   if (!images) return images.error();
   // The shape features of the model are taken from renders with the capture's kind of noise (a fixed seed), so

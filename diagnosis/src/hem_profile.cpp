@@ -183,6 +183,24 @@ std::vector<Harmonic> harmonics(const HemProfile& profile, int max_order) {
   return out;
 }
 
+HemProfile low_pass(const HemProfile& profile, int max_order) {
+  const int n = profile.bins();
+  const std::vector<Harmonic> h = harmonics(profile, max_order);
+  HemProfile out = profile;
+  for (int k = 0; k < n; ++k) {
+    if (!std::isfinite(profile.radius[k])) continue;
+    const double theta = (k + 0.5) * kTwoPi / n;
+    double r = 0.0;
+    for (const Harmonic& c : h) r += c.amplitude * std::cos(c.order * theta + c.phase);
+    out.radius[k] = r;
+  }
+  return out;
+}
+
+Alignment align_orientation(const HemProfile& model, const HemProfile& target) {
+  return align(low_pass(model, kOrientationOrders), low_pass(target, kOrientationOrders));
+}
+
 int fold_count(const HemProfile& profile, double prominence) {
   const int n = profile.bins();
   if (n < 8) return 0;

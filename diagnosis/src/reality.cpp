@@ -22,7 +22,7 @@ namespace fs = std::filesystem;
 namespace {
 
 const std::map<std::string, double>& defaults() {
-  static const std::map<std::string, double> d = {{"yield", 20.0}, {"shear", 1.0},     {"curl", 25.0},
+  static const std::map<std::string, double> d = {{"yield", 20.0}, {"shear", 1.0},     {"curl", 200.0},
                                                   {"friction", 0.05}, {"misalign", 15.0}, {"pose", 1.0},
                                                   {"bias", 5.0},   {"multipath", 15.0}};
   return d;
@@ -54,12 +54,27 @@ sim::Expected<RealityEffect> parse_reality_effect(const std::string& text) {
   e.strength = it->second;
   if (eq != std::string::npos) {
     const std::string v = text.substr(eq + 1);
-    try {
-      std::size_t used = 0;
-      e.strength = std::stod(v, &used);
-      if (used != v.size() || !std::isfinite(e.strength)) throw std::invalid_argument("");
-    } catch (const std::exception&) {
-      return sim::Error{fmt::format("--effect {}: '{}' is not a number", e.name, v)};
+    const auto comma = v.find(',');
+    if (comma != std::string::npos && e.name != "curl") {
+      return sim::Error{fmt::format("--effect {}: one value expected (only curl=K,W takes two)", e.name)};
+    }
+    auto number = [&](const std::string& s, double& out) {
+      try {
+        std::size_t used = 0;
+        out = std::stod(s, &used);
+        return used == s.size() && std::isfinite(out);
+      } catch (const std::exception&) {
+        return false;
+      }
+    };
+    if (!number(v.substr(0, comma), e.strength)) {
+      return sim::Error{fmt::format("--effect {}: '{}' is not a number", e.name, v.substr(0, comma))};
+    }
+    if (comma != std::string::npos) {
+      const std::string w = v.substr(comma + 1);
+      if (!number(w, e.width_mm) || !(e.width_mm > 0.0) || e.width_mm > 150.0) {
+        return sim::Error{fmt::format("--effect curl: the band width '{}' must be a number of mm in (0, 150]", w)};
+      }
     }
   }
   const bool positive = e.name == "yield" || e.name == "shear" || e.name == "friction";
@@ -101,7 +116,18 @@ sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std
     } else if (e.name == "shear") {
       config.effects.shear_stiffness = e.strength;
     } else if (e.name == "curl") {
-      config.effects.edge_curl = sim::EdgeCurl{e.strength, kCurlWidth};
+      const double curl_width_mm = e.width_mm > 0.0 ? e.width_mm : kCurlWidth * 1e3;
+      effects.back()["width_mm"] = curl_width_mm;
+      // The band needs two vertex spacings at least, or the mesh cannot bend within it.
+      const double spacing_mm = config.specimen.size_x * 1e3 / (spec.resolution - 1);
+      if (curl_width_mm < 2.0 * spacing_mm) {
+        return sim::Error{fmt::format("--effect curl: a band of {:g} mm spans fewer than two vertex spacings of the "
+                                      "{}x{} specimen ({:.1f} mm): raise --resolution to at least {}",
+                                      curl_width_mm, spec.resolution, spec.resolution, spacing_mm,
+                                      static_cast<int>(std::ceil(2.0 * config.specimen.size_x * 1e3 / curl_width_mm)) +
+                                          1)};
+      }
+      config.effects.edge_curl = sim::EdgeCurl{e.strength, curl_width_mm * 1e-3};
     } else if (e.name == "friction") {
       sim::FrictionParameters f;
       f.coefficient = e.strength;

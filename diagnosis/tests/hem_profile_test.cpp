@@ -63,6 +63,27 @@ TEST(HemProfile, OffCentreShowsAsFirstHarmonic) {
   EXPECT_NEAR(std::remainder(h[1].phase, 2 * M_PI), 0.0, 0.1);  // towards +x
 }
 
+TEST(HemProfile, OrientationFollowsTheOffCentreNotTheFolds) {
+  // The same off-centre drape (10 mm towards 0.7 rad) with its 8 folds elsewhere (another stable drape): the turn
+  // must bring the offset's direction onto the target's, whatever the folds do; matching the folds would not.
+  auto outline = [](double offset_angle, double fold_phase) {
+    HemProfile p;
+    p.radius.resize(kHemBins);
+    for (int k = 0; k < kHemBins; ++k) {
+      const double t = (k + 0.5) * 2.0 * M_PI / kHemBins;
+      p.radius[k] = 0.12 + 0.010 * std::cos(t - offset_angle) + 0.02 * std::cos(8.0 * t + fold_phase);
+    }
+    return p;
+  };
+  const HemProfile target = outline(0.7, 0.0), model = outline(0.0, 2.0);
+  EXPECT_NEAR(align_orientation(model, target).angle, 0.7, 2.0 * M_PI / kHemBins);
+  EXPECT_GT(std::abs(align(model, target).angle - 0.7), 0.1);
+  // Low-passing keeps the offset and drops the folds.
+  const auto h = harmonics(low_pass(target, kOrientationOrders), 8);
+  EXPECT_NEAR(h[1].amplitude, 0.010, 1e-4);
+  EXPECT_LT(h[8].amplitude, 1e-4);
+}
+
 TEST(FabricSpace, RoundTrip) {
   BendingParameters p;
   p.alpha = {13923, 11455, 8821};

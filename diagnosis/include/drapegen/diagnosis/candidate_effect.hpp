@@ -29,7 +29,7 @@ struct EffectSpace {
 [[nodiscard]] EffectSpace effect_space(Effect effect);
 /// Puts the effect with parameters x (as in effect_space) into `setup`.
 void apply_effect(Effect effect, const std::vector<double>& x, ModelSetup& setup);
-/// Edge curl's width in the refit (the reality generator's default too), m.
+/// Edge curl's band width in the refit (the reality generator's default too), m.
 constexpr double kCurlWidth = 0.03;
 
 /// Specimen regions of the localisation.

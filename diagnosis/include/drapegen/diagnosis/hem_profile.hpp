@@ -46,6 +46,11 @@ struct Alignment {
   double rms = 0.0;
 };
 [[nodiscard]] Alignment align(const HemProfile& model, const HemProfile& target);
+/// The turn of a model drape on the table: `align` on both outlines low-passed to orders 0..kOrientationOrders (the
+/// centre offset, the anisotropy's ellipse and the square's corners), not on the folds: where the folds fall differs
+/// between stable drapes, so matching them turned the low orders (an off-centre specimen's direction) at random.
+constexpr int kOrientationOrders = 4;
+[[nodiscard]] Alignment align_orientation(const HemProfile& model, const HemProfile& target);
 
 /// Complex Fourier coefficients c_n of r(theta), n = 0..max_order: amplitude |c_n| (m; n >= 1 doubled so that it is
 /// the cosine amplitude) and phase (radians).
@@ -55,6 +60,8 @@ struct Harmonic {
   double phase = 0.0;
 };
 [[nodiscard]] std::vector<Harmonic> harmonics(const HemProfile& profile, int max_order = 12);
+/// The profile rebuilt from its harmonics of orders 0..max_order (bins without a radius stay without).
+[[nodiscard]] HemProfile low_pass(const HemProfile& profile, int max_order);
 
 /// Folds: local maxima of the smoothed profile that stand out by at least `prominence` (m).
 [[nodiscard]] int fold_count(const HemProfile& profile, double prominence = 0.004);

@@ -15,7 +15,8 @@ namespace drapegen::diagnosis {
 /// One --effect NAME[=STRENGTH]:
 ///   yield=K       elastoplastic bending, hinges yield at curvature K 1/m (default 20)
 ///   shear=G       trellis membrane with shear stiffness G kg/s^2 (default 1)
-///   curl=K        edge rest curvature K 1/m over 30 mm (default 25)
+///   curl=K[,W]    edge rest curvature K 1/m falling to 0 over a band of W mm (default 200 over 30: an edge that rolls
+///                 to a 5 mm radius); the band must span at least two vertex spacings of the simulated specimen
 ///   friction=MU   Coulomb friction on the top instead of adhesion (default 0.05)
 ///   misalign=MM   specimen centre MM mm off the axis, seeded direction (default 15; the data's augmentation: 2)
 ///   pose=DEG      camera pose error: rotation DEG degrees about a seeded axis and translation 5*DEG mm (default 1)
@@ -24,6 +25,7 @@ namespace drapegen::diagnosis {
 struct RealityEffect {
   std::string name;
   double strength = 0.0;
+  double width_mm = 0.0;  // curl only: the band's width (0: kCurlWidth)
 };
 [[nodiscard]] sim::Expected<RealityEffect> parse_reality_effect(const std::string& text);
 /// The family the diagnosis should name: yield, shear, curl, friction, misalignment or sensor (pose, bias,

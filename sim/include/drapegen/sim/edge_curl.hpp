@@ -16,11 +16,13 @@ struct EdgeCurl {
   double width = 0.01;
 };
 
-/// Rest dihedral angles of every hinge for DihedralBending::set_rest_angles: the rest curvature tensor near an edge
-/// is k(d) n n^T, with n the in-plane normal of the nearest boundary edge and k(d) = curvature * max(0, 1 - d/width)
-/// at rest distance d of the hinge's midpoint from the boundary; a hinge with in-plane edge normal m measures the
-/// normal curvature k(d) (m.n)^2, i.e. a rest angle of that times (H0 + H1) / 2 (Eq. 3). Throws std::invalid_argument
-/// on a non-finite curvature or a non-positive width.
+/// Rest dihedral angles of every hinge for DihedralBending::set_rest_angles. The rest shape near an edge is a roll
+/// about the edge: the curvature across it is k(d) = curvature * max(0, 1 - d/width) at rest distance d from the
+/// edge, bending the band isometrically (a developable surface the mesh can take without stretching). A hinge
+/// within the band of its midpoint's nearest boundary edge gets the dihedral angle its four vertices make on that
+/// roll, so the rest angles are those of a realisable shape on any triangulation (a per-hinge normal curvature times
+/// (H0 + H1) / 2 is not: on right-triangle grids the diagonals of a cylindrically bent strip stay flat, and such
+/// rest angles fight each other). Throws std::invalid_argument on a non-finite curvature or a non-positive width.
 [[nodiscard]] Eigen::VectorXd edge_curl_rest_angles(const ClothMesh& mesh, const Topology& topology,
                                                     const EdgeCurl& curl);
 
