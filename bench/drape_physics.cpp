@@ -31,6 +31,7 @@
 #include "drapegen/sim/dihedral.hpp"
 #include "drapegen/sim/drape.hpp"
 #include "drapegen/sim/measures.hpp"
+#include "drapegen/sim/mesh_transfer.hpp"
 #include "drapegen/sim/ply.hpp"
 
 namespace {
@@ -201,17 +202,8 @@ double grid_mirror_defect(int n, const Eigen::Matrix3Xd& a) {
   return max_distance(image, a);
 }
 
-/// Restarts `config` from its drape `r` with every hanging vertex moved by Gaussian noise of `amplitude` metres: a
-/// stable equilibrium comes back, an unstable one (a saddle kept by symmetry) leaves.
-Run restart_perturbed(const std::string& label, DrapeConfig config, const DrapeResult& r, double amplitude) {
-  ClothMesh mesh = r.mesh;
-  std::mt19937_64 rng(1);
-  std::normal_distribution<double> noise(0.0, amplitude);
-  for (int v = 0; v < mesh.vertex_count(); ++v) {
-    if (mesh.positions(2, v) < -0.003) {
-      for (int k = 0; k < 3; ++k) mesh.positions(k, v) += noise(rng);
-    }
-  }
+/// Solves `config` from the initial state `mesh` (its own specimen: rest coordinates and triangles).
+Run restart_from(const std::string& label, DrapeConfig config, const ClothMesh& mesh) {
   const std::string path = (std::filesystem::temp_directory_path() /
                             ("drapegen_drape_physics_restart_" + std::to_string(::getpid()) + ".ply"))
                                .string();
@@ -225,6 +217,20 @@ Run restart_perturbed(const std::string& label, DrapeConfig config, const DrapeR
   Run out = run(label, config);
   std::filesystem::remove(path);
   return out;
+}
+
+/// Restarts `config` from its drape `r` with every hanging vertex moved by Gaussian noise of `amplitude` metres: a
+/// stable equilibrium comes back, an unstable one (a saddle kept by symmetry) leaves.
+Run restart_perturbed(const std::string& label, const DrapeConfig& config, const DrapeResult& r, double amplitude) {
+  ClothMesh mesh = r.mesh;
+  std::mt19937_64 rng(1);
+  std::normal_distribution<double> noise(0.0, amplitude);
+  for (int v = 0; v < mesh.vertex_count(); ++v) {
+    if (mesh.positions(2, v) < -0.003) {
+      for (int k = 0; k < 3; ++k) mesh.positions(k, v) += noise(rng);
+    }
+  }
+  return restart_from(label, config, mesh);
 }
 
 // b: the cylinder is axisymmetric, so the drape of a specimen rotated about the axis is the rotated drape. On an odd
@@ -424,6 +430,8 @@ void check_mesh_dependence(Table& t, int n, const Options& o) {
     if (o.mesh_cases.find("ice"[k]) == std::string::npos) continue;
     double mean[2], standard_error[2];
     std::vector<double> dcs_of[2];
+    std::vector<DrapeConfig> configs_of[2];
+    std::vector<DrapeResult> drapes_of[2];
     for (int perturbed = 0; perturbed < 2; ++perturbed) {
       std::vector<double>& dcs = dcs_of[perturbed];
       for (const Start& start : starts) {
@@ -440,6 +448,8 @@ void check_mesh_dependence(Table& t, int n, const Options& o) {
         const Run r = run("d: " + label, c);
         check_converged(t, n, "d", label, r);
         dcs.push_back(r.result.measures.drape_coefficient);
+        configs_of[perturbed].push_back(c);
+        drapes_of[perturbed].push_back(r.result);
       }
       const double count = static_cast<double>(dcs.size());
       mean[perturbed] = std::accumulate(dcs.begin(), dcs.end(), 0.0) / count;
@@ -466,6 +476,33 @@ void check_mesh_dependence(Table& t, int n, const Options& o) {
     const double count = static_cast<double>(paired.size());
     t.row(n, "d", fmt::format("{}: standard error of that difference, paired by start", names[k]),
           count > 1 ? std::sqrt(paired_square_sum / (count - 1) / count) : 0.0);
+    // Without the multistability: each drape moved onto the other grid (interpolated in its rest triangles) and
+    // solved there. It mostly keeps its folds, so the difference is the grids' own.
+    std::vector<double> same_state;
+    int same_folds = 0;
+    for (int from = 0; from < 2; ++from) {
+      for (std::size_t i = 0; i < drapes_of[from].size(); ++i) {
+        const DrapeConfig& other = configs_of[1 - from][i];
+        ClothMesh moved = make_specimen(other.specimen);
+        moved.positions = transfer_positions(drapes_of[from][i].mesh, moved.rest);
+        const std::string label = fmt::format("{}, start {} moved to the {} mesh", names[k], i,
+                                              from == 0 ? "perturbed" : "structured");
+        const Run r = restart_from("d: " + label, other, moved);
+        check_converged(t, n, "d", label, r);
+        const double dc = drapes_of[from][i].measures.drape_coefficient, moved_dc = r.result.measures.drape_coefficient;
+        same_state.push_back(from == 0 ? (moved_dc - dc) / dc : (dc - moved_dc) / moved_dc);
+        same_folds += r.result.measures.folds == drapes_of[from][i].measures.folds ? 1 : 0;
+      }
+    }
+    const double same_count = static_cast<double>(same_state.size());
+    const double same_mean = std::accumulate(same_state.begin(), same_state.end(), 0.0) / same_count;
+    double same_square_sum = 0.0;
+    for (double d : same_state) same_square_sum += (d - same_mean) * (d - same_mean);
+    t.row(n, "d", fmt::format("{}: same state, (perturbed - structured) / structured DC, mean", names[k]), same_mean);
+    t.row(n, "d", fmt::format("{}: same state, standard error of that mean", names[k]),
+          same_count > 1 ? std::sqrt(same_square_sum / (same_count - 1) / same_count) : 0.0);
+    t.row(n, "d", fmt::format("{}: same state, drapes that kept their fold count (of {})", names[k], same_state.size()),
+          same_folds);
   }
   const auto has = [&](char c) { return o.mesh_cases.find(c) != std::string::npos; };
   if (has('i')) t.row(n, "d", "isotropic: |d mean DC| / mean DC, structured vs perturbed", difference[0]);
