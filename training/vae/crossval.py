@@ -108,13 +108,8 @@ def run_fold(args):
 
     t0 = time.time()
     hidden, latent = vae.ARCHITECTURES[args.vae]
-    torch.manual_seed(args.seed)
-    model = vae.VAE(hidden, latent, observation=args.observation)
-    model.feature_mean[:] = torch.as_tensor(m)
-    model.feature_std[:] = torch.as_tensor(s)
-    fit, stop = fabrics.split(len(tr), args.seed + 1, validation_fraction=0.1)
-    chosen = vae.train(model, (x[tr[fit]] - m) / s, args.epochs, args.seed, stop_s=(x[tr[stop]] - m) / s,
-                       check_every=args.check_every, log=log)
+    model, chosen, fit_count, stop_count = vae.fit(args.vae, x[tr], m, s, args.seed, args.epochs, args.observation,
+                                                   args.check_every, log)
     train_seconds = time.time() - t0
     model.eval()
     ll = model.log_likelihood(torch.as_tensor((x[va] - m) / s), args.iw_samples,
@@ -125,7 +120,7 @@ def run_fold(args):
     out["models"][args.vae] = {"ll": ll.tolist(), "es": energy_scores(prior, x[va]).tolist(),
                                "es_widened": energy_scores(wide, x[va]).tolist(), "epochs": args.epochs,
                                "check_every": args.check_every, "chosen_epoch": chosen,
-                               "observation": args.observation, "fit_fabrics": len(fit), "stop_fabrics": len(stop),
+                               "observation": args.observation, "fit_fabrics": fit_count, "stop_fabrics": stop_count,
                                "train_seconds": round(train_seconds, 1), "seconds": round(time.time() - t0, 1)}
     log(f"  {args.vae}: epoch {chosen} of {args.epochs}, validation LL mean {ll.mean():.3f} median "
         f"{np.median(ll):.3f}; training {train_seconds:.0f} s")

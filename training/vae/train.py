@@ -105,15 +105,9 @@ def main():
             res["w_prior"], res["w_prior_std"], res["w_chunks"] = metrics.wasserstein_exact(gen, x)
         else:
             hidden, latent = vae.ARCHITECTURES[name]
-            torch.manual_seed(args.seed)
-            model = vae.VAE(hidden, latent, observation=args.observation)
-            model.feature_mean[:] = torch.as_tensor(m)
-            model.feature_std[:] = torch.as_tensor(s)
-            # Early stopping on a tenth of the training fabrics (the validation fabrics stay unseen).
-            fit, stop = fabrics.split(len(tr), args.seed + 1, validation_fraction=0.1)
-            chosen = vae.train(model, (x[tr[fit]] - m) / s, args.epochs, args.seed, stop_s=(x[tr[stop]] - m) / s,
-                               check_every=args.check_every, log=log, lr=args.lr, lr_final=args.lr_final,
-                               kl_warmup=args.kl_warmup, criterion=args.criterion)
+            model, chosen, fit_count, stop_count = vae.fit(
+                name, x[tr], m, s, args.seed, args.epochs, args.observation, args.check_every, log, lr=args.lr,
+                lr_final=args.lr_final, kl_warmup=args.kl_warmup, criterion=args.criterion)
             model.eval()
             res = evaluate_vae(model, x, tr, va, m, s, args.iw_samples, args.seed, args.generated)
             if name == export_name:
@@ -127,7 +121,7 @@ def main():
         if not name.startswith("GMM-"):
             res["epochs"] = args.epochs
             res["chosen_epoch"] = chosen
-            res["fit_fabrics"], res["stop_fabrics"] = len(fit), len(stop)
+            res["fit_fabrics"], res["stop_fabrics"] = fit_count, stop_count
             res["training"] = {"observation": args.observation, "lr": args.lr, "lr_final": args.lr_final,
                                "kl_warmup": args.kl_warmup, "criterion": args.criterion}
         results["models"][name] = res

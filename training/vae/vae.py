@@ -118,6 +118,22 @@ class VAE(nn.Module):
         return torch.stack(out)
 
 
+def fit(name, x_train, mean, std, seed, epochs, observation, check_every, log=None, **options):
+    """A VAE of architecture `name` (ARCHITECTURES) trained on the raw features `x_train` standardised by `mean` and
+    `std`, early-stopped on a tenth of them (split seed + 1; the validation fabrics stay unseen). `options` go to
+    train(). Returns (model, chosen epoch, fit fabrics, stop fabrics)."""
+    import fabrics  # the split; fabrics does not import this module
+    hidden, latent = ARCHITECTURES[name]
+    torch.manual_seed(seed)
+    model = VAE(hidden, latent, observation=observation)
+    model.feature_mean[:] = torch.as_tensor(mean)
+    model.feature_std[:] = torch.as_tensor(std)
+    fit_rows, stop_rows = fabrics.split(len(x_train), seed + 1, validation_fraction=0.1)
+    chosen = train(model, (x_train[fit_rows] - mean) / std, epochs, seed, stop_s=(x_train[stop_rows] - mean) / std,
+                   check_every=check_every, log=log, **options)
+    return model, chosen, len(fit_rows), len(stop_rows)
+
+
 def train(model, train_s, epochs, seed, stop_s=None, check_every=500, stop_samples=300, lr=1e-4,
           weight_decay=1e-5, batch=16, log=None, kl_warmup=0, lr_final=None, criterion="median"):
     """Adam, lr 1e-4, weight decay 1e-5, batch 16 (paper Section 5.1.3); maximises the ELBO. With `stop_s`, every
