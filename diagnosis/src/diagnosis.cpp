@@ -138,8 +138,9 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
   r.gap_fit = r.fit.best.fit_score;
   r.gap_held_out = r.fit.best.held_out_score;
   // Within the floors: neither the stable-region term (sensor errors) nor the shape distance (physical effects)
-  // exceeds what sensor noise and other stable drapes of the fitted fabric produce.
-  r.within_floors = r.fit.best.stable_all <= r.floors.stable && r.fit.best.shape_all <= r.floors.shape;
+  // exceeds what sensor noise and other stable drapes of the fitted fabric produce. The attribution's shrinkage is
+  // measured on the same excess.
+  r.within_floors = excess_above_floors(r.fit.best, r.floors) == 0.0;
 
   // 3. Where the gap sits.
   r.localisation = localise(model, r.fit.best);
