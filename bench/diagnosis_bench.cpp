@@ -250,7 +250,7 @@ int main(int argc, char** argv) {
                     effect_total ? 100.0 * effect_correct / effect_total : 0.0);
   md += fmt::format("- controls within the floors: {}/{} ({:.0f}%)\n", control_within, control_total,
                     control_total ? 100.0 * control_within / control_total : 0.0);
-  md += fmt::format("- median shrinkage of the gap above the typical floor once the named effect is added (0 when "
+  md += fmt::format("- median shrinkage of the excess above the floors once the named effect is added (0 when "
                     "none is named): {:.0f}%; over the correctly named captures alone: {:.0f}%\n",
                     100.0 * median(shrinkages), named_shrinkages.empty() ? 0.0 : 100.0 * median(named_shrinkages));
   md += fmt::format("- localised region matches the effect's region: {}/{}\n", region_match, region_total);

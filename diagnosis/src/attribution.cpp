@@ -89,6 +89,10 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, Effect effect, const M
 
 }  // namespace
 
+double gap_shrinkage(double excess_before, double excess_after) {
+  return excess_before > 0.0 ? 1.0 - excess_after / excess_before : 0.0;
+}
+
 double bootstrap_confidence(const ForwardModel& model, const ScoredDrape& a, const ScoredDrape& b, int samples,
                             int tile_px, std::uint64_t seed) {
   const auto& fit_views = model.settings().fit_views;
@@ -160,16 +164,15 @@ sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& base
     for (auto& t : threads) t.join();
     if (error) return *error;
   }
-  // Shrinkage: of the all-view gap above what a correct model typically leaves (the median floor sample), once the
-  // candidate is added; the held-out view (not in the refit) must confirm it, i.e. not get worse.
+  // Shrinkage: of the excess above the floors that made the gate fire (the same two tests), once the candidate is
+  // added; the held-out view (not in the refit) must confirm it, i.e. not get worse.
   Attribution a;
-  const double a0 = fit.best.all_score, h0 = fit.best.held_out_score;
-  const double excess0 = std::max(0.0, a0 - floors.typical_all);
+  const double h0 = fit.best.held_out_score;
+  const double excess0 = excess_above_floors(fit.best, floors);
   for (auto& r : results) {
     if (!r || !*r) return r ? r->error() : sim::Error{"candidate refit did not run"};
     CandidateResult c = std::move(r->value());
-    const double excess = std::max(0.0, c.all_score - floors.typical_all);
-    c.shrinkage = excess0 > 0.0 ? (excess0 - excess) / excess0 : 0.0;
+    c.shrinkage = gap_shrinkage(excess0, excess_above_floors(c.drape, floors));
     c.held_out_shrinkage = h0 > 0.0 ? 1.0 - c.held_out_score / h0 : 0.0;
     c.confirmed = c.held_out_score <= h0;
     a.candidates.push_back(std::move(c));

@@ -138,8 +138,9 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
   r.gap_fit = r.fit.best.fit_score;
   r.gap_held_out = r.fit.best.held_out_score;
   // Within the floors: neither the stable-region term (sensor errors) nor the shape distance (physical effects)
-  // exceeds what sensor noise and other stable drapes of the fitted fabric produce.
-  r.within_floors = r.fit.best.stable_all <= r.floors.stable && r.fit.best.shape_all <= r.floors.shape;
+  // exceeds what sensor noise and other stable drapes of the fitted fabric produce. The attribution's shrinkage is
+  // measured on the same excess.
+  r.within_floors = excess_above_floors(r.fit.best, r.floors) == 0.0;
 
   // 3. Where the gap sits.
   r.localisation = localise(model, r.fit.best);
@@ -178,7 +179,8 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
   j["gap_tests"] = {{"stable_mm", r.fit.best.stable_all * 1e3},
                     {"stable_floor_mm", r.floors.stable * 1e3},
                     {"shape", r.fit.best.shape_all},
-                    {"shape_floor", r.floors.shape}};
+                    {"shape_floor", r.floors.shape},
+                    {"excess_above_floors", excess_above_floors(r.fit.best, r.floors)}};
   nlohmann::json floors = {{"all_views_mm", r.floors.all * 1e3},
                            {"held_out_view_mm", r.floors.held_out * 1e3},
                            {"margin", r.floors.margin},
@@ -253,6 +255,9 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                           {"fit_score_mm", c.fit_score * 1e3},
                           {"held_out_score_mm", c.held_out_score * 1e3},
                           {"all_views_score_mm", c.all_score * 1e3},
+                          {"stable_mm", c.drape.stable_all * 1e3},
+                          {"shape", c.drape.shape_all},
+                          {"excess_above_floors", excess_above_floors(c.drape, r.floors)},
                           {"shrinkage", c.shrinkage},
                           {"held_out_shrinkage", c.held_out_shrinkage},
                           {"confirmed", c.confirmed},

@@ -69,6 +69,12 @@ std::vector<double> Floors::group_floor() const {
 
 double Floors::stable_floor() const { return largest(pooled(*this, &FloorSamples::stable)); }
 
+double excess_above_floors(const ScoredDrape& drape, const Floors& floors) {
+  // value - floor is positive exactly when value > floor, so the sum is 0 exactly when both tests pass.
+  auto relative_excess = [](double value, double floor) { return value > floor ? (value - floor) / floor : 0.0; };
+  return relative_excess(drape.stable_all, floors.stable) + relative_excess(drape.shape_all, floors.shape);
+}
+
 sim::Expected<Floors> measure_floors(ForwardModel& model, const ModelSetup& fitted, const Evaluation& fit,
                                      const FloorSettings& settings) {
   Floors floors;

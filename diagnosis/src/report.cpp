@@ -150,7 +150,7 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
         "![views](views.png)\n\nTop: the capture; bottom: the fitted baseline.\n\n";
   if (!r.attribution.candidates.empty()) {
     md += "## Candidate effects (refitted on the fit views, confirmed on the held-out view)\n\n"
-          "| effect | all-view score (mm) | shrinkage above the typical floor | held-out score (mm) | held-out "
+          "| effect | all-view score (mm) | shrinkage of the excess above the floors | held-out score (mm) | held-out "
           "shrinkage | confirmed | parameters |\n|---|---|---|---|---|---|---|\n";
     for (const auto& c : r.attribution.candidates) {
       std::string params;

@@ -1,8 +1,9 @@
 #pragma once
 // Which effect explains the gap: each candidate is added to the model with its own parameters, refitted on the fit
-// views (with the bending scale free as well), and judged by how much it shrinks the gap above the typical floor,
-// confirmed on the held-out view (which must not get worse). Confidence: a block bootstrap over the held-out view's
-// residual tiles of the named effect against the runner-up.
+// views (with the bending scale free as well), and judged by how much it shrinks the excess above the floors that
+// made the gate fire (excess_above_floors: the stable term and the shape distance over their floors), confirmed on
+// the held-out view (which must not get worse). Confidence: a block bootstrap over the held-out view's residual tiles
+// of the named effect against the runner-up.
 
 #include <string>
 #include <vector>
@@ -20,7 +21,7 @@ struct CandidateResult {
   std::vector<double> parameters;   // as in effect_space
   double alpha_scale = 1.0;         // the refitted bending scale relative to the baseline fit
   double fit_score = 0.0, held_out_score = 0.0, all_score = 0.0;
-  /// All-view gap above the typical floor sample (Floors::typical_all): 1 - excess_after / excess_before.
+  /// gap_shrinkage of excess_above_floors: the baseline's against this candidate's refitted drape.
   double shrinkage = 0.0;
   double held_out_shrinkage = 0.0;  // 1 - held_out_after / held_out_before (the view not in the refit)
   bool confirmed = false;           // the held-out view does not get worse
@@ -51,6 +52,10 @@ struct Attribution {
     ForwardModel& model, const ModelSetup& baseline, const Evaluation& fit, const Floors& floors,
     const AttributionSettings& settings,
     const std::function<sim::Expected<std::unique_ptr<ForwardModel>>()>& make_model = {});
+
+/// 1 - excess_after / excess_before (0 when excess_before is 0): 1 when the candidate brings the drape within the
+/// floors, 0 when it leaves the excess as it was, negative when it adds to it.
+[[nodiscard]] double gap_shrinkage(double excess_before, double excess_after);
 
 /// The probability, by block bootstrap over tiles of the held-out views, that `a`'s squared residuals are smaller
 /// than `b`'s in total.

@@ -30,8 +30,8 @@ struct Floors {
   double stable = 0.0;
   double shape = 0.0;
   double shape_margin = 1.0;
-  /// The median sample score over all views / the held-out view: what a correct model typically leaves (the
-  /// reference the attribution's shrinkage is measured above).
+  /// The median sample score over all views / the held-out view: what a correct model typically leaves (reported
+  /// for reference; the gate and the attribution use `stable` and `shape`, see excess_above_floors).
   double typical_all = 0.0;
   double typical_held_out = 0.0;
 
@@ -51,6 +51,12 @@ struct FloorSettings {
   /// overstate the floor.
   double shape_threshold = 1.15;
 };
+
+/// How far `drape` is above the floors, in the terms of the gate "within the floors" (dimensionless): the excess of
+/// the stable-region term over `floors.stable` and of the shape distance over `floors.shape`, each relative to its
+/// floor and clipped at 0, summed. Zero exactly when the drape is within the floors (both tests pass); the floors
+/// must be positive.
+[[nodiscard]] double excess_above_floors(const ScoredDrape& drape, const Floors& floors);
 
 [[nodiscard]] sim::Expected<Floors> measure_floors(ForwardModel& model, const ModelSetup& fitted,
                                                    const Evaluation& fit, const FloorSettings& settings);

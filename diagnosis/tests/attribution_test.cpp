@@ -1,0 +1,66 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "drapegen/diagnosis/attribution.hpp"
+#include "drapegen/diagnosis/floors.hpp"
+
+using namespace drapegen::diagnosis;
+
+namespace {
+
+/// Floors as the gate sees them: the stable-region term's floor (m) and the shape distance's floor.
+Floors floors_of(double stable, double shape) {
+  Floors f;
+  f.stable = stable;
+  f.shape = shape;
+  return f;
+}
+
+/// A drape with the two gated terms set (m, dimensionless) and an all-view score that the excess must ignore.
+ScoredDrape drape_of(double stable_all, double shape_all, double all_score = 0.0) {
+  ScoredDrape d;
+  d.stable_all = stable_all;
+  d.shape_all = shape_all;
+  d.all_score = all_score;
+  return d;
+}
+
+}  // namespace
+
+TEST(ExcessAboveFloors, IsZeroExactlyWhenBothTestsPass) {
+  const Floors f = floors_of(2e-3, 1.15);
+  EXPECT_EQ(excess_above_floors(drape_of(1e-3, 0.9), f), 0.0);
+  EXPECT_EQ(excess_above_floors(drape_of(2e-3, 1.15), f), 0.0);  // at the floor is within it
+  EXPECT_GT(excess_above_floors(drape_of(2e-3, std::nextafter(1.15, 2.0)), f), 0.0);
+  EXPECT_GT(excess_above_floors(drape_of(std::nextafter(2e-3, 1.0), 1.15), f), 0.0);
+}
+
+TEST(ExcessAboveFloors, SumsEachTermsExcessRelativeToItsFloor) {
+  const Floors f = floors_of(2e-3, 1.15);
+  EXPECT_NEAR(excess_above_floors(drape_of(1e-3, 1.38), f), 0.2, 1e-12);  // shape only: 1.38 / 1.15 - 1
+  EXPECT_NEAR(excess_above_floors(drape_of(3e-3, 0.5), f), 0.5, 1e-12);   // stable only: 3 / 2 - 1
+  EXPECT_NEAR(excess_above_floors(drape_of(3e-3, 1.38), f), 0.7, 1e-12);  // both
+}
+
+TEST(ExcessAboveFloors, IgnoresTheAllViewScore) {
+  // Run B's shear_00 in kind: the refit lowers the all-view score below the typical floor sample's, which the old
+  // definition (all-view score above the median floor sample) could not see; only the gated terms count.
+  const Floors f = floors_of(2e-3, 1.15);
+  const double baseline = excess_above_floors(drape_of(1e-3, 1.22, 7.81e-3), f);
+  EXPECT_EQ(baseline, excess_above_floors(drape_of(1e-3, 1.22, 6.26e-3), f));
+  EXPECT_GT(baseline, 0.0);
+}
+
+TEST(GapShrinkage, CreditsRemovingTheReasonTheGateFired) {
+  const Floors f = floors_of(2e-3, 1.15);
+  const double before = excess_above_floors(drape_of(1e-3, 1.38), f);  // the gate fired on the shape test
+  EXPECT_DOUBLE_EQ(gap_shrinkage(before, excess_above_floors(drape_of(1e-3, 1.1), f)), 1.0);    // within: full
+  EXPECT_NEAR(gap_shrinkage(before, excess_above_floors(drape_of(1e-3, 1.265), f)), 0.5, 1e-12);  // half way
+  EXPECT_DOUBLE_EQ(gap_shrinkage(before, excess_above_floors(drape_of(1e-3, 1.38, 1e-3), f)), 0.0);  // unchanged
+  // Trading the shape excess for a new stable-term excess of the same relative size earns nothing.
+  EXPECT_NEAR(gap_shrinkage(before, excess_above_floors(drape_of(2.4e-3, 1.1), f)), 0.0, 1e-12);
+  EXPECT_LT(gap_shrinkage(before, excess_above_floors(drape_of(1e-3, 1.5), f)), 0.0);  // worse: negative
+}
+
+TEST(GapShrinkage, IsZeroWhenThereWasNoExcess) { EXPECT_EQ(gap_shrinkage(0.0, 0.3), 0.0); }
