@@ -347,6 +347,21 @@ const char* shape_name(InitialShape shape) {
   return "?";
 }
 
+struct MeanAndError {
+  double mean = 0.0;
+  double standard_error = 0.0;  // of the mean, from the sample's spread (0 for a single value)
+};
+
+MeanAndError mean_and_error(const std::vector<double>& values) {
+  const double count = static_cast<double>(values.size());
+  MeanAndError out;
+  out.mean = std::accumulate(values.begin(), values.end(), 0.0) / count;
+  double square_sum = 0.0;
+  for (double v : values) square_sum += (v - out.mean) * (v - out.mean);
+  out.standard_error = count > 1 ? std::sqrt(square_sum / (count - 1) / count) : 0.0;
+  return out;
+}
+
 /// The hinge energy of a constant curvature field K, imposed on the flat specimen as the surface z = p^T K p / 2 with
 /// an infinitesimal amplitude (so the dihedral angles are exactly linear in K), over the continuum energy
 /// (alpha/2)(K_xx^2 + 2 K_xy^2 + K_yy^2) * area, over the vertices away from the border (half of each hinge's energy
@@ -428,12 +443,11 @@ void check_mesh_dependence(Table& t, int n, const Options& o) {
   const char* names[3] = {"isotropic", "curvature rule", "edge rule"};
   for (int k = 0; k < 3; ++k) {
     if (o.mesh_cases.find("ice"[k]) == std::string::npos) continue;
-    double mean[2], standard_error[2];
-    std::vector<double> dcs_of[2];
+    MeanAndError dc_of[2];
     std::vector<DrapeConfig> configs_of[2];
     std::vector<DrapeResult> drapes_of[2];
     for (int perturbed = 0; perturbed < 2; ++perturbed) {
-      std::vector<double>& dcs = dcs_of[perturbed];
+      std::vector<double> dcs;
       for (const Start& start : starts) {
         DrapeConfig c = perturbed ? base_config(n, Triangulation::kRandom, 0.2, o)
                                   : base_config(n, Triangulation::kAlternating, 0.0, o);
@@ -451,31 +465,26 @@ void check_mesh_dependence(Table& t, int n, const Options& o) {
         configs_of[perturbed].push_back(c);
         drapes_of[perturbed].push_back(r.result);
       }
-      const double count = static_cast<double>(dcs.size());
-      mean[perturbed] = std::accumulate(dcs.begin(), dcs.end(), 0.0) / count;
-      double square_sum = 0.0;
-      for (double dc : dcs) square_sum += (dc - mean[perturbed]) * (dc - mean[perturbed]);
-      standard_error[perturbed] = count > 1 ? std::sqrt(square_sum / (count - 1) / count) : 0.0;
+      dc_of[perturbed] = mean_and_error(dcs);
+      const double mean = dc_of[perturbed].mean;
       const auto [lo, hi] = std::minmax_element(dcs.begin(), dcs.end());
       const char* mesh = perturbed ? "perturbed" : "structured";
-      t.row(n, "d", fmt::format("{}: mean DC, {} mesh, {} starts", names[k], mesh, dcs.size()), mean[perturbed]);
+      t.row(n, "d", fmt::format("{}: mean DC, {} mesh, {} starts", names[k], mesh, dcs.size()), mean);
       t.row(n, "d", fmt::format("{}: (max - min) / mean DC over the starts, {} mesh", names[k], mesh),
-            (*hi - *lo) / mean[perturbed]);
+            (*hi - *lo) / mean);
     }
-    const double scale = 0.5 * (mean[0] + mean[1]);
-    difference[k] = std::abs(mean[0] - mean[1]) / scale;
+    const double scale = 0.5 * (dc_of[0].mean + dc_of[1].mean);
+    difference[k] = std::abs(dc_of[0].mean - dc_of[1].mean) / scale;
     t.row(n, "d", fmt::format("{}: standard error of that difference (from the spread over starts)", names[k]),
-          std::hypot(standard_error[0], standard_error[1]) / scale);
+          std::hypot(dc_of[0].standard_error, dc_of[1].standard_error) / scale);
     // The same initial state on both meshes often finds the same fold pattern: the spread of the per-start
     // differences then says more than the two spreads.
-    std::vector<double> paired(dcs_of[0].size());
-    for (std::size_t i = 0; i < paired.size(); ++i) paired[i] = (dcs_of[1][i] - dcs_of[0][i]) / scale;
-    const double paired_mean = std::accumulate(paired.begin(), paired.end(), 0.0) / static_cast<double>(paired.size());
-    double paired_square_sum = 0.0;
-    for (double d : paired) paired_square_sum += (d - paired_mean) * (d - paired_mean);
-    const double count = static_cast<double>(paired.size());
+    std::vector<double> paired(drapes_of[0].size());
+    for (std::size_t i = 0; i < paired.size(); ++i) {
+      paired[i] = (drapes_of[1][i].measures.drape_coefficient - drapes_of[0][i].measures.drape_coefficient) / scale;
+    }
     t.row(n, "d", fmt::format("{}: standard error of that difference, paired by start", names[k]),
-          count > 1 ? std::sqrt(paired_square_sum / (count - 1) / count) : 0.0);
+          mean_and_error(paired).standard_error);
     // Without the multistability: each drape moved onto the other grid (interpolated in its rest triangles) and
     // solved there. It mostly keeps its folds, so the difference is the grids' own.
     std::vector<double> same_state;
@@ -494,13 +503,9 @@ void check_mesh_dependence(Table& t, int n, const Options& o) {
         same_folds += r.result.measures.folds == drapes_of[from][i].measures.folds ? 1 : 0;
       }
     }
-    const double same_count = static_cast<double>(same_state.size());
-    const double same_mean = std::accumulate(same_state.begin(), same_state.end(), 0.0) / same_count;
-    double same_square_sum = 0.0;
-    for (double d : same_state) same_square_sum += (d - same_mean) * (d - same_mean);
-    t.row(n, "d", fmt::format("{}: same state, (perturbed - structured) / structured DC, mean", names[k]), same_mean);
-    t.row(n, "d", fmt::format("{}: same state, standard error of that mean", names[k]),
-          same_count > 1 ? std::sqrt(same_square_sum / (same_count - 1) / same_count) : 0.0);
+    const MeanAndError same = mean_and_error(same_state);
+    t.row(n, "d", fmt::format("{}: same state, (perturbed - structured) / structured DC, mean", names[k]), same.mean);
+    t.row(n, "d", fmt::format("{}: same state, standard error of that mean", names[k]), same.standard_error);
     t.row(n, "d", fmt::format("{}: same state, drapes that kept their fold count (of {})", names[k], same_state.size()),
           same_folds);
   }
