@@ -7,7 +7,9 @@
 //   d  mesh dependence of anisotropic bending (Section 4.4, Fig. 12): curvature vs edge rule
 //   e  initial states flat, sine and fold (Fig. 16)
 //
-// Usage: drapegen_drape_physics [--resolution N]... [--checks abcde] [--tolerance T]
+// Usage: drapegen_drape_physics [--resolution N]... [--checks abcde] [--tolerance T] [--bending-model M]
+//        [--mesh-starts K] [--mesh-cases ice] [--structured-mesh alternating|equilateral|uniform] [--jitter J]
+//        [--band-width W] [--beta-scale S]   (the last six shape check d)
 // Each drape's solve is logged on stderr; the table goes to stdout. Exit code 0 when every bounded row passes.
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
@@ -50,6 +52,10 @@ struct Options {
   double tolerance = 1e-3;  // the solver's default; the exact checks do not depend on it
   int mesh_starts = 5;      // initial states per mesh in check d
   std::string mesh_cases = "ice";  // check d: i isotropic, c curvature rule, e edge rule
+  double beta_scale = 1.0;          // check d: the fabrics' beta times this (0: the linear law)
+  double jitter = 0.2;              // check d: the perturbed mesh's jitter (fraction of the spacing)
+  Triangulation structured = Triangulation::kAlternating;  // check d: the structured mesh
+  double band_width = 0.01;         // check d: the stretch band [1 - w, 1 + w]
   BendingModel model = BendingModel::kNonlinearDihedral;  // for everything but the edge rule (a hinge concept)
 };
 
@@ -428,8 +434,10 @@ void check_hinge_consistency(Table& t, int n) {
 
 void check_mesh_dependence(Table& t, int n, const Options& o) {
   check_hinge_consistency(t, n);
-  const FabricParameters aniso = fabric_from_paper_units({20000, 12500, 5000}, {-50000, -31250, -12500}, 300.0);
-  const FabricParameters iso = fabric_from_paper_units({11180, 11180, 11180}, {-27950, -27950, -27950}, 300.0);
+  const double b = o.beta_scale;
+  const FabricParameters aniso =
+      fabric_from_paper_units({20000, 12500, 5000}, {-50000 * b, -31250 * b, -12500 * b}, 300.0);
+  const FabricParameters iso = fabric_from_paper_units({11180, 11180, 11180}, {-27950 * b, -27950 * b, -27950 * b}, 300.0);
   struct Start {
     InitialShape shape;
     unsigned seed;
@@ -449,8 +457,10 @@ void check_mesh_dependence(Table& t, int n, const Options& o) {
     for (int perturbed = 0; perturbed < 2; ++perturbed) {
       std::vector<double> dcs;
       for (const Start& start : starts) {
-        DrapeConfig c = perturbed ? base_config(n, Triangulation::kRandom, 0.2, o)
-                                  : base_config(n, Triangulation::kAlternating, 0.0, o);
+        DrapeConfig c = perturbed ? base_config(n, Triangulation::kRandom, o.jitter, o)
+                                  : base_config(n, o.structured, 0.0, o);
+        c.membrane.band_low = 1.0 - o.band_width;
+        c.membrane.band_high = 1.0 + o.band_width;
         c.fabric = k == 0 ? iso : aniso;
         c.anisotropy = k == 2 ? AnisotropyRule::kEdge : AnisotropyRule::kCurvature;
         if (k == 2) c.bending_model = BendingModel::kNonlinearDihedral;
@@ -577,6 +587,20 @@ int main(int argc, char** argv) {
                  "fabrics of check d: i isotropic, c warp 4 x weft under the curvature rule, e the same under the "
                  "edge rule")
       ->capture_default_str();
+  app.add_option("--beta-scale", options.beta_scale,
+                 "check d: multiply the fabrics' beta (softening) by this; 0 gives the linear law")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  app.add_option("--jitter", options.jitter, "check d: jitter of the perturbed mesh, a fraction of the spacing")
+      ->check(CLI::Range(0.0, 0.3))
+      ->capture_default_str();
+  std::string structured = "alternating";
+  app.add_option("--structured-mesh", structured, "check d: the structured mesh (alternating: union jack; uniform: every quad split along the same diagonal)")
+      ->check(CLI::IsMember({"alternating", "equilateral", "uniform"}))
+      ->capture_default_str();
+  app.add_option("--band-width", options.band_width, "check d: stretch band [1 - w, 1 + w] of the membrane")
+      ->check(CLI::Range(0.0, 0.2))
+      ->capture_default_str();
   std::string model = "dihedral";
   app.add_option("--bending-model", model,
                  "dihedral: hinge curvature (paper Eq. 3); triangle: per-triangle curvature tensors (the edge rule "
@@ -584,6 +608,9 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"dihedral", "triangle"}))
       ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
+  options.structured = structured == "equilateral" ? Triangulation::kEquilateral
+                       : structured == "uniform"   ? Triangulation::kUniform
+                                                   : Triangulation::kAlternating;
   options.model = model == "triangle" ? BendingModel::kNonlinearTriangle : BendingModel::kNonlinearDihedral;
   if (options.resolutions.empty()) options.resolutions = {60};
   Table table;

@@ -77,8 +77,9 @@ ClothMesh grid_specimen(const SpecimenSpec& spec, std::mt19937_64& rng) {
   for (int j = 0; j + 1 < ny; ++j) {
     for (int i = 0; i + 1 < nx; ++i) {
       const int a = j * nx + i, b = a + 1, c = a + nx, d = c + 1;
-      const bool main_diagonal =
-          spec.triangulation == Triangulation::kRandom ? coin(rng) : ((i + j) % 2 == 0);
+      const bool main_diagonal = spec.triangulation == Triangulation::kRandom    ? coin(rng)
+                                 : spec.triangulation == Triangulation::kUniform ? true
+                                                                                 : (i + j) % 2 == 0;
       if (main_diagonal) {  // diagonal a-d
         mesh.triangles.col(t++) = Eigen::Vector3i(a, b, d);
         mesh.triangles.col(t++) = Eigen::Vector3i(a, d, c);

@@ -12,6 +12,7 @@ enum class Triangulation {
   kAlternating,  // grid quads split by alternating diagonals ("union jack")
   kRandom,       // grid quads split by random diagonals (the paper's perturbed triangulation, with jitter)
   kEquilateral,  // rows of (nearly) equilateral triangles, odd rows offset by half a spacing; straight borders
+  kUniform,      // grid quads all split along the same diagonal (lower left to upper right)
 };
 
 struct SpecimenSpec {
