@@ -58,7 +58,21 @@ struct AngleTables {
   }
 };
 
-int round_to_int(float x) { return static_cast<int>(std::floor(x + 0.5f)); }
+/// floor(x + 0.5) as an int for |x| < 2^30: truncation, one down for negative non-integers (the same value as
+/// std::floor without its generic code).
+int round_to_int(float x) {
+  const float y = x + 0.5f;
+  const int t = static_cast<int>(y);
+  return t - (static_cast<float>(t) > y);
+}
+
+/// std::nearbyint in the default rounding mode (to nearest, ties to even) without a library call: adding and
+/// subtracting 2^52 leaves no fraction bits. Numbers of 2^52 and more are integers already.
+double round_to_nearest(double x) {
+  constexpr double kBig = 0x1p52;
+  if (!(std::abs(x) < kBig)) return x;
+  return x >= 0.0 ? (x + kBig) - kBig : (x - kBig) + kBig;
+}
 
 }  // namespace
 
@@ -81,23 +95,30 @@ DepthImage NoiseModel::apply(const DepthImage& clean, std::uint64_t seed) const 
 
   // Lateral jitter: each pixel copies the clean pixel at a rounded Gaussian offset. The jittered images are scratch
   // reused by every call on this thread (no allocation per view).
-  thread_local std::vector<float> z0, c0;
+  // Only pixels of the box are read from c0, and (with their 4-neighbours) from z0, which is 0 outside the box.
+  thread_local std::vector<float> z0, c0, offsets;
   z0.assign(clean.depth.begin(), clean.depth.end());
-  if (have_incidence) {
+  if (lateral) {
+    c0.resize(n);
+  } else if (have_incidence) {
     c0.assign(clean.incidence.begin(), clean.incidence.end());
   } else {
     c0.assign(n, 1.0f);
   }
   if (lateral) {
-    Rng rng(mix_seed(seed, 1));
+    // Two unit Gaussians per pixel of the box, u then v, in row order: drawn in one go.
+    const int box_width = bx1 - bx0 + 1;
+    offsets.resize(2 * static_cast<std::size_t>(box_width) * (by1 - by0 + 1));
+    Rng(mix_seed(seed, 1)).gaussians(offsets.data(), offsets.size());
+    const float* g = offsets.data();
     const float background_sigma = static_cast<float>(lateral_sigma_px(0.0));
     for (int v = by0; v <= by1; ++v) {
-      for (int u = bx0; u <= bx1; ++u) {
+      for (int u = bx0; u <= bx1; ++u, g += 2) {
         const std::size_t i = static_cast<std::size_t>(v) * W + u;
         const float sigma =
             clean.depth[i] > 0.0f ? l0 + l1 * AngleTables::lookup(tables.ratio, cos_at(i)) : background_sigma;
-        const int su = std::clamp(u + round_to_int(sigma * rng.gaussian()), 0, W - 1);
-        const int sv = std::clamp(v + round_to_int(sigma * rng.gaussian()), 0, H - 1);
+        const int su = std::clamp(u + round_to_int(sigma * g[0]), 0, W - 1);
+        const int sv = std::clamp(v + round_to_int(sigma * g[1]), 0, H - 1);
         const std::size_t s = static_cast<std::size_t>(sv) * W + su;
         z0[i] = clean.depth[s];
         c0[i] = cos_at(s);
@@ -108,6 +129,9 @@ DepthImage NoiseModel::apply(const DepthImage& clean, std::uint64_t seed) const 
   Rng rng(mix_seed(seed, 2));
   const float cos_grazing = static_cast<float>(std::cos(grazing_max_deg * M_PI / 180.0));
   const double a = axial_scale * axial_a, b = axial_scale * axial_b, c = axial_scale * axial_c;
+  const std::uint64_t hole_threshold = Rng::below_threshold(edge_hole_probability),
+                      flying_threshold = Rng::below_threshold(flying_probability),
+                      dropout_threshold = Rng::below_threshold(dropout_probability);
   for (int v = by0; v <= by1; ++v) {
     for (int u = bx0; u <= bx1; ++u) {
       const std::size_t i = static_cast<std::size_t>(v) * W + u;
@@ -131,16 +155,16 @@ DepthImage NoiseModel::apply(const DepthImage& clean, std::uint64_t seed) const 
             other = zn;
           }
         }
-        if (hole_side && rng.uniform() < edge_hole_probability) continue;
-        if (jump > 0.0 && rng.uniform() < flying_probability) z += rng.uniform() * (other - z);
+        if (hole_side && rng.uniform_below(hole_threshold)) continue;
+        if (jump > 0.0 && rng.uniform_below(flying_threshold)) z += rng.uniform() * (other - z);
       }
       if (axial) {
         const double sigma = a + b * (z - axial_z0) * (z - axial_z0) +
                              c / std::sqrt(z) * AngleTables::lookup(tables.ratio_sq, cos_theta);
         z += sigma * rng.gaussian();
       }
-      if (quantisation) z = quantisation_step * std::nearbyint(z / quantisation_step);
-      if (dropout && rng.uniform() < dropout_probability) continue;
+      if (quantisation) z = quantisation_step * round_to_nearest(z / quantisation_step);
+      if (dropout && rng.uniform_below(dropout_threshold)) continue;
       if (z > 0.0) out.depth[i] = static_cast<float>(z);
     }
   }

@@ -2,6 +2,7 @@
 // Seeded random numbers that are the same on every platform and standard library (std::normal_distribution is
 // not): xoshiro256** seeded through splitmix64, and Gaussians from a normalised inverse-CDF table.
 
+#include <cstddef>
 #include <cstdint>
 
 #include "drapegen/sim/xoshiro.hpp"
@@ -18,6 +19,10 @@ class Rng {
   std::uint64_t next() { return generator_.next(); }
   /// Uniform in [0, 1) with 53 random bits.
   double uniform() { return generator_.uniform(); }
+  /// uniform() < p, decided on the same 53 bits without converting them: `threshold` is below_threshold(p).
+  bool uniform_below(std::uint64_t threshold) { return (next() >> 11) < threshold; }
+  /// The integer threshold of uniform_below for a probability p: ceil(p 2^53), clamped to [0, 2^53].
+  [[nodiscard]] static std::uint64_t below_threshold(double p);
   /// Standard normal from 16 random bits: the inverse normal CDF at the midpoints of 65536 equal-probability cells,
   /// rescaled to unit variance (range about +-4.3). Four per call of next().
   float gaussian() {
@@ -29,6 +34,16 @@ class Rng {
     pool_ >>= 16;
     --pooled_;
     return gaussian_table_[index];
+  }
+  /// n Gaussians into out: the same numbers as n calls of gaussian(), without a branch per number.
+  void gaussians(float* out, std::size_t n) {
+    std::size_t k = 0;
+    for (; k < n && pooled_ > 0; ++k) out[k] = gaussian();
+    for (; k + 4 <= n; k += 4) {
+      const std::uint64_t r = next();
+      for (int j = 0; j < 4; ++j) out[k + j] = gaussian_table_[static_cast<std::uint16_t>(r >> (16 * j))];
+    }
+    for (; k < n; ++k) out[k] = gaussian();
   }
 
  private:
