@@ -1,5 +1,5 @@
 #pragma once
-// One data point (the 4 views of one specimen orientation) as one OpenEXR file, through OpenEXR's own API. Layout
+// One data point (the 4 views of one specimen orientation) as one OpenEXR file, the one OpenEXR's API writes. Layout
 // (docs/RENDERER.md, "EXR layout"): a single scan-line part, one channel "viewN.Z" per view (camera-space z in
 // metres, 0 = no return), and header attributes for everything a consumer needs.
 
@@ -49,13 +49,18 @@ class ExrWriter {
   explicit ExrWriter(ExrStorage storage = {});
   /// Checks the storage settings (compression name, quantum, level).
   [[nodiscard]] sim::Status validate() const;
-  /// Encodes to memory (what a worker sends over the network).
+  /// Encodes to memory (what a worker sends over the network). Compressions none, zips and zip are written by the
+  /// library itself (the same bytes as OpenEXR's writer, faster), the others through OpenEXR.
   [[nodiscard]] sim::Expected<std::vector<char>> encode(const DataPointRecord& point) const;
+  /// The same file, always through OpenEXR's Imf::OutputFile (the reference for encode()).
+  [[nodiscard]] sim::Expected<std::vector<char>> encode_with_openexr(const DataPointRecord& point) const;
   /// Writes `path + ".tmp"`, then renames it over `path`.
   [[nodiscard]] sim::Status write_file(const std::string& path, const DataPointRecord& point) const;
   [[nodiscard]] const ExrStorage& storage() const { return storage_; }
 
  private:
+  [[nodiscard]] sim::Expected<std::vector<char>> encode(const DataPointRecord& point, bool with_openexr) const;
+
   ExrStorage storage_;
 };
 
