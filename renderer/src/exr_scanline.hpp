@@ -1,9 +1,10 @@
 #pragma once
 // A single-part scan-line OpenEXR file written directly (private to the renderer library): the header attributes,
 // the line offset table and the chunks, uncompressed (NONE) or deflated (ZIPS: 1 line per chunk, ZIP: 16), as the
-// OpenEXR file format specifies them. For these compressions it writes the same bytes as OpenEXR 3.1's
-// Imf::OutputFile (tested in exr_test.cpp) without its per-file and per-chunk set-up: the header map, the frame
-// buffer slices, a zlib stream made and freed for every chunk.
+// OpenEXR file format specifies them, without OpenEXR's per-file and per-chunk set-up (the header map, the frame
+// buffer slices, a zlib stream made and freed for every chunk). The layout is the one OpenEXR 3.1's Imf::OutputFile
+// writes (NONE files are the same bytes); ZIP and ZIPS chunks are deflated by libdeflate instead of zlib, faster and
+// smaller, into zlib streams any reader inflates (tested in exr_test.cpp).
 
 #include <cstdint>
 #include <string>

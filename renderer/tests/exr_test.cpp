@@ -183,10 +183,11 @@ TEST(Exr, ReportsBadInputAndUnwritablePaths) {
   EXPECT_FALSE(ExrWriter().encode(DataPointRecord{}));
 }
 
-TEST(Exr, OwnWriterWritesTheBytesOfOpenExrsWriter) {
-  // encode() writes NONE, ZIPS and ZIP files itself; OpenEXR's Imf::OutputFile is the reference. Smooth depth with
-  // holes; no return at all (a one-pixel data window: deflate makes it longer, so it is stored raw); random depth
-  // (deflate gains little); 11 views (channel names sort as view0, view1, view10, view2, ...).
+TEST(Exr, OwnWriterWritesWhatOpenExrsWriterWrites) {
+  // encode() writes NONE, ZIPS and ZIP files itself, OpenEXR's Imf::OutputFile is the reference: the same bytes
+  // uncompressed; deflated by libdeflate instead of zlib, other bytes that OpenEXR reads back to the same pixels and
+  // attributes. Smooth depth with holes; no return at all (a one-pixel data window: deflate makes it longer, so it
+  // is stored raw); random depth (deflate gains little); 11 views (channels sort as view0, view1, view10, view2...).
   std::vector<DataPointRecord> points = {sample_point(), sample_point(), sample_point(), sample_point()};
   for (auto& v : points[1].views) v.depth = DepthImage(240, 180);
   std::uint64_t state = 5;
@@ -209,8 +210,18 @@ TEST(Exr, OwnWriterWritesTheBytesOfOpenExrsWriter) {
         for (const auto& point : points) {
           const auto own = writer.encode(point), reference = writer.encode_with_openexr(point);
           ASSERT_TRUE(own && reference);
-          EXPECT_EQ(*own, *reference) << compression << " level " << level << ", point of " << point.views.size()
-                                      << " views";
+          const std::string what = compression + " level " + std::to_string(level) + ", data point of " +
+                                   std::to_string(point.views.size()) + " views";
+          if (compression == "none") {
+            EXPECT_EQ(*own, *reference) << what;
+          }
+          const auto a = read_exr(*own), b = read_exr(*reference);
+          ASSERT_TRUE(a && b) << what;
+          expect_same_metadata(*a, *b);
+          ASSERT_EQ(a->views.size(), b->views.size());
+          for (std::size_t v = 0; v < a->views.size(); ++v) {
+            EXPECT_EQ(a->views[v].depth.depth, b->views[v].depth.depth) << what << ", view " << v;
+          }
           ++compared;
         }
       }

@@ -38,7 +38,8 @@ struct ExrStorage {
   Pixel pixel = Pixel::kHalf;
   std::string compression = "zip";  // none, rle, zips, zip, piz, pxr24, b44, b44a, dwaa, dwab
   double quantum = 0.0;             // m; 0: none
-  int zip_level = 3;                // zlib level for zip/zips (1 fastest .. 9 smallest; docs/RENDERER.md)
+  int zip_level = 1;                // deflate level for zip/zips, 1..9 (libdeflate's in encode(), zlib's through
+                                    // OpenEXR; docs/RENDERER.md, "Storage choice")
 
   /// Upper bound of the storage error (rounding to the quantum, then to half or float) for depths up to z_max, m.
   [[nodiscard]] double max_error(double z_max) const;
