@@ -74,6 +74,22 @@ double round_to_nearest(double x) {
   return x >= 0.0 ? (x + kBig) - kBig : (x - kBig) + kBig;
 }
 
+/// The first k in [0, 65536) where `reached` holds, which is false below some k and true from there on; 65536 if
+/// none.
+template <class Predicate>
+int first_index(Predicate reached) {
+  int lo = 0, hi = 65536;
+  while (lo < hi) {
+    const int mid = (lo + hi) / 2;
+    if (reached(mid)) {
+      hi = mid;
+    } else {
+      lo = mid + 1;
+    }
+  }
+  return lo;
+}
+
 }  // namespace
 
 DepthImage NoiseModel::apply(const DepthImage& clean, std::uint64_t seed) const {
@@ -96,7 +112,8 @@ DepthImage NoiseModel::apply(const DepthImage& clean, std::uint64_t seed) const 
   // Lateral jitter: each pixel copies the clean pixel at a rounded Gaussian offset. The jittered images are scratch
   // reused by every call on this thread (no allocation per view).
   // Only pixels of the box are read from c0, and (with their 4-neighbours) from z0, which is 0 outside the box.
-  thread_local std::vector<float> z0, c0, offsets;
+  thread_local std::vector<float> z0, c0;
+  thread_local std::vector<std::uint16_t> indices;
   z0.assign(clean.depth.begin(), clean.depth.end());
   if (lateral) {
     c0.resize(n);
@@ -106,19 +123,36 @@ DepthImage NoiseModel::apply(const DepthImage& clean, std::uint64_t seed) const 
     c0.assign(n, 1.0f);
   }
   if (lateral) {
-    // Two unit Gaussians per pixel of the box, u then v, in row order: drawn in one go.
+    // Two unit Gaussians per pixel of the box, u then v, in row order, as table indices drawn in one go.
     const int box_width = bx1 - bx0 + 1;
-    offsets.resize(2 * static_cast<std::size_t>(box_width) * (by1 - by0 + 1));
-    Rng(mix_seed(seed, 1)).gaussians(offsets.data(), offsets.size());
-    const float* g = offsets.data();
+    indices.resize(2 * static_cast<std::size_t>(box_width) * (by1 - by0 + 1));
+    Rng rng(mix_seed(seed, 1));
+    rng.gaussian_indices(indices.data(), indices.size());
+    const auto offset = [&](float sigma, std::uint16_t index) { return round_to_int(sigma * rng.gaussian_of(index)); };
+    // A pixel without a return keeps none unless it moves. All such pixels have the same sigma, and the indices whose
+    // Gaussian rounds to no offset at that sigma are one range [still_begin, still_end) (the Gaussian increases
+    // with the index), found once: those pixels are left as they are (z0 is 0 there, c0 is not read).
     const float background_sigma = static_cast<float>(lateral_sigma_px(0.0));
+    int still_begin = 0, still_end = 0;
+    if (background_sigma >= 0.0f) {
+      still_begin = first_index([&](int k) { return offset(background_sigma, static_cast<std::uint16_t>(k)) >= 0; });
+      still_end = first_index([&](int k) { return offset(background_sigma, static_cast<std::uint16_t>(k)) >= 1; });
+    }
+    const auto still = [&](std::uint16_t index) {
+      return static_cast<unsigned>(index - still_begin) < static_cast<unsigned>(still_end - still_begin);
+    };
+    const std::uint16_t* g = indices.data();
     for (int v = by0; v <= by1; ++v) {
       for (int u = bx0; u <= bx1; ++u, g += 2) {
         const std::size_t i = static_cast<std::size_t>(v) * W + u;
-        const float sigma =
-            clean.depth[i] > 0.0f ? l0 + l1 * AngleTables::lookup(tables.ratio, cos_at(i)) : background_sigma;
-        const int su = std::clamp(u + round_to_int(sigma * g[0]), 0, W - 1);
-        const int sv = std::clamp(v + round_to_int(sigma * g[1]), 0, H - 1);
+        float sigma = background_sigma;
+        if (clean.depth[i] > 0.0f) {
+          sigma = l0 + l1 * AngleTables::lookup(tables.ratio, cos_at(i));
+        } else if (still(g[0]) && still(g[1])) {
+          continue;
+        }
+        const int su = std::clamp(u + offset(sigma, g[0]), 0, W - 1);
+        const int sv = std::clamp(v + offset(sigma, g[1]), 0, H - 1);
         const std::size_t s = static_cast<std::size_t>(sv) * W + su;
         z0[i] = clean.depth[s];
         c0[i] = cos_at(s);
@@ -129,6 +163,7 @@ DepthImage NoiseModel::apply(const DepthImage& clean, std::uint64_t seed) const 
   Rng rng(mix_seed(seed, 2));
   const float cos_grazing = static_cast<float>(std::cos(grazing_max_deg * M_PI / 180.0));
   const double a = axial_scale * axial_a, b = axial_scale * axial_b, c = axial_scale * axial_c;
+  const double per_step = 1.0 / quantisation_step;
   const std::uint64_t hole_threshold = Rng::below_threshold(edge_hole_probability),
                       flying_threshold = Rng::below_threshold(flying_probability),
                       dropout_threshold = Rng::below_threshold(dropout_probability);
@@ -163,7 +198,7 @@ DepthImage NoiseModel::apply(const DepthImage& clean, std::uint64_t seed) const 
                              c / std::sqrt(z) * AngleTables::lookup(tables.ratio_sq, cos_theta);
         z += sigma * rng.gaussian();
       }
-      if (quantisation) z = quantisation_step * round_to_nearest(z / quantisation_step);
+      if (quantisation) z = quantisation_step * round_to_nearest(z * per_step);
       if (dropout && rng.uniform_below(dropout_threshold)) continue;
       if (z > 0.0) out.depth[i] = static_cast<float>(z);
     }

@@ -25,7 +25,23 @@ class Rng {
   [[nodiscard]] static std::uint64_t below_threshold(double p);
   /// Standard normal from 16 random bits: the inverse normal CDF at the midpoints of 65536 equal-probability cells,
   /// rescaled to unit variance (range about +-4.3). Four per call of next().
-  float gaussian() {
+  float gaussian() { return gaussian_table_[next_index()]; }
+  /// The table indices of the next n Gaussians (gaussian() would return gaussian_of(out[0]), ... in turn), drawn in
+  /// one go.
+  void gaussian_indices(std::uint16_t* out, std::size_t n) {
+    std::size_t k = 0;
+    for (; k < n && pooled_ > 0; ++k) out[k] = next_index();
+    for (; k + 4 <= n; k += 4) {
+      const std::uint64_t r = next();
+      for (int j = 0; j < 4; ++j) out[k + j] = static_cast<std::uint16_t>(r >> (16 * j));
+    }
+    for (; k < n; ++k) out[k] = next_index();
+  }
+  /// The Gaussian of a table index; it increases with the index.
+  [[nodiscard]] float gaussian_of(std::uint16_t index) const { return gaussian_table_[index]; }
+
+ private:
+  std::uint16_t next_index() {
     if (pooled_ == 0) {
       pool_ = next();
       pooled_ = 4;
@@ -33,20 +49,9 @@ class Rng {
     const auto index = static_cast<std::uint16_t>(pool_);
     pool_ >>= 16;
     --pooled_;
-    return gaussian_table_[index];
-  }
-  /// n Gaussians into out: the same numbers as n calls of gaussian(), without a branch per number.
-  void gaussians(float* out, std::size_t n) {
-    std::size_t k = 0;
-    for (; k < n && pooled_ > 0; ++k) out[k] = gaussian();
-    for (; k + 4 <= n; k += 4) {
-      const std::uint64_t r = next();
-      for (int j = 0; j < 4; ++j) out[k + j] = gaussian_table_[static_cast<std::uint16_t>(r >> (16 * j))];
-    }
-    for (; k < n; ++k) out[k] = gaussian();
+    return index;
   }
 
- private:
   sim::Xoshiro256 generator_;
   const float* gaussian_table_;  // 65536 entries, built once per process
   std::uint64_t pool_ = 0;
