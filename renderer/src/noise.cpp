@@ -178,18 +178,19 @@ DepthImage NoiseModel::apply(const DepthImage& clean, std::uint64_t seed) const 
         // The neighbour across the largest jump, if any jump exceeds the threshold.
         double jump = 0.0, other = 0.0;
         bool hole_side = false;
-        const int du[4] = {-1, 1, 0, 0}, dv[4] = {0, 0, -1, 1};
-        for (int k = 0; k < 4; ++k) {
-          const int nu = u + du[k], nv = v + dv[k];
-          if (nu < 0 || nu >= W || nv < 0 || nv >= H) continue;
-          const double zn = z0[static_cast<std::size_t>(nv) * W + nu];
+        const auto neighbour = [&](double zn) {
           if (zn <= 0.0) {
             hole_side = true;
           } else if (std::abs(zn - z) > std::max(jump, edge_jump)) {
             jump = std::abs(zn - z);
             other = zn;
           }
-        }
+        };
+        // Left, right, up, down (within the image).
+        if (u > 0) neighbour(z0[i - 1]);
+        if (u + 1 < W) neighbour(z0[i + 1]);
+        if (v > 0) neighbour(z0[i - W]);
+        if (v + 1 < H) neighbour(z0[i + W]);
         if (hole_side && rng.uniform_below(hole_threshold)) continue;
         if (jump > 0.0 && rng.uniform_below(flying_threshold)) z += rng.uniform() * (other - z);
       }
