@@ -1,6 +1,7 @@
 #include "drapegen/renderer/noise.hpp"
 
 #include <algorithm>
+#include <utility>
 #include <cmath>
 #include <fmt/format.h>
 
@@ -129,26 +130,39 @@ DepthImage NoiseModel::apply(const DepthImage& clean, std::uint64_t seed) const 
     Rng rng(mix_seed(seed, 1));
     rng.gaussian_indices(indices.data(), indices.size());
     const auto offset = [&](float sigma, std::uint16_t index) { return round_to_int(sigma * rng.gaussian_of(index)); };
-    // A pixel without a return keeps none unless it moves. All such pixels have the same sigma, and the indices whose
-    // Gaussian rounds to no offset at that sigma are one range [still_begin, still_end) (the Gaussian increases
-    // with the index), found once: those pixels are left as they are (z0 is 0 there, c0 is not read).
-    const float background_sigma = static_cast<float>(lateral_sigma_px(0.0));
-    int still_begin = 0, still_end = 0;
-    if (background_sigma >= 0.0f) {
-      still_begin = first_index([&](int k) { return offset(background_sigma, static_cast<std::uint16_t>(k)) >= 0; });
-      still_end = first_index([&](int k) { return offset(background_sigma, static_cast<std::uint16_t>(k)) >= 1; });
-    }
-    const auto still = [&](std::uint16_t index) {
-      return static_cast<unsigned>(index - still_begin) < static_cast<unsigned>(still_end - still_begin);
+    // Most pixels do not move: a pixel moves only where a Gaussian rounds to a non-zero offset at its sigma. For a
+    // sigma, the indices whose Gaussian rounds to no offset are one range (the Gaussian increases with the index),
+    // and that range only shrinks as sigma grows. Found once for the sigma of pixels without a return (all the
+    // same; such a pixel keeps no return if it does not move: z0 is 0 there and c0 is not read) and for the
+    // largest sigma of pixels with a return that face the camera within 80 degrees (one that does not move keeps
+    // its own depth, already in z0, and incidence).
+    const auto still_range = [&](float sigma) {
+      if (!(sigma >= 0.0f)) return std::pair{0, 0};
+      return std::pair{first_index([&](int k) { return offset(sigma, static_cast<std::uint16_t>(k)) >= 0; }),
+                       first_index([&](int k) { return offset(sigma, static_cast<std::uint16_t>(k)) >= 1; })};
     };
+    const auto in = [](const std::pair<int, int>& range, std::uint16_t index) {
+      return static_cast<unsigned>(index - range.first) < static_cast<unsigned>(range.second - range.first);
+    };
+    const float background_sigma = static_cast<float>(lateral_sigma_px(0.0));
+    const auto background_still = still_range(background_sigma);
+    const float facing_cos = static_cast<float>(std::cos(80.0 * M_PI / 180.0));
+    // sigma = l0 + l1 r increases with r, which decreases as cos grows (and so does its interpolation).
+    const auto facing_still =
+        l1 >= 0.0f ? still_range(l0 + l1 * AngleTables::lookup(tables.ratio, facing_cos)) : std::pair{0, 0};
     const std::uint16_t* g = indices.data();
     for (int v = by0; v <= by1; ++v) {
       for (int u = bx0; u <= bx1; ++u, g += 2) {
         const std::size_t i = static_cast<std::size_t>(v) * W + u;
         float sigma = background_sigma;
         if (clean.depth[i] > 0.0f) {
-          sigma = l0 + l1 * AngleTables::lookup(tables.ratio, cos_at(i));
-        } else if (still(g[0]) && still(g[1])) {
+          const float cos_theta = cos_at(i);
+          if (cos_theta >= facing_cos && in(facing_still, g[0]) && in(facing_still, g[1])) {
+            c0[i] = cos_theta;
+            continue;
+          }
+          sigma = l0 + l1 * AngleTables::lookup(tables.ratio, cos_theta);
+        } else if (in(background_still, g[0]) && in(background_still, g[1])) {
           continue;
         }
         const int su = std::clamp(u + offset(sigma, g[0]), 0, W - 1);
