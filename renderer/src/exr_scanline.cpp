@@ -61,17 +61,19 @@ class Deflater {
 
 /// ZIP and ZIPS chunk data before deflating: the bytes split into the even-numbered ones followed by the odd-numbered
 /// ones, then each byte after the first replaced by its difference from the byte before it, plus 128 (mod 256).
-void split_and_predict(const unsigned char* raw, std::size_t n, std::vector<unsigned char>& out) {
+/// Written as loops without a carried value, which the compiler vectorises.
+void split_and_predict(const unsigned char* raw, std::size_t n, std::vector<unsigned char>& split,
+                       std::vector<unsigned char>& out) {
+  split.resize(n);
   out.resize(n);
-  const std::size_t half = (n + 1) / 2;
-  for (std::size_t i = 0; i < half; ++i) out[i] = raw[2 * i];
-  for (std::size_t i = 0; 2 * i + 1 < n; ++i) out[half + i] = raw[2 * i + 1];
-  unsigned char previous = n > 0 ? out[0] : 0;
-  for (std::size_t i = 1; i < n; ++i) {
-    const unsigned char current = out[i];
-    out[i] = static_cast<unsigned char>(current - previous + 128);
-    previous = current;
+  const std::size_t half = (n + 1) / 2, pairs = n / 2;
+  for (std::size_t i = 0; i < pairs; ++i) {
+    split[i] = raw[2 * i];
+    split[half + i] = raw[2 * i + 1];
   }
+  if (n % 2 != 0) split[half - 1] = raw[n - 1];
+  if (n > 0) out[0] = split[0];
+  for (std::size_t i = 1; i < n; ++i) out[i] = static_cast<unsigned char>(split[i] - split[i - 1] + 128);
 }
 
 }  // namespace
@@ -186,7 +188,7 @@ std::vector<char> write(const Image& image, int display_width, int display_heigh
   file.resize(table + sizeof(std::uint64_t) * chunks);
 
   thread_local Deflater deflater;
-  thread_local std::vector<unsigned char> raw, predicted, deflated;
+  thread_local std::vector<unsigned char> raw, split, predicted, deflated;
   for (int k = 0; k < chunks; ++k) {
     const int first = k * lines_per_chunk, lines = std::min(lines_per_chunk, height - first);
     raw.resize(line_bytes * channels * lines);
@@ -200,7 +202,7 @@ std::vector<char> write(const Image& image, int display_width, int display_heigh
     const unsigned char* data = raw.data();
     std::size_t size = raw.size();
     if (compression != Compression::kNone) {
-      split_and_predict(raw.data(), raw.size(), predicted);
+      split_and_predict(raw.data(), raw.size(), split, predicted);
       deflater.deflate(predicted.data(), predicted.size(), zip_level, deflated);
       if (deflated.size() < raw.size()) {  // otherwise the chunk is stored as it is
         data = deflated.data();
