@@ -6,7 +6,7 @@ packages=(
   libeigen3-dev libsuitesparse-dev libopenblas0-serial
   libspdlog-dev libfmt-dev libcli11-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  libosmesa6-dev libopenexr-dev openexr libpng-dev
+  libosmesa6-dev libopenexr-dev openexr libpng-dev libdeflate-dev
   python3-torch python3-numpy python3-scipy
   cppzmq-dev libzmq3-dev libprotobuf-dev protobuf-compiler libsqlite3-dev libtomlplusplus-dev
   slurm-wlm munge sqlite3

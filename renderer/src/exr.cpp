@@ -21,6 +21,8 @@
 #include <algorithm>
 #include <map>
 
+#include "exr_scanline.hpp"
+
 namespace drapegen::renderer {
 namespace {
 
@@ -30,6 +32,14 @@ const std::map<std::string, Imf::Compression>& compressions() {
       {"zip", Imf::ZIP_COMPRESSION}, {"piz", Imf::PIZ_COMPRESSION},     {"pxr24", Imf::PXR24_COMPRESSION},
       {"b44", Imf::B44_COMPRESSION}, {"b44a", Imf::B44A_COMPRESSION},   {"dwaa", Imf::DWAA_COMPRESSION},
       {"dwab", Imf::DWAB_COMPRESSION}};
+  return m;
+}
+
+/// The compressions encode() writes itself (exr_scanline.hpp); the others go through OpenEXR.
+const std::map<std::string, exr_scanline::Compression>& own_compressions() {
+  static const std::map<std::string, exr_scanline::Compression> m = {{"none", exr_scanline::Compression::kNone},
+                                                                     {"zips", exr_scanline::Compression::kZips},
+                                                                     {"zip", exr_scanline::Compression::kZip}};
   return m;
 }
 
@@ -169,7 +179,13 @@ sim::Status ExrWriter::validate() const {
   return {};
 }
 
-sim::Expected<std::vector<char>> ExrWriter::encode(const DataPointRecord& point) const {
+sim::Expected<std::vector<char>> ExrWriter::encode(const DataPointRecord& point) const { return encode(point, false); }
+
+sim::Expected<std::vector<char>> ExrWriter::encode_with_openexr(const DataPointRecord& point) const {
+  return encode(point, true);
+}
+
+sim::Expected<std::vector<char>> ExrWriter::encode(const DataPointRecord& point, bool with_openexr) const {
   if (sim::Status s = validate(); !s) return s.error();
   if (point.views.empty()) return sim::Error{"data point has no views"};
   const int W = point.views[0].depth.width, H = point.views[0].depth.height;
@@ -185,39 +201,18 @@ sim::Expected<std::vector<char>> ExrWriter::encode(const DataPointRecord& point)
   if (returns.empty()) returns = PixelBox{0, 0, 0, 0};  // nothing anywhere: one pixel of 0
   const int x0 = returns.u0, y0 = returns.v0, x1 = returns.u1, y1 = returns.v1;
   const int dw = x1 - x0 + 1, dh = y1 - y0 + 1;
+  const bool half = storage_.pixel == ExrStorage::Pixel::kHalf;
+  const int views = static_cast<int>(point.views.size());
+  const std::string storage_text =
+      fmt::format("{} {} quantum={} m", half ? "half" : "float", storage_.compression, storage_.quantum);
   try {
-    Imf::Header header(Imath::Box2i({0, 0}, {W - 1, H - 1}), Imath::Box2i({x0, y0}, {x1, y1}));
-    header.compression() = compressions().at(storage_.compression);
-    header.zipCompressionLevel() = storage_.zip_level;
-    const bool half = storage_.pixel == ExrStorage::Pixel::kHalf;
-    const int views = static_cast<int>(point.views.size());
-    for (int v = 0; v < views; ++v) header.channels().insert(channel_name(v), Imf::Channel(half ? Imf::HALF : Imf::FLOAT));
-    header.insert("drapegen.units", Imf::StringAttribute(kUnits));
-    header.insert("drapegen.views", Imf::IntAttribute(views));
-    header.insert("drapegen.index", Imf::IntAttribute(point.index));
-    header.insert("drapegen.orientation", Imf::DoubleAttribute(point.orientation));
-    header.insert("drapegen.seed", Imf::StringAttribute(std::to_string(point.seed)));
-    header.insert("drapegen.noise", Imf::StringAttribute(point.noise));
-    header.insert("drapegen.source", Imf::StringAttribute(point.source));
-    header.insert("drapegen.storage", Imf::StringAttribute(fmt::format(
-                                          "{} {} quantum={} m", half ? "half" : "float", storage_.compression,
-                                          storage_.quantum)));
-    for (int v = 0; v < views; ++v) {
-      const ViewRecord& r = point.views[v];
-      const std::string prefix = fmt::format("view{}.", v);
-      header.insert(prefix + "K", Imf::M33fAttribute(to_m33(r.camera.intrinsics.K)));
-      header.insert(prefix + "meshToCamera", Imf::M44fAttribute(to_m44(r.camera.world_to_camera)));
-      header.insert(prefix + "tableAngle", Imf::DoubleAttribute(r.table_angle));
-      header.insert(prefix + "noiseSeed", Imf::StringAttribute(std::to_string(r.noise_seed)));
-    }
-
+    // The pixels of the data window, view after view, as stored.
     const std::size_t n = static_cast<std::size_t>(dw) * dh;
-    std::vector<Imath::half> halves(half ? n * views : 0);
-    std::vector<float> floats(half ? 0 : n * views);
+    thread_local std::vector<Imath::half> halves;
+    thread_local std::vector<float> floats;
+    halves.resize(half ? n * views : 0);
+    floats.resize(half ? 0 : n * views);
     const double q = storage_.quantum;
-    Imf::FrameBuffer fb;
-    // Slices address pixel (x, y) of the data window at base + x * xStride + y * yStride.
-    const std::ptrdiff_t origin = static_cast<std::ptrdiff_t>(y0) * dw + x0;
     for (int v = 0; v < views; ++v) {
       const DepthImage& depth = point.views[v].depth;
       for (int y = 0; y < dh; ++y) {
@@ -233,6 +228,69 @@ sim::Expected<std::vector<char>> ExrWriter::encode(const DataPointRecord& point)
           }
         }
       }
+    }
+    auto view_pixels = [&](int v) -> const void* { return half ? static_cast<const void*>(halves.data() + v * n)
+                                                               : static_cast<const void*>(floats.data() + v * n); };
+
+    if (!with_openexr && own_compressions().contains(storage_.compression)) {
+      exr_scanline::Attributes attributes;
+      attributes.add_string("drapegen.units", kUnits);
+      attributes.add_int("drapegen.views", views);
+      attributes.add_int("drapegen.index", point.index);
+      attributes.add_double("drapegen.orientation", point.orientation);
+      attributes.add_string("drapegen.seed", std::to_string(point.seed));
+      attributes.add_string("drapegen.noise", point.noise);
+      attributes.add_string("drapegen.source", point.source);
+      attributes.add_string("drapegen.storage", storage_text);
+      exr_scanline::Image image;
+      image.type = half ? exr_scanline::PixelType::kHalf : exr_scanline::PixelType::kFloat;
+      image.x0 = x0;
+      image.y0 = y0;
+      image.x1 = x1;
+      image.y1 = y1;
+      for (int v = 0; v < views; ++v) {
+        const ViewRecord& r = point.views[v];
+        const std::string prefix = fmt::format("view{}.", v);
+        float K[9], M[16];
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j) K[3 * i + j] = static_cast<float>(r.camera.intrinsics.K(i, j));
+        for (int i = 0; i < 4; ++i)
+          for (int j = 0; j < 4; ++j) M[4 * i + j] = static_cast<float>(r.camera.world_to_camera.matrix()(i, j));
+        attributes.add_m33f(prefix + "K", K);
+        attributes.add_m44f(prefix + "meshToCamera", M);
+        attributes.add_double(prefix + "tableAngle", r.table_angle);
+        attributes.add_string(prefix + "noiseSeed", std::to_string(r.noise_seed));
+        image.channel_names.push_back(channel_name(v));
+        image.pixels.push_back(view_pixels(v));
+      }
+      return exr_scanline::write(image, W, H, own_compressions().at(storage_.compression), storage_.zip_level,
+                                 attributes);
+    }
+
+    Imf::Header header(Imath::Box2i({0, 0}, {W - 1, H - 1}), Imath::Box2i({x0, y0}, {x1, y1}));
+    header.compression() = compressions().at(storage_.compression);
+    header.zipCompressionLevel() = storage_.zip_level;
+    for (int v = 0; v < views; ++v) header.channels().insert(channel_name(v), Imf::Channel(half ? Imf::HALF : Imf::FLOAT));
+    header.insert("drapegen.units", Imf::StringAttribute(kUnits));
+    header.insert("drapegen.views", Imf::IntAttribute(views));
+    header.insert("drapegen.index", Imf::IntAttribute(point.index));
+    header.insert("drapegen.orientation", Imf::DoubleAttribute(point.orientation));
+    header.insert("drapegen.seed", Imf::StringAttribute(std::to_string(point.seed)));
+    header.insert("drapegen.noise", Imf::StringAttribute(point.noise));
+    header.insert("drapegen.source", Imf::StringAttribute(point.source));
+    header.insert("drapegen.storage", Imf::StringAttribute(storage_text));
+    for (int v = 0; v < views; ++v) {
+      const ViewRecord& r = point.views[v];
+      const std::string prefix = fmt::format("view{}.", v);
+      header.insert(prefix + "K", Imf::M33fAttribute(to_m33(r.camera.intrinsics.K)));
+      header.insert(prefix + "meshToCamera", Imf::M44fAttribute(to_m44(r.camera.world_to_camera)));
+      header.insert(prefix + "tableAngle", Imf::DoubleAttribute(r.table_angle));
+      header.insert(prefix + "noiseSeed", Imf::StringAttribute(std::to_string(r.noise_seed)));
+    }
+    Imf::FrameBuffer fb;
+    // Slices address pixel (x, y) of the data window at base + x * xStride + y * yStride.
+    const std::ptrdiff_t origin = static_cast<std::ptrdiff_t>(y0) * dw + x0;
+    for (int v = 0; v < views; ++v) {
       if (half) {
         fb.insert(channel_name(v), Imf::Slice(Imf::HALF, reinterpret_cast<char*>(halves.data() + v * n - origin),
                                               sizeof(Imath::half), sizeof(Imath::half) * dw));

@@ -1,6 +1,7 @@
 #include "drapegen/renderer/noise.hpp"
 
 #include <algorithm>
+#include <utility>
 #include <cmath>
 #include <fmt/format.h>
 
@@ -58,7 +59,37 @@ struct AngleTables {
   }
 };
 
-int round_to_int(float x) { return static_cast<int>(std::floor(x + 0.5f)); }
+/// floor(x + 0.5) as an int for |x| < 2^30: truncation, one down for negative non-integers (the same value as
+/// std::floor without its generic code).
+int round_to_int(float x) {
+  const float y = x + 0.5f;
+  const int t = static_cast<int>(y);
+  return t - (static_cast<float>(t) > y);
+}
+
+/// std::nearbyint in the default rounding mode (to nearest, ties to even) without a library call: adding and
+/// subtracting 2^52 leaves no fraction bits. Numbers of 2^52 and more are integers already.
+double round_to_nearest(double x) {
+  constexpr double kBig = 0x1p52;
+  if (!(std::abs(x) < kBig)) return x;
+  return x >= 0.0 ? (x + kBig) - kBig : (x - kBig) + kBig;
+}
+
+/// The first k in [0, 65536) where `reached` holds, which is false below some k and true from there on; 65536 if
+/// none.
+template <class Predicate>
+int first_index(Predicate reached) {
+  int lo = 0, hi = 65536;
+  while (lo < hi) {
+    const int mid = (lo + hi) / 2;
+    if (reached(mid)) {
+      hi = mid;
+    } else {
+      lo = mid + 1;
+    }
+  }
+  return lo;
+}
 
 }  // namespace
 
@@ -81,23 +112,61 @@ DepthImage NoiseModel::apply(const DepthImage& clean, std::uint64_t seed) const 
 
   // Lateral jitter: each pixel copies the clean pixel at a rounded Gaussian offset. The jittered images are scratch
   // reused by every call on this thread (no allocation per view).
+  // Only pixels of the box are read from c0, and (with their 4-neighbours) from z0, which is 0 outside the box.
   thread_local std::vector<float> z0, c0;
+  thread_local std::vector<std::uint16_t> indices;
   z0.assign(clean.depth.begin(), clean.depth.end());
-  if (have_incidence) {
+  if (lateral) {
+    c0.resize(n);
+  } else if (have_incidence) {
     c0.assign(clean.incidence.begin(), clean.incidence.end());
   } else {
     c0.assign(n, 1.0f);
   }
   if (lateral) {
+    // Two unit Gaussians per pixel of the box, u then v, in row order, as table indices drawn in one go.
+    const int box_width = bx1 - bx0 + 1;
+    indices.resize(2 * static_cast<std::size_t>(box_width) * (by1 - by0 + 1));
     Rng rng(mix_seed(seed, 1));
+    rng.gaussian_indices(indices.data(), indices.size());
+    const auto offset = [&](float sigma, std::uint16_t index) { return round_to_int(sigma * rng.gaussian_of(index)); };
+    // Most pixels do not move: a pixel moves only where a Gaussian rounds to a non-zero offset at its sigma. For a
+    // sigma, the indices whose Gaussian rounds to no offset are one range (the Gaussian increases with the index),
+    // and that range only shrinks as sigma grows. Found once for the sigma of pixels without a return (all the
+    // same; such a pixel keeps no return if it does not move: z0 is 0 there and c0 is not read) and for the
+    // largest sigma of pixels with a return that face the camera within 80 degrees (one that does not move keeps
+    // its own depth, already in z0, and incidence).
+    const auto still_range = [&](float sigma) {
+      if (!(sigma >= 0.0f)) return std::pair{0, 0};
+      return std::pair{first_index([&](int k) { return offset(sigma, static_cast<std::uint16_t>(k)) >= 0; }),
+                       first_index([&](int k) { return offset(sigma, static_cast<std::uint16_t>(k)) >= 1; })};
+    };
+    const auto in = [](const std::pair<int, int>& range, std::uint16_t index) {
+      return static_cast<unsigned>(index - range.first) < static_cast<unsigned>(range.second - range.first);
+    };
     const float background_sigma = static_cast<float>(lateral_sigma_px(0.0));
+    const auto background_still = still_range(background_sigma);
+    const float facing_cos = static_cast<float>(std::cos(80.0 * M_PI / 180.0));
+    // sigma = l0 + l1 r increases with r, which decreases as cos grows (and so does its interpolation).
+    const auto facing_still =
+        l1 >= 0.0f ? still_range(l0 + l1 * AngleTables::lookup(tables.ratio, facing_cos)) : std::pair{0, 0};
+    const std::uint16_t* g = indices.data();
     for (int v = by0; v <= by1; ++v) {
-      for (int u = bx0; u <= bx1; ++u) {
+      for (int u = bx0; u <= bx1; ++u, g += 2) {
         const std::size_t i = static_cast<std::size_t>(v) * W + u;
-        const float sigma =
-            clean.depth[i] > 0.0f ? l0 + l1 * AngleTables::lookup(tables.ratio, cos_at(i)) : background_sigma;
-        const int su = std::clamp(u + round_to_int(sigma * rng.gaussian()), 0, W - 1);
-        const int sv = std::clamp(v + round_to_int(sigma * rng.gaussian()), 0, H - 1);
+        float sigma = background_sigma;
+        if (clean.depth[i] > 0.0f) {
+          const float cos_theta = cos_at(i);
+          if (cos_theta >= facing_cos && in(facing_still, g[0]) && in(facing_still, g[1])) {
+            c0[i] = cos_theta;
+            continue;
+          }
+          sigma = l0 + l1 * AngleTables::lookup(tables.ratio, cos_theta);
+        } else if (in(background_still, g[0]) && in(background_still, g[1])) {
+          continue;
+        }
+        const int su = std::clamp(u + offset(sigma, g[0]), 0, W - 1);
+        const int sv = std::clamp(v + offset(sigma, g[1]), 0, H - 1);
         const std::size_t s = static_cast<std::size_t>(sv) * W + su;
         z0[i] = clean.depth[s];
         c0[i] = cos_at(s);
@@ -108,6 +177,10 @@ DepthImage NoiseModel::apply(const DepthImage& clean, std::uint64_t seed) const 
   Rng rng(mix_seed(seed, 2));
   const float cos_grazing = static_cast<float>(std::cos(grazing_max_deg * M_PI / 180.0));
   const double a = axial_scale * axial_a, b = axial_scale * axial_b, c = axial_scale * axial_c;
+  const double per_step = 1.0 / quantisation_step;
+  const std::uint64_t hole_threshold = Rng::below_threshold(edge_hole_probability),
+                      flying_threshold = Rng::below_threshold(flying_probability),
+                      dropout_threshold = Rng::below_threshold(dropout_probability);
   for (int v = by0; v <= by1; ++v) {
     for (int u = bx0; u <= bx1; ++u) {
       const std::size_t i = static_cast<std::size_t>(v) * W + u;
@@ -119,28 +192,29 @@ DepthImage NoiseModel::apply(const DepthImage& clean, std::uint64_t seed) const 
         // The neighbour across the largest jump, if any jump exceeds the threshold.
         double jump = 0.0, other = 0.0;
         bool hole_side = false;
-        const int du[4] = {-1, 1, 0, 0}, dv[4] = {0, 0, -1, 1};
-        for (int k = 0; k < 4; ++k) {
-          const int nu = u + du[k], nv = v + dv[k];
-          if (nu < 0 || nu >= W || nv < 0 || nv >= H) continue;
-          const double zn = z0[static_cast<std::size_t>(nv) * W + nu];
+        const auto neighbour = [&](double zn) {
           if (zn <= 0.0) {
             hole_side = true;
           } else if (std::abs(zn - z) > std::max(jump, edge_jump)) {
             jump = std::abs(zn - z);
             other = zn;
           }
-        }
-        if (hole_side && rng.uniform() < edge_hole_probability) continue;
-        if (jump > 0.0 && rng.uniform() < flying_probability) z += rng.uniform() * (other - z);
+        };
+        // Left, right, up, down (within the image).
+        if (u > 0) neighbour(z0[i - 1]);
+        if (u + 1 < W) neighbour(z0[i + 1]);
+        if (v > 0) neighbour(z0[i - W]);
+        if (v + 1 < H) neighbour(z0[i + W]);
+        if (hole_side && rng.uniform_below(hole_threshold)) continue;
+        if (jump > 0.0 && rng.uniform_below(flying_threshold)) z += rng.uniform() * (other - z);
       }
       if (axial) {
         const double sigma = a + b * (z - axial_z0) * (z - axial_z0) +
                              c / std::sqrt(z) * AngleTables::lookup(tables.ratio_sq, cos_theta);
         z += sigma * rng.gaussian();
       }
-      if (quantisation) z = quantisation_step * std::nearbyint(z / quantisation_step);
-      if (dropout && rng.uniform() < dropout_probability) continue;
+      if (quantisation) z = quantisation_step * round_to_nearest(z * per_step);
+      if (dropout && rng.uniform_below(dropout_threshold)) continue;
       if (z > 0.0) out.depth[i] = static_cast<float>(z);
     }
   }

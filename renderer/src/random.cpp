@@ -49,6 +49,14 @@ std::uint64_t mix_seed(std::uint64_t seed, std::uint64_t stream) {
   return splitmix(x);
 }
 
+std::uint64_t Rng::below_threshold(double p) {
+  // uniform() = k 2^-53 for an integer k, so uniform() < p exactly when k < p 2^53, i.e. k < ceil(p 2^53).
+  constexpr double kScale = 0x1p53;
+  if (!(p > 0.0)) return 0;
+  if (p >= 1.0) return static_cast<std::uint64_t>(kScale);
+  return static_cast<std::uint64_t>(std::ceil(p * kScale));
+}
+
 Rng::Rng(std::uint64_t seed) : generator_(seed), gaussian_table_(gaussian_table().data()) {}
 
 }  // namespace drapegen::renderer

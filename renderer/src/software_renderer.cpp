@@ -51,11 +51,19 @@ void set_image_point(Point& p, const Eigen::Vector3d& projected) {
   p.exact_u = projected.x();
   p.exact_v = projected.y();
   p.inverse_z = projected.z();
-  // Arithmetic shifts round towards -infinity (C++20).
-  p.floor_u = static_cast<int>(p.u >> kSubpixelBits);
-  p.ceil_u = static_cast<int>(-((-p.u) >> kSubpixelBits));
-  p.floor_v = static_cast<int>(p.v >> kSubpixelBits);
-  p.ceil_v = static_cast<int>(-((-p.v) >> kSubpixelBits));
+}
+
+// Arithmetic shifts round towards -infinity (C++20): the pixel centres (integer coordinates) at or below and at or
+// above a snapped coordinate.
+int floor_px(std::int64_t x) { return static_cast<int>(x >> kSubpixelBits); }
+int ceil_px(std::int64_t x) { return static_cast<int>(-((-x) >> kSubpixelBits)); }
+
+using Centres = SoftwareRenderer::Centres;
+
+/// The pixel centres of the image in the bounding box of the snapped points (a, b, c).
+Centres centres_in_box(const Point& a, const Point& b, const Point& c, int width, int height) {
+  return {std::max(ceil_px(std::min({a.u, b.u, c.u})), 0), std::min(floor_px(std::max({a.u, b.u, c.u})), width - 1),
+          std::max(ceil_px(std::min({a.v, b.v, c.v})), 0), std::min(floor_px(std::max({a.v, b.v, c.v})), height - 1)};
 }
 
 /// The edge p -> q of a triangle with positive area as its edge function at pixel centres, stepped along rows and
@@ -94,13 +102,15 @@ struct Target {
   /// Covers the pixel centres inside the image triangle (a, b, c) with triangle `id`; the depth of a pixel is the
   /// perspective-correct interpolation of camera z (1/z is linear in the image) over the exact (unsnapped)
   /// triangle, in double precision.
-  void triangle(const Point& a, const Point& b_in, const Point& c_in, int id) {
+  void triangle(const Point& a, const Point& b, const Point& c, int id) {
+    const Centres box = centres_in_box(a, b, c, image.width, image.height);
+    if (!box.empty()) triangle(a, b, c, box, id);
+  }
+
+  /// The same, given the pixel centres of the image in the triangle's bounding box (not empty).
+  void triangle(const Point& a, const Point& b_in, const Point& c_in, const Centres& box, int id) {
     const Point *pb = &b_in, *pc = &c_in;
-    const int lo_u = std::max(std::min({a.ceil_u, pb->ceil_u, pc->ceil_u}), 0);
-    const int hi_u = std::min(std::max({a.floor_u, pb->floor_u, pc->floor_u}), image.width - 1);
-    const int lo_v = std::max(std::min({a.ceil_v, pb->ceil_v, pc->ceil_v}), 0);
-    const int hi_v = std::min(std::max({a.floor_v, pb->floor_v, pc->floor_v}), image.height - 1);
-    if (lo_u > hi_u || lo_v > hi_v) return;  // no pixel centre in the bounding box
+    const int lo_u = box.lo_u, hi_u = box.hi_u, lo_v = box.lo_v, hi_v = box.hi_v;
     const std::int64_t area = (pb->u - a.u) * (pc->v - a.v) - (pb->v - a.v) * (pc->u - a.u);
     if (area == 0) return;  // no fragments, as in OpenGL
     if (area < 0) std::swap(pb, pc);
@@ -182,14 +192,20 @@ sim::Expected<DepthImage> SoftwareRenderer::render(const Camera& camera, const E
   const std::size_t nv = scene_.vertices.size();
   eye_.resize(nv);
   points_.resize(nv);
+  centres_.resize(nv);
   for (std::size_t i = 0; i < nv; ++i) {
     const Eigen::Vector3d x = R * scene_.vertices[i].cast<double>() + t;
     eye_[i] = x;
-    points_[i].clipped = true;
+    Point& p = points_[i];
+    p.clipped = true;
+    // A vertex to be clipped gets the whole image, so that its triangles are always candidates.
+    centres_[i] = Centres{0, W - 1, 0, H - 1};
     if (!(x.z() >= range_.near)) continue;
     const Eigen::Vector3d projected = project(x, K);
     if (std::abs(projected.x()) <= kGuardBand && std::abs(projected.y()) <= kGuardBand) {
-      set_image_point(points_[i], projected);
+      set_image_point(p, projected);
+      centres_[i] = Centres{std::max(ceil_px(p.u), 0), std::min(floor_px(p.u), W - 1), std::max(ceil_px(p.v), 0),
+                            std::min(floor_px(p.v), H - 1)};
     }
   }
 
@@ -205,7 +221,21 @@ sim::Expected<DepthImage> SoftwareRenderer::render(const Camera& camera, const E
       if (!(eye_[k].z() >= range_.near)) closed_from = scene_.triangle_count();
     }
   }
+  // First the triangles whose bounding box holds a pixel centre of the image (a third of the drape's hold none), in
+  // their order, without a branch per triangle (the per-vertex centres make the box); then only these are set up.
+  candidates_.resize(scene_.triangles.size());
+  int candidate_count = 0;
   for (int id = 0; id < scene_.triangle_count(); ++id) {
+    const std::array<int, 3>& tri = scene_.triangles[id];
+    const Centres &a = centres_[tri[0]], &b = centres_[tri[1]], &c = centres_[tri[2]];
+    Candidate& candidate = candidates_[candidate_count];
+    candidate.id = id;
+    candidate.box = {std::min({a.lo_u, b.lo_u, c.lo_u}), std::max({a.hi_u, b.hi_u, c.hi_u}),
+                     std::min({a.lo_v, b.lo_v, c.lo_v}), std::max({a.hi_v, b.hi_v, c.hi_v})};
+    candidate_count += !candidate.box.empty();
+  }
+  for (int k = 0; k < candidate_count; ++k) {
+    const int id = candidates_[k].id;
     const std::array<int, 3>& tri = scene_.triangles[id];
     if (id >= closed_from) {  // a back face (its normal points away from the camera)
       const Eigen::Vector3d& p = eye_[tri[0]];
@@ -213,7 +243,7 @@ sim::Expected<DepthImage> SoftwareRenderer::render(const Camera& camera, const E
     }
     const Point &a = points_[tri[0]], &b = points_[tri[1]], &c = points_[tri[2]];
     if (!(a.clipped || b.clipped || c.clipped)) {
-      target.triangle(a, b, c, id);
+      target.triangle(a, b, c, candidates_[k].box, id);
       continue;
     }
     const int n = clip(eye_[tri[0]], eye_[tri[1]], eye_[tri[2]], volume, polygon);

@@ -2,7 +2,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <vector>
 
 #include "drapegen/renderer/depth_renderer.hpp"
 #include "shared_renderer.hpp"
@@ -242,6 +244,28 @@ TEST(Random, GaussianTableHasUnitVarianceAndZeroMean) {
   EXPECT_NEAR(sum_sq / n, 1.0, 0.005);
   EXPECT_NE(mix_seed(1, 0), mix_seed(1, 1));
   EXPECT_NE(mix_seed(1, 0), mix_seed(2, 0));
+}
+
+TEST(Random, BulkIndicesAndThresholdsDrawTheSameNumbers) {
+  // gaussian_indices gives the draws of gaussian() in turn, whatever the pool holds before; uniform_below(t) is
+  // uniform() < p for t = below_threshold(p), on the same random bits.
+  for (const std::size_t before : {0, 1, 3, 4, 5}) {
+    Rng one(11), bulk(11);
+    for (std::size_t k = 0; k < before; ++k) EXPECT_EQ(one.gaussian(), bulk.gaussian());
+    std::vector<std::uint16_t> indices(37);
+    bulk.gaussian_indices(indices.data(), indices.size());
+    for (const std::uint16_t index : indices) EXPECT_EQ(one.gaussian(), bulk.gaussian_of(index));
+    EXPECT_EQ(one.gaussian(), bulk.gaussian());
+  }
+  for (const double p : {-0.5, 0.0, 0x1p-53, 0.002, 0.3, 0.5, 1.0 - 0x1p-53, 1.0, 2.0}) {
+    Rng a(5), b(5);
+    for (int k = 0; k < 10000; ++k) EXPECT_EQ(a.uniform() < p, b.uniform_below(Rng::below_threshold(p))) << p;
+  }
+  // Exactly at the threshold: k 2^-53 < p for the integer k just below p 2^53 and not for k at it.
+  EXPECT_EQ(Rng::below_threshold(0.25), std::uint64_t{1} << 51);
+  EXPECT_EQ(Rng::below_threshold(0.25 + 0x1p-54), (std::uint64_t{1} << 51) + 1);
+  EXPECT_GT(Rng::below_threshold(0.002), 0u);
+  EXPECT_GT(std::abs(Rng(1).gaussian_of(65535)), 4.0f);
 }
 
 }  // namespace

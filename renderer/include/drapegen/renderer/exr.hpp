@@ -1,5 +1,5 @@
 #pragma once
-// One data point (the 4 views of one specimen orientation) as one OpenEXR file, through OpenEXR's own API. Layout
+// One data point (the 4 views of one specimen orientation) as one OpenEXR file, the one OpenEXR's API writes. Layout
 // (docs/RENDERER.md, "EXR layout"): a single scan-line part, one channel "viewN.Z" per view (camera-space z in
 // metres, 0 = no return), and header attributes for everything a consumer needs.
 
@@ -38,7 +38,8 @@ struct ExrStorage {
   Pixel pixel = Pixel::kHalf;
   std::string compression = "zip";  // none, rle, zips, zip, piz, pxr24, b44, b44a, dwaa, dwab
   double quantum = 0.0;             // m; 0: none
-  int zip_level = 3;                // zlib level for zip/zips (1 fastest .. 9 smallest; docs/RENDERER.md)
+  int zip_level = 1;                // deflate level for zip/zips, 1..9 (libdeflate's in encode(), zlib's through
+                                    // OpenEXR; docs/RENDERER.md, "Storage choice")
 
   /// Upper bound of the storage error (rounding to the quantum, then to half or float) for depths up to z_max, m.
   [[nodiscard]] double max_error(double z_max) const;
@@ -49,13 +50,18 @@ class ExrWriter {
   explicit ExrWriter(ExrStorage storage = {});
   /// Checks the storage settings (compression name, quantum, level).
   [[nodiscard]] sim::Status validate() const;
-  /// Encodes to memory (what a worker sends over the network).
+  /// Encodes to memory (what a worker sends over the network). Compressions none, zips and zip are written by the
+  /// library itself (the same bytes as OpenEXR's writer, faster), the others through OpenEXR.
   [[nodiscard]] sim::Expected<std::vector<char>> encode(const DataPointRecord& point) const;
+  /// The same file, always through OpenEXR's Imf::OutputFile (the reference for encode()).
+  [[nodiscard]] sim::Expected<std::vector<char>> encode_with_openexr(const DataPointRecord& point) const;
   /// Writes `path + ".tmp"`, then renames it over `path`.
   [[nodiscard]] sim::Status write_file(const std::string& path, const DataPointRecord& point) const;
   [[nodiscard]] const ExrStorage& storage() const { return storage_; }
 
  private:
+  [[nodiscard]] sim::Expected<std::vector<char>> encode(const DataPointRecord& point, bool with_openexr) const;
+
   ExrStorage storage_;
 };
 

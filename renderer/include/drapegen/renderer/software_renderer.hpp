@@ -27,13 +27,18 @@ class SoftwareRenderer final : public Renderer {
   [[nodiscard]] std::string name() const override;
 
   /// A vertex in the image: position (u, v) snapped to 1/256 px (for coverage) and exact (for depth), 1 / camera z,
-  /// the nearest pixel centres around it, and whether it lies outside the volume drawn directly (behind the near
-  /// plane or far outside the image).
+  /// and whether it lies outside the volume drawn directly (behind the near plane or far outside the image).
   struct ImagePoint {
     std::int64_t u = 0, v = 0;
     double exact_u = 0.0, exact_v = 0.0, inverse_z = 0.0;
-    int floor_u = 0, ceil_u = 0, floor_v = 0, ceil_v = 0;
     bool clipped = false;
+  };
+
+  /// Pixel centres of the image (integer u, v) in a range, empty if lo > hi: for a vertex, those at or next to it;
+  /// for a triangle, those in its bounding box (the smallest lo and largest hi of its vertices).
+  struct Centres {
+    int lo_u = 0, hi_u = -1, lo_v = 0, hi_v = -1;
+    [[nodiscard]] bool empty() const { return (lo_u > hi_u) | (lo_v > hi_v); }
   };
 
  private:
@@ -42,6 +47,12 @@ class SoftwareRenderer final : public Renderer {
   // Per vertex, in the current view: camera-space position, and its image point.
   std::vector<Eigen::Vector3d> eye_;
   std::vector<ImagePoint> points_;
+  std::vector<Centres> centres_;
+  struct Candidate {
+    int id;
+    Centres box;
+  };
+  std::vector<Candidate> candidates_;  // the triangles of the current view with a pixel centre in their box
   std::vector<int> triangle_of_;  // per pixel: the triangle seen
 };
 
