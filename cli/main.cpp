@@ -2,6 +2,7 @@
 #include <iostream>
 #include <map>
 #include <new>
+#include <string>
 
 #include "commands.hpp"
 
@@ -37,7 +38,16 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    // Like every other bad input: one line on stderr, exit code 1.
+    std::string message = e.what();
+    for (char& c : message) c = c == '\n' ? ' ' : c;
+    std::string where = "drapegen";
+    for (const auto& [sub, run] : runners) {
+      if (sub->parsed()) where += " " + sub->get_name();
+    }
+    std::cerr << where << ": error: " << message << " (see --help)\n";
+    return drapegen::cli::kExitUsage;
   }
   for (const auto& [sub, run] : runners) {
     if (!sub->parsed()) continue;

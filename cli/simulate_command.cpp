@@ -32,6 +32,7 @@ struct SimulateOptions {
   double sigma = 200.0;
   std::string band = "0.99,1.01";
   bool structured = false;
+  std::string mesh = "perturbed";
   int max_iterations = 400;
   double tolerance = 1e-3;
   bool verbose = false;
@@ -116,9 +117,12 @@ int run_simulate(const SimulateOptions& o) {
   if (!(o.sigma > 0.0) || !std::isfinite(o.sigma)) return fail("--sigma must be positive (kg/s^2)");
   config.specimen.vertices_x = config.specimen.vertices_y = o.resolution;
   config.specimen.seed = o.seed;
-  if (o.structured) {
+  const std::string mesh = o.structured ? "union-jack" : o.mesh;
+  if (mesh != "perturbed") {
     config.specimen.jitter = 0.0;
-    config.specimen.triangulation = sim::Triangulation::kAlternating;
+    config.specimen.triangulation = mesh == "union-jack" ? sim::Triangulation::kAlternating
+                                    : mesh == "uniform"  ? sim::Triangulation::kUniform
+                                                         : sim::Triangulation::kEquilateral;
   }
   initial->seed = o.seed;
   initial->rotation = o.rotation_deg * M_PI / 180.0;
@@ -199,7 +203,13 @@ Runner add_simulate_command(CLI::App& app) {
   app.add_option("--sigma", o->sigma, "In-plane stiffness at the standard density (300 g/m^2), kg/s^2")->capture_default_str();
   app.add_option("--band", o->band, "Stretch band LOW,HIGH absorbed by the adaptive reference (1,1: none)")
       ->capture_default_str();
-  app.add_flag("--structured", o->structured, "Use a regular grid instead of the perturbed triangulation");
+  auto* mesh = app.add_option("--mesh", o->mesh,
+                              "Triangulation: perturbed (the paper's: random diagonals, jittered vertices), union-jack "
+                              "(alternating diagonals), uniform (every quad split along the same diagonal) or "
+                              "equilateral (rows of equilateral triangles)")
+                   ->check(CLI::IsMember({"perturbed", "union-jack", "uniform", "equilateral"}))
+                   ->capture_default_str();
+  app.add_flag("--structured", o->structured, "Shorthand for --mesh union-jack")->excludes(mesh);
   app.add_option("--max-iterations", o->max_iterations, "Newton iteration limit")->capture_default_str();
   app.add_option("--tolerance", o->tolerance, "Residual force over the largest vertex weight")->capture_default_str();
   app.add_flag("-v,--verbose", o->verbose, "Print every Newton iteration on stderr");
