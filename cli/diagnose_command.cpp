@@ -42,7 +42,7 @@ int run_diagnose(const DiagnoseOptions& o) {
     return fail("--evaluations and --refit-evaluations must be 1 .. 10000");
   }
   if (o.shape_floor > 100.0) return fail("--shape-floor must be 0 (from the floor samples) .. 100");
-  if (o.verbose) sim::logger()->set_level(spdlog::level::info);
+  if (o.verbose) sim::logger()->set_level(spdlog::level::debug);
   auto capture = diagnosis::read_capture(o.capture);
   if (!capture) return fail(capture.error().message);
   if (!o.report.empty()) {

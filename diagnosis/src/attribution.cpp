@@ -7,7 +7,10 @@
 #include <mutex>
 #include <thread>
 
+#include <fmt/ranges.h>
+
 #include "drapegen/renderer/random.hpp"
+#include "drapegen/sim/logging.hpp"
 
 namespace drapegen::diagnosis {
 namespace {
@@ -67,6 +70,8 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, Effect effect, const M
       error = e.error();
       return std::numeric_limits<double>::infinity();
     }
+    sim::logger()->debug("refit {}: {} -> {:.3f} mm (state {}, shape {:.2f})", effect_name(effect), fmt::join(x, ", "),
+                         e->best.fit_score * 1e3, e->best.state, e->best.shape_fit);
     if (e->best.fit_score < best) {
       best = e->best.fit_score;
       c.drape = e->best;

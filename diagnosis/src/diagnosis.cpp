@@ -111,6 +111,8 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
       return std::numeric_limits<double>::infinity();
     }
     const double value = e->best.fit_score;
+    sim::logger()->debug("baseline fit: ({:.3f}, {:.3f}, {:.3f}, {:.3f}) -> {:.3f} mm (state {}, shape {:.2f})", x[0],
+                         x[1], x[2], x[3], value * 1e3, e->best.state, e->best.shape_fit);
     if (value < best) {
       best = value;
       r.fit = std::move(*e);

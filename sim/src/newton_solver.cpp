@@ -146,7 +146,9 @@ SolveReport NewtonSolver::solve(const std::vector<EnergyTerm*>& terms, const std
   int creeping = 0;  // consecutive iterations whose step moved no vertex measurably
   for (int it = 0; it < options_.max_iterations; ++it) {
     report.iterations = it;
-    const bool outer = it > 0 && report.residual < options_.lagged_outer_below;
+    // The outer loop starts once Newton has stepped: the residual at iteration 1 is the initial state's, which
+    // need not be an equilibrium (a flat start has a small one, yet has not fallen yet).
+    const bool outer = it > 1 && report.residual < options_.lagged_outer_below;
     const bool early = it < options_.lagged_every_iterations && report.residual > options_.lagged_every_above;
     if (!frozen && (it == 0 || outer || early)) {
       double change = 0.0;
@@ -154,7 +156,10 @@ SolveReport NewtonSolver::solve(const std::vector<EnergyTerm*>& terms, const std
       ++report.lagged_updates;
       outer_updates += outer ? 1 : 0;
       report.lagged_change = change;
-      frozen = it > 0 && (change < options_.lagged_tolerance || outer_updates >= options_.max_lagged_outer_updates);
+      // Only the outer loop may freeze the parameters (as documented): an update that changes nothing before the
+      // drape has formed (a flat start, where no hinge has bent yet) says nothing about convergence, yet it froze
+      // them for good, so that plasticity never acted on drapes from a flat initial state.
+      frozen = outer && (change < options_.lagged_tolerance || outer_updates >= options_.max_lagged_outer_updates);
     }
     bool exact = it > 0 && report.residual < options_.exact_hessian_below && exact_cooldown == 0;
     exact_cooldown = std::max(0, exact_cooldown - 1);
