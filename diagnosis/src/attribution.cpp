@@ -15,11 +15,6 @@
 namespace drapegen::diagnosis {
 namespace {
 
-/// The validation states: fresh seeds, none of the fit's or the floors'.
-std::vector<sim::InitialStateSpec> validation_states(const AttributionSettings& settings) {
-  return fit_initial_states(settings.validation_states, settings.validation_seed);
-}
-
 /// Refits `effect` (with the bending scale free), or with no effect (the bar) the baseline's own bending parameters in
 /// the fit's reduced coordinates, on the fit states; then evaluates the refitted setup from the validation states.
 sim::Expected<CandidateResult> refit(ForwardModel& model, std::optional<Effect> effect, const ModelSetup& baseline,
@@ -132,6 +127,10 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, std::optional<Effect> 
 
 }  // namespace
 
+std::vector<sim::InitialStateSpec> validation_states(const AttributionSettings& settings) {
+  return fit_initial_states(settings.validation_states, settings.validation_seed);
+}
+
 double gap_shrinkage(double excess_before, double excess_after) {
   return excess_before > 0.0 ? 1.0 - excess_after / excess_before : 0.0;
 }
@@ -172,10 +171,9 @@ double bootstrap_confidence(const ForwardModel& model, const ScoredDrape& a, con
 }
 
 sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& baseline, const Evaluation& fit,
-                                     const Floors& floors, const AttributionSettings& settings,
+                                     const Evaluation& validated, const Floors& floors,
+                                     const AttributionSettings& settings,
                                      const std::function<sim::Expected<std::unique_ptr<ForwardModel>>()>& make_model) {
-  auto baseline_validated = model.evaluate(baseline, validation_states(settings));
-  if (!baseline_validated) return baseline_validated.error();
   // Tasks: the candidates, then the bar (no effect: the baseline's bending refitted with the same budget).
   const std::size_t tasks = settings.candidates.size() + 1;
   auto task_effect = [&](std::size_t k) -> std::optional<Effect> {
@@ -185,7 +183,7 @@ sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& base
   const int jobs = std::max(1, std::min<int>(settings.jobs, static_cast<int>(tasks)));
   if (jobs == 1 || !make_model) {
     for (std::size_t k = 0; k < tasks; ++k)
-      results[k] = refit(model, task_effect(k), baseline, fit, *baseline_validated, settings);
+      results[k] = refit(model, task_effect(k), baseline, fit, validated, settings);
   } else {
     std::vector<std::thread> threads;
     std::mutex mutex;
@@ -205,7 +203,7 @@ sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& base
           m = own.get();
         }
         for (std::size_t k = static_cast<std::size_t>(j); k < tasks; k += jobs) {
-          auto r = refit(*m, task_effect(k), baseline, fit, *baseline_validated, settings);
+          auto r = refit(*m, task_effect(k), baseline, fit, validated, settings);
           std::lock_guard lock(mutex);
           results[k] = std::move(r);
         }
@@ -221,12 +219,11 @@ sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& base
   // and the bar. So an effect counts only for what it adds beyond refitting the bending alone. The held-out view (not
   // in any refit) must confirm it, i.e. not get worse than the reference's.
   Attribution a;
-  a.baseline_validated = baseline_validated->best;
   a.bar = std::move(results.back()->value());
-  a.bar.shrinkage = gap_shrinkage(excess_above_floors(a.baseline_validated, floors),
+  a.bar.shrinkage = gap_shrinkage(excess_above_floors(validated.best, floors),
                                   excess_above_floors(a.bar.validated, floors));
   const bool bar_is_reference = a.bar.shrinkage > 0.0;
-  const ScoredDrape& reference = bar_is_reference ? a.bar.validated : a.baseline_validated;
+  const ScoredDrape& reference = bar_is_reference ? a.bar.validated : validated.best;
   const double h0 = reference.held_out_score;
   const double excess0 = excess_above_floors(reference, floors);
   for (std::size_t k = 0; k + 1 < tasks; ++k) {

@@ -40,7 +40,8 @@ struct AttributionSettings {
   double significant_shrinkage = 0.25;
   int bootstrap_samples = 1000;
   int tile_px = 16;
-  /// Fresh initial states (flat, then sine) on which the baseline and each refitted candidate are compared.
+  /// Fresh initial states (flat, then sine) from which the gap is measured at the fitted parameters (the gate) and
+  /// each refitted candidate is compared with it.
   int validation_states = 10;
   std::uint64_t validation_seed = 2000;
   int jobs = 1;                     // candidate refits in parallel (one forward model per thread)
@@ -48,7 +49,6 @@ struct AttributionSettings {
 };
 
 struct Attribution {
-  ScoredDrape baseline_validated;           // the baseline's best drape from the validation states
   /// The bar: the baseline's bending parameters alone refitted (reduced coordinates, same budget), validated the same
   /// way; its shrinkage is against the baseline's. Candidates are measured against the better of the two.
   CandidateResult bar;
@@ -57,11 +57,14 @@ struct Attribution {
   double confidence = 0.0;                  // bootstrap P(best beats runner-up on the held-out view)
 };
 
-/// `baseline` is the fitted setup and `fit` its evaluation; `floors` from measure_floors. make_model creates a
-/// forward model for another thread (jobs > 1).
+/// The validation states: fresh initial states (flat, then sine) that no fit selects on.
+[[nodiscard]] std::vector<sim::InitialStateSpec> validation_states(const AttributionSettings& settings);
+
+/// `baseline` is the fitted setup, `fit` its evaluation (fit states) and `validated` its evaluation from the
+/// validation states; `floors` from measure_floors. make_model creates a forward model for another thread (jobs > 1).
 [[nodiscard]] sim::Expected<Attribution> attribute(
-    ForwardModel& model, const ModelSetup& baseline, const Evaluation& fit, const Floors& floors,
-    const AttributionSettings& settings,
+    ForwardModel& model, const ModelSetup& baseline, const Evaluation& fit, const Evaluation& validated,
+    const Floors& floors, const AttributionSettings& settings,
     const std::function<sim::Expected<std::unique_ptr<ForwardModel>>()>& make_model = {});
 
 /// 1 - excess_after / excess_before (0 when excess_before is 0): 1 when the candidate brings the drape within the
