@@ -101,7 +101,7 @@ Runner add_diagnose_command(CLI::App& app) {
                  "Evaluations per candidate refit (default 14, also with --quick)");
   app.add_option("--jobs", o->jobs, "Candidate refits in parallel threads")->capture_default_str();
   app.add_option("--shape-floor", o->shape_floor,
-                 "Shape-distance floor (default: calibrated 1.15; 0: the largest floor sample)");
+                 "Shape-distance floor (default: calibrated 1.39; 0: the largest floor sample)");
   app.add_flag("-v,--verbose", o->verbose, "Log progress on stderr");
   return [o] { return run_diagnose(*o); };
 }
