@@ -95,8 +95,7 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, std::optional<Effect> 
       return std::numeric_limits<double>::infinity();
     }
     sim::logger()->debug("refit {}: {} -> {:.3f} mm (state {}, shape {:.2f})", bar ? "bending" : effect_name(*effect),
-                         fmt::join(x, ", "),
-                         e->best.fit_score * 1e3, e->best.state, e->best.shape_fit);
+                         fmt::join(x, ", "), e->best.fit_score * 1e3, e->best.state, e->best.shape_fit);
     if (e->best.fit_score < best) {
       best = e->best.fit_score;
       c.drape = e->best;
