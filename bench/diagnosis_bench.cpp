@@ -49,7 +49,7 @@ const std::map<std::string, std::pair<double, double>> kDefaultStrength = {
 int main(int argc, char** argv) {
   CLI::App app{"drapegen diagnosis benchmark: reality captures, diagnoses, confusion matrix"};
   std::string out = "out/diagnosis_bench", fabrics_path = DRAPEGEN_FABRIC_DATA_DEFAULT, drapegen;
-  int per_family = 5, controls = 5, jobs = 1, resolution = 30, diagnose_jobs = 1;
+  int per_family = 5, controls = 5, jobs = 1, resolution = 60, diagnose_jobs = 1;
   bool quick = false, generate_only = false, score_only = false;
   std::uint64_t seed = 1;
   std::vector<std::string> families{"yield", "shear", "curl", "friction", "misalignment", "sensor"};
@@ -63,6 +63,9 @@ int main(int argc, char** argv) {
   app.add_option("--diagnose-jobs", diagnose_jobs, "--jobs of each diagnosis (refit threads)")->capture_default_str();
   std::string diagnose_args;
   app.add_option("--diagnose-args", diagnose_args, "More options for drapegen diagnose (e.g. \"--shape-floor 0\")");
+  // 60x60 (5 mm spacing): real cloth is continuous, so the reality mesh must resolve what the coarse fitting mesh
+  // cannot: a 30 mm curl band (6 spacings; at 30x30, 3) and a slide on the rim's 2 mm fillet, on which a 10 mm mesh
+  // cogs (docs/DIAGNOSIS.md, "Detectability").
   app.add_option("--resolution", resolution, "Reality mesh resolution")->capture_default_str();
   app.add_option("--seed", seed, "Seed of fabrics, strengths and captures")->capture_default_str();
   std::vector<std::string> strength_overrides;

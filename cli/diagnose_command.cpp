@@ -42,7 +42,7 @@ int run_diagnose(const DiagnoseOptions& o) {
     return fail("--evaluations and --refit-evaluations must be 1 .. 10000");
   }
   if (o.shape_floor > 100.0) return fail("--shape-floor must be 0 (from the floor samples) .. 100");
-  if (o.verbose) sim::logger()->set_level(spdlog::level::info);
+  if (o.verbose) sim::logger()->set_level(spdlog::level::debug);
   auto capture = diagnosis::read_capture(o.capture);
   if (!capture) return fail(capture.error().message);
   if (!o.report.empty()) {
@@ -101,7 +101,7 @@ Runner add_diagnose_command(CLI::App& app) {
                  "Evaluations per candidate refit (default 14, also with --quick)");
   app.add_option("--jobs", o->jobs, "Candidate refits in parallel threads")->capture_default_str();
   app.add_option("--shape-floor", o->shape_floor,
-                 "Shape-distance floor (default: calibrated 1.15; 0: the largest floor sample)");
+                 "Shape-distance floor (default: calibrated 1.39; 0: the largest floor sample)");
   app.add_flag("-v,--verbose", o->verbose, "Log progress on stderr");
   return [o] { return run_diagnose(*o); };
 }

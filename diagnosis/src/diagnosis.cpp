@@ -111,6 +111,8 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
       return std::numeric_limits<double>::infinity();
     }
     const double value = e->best.fit_score;
+    sim::logger()->debug("baseline fit: ({:.3f}, {:.3f}, {:.3f}, {:.3f}) -> {:.3f} mm (state {}, shape {:.2f})", x[0],
+                         x[1], x[2], x[3], value * 1e3, e->best.state, e->best.shape_fit);
     if (value < best) {
       best = value;
       r.fit = std::move(*e);
@@ -133,19 +135,24 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
   auto floors = measure_floors(model, fitted, r.fit, settings.floors);
   if (!floors) return floors.error();
   r.floors = *floors;
-  r.seconds_floors = since(floors_start);
-  r.gap_all = r.fit.best.all_score;
-  r.gap_fit = r.fit.best.fit_score;
-  r.gap_held_out = r.fit.best.held_out_score;
+  // The gap: the fitted parameters simulated from fresh initial states (the fit's best score is biased low).
+  auto validated = model.evaluate(fitted, validation_states(settings.attribution));
+  if (!validated) return validated.error();
+  r.validated = std::move(*validated);
+  const ScoredDrape& gap = r.gap_drape();
+  r.gap_all = gap.all_score;
+  r.gap_fit = gap.fit_score;
+  r.gap_held_out = gap.held_out_score;
   // Within the floors: neither the stable-region term (sensor errors) nor the shape distance (physical effects)
   // exceeds what sensor noise and other stable drapes of the fitted fabric produce. The attribution's shrinkage is
   // measured on the same excess.
-  r.within_floors = excess_above_floors(r.fit.best, r.floors) == 0.0;
+  r.within_floors = excess_above_floors(gap, r.floors) == 0.0;
+  r.seconds_floors = since(floors_start);
 
   // 3. Where the gap sits.
-  r.localisation = localise(model, r.fit.best);
+  r.localisation = localise(model, gap);
   r.fit_target = model.target().shape;
-  localise_features(r.localisation, r.fit.best, model.target(), r.floors.group_floor(), r.floors.stable_floor());
+  localise_features(r.localisation, gap, model.target(), r.floors.group_floor(), r.floors.stable_floor());
 
   // 4. Which effect explains it (not when the gap is within the floors).
   const auto attribution_start = std::chrono::steady_clock::now();
@@ -154,7 +161,7 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
   } else {
     const FitSettings fit_settings = settings.fit;
     auto make_model = [&capture, fit_settings]() { return ForwardModel::create(capture, fit_settings); };
-    auto attribution = attribute(model, fitted, r.fit, r.floors, settings.attribution, make_model);
+    auto attribution = attribute(model, fitted, r.fit, r.validated, r.floors, settings.attribution, make_model);
     if (!attribution) return attribution.error();
     r.attribution = std::move(*attribution);
     const auto& c = r.attribution.candidates;
@@ -176,11 +183,16 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
   j["confidence"] = r.attribution.confidence;
   j["within_floors"] = r.within_floors;
   j["gap_mm"] = {{"all_views", r.gap_all * 1e3}, {"fit_views", r.gap_fit * 1e3}, {"held_out_view", r.gap_held_out * 1e3}};
-  j["gap_tests"] = {{"stable_mm", r.fit.best.stable_all * 1e3},
+  j["gap_tests"] = {{"stable_mm", r.gap_drape().stable_all * 1e3},
                     {"stable_floor_mm", r.floors.stable * 1e3},
-                    {"shape", r.fit.best.shape_all},
+                    {"shape", r.gap_drape().shape_all},
                     {"shape_floor", r.floors.shape},
-                    {"excess_above_floors", excess_above_floors(r.fit.best, r.floors)}};
+                    {"excess_above_floors", excess_above_floors(r.gap_drape(), r.floors)},
+                    {"validation_states", r.validated.states.size()},
+                    {"best_validation_state", r.gap_drape().state},
+                    {"fit_states", {{"stable_mm", r.fit.best.stable_all * 1e3},
+                                    {"shape", r.fit.best.shape_all},
+                                    {"excess_above_floors", excess_above_floors(r.fit.best, r.floors)}}}};
   nlohmann::json floors = {{"all_views_mm", r.floors.all * 1e3},
                            {"held_out_view_mm", r.floors.held_out * 1e3},
                            {"margin", r.floors.margin},
@@ -258,6 +270,10 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                           {"stable_mm", c.drape.stable_all * 1e3},
                           {"shape", c.drape.shape_all},
                           {"excess_above_floors", excess_above_floors(c.drape, r.floors)},
+                          {"validated", {{"stable_mm", c.validated.stable_all * 1e3},
+                                         {"shape", c.validated.shape_all},
+                                         {"held_out_score_mm", c.validated.held_out_score * 1e3},
+                                         {"excess_above_floors", excess_above_floors(c.validated, r.floors)}}},
                           {"shrinkage", c.shrinkage},
                           {"held_out_shrinkage", c.held_out_shrinkage},
                           {"confirmed", c.confirmed},
@@ -265,6 +281,15 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                           {"seconds", c.seconds}});
   }
   j["attribution"] = {{"ran", !r.within_floors},
+                      {"bending_refit_bar",
+                       {{"parameters", r.attribution.bar.parameters},
+                        {"fit_score_mm", r.attribution.bar.fit_score * 1e3},
+                        {"validated", {{"stable_mm", r.attribution.bar.validated.stable_all * 1e3},
+                                       {"shape", r.attribution.bar.validated.shape_all},
+                                       {"held_out_score_mm", r.attribution.bar.validated.held_out_score * 1e3},
+                                       {"excess_above_floors",
+                                        r.within_floors ? 0.0 : excess_above_floors(r.attribution.bar.validated, r.floors)}}},
+                        {"shrinkage", r.attribution.bar.shrinkage}}},
                       {"named", r.attribution.named},
                       {"confidence", r.attribution.confidence},
                       {"candidates", candidates}};

@@ -194,12 +194,15 @@ sim::Expected<ScoredDrape> ForwardModel::score(const sim::ClothMesh& mesh, const
   return score(mesh, setup, target_);
 }
 
-sim::Expected<Evaluation> ForwardModel::evaluate(const ModelSetup& setup) {
+sim::Expected<Evaluation> ForwardModel::evaluate(const ModelSetup& setup) { return evaluate(setup, states_); }
+
+sim::Expected<Evaluation> ForwardModel::evaluate(const ModelSetup& setup,
+                                                 const std::vector<sim::InitialStateSpec>& states) {
   Evaluation e;
   double best = std::numeric_limits<double>::infinity();
-  for (std::size_t k = 0; k < states_.size(); ++k) {
+  for (std::size_t k = 0; k < states.size(); ++k) {
     bool converged = true;
-    auto mesh = simulate(setup, states_[k], &converged);
+    auto mesh = simulate(setup, states[k], &converged);
     if (!mesh) return mesh.error();
     auto scored = score(*mesh, setup);
     if (!scored) return scored.error();

@@ -80,16 +80,16 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
     for (const auto& v : d.views) out.push_back(v.residual);
     return out;
   };
-  if (sim::Status s = write_residual_png((dir / "residual.png").string(), residuals(r.fit.best), W, H, range); !s) return s;
+  if (sim::Status s = write_residual_png((dir / "residual.png").string(), residuals(r.gap_drape()), W, H, range); !s) return s;
   const bool after = r.attribution.named && !r.attribution.candidates.empty();
   if (after) {
     if (sim::Status s = write_residual_png((dir / "residual_after.png").string(),
-                                           residuals(r.attribution.candidates[0].drape), W, H, range);
+                                           residuals(r.attribution.candidates[0].validated), W, H, range);
         !s) {
       return s;
     }
   }
-  auto fitted = model.render(r.fit.best.mesh, r.fit.best.angle, {});
+  auto fitted = model.render(r.gap_drape().mesh, r.gap_drape().angle, {});
   if (!fitted) return fitted.error();
   std::vector<std::vector<renderer::DepthImage>> rows(2);
   for (const auto& v : capture.views) rows[0].push_back(v.depth);
@@ -116,7 +116,7 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
                     r.floors.held_out * 1e3);
   md += fmt::format("Tests (all views): stable-region term {:.2f} mm against its floor {:.2f} mm; shape distance {:.2f} "
                     "against its floor {:.2f}.\n\n",
-                    r.fit.best.stable_all * 1e3, r.floors.stable * 1e3, r.fit.best.shape_all, r.floors.shape);
+                    r.gap_drape().stable_all * 1e3, r.floors.stable * 1e3, r.gap_drape().shape_all, r.floors.shape);
   md += fmt::format("Fitted baseline: alpha = {:.0f}, {:.0f}, {:.0f} g mm^2/s^2; beta = {:.0f}, {:.0f}, {:.0f} g mm^3/s^2 "
                     "({} evaluations).\n\n",
                     r.fitted.alpha.warp, r.fitted.alpha.bias, r.fitted.alpha.weft, r.fitted.beta.warp,

@@ -64,3 +64,17 @@ TEST(GapShrinkage, CreditsRemovingTheReasonTheGateFired) {
 }
 
 TEST(GapShrinkage, IsZeroWhenThereWasNoExcess) { EXPECT_EQ(gap_shrinkage(0.0, 0.3), 0.0); }
+
+TEST(ValidationStates, AreFreshStatesNoFitOrFloorSelectsOn) {
+  // The gap and every refitted candidate are judged from these: none may be one of the fit's states (flat and sine
+  // from seed 1) or the floors' (sine from seed 1000), or the comparison inherits the fit's luckiest draw.
+  AttributionSettings settings;
+  const auto states = validation_states(settings);
+  ASSERT_EQ(static_cast<int>(states.size()), settings.validation_states);
+  const auto fit = fit_initial_states(16);
+  const auto floors = fit_initial_states(17, 1000);
+  for (const auto& v : states) {
+    for (const auto& f : fit) EXPECT_FALSE(v.shape == f.shape && v.seed == f.seed);
+    for (const auto& f : floors) EXPECT_FALSE(v.shape == f.shape && v.seed == f.seed);
+  }
+}

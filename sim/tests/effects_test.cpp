@@ -262,5 +262,19 @@ TEST(Effects, CurlAndPlasticityChangeTheDrape) {
   EXPECT_GT(std::abs(yielded.measures.drape_coefficient - dc0), 0.002);
 }
 
+TEST(Effects, PlasticityActsFromAFlatStartOnAnIsotropicFabric) {
+  // An isotropic fabric has no anisotropy directions to update, and a flat start has no bent hinge at first: the
+  // solver once froze the lagged parameters at that first update (nothing changed), so the yield never acted.
+  DrapeConfig base = drape_config();
+  base.fabric = fabric_from_paper_units({1420, 1420, 1420}, {-3550, -3550, -3550}, 200.0);
+  base.specimen.vertices_x = base.specimen.vertices_y = 16;
+  base.initial.shape = InitialShape::kFlat;
+  const DrapeResult elastic = drape(base, "isotropic, flat start");
+  DrapeConfig plastic = base;
+  plastic.effects.bending_yield_curvature = 10.0;
+  const DrapeResult yielded = drape(plastic, "isotropic, flat start, yield 10 /m");
+  EXPECT_GT(std::abs(yielded.measures.drape_coefficient - elastic.measures.drape_coefficient), 0.002);
+}
+
 }  // namespace
 }  // namespace drapegen::sim

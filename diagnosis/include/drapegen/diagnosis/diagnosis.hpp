@@ -28,6 +28,10 @@ struct DiagnosisResult {
   int baseline_evaluations = 0;
   std::vector<double> baseline_history;
   Evaluation fit;
+  /// The fitted parameters from the validation states (AttributionSettings): the gap is measured on its best drape,
+  /// which no fit selected on (the fit's own best is the luckiest of its evaluations of a multistable objective).
+  Evaluation validated;
+  [[nodiscard]] const ScoredDrape& gap_drape() const { return validated.best; }
   Floors floors;
   double gap_all = 0.0, gap_fit = 0.0, gap_held_out = 0.0;
   bool within_floors = false;

@@ -48,8 +48,9 @@ struct FloorSettings {
   /// If positive, the shape test's floor instead of shape_margin x the largest sample: a value calibrated on controls
   /// that are not part of the benchmark (docs/DIAGNOSIS.md, "Floors"). The fitted capture's own shape distance is
   /// smaller than a floor sample's (the fit was optimised for the capture, not for the sample), so the samples
-  /// overstate the floor.
-  double shape_threshold = 1.15;
+  /// overstate the floor. 1.39: the largest of 8 calibration controls (--seed 2, 60x60 reality, --quick, the gap
+  /// measured from the validation states) was 1.26, plus 10%.
+  double shape_threshold = 1.39;
 };
 
 /// How far `drape` is above the floors, in the terms of the gate "within the floors" (dimensionless): the excess of

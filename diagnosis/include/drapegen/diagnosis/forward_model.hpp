@@ -86,6 +86,9 @@ class ForwardModel {
   static constexpr std::uint64_t kModelNoiseSeed = 0x5FEA;
   /// Every initial state simulated and scored; the best by fit score.
   [[nodiscard]] sim::Expected<Evaluation> evaluate(const ModelSetup& setup);
+  /// The same from other initial states (e.g. fresh ones that no fit has selected on).
+  [[nodiscard]] sim::Expected<Evaluation> evaluate(const ModelSetup& setup,
+                                                   const std::vector<sim::InitialStateSpec>& states);
   /// Re-scores given meshes (no simulation): the sensor candidate's refit.
   [[nodiscard]] sim::Expected<Evaluation> rescore(const std::vector<sim::ClothMesh>& meshes, const ModelSetup& setup);
 
