@@ -8,7 +8,7 @@
 //   e  initial states flat, sine and fold (Fig. 16)
 //
 // Usage: drapegen_drape_physics [--resolution N]... [--checks abcde] [--tolerance T] [--bending-model M]
-//        [--mesh-starts K] [--mesh-cases ice] [--structured-mesh alternating|equilateral|uniform] [--jitter J]
+//        [--mesh-starts K] [--mesh-cases ice] [--structured-mesh union-jack|equilateral|uniform] [--jitter J]
 //        [--band-width W] [--beta-scale S]   (the last six shape check d)
 // Each drape's solve is logged on stderr; the table goes to stdout. Exit code 0 when every bounded row passes.
 #include <CLI/CLI.hpp>
@@ -586,6 +586,9 @@ int main(int argc, char** argv) {
   app.add_option("--mesh-cases", options.mesh_cases,
                  "fabrics of check d: i isotropic, c warp 4 x weft under the curvature rule, e the same under the "
                  "edge rule")
+      ->check([](const std::string& cases) {
+        return cases.find_first_not_of("ice") == std::string::npos ? std::string() : "only the letters i, c, e";
+      })
       ->capture_default_str();
   app.add_option("--beta-scale", options.beta_scale,
                  "check d: multiply the fabrics' beta (softening) by this; 0 gives the linear law")
@@ -594,10 +597,11 @@ int main(int argc, char** argv) {
   app.add_option("--jitter", options.jitter, "check d: jitter of the perturbed mesh, a fraction of the spacing")
       ->check(CLI::Range(0.0, 0.3))
       ->capture_default_str();
-  std::string structured = "alternating";
-  app.add_option("--structured-mesh", structured, "check d: the structured mesh (alternating: union jack; uniform: every quad split along the same diagonal)")
-      ->check(CLI::IsMember({"alternating", "equilateral", "uniform"}))
-      ->capture_default_str();
+  app.add_option("--structured-mesh", options.structured,
+                 "check d: the structured mesh (union-jack: alternating diagonals; uniform: every quad split along the "
+                 "same diagonal; equilateral)")
+      ->transform(CLI::CheckedTransformer(structured_triangulations()))
+      ->default_str("union-jack");
   app.add_option("--band-width", options.band_width, "check d: stretch band [1 - w, 1 + w] of the membrane")
       ->check(CLI::Range(0.0, 0.2))
       ->capture_default_str();
@@ -608,9 +612,6 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"dihedral", "triangle"}))
       ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
-  options.structured = structured == "equilateral" ? Triangulation::kEquilateral
-                       : structured == "uniform"   ? Triangulation::kUniform
-                                                   : Triangulation::kAlternating;
   options.model = model == "triangle" ? BendingModel::kNonlinearTriangle : BendingModel::kNonlinearDihedral;
   if (options.resolutions.empty()) options.resolutions = {60};
   Table table;

@@ -2,6 +2,7 @@
 #include <cmath>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <nlohmann/json.hpp>
 #include <random>
 
@@ -32,7 +33,7 @@ struct SimulateOptions {
   double sigma = 200.0;
   std::string band = "0.99,1.01";
   bool structured = false;
-  std::string mesh = "perturbed";
+  std::optional<sim::Triangulation> mesh;  // a structured grid (--mesh); none: the perturbed triangulation
   int max_iterations = 400;
   double tolerance = 1e-3;
   bool verbose = false;
@@ -117,12 +118,9 @@ int run_simulate(const SimulateOptions& o) {
   if (!(o.sigma > 0.0) || !std::isfinite(o.sigma)) return fail("--sigma must be positive (kg/s^2)");
   config.specimen.vertices_x = config.specimen.vertices_y = o.resolution;
   config.specimen.seed = o.seed;
-  const std::string mesh = o.structured ? "union-jack" : o.mesh;
-  if (mesh != "perturbed") {
+  if (o.structured || o.mesh) {
     config.specimen.jitter = 0.0;
-    config.specimen.triangulation = mesh == "union-jack" ? sim::Triangulation::kAlternating
-                                    : mesh == "uniform"  ? sim::Triangulation::kUniform
-                                                         : sim::Triangulation::kEquilateral;
+    config.specimen.triangulation = o.mesh.value_or(sim::Triangulation::kAlternating);
   }
   initial->seed = o.seed;
   initial->rotation = o.rotation_deg * M_PI / 180.0;
@@ -203,12 +201,15 @@ Runner add_simulate_command(CLI::App& app) {
   app.add_option("--sigma", o->sigma, "In-plane stiffness at the standard density (300 g/m^2), kg/s^2")->capture_default_str();
   app.add_option("--band", o->band, "Stretch band LOW,HIGH absorbed by the adaptive reference (1,1: none)")
       ->capture_default_str();
-  auto* mesh = app.add_option("--mesh", o->mesh,
-                              "Triangulation: perturbed (the paper's: random diagonals, jittered vertices), union-jack "
-                              "(alternating diagonals), uniform (every quad split along the same diagonal) or "
-                              "equilateral (rows of equilateral triangles)")
-                   ->check(CLI::IsMember({"perturbed", "union-jack", "uniform", "equilateral"}))
-                   ->capture_default_str();
+  auto* mesh = app.add_option_function<std::string>(
+                     "--mesh",
+                     [o](const std::string& name) {
+                       if (name != "perturbed") o->mesh = sim::structured_triangulations().at(name);
+                     },
+                     "Triangulation: perturbed (the default: the paper's random diagonals and jittered vertices), "
+                     "union-jack (alternating diagonals), uniform (every quad split along the same diagonal) or "
+                     "equilateral (rows of equilateral triangles)")
+                   ->check(CLI::IsMember({"perturbed", "union-jack", "uniform", "equilateral"}));
   app.add_flag("--structured", o->structured, "Shorthand for --mesh union-jack")->excludes(mesh);
   app.add_option("--max-iterations", o->max_iterations, "Newton iteration limit")->capture_default_str();
   app.add_option("--tolerance", o->tolerance, "Residual force over the largest vertex weight")->capture_default_str();

@@ -94,6 +94,13 @@ ClothMesh grid_specimen(const SpecimenSpec& spec, std::mt19937_64& rng) {
 
 }  // namespace
 
+const std::map<std::string, Triangulation>& structured_triangulations() {
+  static const std::map<std::string, Triangulation> names{{"union-jack", Triangulation::kAlternating},
+                                                          {"uniform", Triangulation::kUniform},
+                                                          {"equilateral", Triangulation::kEquilateral}};
+  return names;
+}
+
 ClothMesh make_specimen(const SpecimenSpec& spec) {
   if (spec.vertices_x < 2 || spec.vertices_y < 2) throw std::invalid_argument("specimen needs at least 2x2 vertices");
   if (!(spec.size_x > 0.0) || !(spec.size_y > 0.0)) throw std::invalid_argument("specimen size must be positive");

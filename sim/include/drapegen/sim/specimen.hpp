@@ -2,6 +2,8 @@
 // Rectangular specimens: structured grids with seeded perturbation of the triangulation (paper Section 5.2.1).
 
 #include <cstdint>
+#include <map>
+#include <string>
 
 #include "drapegen/sim/mesh.hpp"
 
@@ -28,6 +30,10 @@ struct SpecimenSpec {
   /// Warp direction relative to the rest x axis, radians.
   double material_angle = 0.0;
 };
+
+/// The structured triangulations by their command-line names: "union-jack" (kAlternating), "uniform" and
+/// "equilateral" (no jitter).
+[[nodiscard]] const std::map<std::string, Triangulation>& structured_triangulations();
 
 /// A flat specimen centred on the origin in the plane z = 0 (positions equal the rest coordinates).
 /// Grid triangulations: vertex (i, j) has index j * vertices_x + i. kEquilateral: `vertices_y` rows, even rows with
