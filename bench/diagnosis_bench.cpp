@@ -237,8 +237,10 @@ int main(int argc, char** argv) {
     std::sort(v.begin(), v.end());
     return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
   };
-  std::string md = fmt::format("Cases scored: {} effect captures, {} controls ({}).\n\n", effect_total, control_total,
-                               quick ? "diagnose --quick" : "diagnose defaults");
+  const std::string options = fmt::format("{}{}{}", quick ? "--quick" : "", quick && !diagnose_args.empty() ? " " : "",
+                                          diagnose_args);
+  std::string md = fmt::format("Cases scored: {} effect captures, {} controls (diagnose {}).\n\n", effect_total,
+                               control_total, options.empty() ? "defaults" : options);
   md += "| truth \\ verdict |";
   for (const auto& c : columns) md += " " + c + " |";
   md += "\n|---|";

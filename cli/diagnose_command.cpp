@@ -20,6 +20,7 @@ struct DiagnoseOptions {
   std::string report;
   bool json = false;
   bool quick = false;
+  bool fine = false;
   int resolution = 0;
   int states = 0;
   int evaluations = 0;
@@ -48,7 +49,9 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (!o.report.empty()) {
     if (sim::Status s = check_writable(o.report + ".probe"); !s) return fail(s.error().message, kExitIo);
   }
-  diagnosis::DiagnosisSettings settings = o.quick ? diagnosis::DiagnosisSettings::quick() : diagnosis::DiagnosisSettings{};
+  diagnosis::DiagnosisSettings settings = o.fine    ? diagnosis::DiagnosisSettings::fine()
+                                          : o.quick ? diagnosis::DiagnosisSettings::quick()
+                                                    : diagnosis::DiagnosisSettings{};
   if (o.resolution > 0) settings.fit.resolution = o.resolution;
   if (o.states > 0) settings.fit.initial_states = o.states;
   if (o.evaluations > 0) settings.baseline_optimiser.max_evaluations = o.evaluations;
@@ -93,15 +96,22 @@ Runner add_diagnose_command(CLI::App& app) {
   app.add_option("--capture", o->capture, "Capture directory (docs/CAPTURE.md)")->required();
   app.add_option("--report", o->report, "Write report.json, report.md and residual PNGs here");
   app.add_flag("--json", o->json, "Print the result as JSON");
-  app.add_flag("--quick", o->quick, "Small budgets (16x16 mesh, 2 initial states, fewer evaluations)");
-  app.add_option("--resolution", o->resolution, "Fitting mesh vertices per side (default 20; quick 16)");
-  app.add_option("--states", o->states, "Initial states per evaluation (default 3; quick 2)");
-  app.add_option("--evaluations", o->evaluations, "Baseline fit evaluations (default 40; quick 20)");
+  auto* quick = app.add_flag("--quick", o->quick, "Small budgets (16x16 mesh, 2 initial states, fewer evaluations)");
+  app.add_flag("--fine", o->fine,
+               fmt::format("--quick's budgets on a {0}x{0} fitting mesh, with the shape floor calibrated for it",
+                           diagnosis::DiagnosisSettings::kFineResolution))
+      ->excludes(quick);
+  app.add_option("--resolution", o->resolution, "Fitting mesh vertices per side (default 20; quick 16; fine " +
+                                                    std::to_string(diagnosis::DiagnosisSettings::kFineResolution) + ")");
+  app.add_option("--states", o->states, "Initial states per evaluation (default 3; quick and fine 2)");
+  app.add_option("--evaluations", o->evaluations, "Baseline fit evaluations (default 40; quick and fine 20)");
   app.add_option("--refit-evaluations", o->refit_evaluations,
-                 "Evaluations per candidate refit (default 14, also with --quick)");
+                 "Evaluations per candidate refit (default 14, also with --quick and --fine)");
   app.add_option("--jobs", o->jobs, "Candidate refits in parallel threads")->capture_default_str();
   app.add_option("--shape-floor", o->shape_floor,
-                 "Shape-distance floor (default: calibrated 1.39; 0: the largest floor sample)");
+                 fmt::format("Shape-distance floor (default and quick: calibrated {:.2f}; fine: {:.2f}; 0: the largest "
+                             "floor sample)",
+                             diagnosis::FloorSettings{}.shape_threshold, diagnosis::DiagnosisSettings::kFineShapeFloor));
   app.add_flag("-v,--verbose", o->verbose, "Log progress on stderr");
   return [o] { return run_diagnose(*o); };
 }

@@ -10,6 +10,10 @@ reference is the better of the baseline's and the bending-only bar's validated d
 held-out view does not get worse than the reference's.
 
     scripts/diagnosis_calibration.py out/calib60_s2 --floors 1.0 1.15 1.3 --thresholds 0.15 0.25 0.35
+
+With --gap-only the run need not have attributed (e.g. `--diagnose-args "--shape-floor 50"`): it prints each case's
+validated shape distance and stable term, the calibrated shape floor (the largest control's shape distance plus 10%,
+the rule of docs/DIAGNOSIS.md, "Floors"), and which captures are above the floors at that floor and at --floors.
 """
 import argparse
 import json
@@ -56,6 +60,32 @@ def verdict(d, shape_floor, threshold, confirm=True):
     return "unexplained", 0.0
 
 
+def gap_only(cases, floors):
+    """The gate alone: which captures are above the floors, for the calibrated floor and the given ones."""
+    controls = sorted(d["gap_tests"]["shape"] for _, fam, d in cases if fam == "none")
+    if not controls:
+        raise SystemExit("no controls in the run")
+    calibrated = 1.1 * controls[-1]
+    print(f"{len(controls)} controls; shape distances {', '.join(f'{x:.2f}' for x in controls)} (median "
+          f"{statistics.median(controls):.2f}); calibrated floor (largest + 10%): {calibrated:.2f}")
+    print("| case | family | shape | stable / floor (mm) | " + " | ".join(f"above {F:.2f}" for F in [calibrated] + floors)
+          + " |")
+    print("|---|---|---|---|" + "---|" * (1 + len(floors)))
+    above = {F: [0, 0, 0] for F in [calibrated] + floors}  # controls above, effects above, effects
+    for name, fam, d in cases:
+        t = d["gap_tests"]
+        cells = []
+        for F in [calibrated] + floors:
+            up = excess(t["stable_mm"], t["shape"], t["stable_floor_mm"], F) > 0.0
+            cells.append("yes" if up else "")
+            above[F][0 if fam == "none" else 1] += up
+            above[F][2] += fam != "none"
+        print(f"| {name} | {fam} | {t['shape']:.2f} | {t['stable_mm']:.1f} / {t['stable_floor_mm']:.1f} | "
+              + " | ".join(cells) + " |")
+    for F, (c, e, n) in above.items():
+        print(f"floor {F:.2f}: controls above {c}/{len(controls)}, effect captures above {e}/{n}")
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("run", type=Path, help="benchmark directory (diagnoses/, truth/)")
@@ -64,11 +94,16 @@ def main():
     p.add_argument("--cases", action="store_true", help="print each case's verdict at every setting")
     p.add_argument("--confirm", type=int, nargs="+", default=[1],
                    help="1: a candidate counts only if the held-out view confirms it (drapegen diagnose); 0: any")
+    p.add_argument("--gap-only", action="store_true",
+                   help="the gate alone (no attribution needed): the calibrated floor and the captures above it")
     args = p.parse_args()
     cases = []
     for f in sorted((args.run / "diagnoses").glob("*.json")):
         truth = json.loads((args.run / "truth" / f.name).read_text())
         cases.append((f.stem, truth["family"], json.loads(f.read_text())))
+    if args.gap_only:
+        gap_only(cases, [F for F in args.floors if F > 0])
+        return
     print(f"{len(cases)} cases; control shape distances: "
           + ", ".join(f"{d['gap_tests']['shape']:.2f}" for _, fam, d in cases if fam == "none"))
     print("| held-out confirmation | shape floor | threshold | controls within | top-1 | median shrinkage | named wrongly |")

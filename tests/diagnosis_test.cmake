@@ -91,6 +91,7 @@ file(COPY ${WORK}/capture/ DESTINATION ${WORK}/garbage)
 file(WRITE ${WORK}/garbage/view2.exr "not an exr")
 expect_failure(1 "not a readable OpenEXR" diagnose --capture ${WORK}/garbage)
 expect_failure(1 "not a directory" diagnose --capture ${WORK}/does_not_exist)
+expect_failure(1 "excludes" diagnose --capture ${WORK}/capture --quick --fine)
 expect_failure(1 "unknown effect" reality ${FABRIC} --effect gravity=2 --out ${WORK}/bad)
 expect_failure(1 "given twice" reality ${FABRIC} --effect curl=10 --effect curl=20 --out ${WORK}/bad)
 expect_failure(1 "fewer than two vertex spacings" reality ${FABRIC} --effect curl=200,10 --resolution 14

@@ -90,6 +90,13 @@ DiagnosisSettings DiagnosisSettings::quick() {
   return s;
 }
 
+DiagnosisSettings DiagnosisSettings::fine() {
+  DiagnosisSettings s = quick();
+  s.fit.resolution = kFineResolution;
+  s.floors.shape_threshold = kFineShapeFloor;
+  return s;
+}
+
 sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisSettings& settings) {
   const auto start = std::chrono::steady_clock::now();
   auto created = ForwardModel::create(capture, settings.fit);

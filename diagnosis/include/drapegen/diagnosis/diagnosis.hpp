@@ -19,6 +19,14 @@ struct DiagnosisSettings {
 
   /// Small budgets for tests and the --quick benchmark.
   [[nodiscard]] static DiagnosisSettings quick();
+  /// quick()'s budgets on a finer fitting mesh (kFineResolution), with the shape floor calibrated for that mesh
+  /// (kFineShapeFloor): the --fine preset, which spends more of the 10-minute budget on fidelity (docs/DIAGNOSIS.md,
+  /// "Branch diag-s6"). 1.17: the largest validated shape distance of 16 calibration controls (--seed 2, 60x60
+  /// reality, this preset) was 1.06, plus 10%; the same controls at 24x24 needed 1.42 and kept 3 of 12 effect
+  /// captures above it, 32x32 6 of 12.
+  [[nodiscard]] static DiagnosisSettings fine();
+  static constexpr int kFineResolution = 32;
+  static constexpr double kFineShapeFloor = 1.17;
 };
 
 struct DiagnosisResult {
