@@ -29,10 +29,14 @@ def read_rows(path):
     return raw[:, 0], raw[:, CSV_TO_FEATURE]
 
 
+def signlog(k):
+    """The feature map sign(k) * ln|k| (one-to-one for |k| > 1); from_features is its inverse."""
+    return np.sign(k) * np.log(np.abs(k))
+
+
 def to_features(density, moduli):
     """sign(k) * ln|k| of the moduli normalised to 300 g/m^2."""
-    k = moduli * (STANDARD_DENSITY / density[:, None])
-    return np.sign(k) * np.log(np.abs(k))
+    return signlog(moduli * (STANDARD_DENSITY / density[:, None]))
 
 
 def from_features(x):

@@ -50,14 +50,6 @@ PAPER = {"VAE-3": (-6.42, 11.1), "GMM-5": (-13.61, 72.6), "GMM-3": (-14.86, 98.9
          "GMM-6": (-15.71, 72.5), "GMM-7": (-15.79, 97.6)}
 
 
-def to_moduli(x):
-    return fabrics.from_features(x)
-
-
-def to_signlog(k):
-    return np.sign(k) * np.log(np.abs(k))
-
-
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     vae.add_checkpoint_arguments(ap, REPO)
@@ -70,7 +62,7 @@ def main():
     torch.set_num_threads(1)
 
     x = fabrics.distinct_fabrics(args.data)
-    k = to_moduli(x)
+    k = fabrics.from_features(x)
     tr, va = fabrics.split(len(x), args.seed)
     # sign-log standardisation (train.py) and raw standardisation, both by the training split
     mx, sx = x[tr].mean(0), x[tr].std(0)
@@ -86,13 +78,13 @@ def main():
     def rejected_sample(draw):
         """The first `generated` of 4x as many candidates (sign-log vectors from draw(n)) that the sampler keeps."""
         cand = draw(4 * args.generated)
-        keep = np.all((cand >= lo) & (cand <= hi), axis=1) & np.all(to_moduli(cand)[:, :3] > 0, axis=1)
+        keep = np.all((cand >= lo) & (cand <= hi), axis=1) & np.all(fabrics.from_features(cand)[:, :3] > 0, axis=1)
         if keep.sum() < args.generated:
             raise RuntimeError("too few accepted candidates")
         return cand[keep][:args.generated], float(keep.mean())
 
     def w1_both(gen_x):
-        gen_k = to_moduli(gen_x)
+        gen_k = fabrics.from_features(gen_x)
         w_x = metrics.wasserstein_exact(gen_x, x)
         w_k = metrics.wasserstein_exact((gen_k - mk_all) / sk_all, (k - mk_all) / sk_all)
         return w_x, w_k
@@ -107,9 +99,9 @@ def main():
         fx, fk = [], []
         for r in range(args.references):
             ref_x = rejected_sample(draw_factory(np.random.default_rng(100 + r)))[0][:len(x)]
-            ref_k = (to_moduli(ref_x) - mk_all) / sk_all
+            ref_k = (fabrics.from_features(ref_x) - mk_all) / sk_all
             fx.append(metrics.wasserstein_exact(gen, ref_x)[0])
-            fk.append(metrics.wasserstein_exact((to_moduli(gen) - mk_all) / sk_all, ref_k)[0])
+            fk.append(metrics.wasserstein_exact((fabrics.from_features(gen) - mk_all) / sk_all, ref_k)[0])
         return [float(np.mean(fx)), float(np.std(fx))], [float(np.mean(fk)), float(np.std(fk))]
 
     def evaluate(space, draw_factory, ll_v, ll_t, own_shift):
@@ -120,7 +112,7 @@ def main():
         acc_x, acc = rejected_sample(draw_factory(np.random.default_rng(args.seed + 1)))
         rej = w1_both(acc_x)
         fx, fk = floor(draw_factory)
-        gen_k = to_moduli(gen_x)
+        gen_k = fabrics.from_features(gen_x)
         return {"space": space,
                 "ll_validation_signlog": ll_summary(ll_v),
                 "ll_validation_rawstd": ll_summary(ll_v - log_jac[va] + log_sk),
@@ -169,7 +161,7 @@ def main():
         # raw GMM: the same EM on the standardised raw moduli; log p_x = log p_u - sum log s_k + sum ln|k|
         m2 = gmm.GaussianMixture(K, iterations=200, seed=args.seed).fit((k[tr] - mk) / sk)
         rows[f"GMM-{K} raw"] = evaluate(
-            "standardised raw moduli", lambda rng, m2=m2: (lambda n: to_signlog(m2.sample(n, rng) * sk + mk)),
+            "standardised raw moduli", lambda rng, m2=m2: (lambda n: fabrics.signlog(m2.sample(n, rng) * sk + mk)),
             m2.log_likelihood((k[va] - mk) / sk) - log_sk + log_jac[va],
             m2.log_likelihood((k[tr] - mk) / sk) - log_sk + log_jac[tr], log_sk - log_jac[va])
         # x = sign(k) ln|k| is one-to-one only on |k| > 1; the change of variables ignores the mass at |k| < 1.
