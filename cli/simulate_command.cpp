@@ -5,6 +5,7 @@
 #include <optional>
 #include <nlohmann/json.hpp>
 #include <random>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -201,6 +202,8 @@ Runner add_simulate_command(CLI::App& app) {
   app.add_option("--sigma", o->sigma, "In-plane stiffness at the standard density (300 g/m^2), kg/s^2")->capture_default_str();
   app.add_option("--band", o->band, "Stretch band LOW,HIGH absorbed by the adaptive reference (1,1: none)")
       ->capture_default_str();
+  std::vector<std::string> mesh_names{"perturbed"};
+  for (const auto& entry : sim::structured_triangulations()) mesh_names.push_back(entry.first);
   auto* mesh = app.add_option_function<std::string>(
                      "--mesh",
                      [o](const std::string& name) {
@@ -209,7 +212,7 @@ Runner add_simulate_command(CLI::App& app) {
                      "Triangulation: perturbed (the default: the paper's random diagonals and jittered vertices), "
                      "union-jack (alternating diagonals), uniform (every quad split along the same diagonal) or "
                      "equilateral (rows of equilateral triangles)")
-                   ->check(CLI::IsMember({"perturbed", "union-jack", "uniform", "equilateral"}));
+                   ->check(CLI::IsMember(mesh_names));
   app.add_flag("--structured", o->structured, "Shorthand for --mesh union-jack")->excludes(mesh);
   app.add_option("--max-iterations", o->max_iterations, "Newton iteration limit")->capture_default_str();
   app.add_option("--tolerance", o->tolerance, "Residual force over the largest vertex weight")->capture_default_str();
