@@ -3,6 +3,7 @@
 #include <cholmod.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <cstring>
 #include <mutex>
 #include <vector>
@@ -11,6 +12,7 @@
 #include <omp.h>
 #endif
 
+#include "drapegen/sim/bfloat16_panel.hpp"
 #include "drapegen/sim/logging.hpp"
 
 namespace drapegen::sim {
@@ -55,6 +57,28 @@ class SerialOpenMp {
   bool active_;
 };
 
+/// Factors with at least this many values (8 MB in single precision: more than the share of a last-level cache one
+/// core of a busy node can count on) keep the rows below their diagonal blocks in bfloat16 for preconditioning: the
+/// triangular solves are bound by memory traffic there (docs/BENCHMARKS.md, session 7). Smaller ones stay in cache
+/// and gain nothing from it.
+constexpr std::size_t kBfloat16MinEntries = std::size_t{1} << 21;
+
+// y += A x and y -= A^T x for a column-major panel below a supernode's diagonal block, by storage type.
+void multiply_add(const float* a, int rows, int cols, const float* x, float* y) {
+  Eigen::Map<Eigen::VectorXf>(y, rows).noalias() +=
+      Eigen::Map<const Eigen::MatrixXf>(a, rows, cols) * Eigen::Map<const Eigen::VectorXf>(x, cols);
+}
+void transpose_multiply_subtract(const float* a, int rows, int cols, const float* x, float* y) {
+  Eigen::Map<Eigen::VectorXf>(y, cols).noalias() -=
+      Eigen::Map<const Eigen::MatrixXf>(a, rows, cols).transpose() * Eigen::Map<const Eigen::VectorXf>(x, rows);
+}
+void multiply_add(const std::uint16_t* a, int rows, int cols, const float* x, float* y) {
+  bfloat16_multiply_add(a, rows, cols, x, y);
+}
+void transpose_multiply_subtract(const std::uint16_t* a, int rows, int cols, const float* x, float* y) {
+  bfloat16_transpose_multiply_subtract(a, rows, cols, x, y);
+}
+
 }  // namespace
 
 struct SparseCholesky::Impl {
@@ -64,9 +88,92 @@ struct SparseCholesky::Impl {
   std::vector<int> colptr, rowind;
   std::vector<double> values;
   bool analysed = false;
-  std::vector<float> single;  // single-precision copy of a supernodal factor's values, empty until needed
+  // The preconditioner's compact copy of a supernodal factor, made on first use after each factorisation (empty
+  // until then): per supernode, its diagonal block in single precision and the rows below it in single precision or,
+  // for a factor of at least kBfloat16MinEntries values, in bfloat16.
+  std::vector<float> diagonal;
+  std::vector<float> below_single;
+  std::vector<std::uint16_t> below_bfloat16;
+  std::vector<std::size_t> diagonal_offset, below_offset;
   std::vector<float> work;
-  Eigen::VectorXf update;  // scratch for one supernode's rows below its diagonal block
+  std::vector<float> update;  // scratch for one supernode's rows below its diagonal block
+
+  /// P^T L^-T L^-1 P rhs with the compact copy; `below` is below_single or below_bfloat16.
+  template <class Panel>
+  void solve_compact(const Panel* below, const Eigen::VectorXd& rhs, Eigen::VectorXd& solution) {
+    const int* super = static_cast<const int*>(factor->super);
+    const int* pi = static_cast<const int*>(factor->pi);
+    const int* s = static_cast<const int*>(factor->s);
+    const int* perm = static_cast<const int*>(factor->Perm);
+    const int nsuper = static_cast<int>(factor->nsuper);
+    const int n = static_cast<int>(factor->n);
+    work.resize(n);
+    if (update.size() < static_cast<std::size_t>(n)) update.resize(n);
+    Eigen::Map<Eigen::VectorXf> y(work.data(), n);
+    for (int k = 0; k < n; ++k) y[k] = static_cast<float>(rhs[perm[k]]);
+    using Block = Eigen::Map<const Eigen::MatrixXf>;
+    // L y = P b, supernode by supernode: the dense diagonal block, then the rows below it.
+    for (int k = 0; k < nsuper; ++k) {
+      const int k1 = super[k], ncol = super[k + 1] - k1, nbelow = pi[k + 1] - pi[k] - ncol;
+      const Block block(diagonal.data() + diagonal_offset[k], ncol, ncol);
+      auto own = y.segment(k1, ncol);
+      block.triangularView<Eigen::Lower>().solveInPlace(own);
+      if (nbelow > 0) {
+        std::fill(update.begin(), update.begin() + nbelow, 0.0f);
+        multiply_add(below + below_offset[k], nbelow, ncol, own.data(), update.data());
+        const int* rows = s + pi[k] + ncol;
+        for (int i = 0; i < nbelow; ++i) y[rows[i]] -= update[i];
+      }
+    }
+    // L^T x = y, in reverse.
+    for (int k = nsuper - 1; k >= 0; --k) {
+      const int k1 = super[k], ncol = super[k + 1] - k1, nbelow = pi[k + 1] - pi[k] - ncol;
+      const Block block(diagonal.data() + diagonal_offset[k], ncol, ncol);
+      auto own = y.segment(k1, ncol);
+      if (nbelow > 0) {
+        const int* rows = s + pi[k] + ncol;
+        for (int i = 0; i < nbelow; ++i) update[i] = y[rows[i]];
+        transpose_multiply_subtract(below + below_offset[k], nbelow, ncol, update.data(), own.data());
+      }
+      block.triangularView<Eigen::Lower>().transpose().solveInPlace(own);
+    }
+    solution.resize(n);
+    for (int k = 0; k < n; ++k) solution[perm[k]] = static_cast<double>(y[k]);
+  }
+
+  /// Fills the compact copy from the factor (supernodal, LL^T).
+  void make_compact_copy() {
+    const int* super = static_cast<const int*>(factor->super);
+    const int* pi = static_cast<const int*>(factor->pi);
+    const int* px = static_cast<const int*>(factor->px);
+    const double* x = static_cast<const double*>(factor->x);
+    const int nsuper = static_cast<int>(factor->nsuper);
+    diagonal_offset.assign(nsuper + 1, 0);
+    below_offset.assign(nsuper + 1, 0);
+    for (int k = 0; k < nsuper; ++k) {
+      const std::size_t ncol = super[k + 1] - super[k], nrow = pi[k + 1] - pi[k];
+      diagonal_offset[k + 1] = diagonal_offset[k] + ncol * ncol;
+      below_offset[k + 1] = below_offset[k] + (nrow - ncol) * ncol;
+    }
+    const bool bfloat16 = factor->xsize >= kBfloat16MinEntries;
+    diagonal.resize(diagonal_offset[nsuper]);
+    below_single.resize(bfloat16 ? 0 : below_offset[nsuper]);
+    below_bfloat16.resize(bfloat16 ? below_offset[nsuper] : 0);
+    for (int k = 0; k < nsuper; ++k) {
+      const int ncol = super[k + 1] - super[k], nrow = pi[k + 1] - pi[k];
+      for (int j = 0; j < ncol; ++j) {
+        const double* column = x + px[k] + static_cast<std::size_t>(j) * nrow;
+        float* d = diagonal.data() + diagonal_offset[k] + static_cast<std::size_t>(j) * ncol;
+        const std::size_t b = below_offset[k] + static_cast<std::size_t>(j) * (nrow - ncol);
+        for (int i = 0; i < ncol; ++i) d[i] = static_cast<float>(column[i]);
+        if (bfloat16) {
+          for (int i = ncol; i < nrow; ++i) below_bfloat16[b + i - ncol] = to_bfloat16(static_cast<float>(column[i]));
+        } else {
+          for (int i = ncol; i < nrow; ++i) below_single[b + i - ncol] = static_cast<float>(column[i]);
+        }
+      }
+    }
+  }
 
   Impl() {
     cholmod_start(&common);
@@ -122,7 +229,7 @@ FactorStatus SparseCholesky::factorize(const HessianAssembler& matrix, double sh
     logger()->debug("cholmod: n {} nnz(A) {} nnz(L) {:.0f} xsize {} nsuper {} flops {:.3g} supernodal {} ordering {}", a.nrow, a.nzmax,
                     m.common.lnz, m.factor->xsize, m.factor->nsuper, m.common.fl, m.factor->is_super, m.common.method[m.common.selected].ordering);
   }
-  m.single.clear();
+  m.diagonal.clear();
   const int ok = cholmod_factorize(&a, m.factor, &m.common);
   if (m.common.status == CHOLMOD_NOT_POSDEF) return FactorStatus::kNotPositiveDefinite;
   if (!ok || m.common.status < CHOLMOD_OK) return FactorStatus::kFailed;
@@ -153,50 +260,12 @@ bool SparseCholesky::solve_approximate(const Eigen::VectorXd& rhs, Eigen::Vector
   cholmod_factor* f = m.factor;
   if (f == nullptr || f->minor < f->n) return false;
   if (!f->is_super || !f->is_ll || f->itype != CHOLMOD_INT) return solve(rhs, solution);
-  const int* super = static_cast<const int*>(f->super);
-  const int* pi = static_cast<const int*>(f->pi);
-  const int* px = static_cast<const int*>(f->px);
-  const int* s = static_cast<const int*>(f->s);
-  const int* perm = static_cast<const int*>(f->Perm);
-  const int nsuper = static_cast<int>(f->nsuper);
-  const int n = static_cast<int>(f->n);
-  if (m.single.empty()) {
-    const double* x = static_cast<const double*>(f->x);
-    m.single.assign(x, x + f->xsize);
+  if (m.diagonal.empty()) m.make_compact_copy();
+  if (m.below_bfloat16.empty()) {
+    m.solve_compact(m.below_single.data(), rhs, solution);
+  } else {
+    m.solve_compact(m.below_bfloat16.data(), rhs, solution);
   }
-  m.work.resize(n);
-  if (m.update.size() < n) m.update.resize(n);
-  Eigen::Map<Eigen::VectorXf> y(m.work.data(), n);
-  for (int k = 0; k < n; ++k) y[k] = static_cast<float>(rhs[perm[k]]);
-  using Block = Eigen::Map<const Eigen::MatrixXf>;
-  // L y = P b, supernode by supernode: the dense diagonal block, then the rows below it.
-  for (int k = 0; k < nsuper; ++k) {
-    const int k1 = super[k], ncol = super[k + 1] - k1, nrow = pi[k + 1] - pi[k];
-    const Block block(m.single.data() + px[k], nrow, ncol);
-    auto own = y.segment(k1, ncol);
-    block.topRows(ncol).triangularView<Eigen::Lower>().solveInPlace(own);
-    if (nrow > ncol) {
-      auto update = m.update.head(nrow - ncol);
-      update.noalias() = block.bottomRows(nrow - ncol) * own;
-      const int* rows = s + pi[k] + ncol;
-      for (int i = 0; i < nrow - ncol; ++i) y[rows[i]] -= update[i];
-    }
-  }
-  // L^T x = y, in reverse.
-  for (int k = nsuper - 1; k >= 0; --k) {
-    const int k1 = super[k], ncol = super[k + 1] - k1, nrow = pi[k + 1] - pi[k];
-    const Block block(m.single.data() + px[k], nrow, ncol);
-    auto own = y.segment(k1, ncol);
-    if (nrow > ncol) {
-      auto gathered = m.update.head(nrow - ncol);
-      const int* rows = s + pi[k] + ncol;
-      for (int i = 0; i < nrow - ncol; ++i) gathered[i] = y[rows[i]];
-      own.noalias() -= block.bottomRows(nrow - ncol).transpose() * gathered;
-    }
-    block.topRows(ncol).triangularView<Eigen::Lower>().transpose().solveInPlace(own);
-  }
-  solution.resize(n);
-  for (int k = 0; k < n; ++k) solution[perm[k]] = static_cast<double>(y[k]);
   return solution.allFinite();
 }
 
