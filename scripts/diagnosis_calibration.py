@@ -11,6 +11,14 @@ held-out view does not get worse than the reference's.
 
     scripts/diagnosis_calibration.py out/calib60_s2 --floors 1.0 1.15 1.3 --thresholds 0.15 0.25 0.35
 
+With --multistability (a gap-only run whose report.json has gap_tests.validation_spread, branch diag-s7) it compares
+the constant shape floor with per-capture floors from the validation drapes' spread among themselves (the
+leave-one-out nearest-neighbour shape distances among them: docs/DIAGNOSIS.md, "Branch diag-s7"), prints each case's
+fabric stiffness from the truth file, and with --rule applies one rule with fixed constants (for the evaluation set):
+
+    scripts/diagnosis_calibration.py out/calib_s7 --multistability
+    scripts/diagnosis_calibration.py out/eval_s7 --multistability --rule floor --c0 0.8 --k 2.0
+
 With --gap-only the run need not have attributed (e.g. `--diagnose-args "--shape-floor 50"`): it prints each case's
 validated shape distance and stable term, the calibrated shape floor (the largest control's shape distance plus 10%,
 the rule of docs/DIAGNOSIS.md, "Floors"), and which captures are above the floors at that floor and at --floors.
@@ -86,6 +94,139 @@ def gap_only(cases, floors):
         print(f"floor {F:.2f}: controls above {c}/{len(controls)}, effect captures above {e}/{n}")
 
 
+FAMILIES = ["yield", "shear", "curl", "friction", "misalignment", "sensor"]
+
+
+def spearman(x, y):
+    """Spearman's rank correlation (no ties expected: continuous values)."""
+    def ranks(v):
+        order = sorted(range(len(v)), key=lambda i: v[i])
+        r = [0.0] * len(v)
+        for k, i in enumerate(order):
+            r[i] = float(k)
+        return r
+    rx, ry = ranks(x), ranks(y)
+    n = len(x)
+    mx, my = sum(rx) / n, sum(ry) / n
+    sxy = sum((a - mx) * (b - my) for a, b in zip(rx, ry))
+    sxx = sum((a - mx) ** 2 for a in rx)
+    syy = sum((b - my) ** 2 for b in ry)
+    return sxy / (sxx * syy) ** 0.5 if sxx > 0 and syy > 0 else 0.0
+
+
+def spread_stats(d, truth):
+    """The per-capture quantities of the multistability rules (docs/DIAGNOSIS.md, "Branch diag-s7")."""
+    t = d["gap_tests"]
+    v = t["validation_spread"]
+    loo = v["nearest_other_shape"]
+    pairs = [v["pairwise_shape"][i][j] for i in range(len(loo)) for j in range(i + 1, len(loo))]
+    alpha = truth["alpha"]
+    return {
+        "c": t["shape"],                          # the gate's: the best validation drape (by fit score), all views
+        "cmin": min(v["capture_shape"]),          # the nearest validation drape by shape distance
+        "loo_med": statistics.median(loo),        # median leave-one-out nearest-neighbour distance
+        "loo_max": max(loo),
+        "pair_med": statistics.median(pairs),
+        "ms_floor": max(d["floors"]["multistability_shape"]) if d["floors"]["multistability_shape"] else 0.0,
+        "stiff": sum(alpha) / 3 / truth["density_g_per_m2"],  # mean alpha / density (the brief's stiffness)
+        "stable_up": t["stable_mm"] > t["stable_floor_mm"],
+    }
+
+
+def rule_above(rule, q, c0=0.0, k=0.0, r=0.0):
+    """Whether the shape test fails (the capture is above the shape floor) under a rule with fixed constants."""
+    if rule == "const":
+        return q["c"] > c0
+    if rule == "ratio":          # c / median LOO distance above r
+        return q["c"] > r * q["loo_med"]
+    if rule == "floor":          # c above max(c0, k x median LOO distance)
+        return q["c"] > max(c0, k * q["loo_med"])
+    if rule == "floor_max":      # c above max(c0, k x largest LOO distance)
+        return q["c"] > max(c0, k * q["loo_max"])
+    if rule == "nearest_const":  # the nearest validation drape by shape distance (not by fit score) above c0
+        return q["cmin"] > c0
+    if rule == "nearest_ratio":  # the same over the median LOO distance above r
+        return q["cmin"] > r * q["loo_med"]
+    if rule == "offset":         # c above c0 + k x median LOO distance (the 60x60-vs-32x32 offset plus the spread)
+        return q["c"] > c0 + k * q["loo_med"]
+    raise SystemExit(f"unknown rule {rule}")
+
+
+def score_rule(rows, rule, **const):
+    """(controls within, {family: effect captures above the floors}) with the stable test as the gate has it."""
+    within, total, above = 0, 0, {f: [0, 0] for f in FAMILIES}
+    for name, fam, q in rows:
+        up = q["stable_up"] or rule_above(rule, q, **const)
+        if fam == "none":
+            total += 1
+            within += not up
+        else:
+            above[fam][0] += up
+            above[fam][1] += 1
+    return within, total, above
+
+
+def fmt_above(above, shape_only_rows=None):
+    cells = [f"{a}/{n}" for a, n in (above[f] for f in FAMILIES)]
+    tot = sum(a for a, _ in above.values()), sum(n for _, n in above.values())
+    return cells + [f"{tot[0]}/{tot[1]}"]
+
+
+def calibrate(rows):
+    """Each rule's constants from the controls: every control within the floor with a 10% margin (the diag-s5/s6
+    rule, largest control + 10%); for the two-constant rules, k from a grid and c0 the smallest that keeps the
+    controls k x spread does not cover. Returns [(rule, constants)]."""
+    ctl = [q for _, fam, q in rows if fam == "none"]
+    out = [("const", {"c0": 1.1 * max(q["c"] for q in ctl)}),
+           ("ratio", {"r": 1.1 * max(q["c"] / q["loo_med"] for q in ctl)})]
+    for rule, key in (("floor", "loo_med"), ("floor_max", "loo_max")):
+        for k in [0.5, 0.75, 1.0, 1.25, 1.5, 2.0, 2.5, 3.0, 4.0]:
+            uncovered = [1.1 * q["c"] for q in ctl if 1.1 * q["c"] > k * q[key]]
+            out.append((rule, {"c0": max(uncovered) if uncovered else 0.0, "k": k}))
+    out.append(("nearest_const", {"c0": 1.1 * max(q["cmin"] for q in ctl)}))
+    out.append(("nearest_ratio", {"r": 1.1 * max(q["cmin"] / q["loo_med"] for q in ctl)}))
+    for k in [0.25, 0.5, 0.75, 1.0, 1.5, 2.0]:
+        out.append(("offset", {"c0": max(1.1 * q["c"] - k * q["loo_med"] for q in ctl), "k": k}))
+    return out
+
+
+def multistability(cases, truths, rule=None, consts=None, fixed_floor=1.17):
+    rows = [(name, fam, spread_stats(d, truths[name])) for name, fam, d in cases]
+    print("| case | family | stiffness (mean alpha / density) | shape (gate) | nearest by shape | LOO median | LOO max |"
+          " pairs median | shape / LOO median | largest floor sample | stable above |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    for name, fam, q in sorted(rows, key=lambda r: (FAMILIES.index(r[1]) + 1 if r[1] in FAMILIES else 0, r[0])):
+        print(f"| {name} | {fam} | {q['stiff']:.3g} | {q['c']:.2f} | {q['cmin']:.2f} | {q['loo_med']:.2f} | "
+              f"{q['loo_max']:.2f} | {q['pair_med']:.2f} | {q['c'] / q['loo_med']:.2f} | {q['ms_floor']:.2f} | "
+              f"{'yes' if q['stable_up'] else ''} |")
+    allq = [q for _, _, q in rows]
+    ctl = [q for _, fam, q in rows if fam == "none"]
+    print(f"\nSpearman, all {len(allq)} captures: stiffness vs LOO median {spearman([q['stiff'] for q in allq], [q['loo_med'] for q in allq]):+.2f}; "
+          f"stiffness vs gate shape {spearman([q['stiff'] for q in allq], [q['c'] for q in allq]):+.2f}")
+    print(f"Spearman, {len(ctl)} controls: stiffness vs LOO median {spearman([q['stiff'] for q in ctl], [q['loo_med'] for q in ctl]):+.2f}; "
+          f"LOO median vs gate shape {spearman([q['loo_med'] for q in ctl], [q['c'] for q in ctl]):+.2f}; "
+          f"stiffness vs gate shape {spearman([q['stiff'] for q in ctl], [q['c'] for q in ctl]):+.2f}\n")
+    head = "| rule | constants | controls within | " + " | ".join(FAMILIES) + " | effect captures above |"
+    print(head)
+    print("|---" * (3 + len(FAMILIES) + 1) + "|")
+    settings = [("const", {"c0": fixed_floor})]
+    if rule:
+        settings.append((rule, consts))
+    else:
+        settings += calibrate(rows)
+    for r, c in settings:
+        within, total, above = score_rule(rows, r, **c)
+        cs = ", ".join(f"{k}={v:.3g}" for k, v in c.items())
+        label = "const (given)" if (r, c) == settings[0] else r
+        print(f"| {label} | {cs} | {within}/{total} | " + " | ".join(fmt_above(above)) + " |")
+    if rule:
+        print(f"\nPer case under {rule} ({consts}) and the constant floor {fixed_floor}:")
+        for name, fam, q in rows:
+            a = q["stable_up"] or rule_above(rule, q, **consts)
+            b = q["stable_up"] or rule_above("const", q, c0=fixed_floor)
+            print(f"  {name}: {'above' if a else 'within'} (constant floor: {'above' if b else 'within'})")
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("run", type=Path, help="benchmark directory (diagnoses/, truth/)")
@@ -96,11 +237,26 @@ def main():
                    help="1: a candidate counts only if the held-out view confirms it (drapegen diagnose); 0: any")
     p.add_argument("--gap-only", action="store_true",
                    help="the gate alone (no attribution needed): the calibrated floor and the captures above it")
+    p.add_argument("--multistability", action="store_true",
+                   help="per-capture floors from the validation drapes' spread (gap-only run, branch diag-s7)")
+    p.add_argument("--rule", choices=["const", "ratio", "floor", "floor_max", "offset", "nearest_const", "nearest_ratio"],
+                   help="with --multistability: apply this rule with the constants given (else calibrate them)")
+    p.add_argument("--c0", type=float, default=0.0)
+    p.add_argument("--k", type=float, default=0.0)
+    p.add_argument("--r", type=float, default=0.0)
+    p.add_argument("--fixed-floor", type=float, default=1.17, help="the constant floor compared with")
     args = p.parse_args()
-    cases = []
+    cases, truths = [], {}
     for f in sorted((args.run / "diagnoses").glob("*.json")):
         truth = json.loads((args.run / "truth" / f.name).read_text())
+        truths[f.stem] = truth
         cases.append((f.stem, truth["family"], json.loads(f.read_text())))
+    if args.multistability:
+        consts = {"const": {"c0": args.c0}, "ratio": {"r": args.r}, "floor": {"c0": args.c0, "k": args.k},
+                  "floor_max": {"c0": args.c0, "k": args.k}, "offset": {"c0": args.c0, "k": args.k},
+                  "nearest_const": {"c0": args.c0}, "nearest_ratio": {"r": args.r}}.get(args.rule)
+        multistability(cases, truths, args.rule, consts, args.fixed_floor)
+        return
     if args.gap_only:
         gap_only(cases, [F for F in args.floors if F > 0])
         return

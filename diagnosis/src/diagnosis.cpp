@@ -73,6 +73,29 @@ nlohmann::json view_json(const ScoredDrape& d) {
   return views;
 }
 
+nlohmann::json groups_json(const std::vector<double>& d) {
+  nlohmann::json g = nlohmann::json::object();
+  for (std::size_t k = 0; k < d.size() && k < static_cast<std::size_t>(kFeatureGroupCount); ++k) {
+    g[std::string(feature_group_name(kFeatureGroups[k]))] = d[k] < 0.0 ? -1.0 : d[k] * 1e3;
+  }
+  return g;
+}
+
+nlohmann::json spread_json(const ValidationSpread& s) {
+  nlohmann::json capture_groups = nlohmann::json::array(), pair_groups = nlohmann::json::array();
+  for (const auto& d : s.capture_groups) capture_groups.push_back(groups_json(d));
+  for (std::size_t i = 0; i < s.pairwise_groups.size(); ++i) {
+    for (std::size_t j = i + 1; j < s.pairwise_groups[i].size(); ++j) {
+      pair_groups.push_back({{"i", i}, {"j", j}, {"groups_mm", groups_json(s.pairwise_groups[i][j])}});
+    }
+  }
+  return {{"capture_shape", s.capture_distance},
+          {"capture_groups_mm", capture_groups},
+          {"pairwise_shape", s.pairwise},
+          {"nearest_other_shape", s.nearest_other},
+          {"pairwise_groups_mm", pair_groups}};
+}
+
 }  // namespace
 
 DiagnosisSettings DiagnosisSettings::quick() {
@@ -146,6 +169,7 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
   auto validated = model.evaluate(fitted, validation_states(settings.attribution));
   if (!validated) return validated.error();
   r.validated = std::move(*validated);
+  r.validation_spread = validation_spread(r.validated.states, model.target().shape.all);
   const ScoredDrape& gap = r.gap_drape();
   r.gap_all = gap.all_score;
   r.gap_fit = gap.fit_score;
@@ -190,6 +214,11 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
   j["confidence"] = r.attribution.confidence;
   j["within_floors"] = r.within_floors;
   j["gap_mm"] = {{"all_views", r.gap_all * 1e3}, {"fit_views", r.gap_fit * 1e3}, {"held_out_view", r.gap_held_out * 1e3}};
+  nlohmann::json states = nlohmann::json::array();
+  for (const auto& d : r.validated.states) {
+    states.push_back({{"state", d.state}, {"stable_mm", d.stable_all * 1e3}, {"shape", d.shape_all},
+                      {"fit_score_mm", d.fit_score * 1e3}, {"converged", d.converged}});
+  }
   j["gap_tests"] = {{"stable_mm", r.gap_drape().stable_all * 1e3},
                     {"stable_floor_mm", r.floors.stable * 1e3},
                     {"shape", r.gap_drape().shape_all},
@@ -197,6 +226,8 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                     {"excess_above_floors", excess_above_floors(r.gap_drape(), r.floors)},
                     {"validation_states", r.validated.states.size()},
                     {"best_validation_state", r.gap_drape().state},
+                    {"validation_spread", spread_json(r.validation_spread)},
+                    {"validation_drapes", states},
                     {"fit_states", {{"stable_mm", r.fit.best.stable_all * 1e3},
                                     {"shape", r.fit.best.shape_all},
                                     {"excess_above_floors", excess_above_floors(r.fit.best, r.floors)}}}};

@@ -7,6 +7,7 @@
 #include "drapegen/diagnosis/attribution.hpp"
 #include "drapegen/diagnosis/floors.hpp"
 #include "drapegen/diagnosis/localisation.hpp"
+#include "drapegen/diagnosis/validation_spread.hpp"
 
 namespace drapegen::diagnosis {
 
@@ -40,6 +41,8 @@ struct DiagnosisResult {
   /// which no fit selected on (the fit's own best is the luckiest of its evaluations of a multistable objective).
   Evaluation validated;
   [[nodiscard]] const ScoredDrape& gap_drape() const { return validated.best; }
+  /// The validation drapes' distances to the capture and among themselves (the fitted fabric's multistability).
+  ValidationSpread validation_spread;
   Floors floors;
   double gap_all = 0.0, gap_fit = 0.0, gap_held_out = 0.0;
   bool within_floors = false;
