@@ -107,9 +107,7 @@ Runner add_diagnose_command(CLI::App& app) {
   app.add_option("--evaluations", o->evaluations, "Baseline fit evaluations (default 40; quick and fine 20)");
   app.add_option("--refit-evaluations", o->refit_evaluations,
                  "Evaluations per candidate refit (default 14, also with --quick and --fine)");
-  app.add_option("--jobs", o->jobs,
-                 "Candidate refits in parallel threads (above 1 the refits' results can differ from run to run and "
-                 "from --jobs 1, a known defect: docs/DIAGNOSIS.md; diagnose several captures as processes instead)")->capture_default_str();
+  app.add_option("--jobs", o->jobs, "Candidate refits in parallel threads (same result as --jobs 1)")->capture_default_str();
   app.add_option("--shape-floor", o->shape_floor,
                  fmt::format("Shape-distance floor (default and quick: calibrated {:.2f}; fine: {:.2f}; 0: the largest "
                              "floor sample)",

@@ -57,6 +57,15 @@ class SerialOpenMp {
   bool active_;
 };
 
+/// CHOLMOD's supernodal factorisation and solve call BLAS, and Debian's serial OpenBLAS is not safe to call from two
+/// threads at once: concurrent drapes in one process (diagnose --jobs 2) got results that differed from run to run,
+/// and identical ones with the reference BLAS (docs/DIAGNOSIS.md). So every CHOLMOD call that may reach BLAS holds
+/// this lock; uncontended (one drape per process: workers, drapegen simulate) it costs nothing.
+std::mutex& blas_mutex() {
+  static std::mutex m;
+  return m;
+}
+
 /// Factors with at least this many values (8 MB in single precision: more than the share of a last-level cache one
 /// core of a busy node can count on) keep the rows below their diagonal blocks in bfloat16 for preconditioning: the
 /// triangular solves are bound by memory traffic there (docs/BENCHMARKS.md, session 7). Smaller ones stay in cache
@@ -221,6 +230,7 @@ FactorStatus SparseCholesky::factorize(const HessianAssembler& matrix, double sh
     for (int p : matrix.diagonal_positions()) m.values[p] += shift;
   }
   cholmod_sparse a = m.view();
+  const std::lock_guard blas(blas_mutex());
   const SerialOpenMp serial(!m.parallel);
   if (!m.analysed) {
     m.factor = cholmod_analyze(&a, &m.common);
@@ -247,7 +257,11 @@ bool SparseCholesky::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution
   b.x = const_cast<double*>(rhs.data());
   b.xtype = CHOLMOD_REAL;
   b.dtype = CHOLMOD_DOUBLE;
-  cholmod_dense* x = cholmod_solve(CHOLMOD_A, m.factor, &b, &m.common);
+  cholmod_dense* x = nullptr;
+  {
+    const std::lock_guard blas(blas_mutex());
+    x = cholmod_solve(CHOLMOD_A, m.factor, &b, &m.common);
+  }
   if (x == nullptr) return false;
   solution.resize(rhs.size());
   std::memcpy(solution.data(), x->x, sizeof(double) * static_cast<size_t>(rhs.size()));
