@@ -3,7 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <atomic>
 #include <random>
+#include <thread>
 
 #include "drapegen/sim/bending.hpp"
 #include "drapegen/sim/gravity.hpp"
@@ -117,6 +119,32 @@ TEST(LinearAlgebra, CompactSolveOfALargeFactorPreconditionsConjugateGradients) {
   EXPECT_LE(error, 2e-2);
   EXPECT_LE(iterations, 10);
   EXPECT_LE((solution - x).norm(), 1e-7 * x.norm());
+}
+
+TEST(LinearAlgebra, ConcurrentFactorisationsGiveTheSequentialResult) {
+  // Two threads factorising and solving at once (diagnose --jobs 2) must get exactly what one thread gets: CHOLMOD's
+  // BLAS calls (Debian's serial OpenBLAS is not thread-safe) are serialised by SparseCholesky.
+  const System s = make_system(40);
+  const HessianAssembler& a = *s.assembler;
+  const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(a.dof_count(), -1.0, 2.0).array().cos();
+  Eigen::VectorXd reference;
+  {
+    SparseCholesky cholesky;
+    ASSERT_EQ(cholesky.factorize(a), FactorStatus::kOk);
+    ASSERT_TRUE(cholesky.solve(b, reference));
+  }
+  std::atomic<int> mismatches{0};
+  auto work = [&] {
+    for (int k = 0; k < 20; ++k) {
+      SparseCholesky cholesky;
+      Eigen::VectorXd x;
+      if (cholesky.factorize(a) != FactorStatus::kOk || !cholesky.solve(b, x) || x != reference) ++mismatches;
+    }
+  };
+  std::thread t1(work), t2(work);
+  t1.join();
+  t2.join();
+  EXPECT_EQ(mismatches.load(), 0);
 }
 
 }  // namespace
