@@ -18,43 +18,28 @@
 namespace drapegen::sim {
 namespace {
 
-/// While alive, OpenMP parallel regions (CHOLMOD's) run on the encountering thread alone. Concurrent guards share
-/// one saved setting: the first saves and lowers max-active-levels, the last restores it.
+/// While alive, OpenMP parallel regions (CHOLMOD's) run on the encountering thread alone: max-active-levels is
+/// lowered to 0 and restored afterwards. Only constructed under blas_mutex(), so no two guards overlap.
 class SerialOpenMp {
  public:
   explicit SerialOpenMp(bool active) : active_(active) {
 #ifdef DRAPEGEN_HAVE_OPENMP
     if (!active_) return;
-    Shared& s = shared();
-    const std::lock_guard lock(s.mutex);
-    if (s.users++ == 0) {
-      s.saved_levels = omp_get_max_active_levels();
-      omp_set_max_active_levels(0);
-    }
+    saved_levels_ = omp_get_max_active_levels();
+    omp_set_max_active_levels(0);
 #endif
   }
   ~SerialOpenMp() {
 #ifdef DRAPEGEN_HAVE_OPENMP
-    if (!active_) return;
-    Shared& s = shared();
-    const std::lock_guard lock(s.mutex);
-    if (--s.users == 0) omp_set_max_active_levels(s.saved_levels);
+    if (active_) omp_set_max_active_levels(saved_levels_);
 #endif
   }
   SerialOpenMp(const SerialOpenMp&) = delete;
   SerialOpenMp& operator=(const SerialOpenMp&) = delete;
 
  private:
-  struct Shared {
-    std::mutex mutex;
-    int users = 0;
-    int saved_levels = 0;
-  };
-  static Shared& shared() {
-    static Shared s;
-    return s;
-  }
   bool active_;
+  int saved_levels_ = 0;
 };
 
 /// CHOLMOD's supernodal factorisation and solve call BLAS, and Debian's serial OpenBLAS is not safe to call from two

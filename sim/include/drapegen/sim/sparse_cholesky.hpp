@@ -20,7 +20,8 @@ class SparseCholesky {
   /// default: drapegen runs one solve per core (workers, diagnosis refits), and there the team's hand-offs cost
   /// more than they save (measured: 390k context switches and 40% more CPU time on a 100x100 drape on a busy
   /// 2-core machine). Off, factorize() runs CHOLMOD with OpenMP's max-active-levels at 0 for the duration of the
-  /// call (a process-wide setting, restored when the last concurrent factorisation ends).
+  /// call, restored afterwards. Distinct instances may be used from different threads: the CHOLMOD calls that reach
+  /// BLAS (factorize, solve) are serialised process-wide, since Debian's serial OpenBLAS is not thread-safe.
   explicit SparseCholesky(bool parallel = false);
   ~SparseCholesky();
   SparseCholesky(const SparseCholesky&) = delete;
@@ -32,9 +33,10 @@ class SparseCholesky {
   /// Solves with the last successful factorisation.
   [[nodiscard]] bool solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution);
   /// Solves approximately with a compact copy of the last successful factorisation (made on first use after each
-  /// factorisation): the supernodes' diagonal blocks in single precision, the rows below them in bfloat16
-  /// (bfloat16_panel.hpp), about a quarter of the memory traffic of solve(). For preconditioning only: the relative
-  /// error is about 2^-8 times the condition number's effect, well inside what a stale factorisation already costs.
+  /// factorisation): the supernodes' diagonal blocks in single precision, the rows below them in single precision,
+  /// or in bfloat16 (bfloat16_panel.hpp) for a factor of at least 2M values: half, or a quarter, of the memory
+  /// traffic of solve(). For preconditioning only: the bfloat16 copy's relative error is about 2^-8 times the
+  /// condition number's effect, well inside what a stale factorisation already costs.
   /// Falls back to solve() for a simplicial factor (CHOLMOD chooses one for small, sparse problems).
   [[nodiscard]] bool solve_approximate(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution);
 
