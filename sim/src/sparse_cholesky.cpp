@@ -14,6 +14,7 @@
 
 #include "drapegen/sim/bfloat16_panel.hpp"
 #include "drapegen/sim/logging.hpp"
+#include "drapegen/sim/packed_triangle.hpp"
 
 namespace drapegen::sim {
 namespace {
@@ -83,7 +84,7 @@ struct SparseCholesky::Impl {
   std::vector<double> values;
   bool analysed = false;
   // The preconditioner's compact copy of a supernodal factor, made on first use after each factorisation (empty
-  // until then): per supernode, its diagonal block in single precision and the rows below it in single precision or,
+  // until then): per supernode, its diagonal block packed in single precision (packed_triangle.hpp) and the rows below it in single precision or,
   // for a factor of at least kBfloat16MinEntries values, in bfloat16.
   std::vector<float> diagonal;
   std::vector<float> below_single;
@@ -105,16 +106,14 @@ struct SparseCholesky::Impl {
     if (update.size() < static_cast<std::size_t>(n)) update.resize(n);
     Eigen::Map<Eigen::VectorXf> y(work.data(), n);
     for (int k = 0; k < n; ++k) y[k] = static_cast<float>(rhs[perm[k]]);
-    using Block = Eigen::Map<const Eigen::MatrixXf>;
     // L y = P b, supernode by supernode: the dense diagonal block, then the rows below it.
     for (int k = 0; k < nsuper; ++k) {
       const int k1 = super[k], ncol = super[k + 1] - k1, nbelow = pi[k + 1] - pi[k] - ncol;
-      const Block block(diagonal.data() + diagonal_offset[k], ncol, ncol);
-      auto own = y.segment(k1, ncol);
-      block.triangularView<Eigen::Lower>().solveInPlace(own);
+      float* own = y.data() + k1;
+      packed_lower_solve(diagonal.data() + diagonal_offset[k], ncol, own);
       if (nbelow > 0) {
         std::fill(update.begin(), update.begin() + nbelow, 0.0f);
-        multiply_add(below + below_offset[k], nbelow, ncol, own.data(), update.data());
+        multiply_add(below + below_offset[k], nbelow, ncol, own, update.data());
         const int* rows = s + pi[k] + ncol;
         for (int i = 0; i < nbelow; ++i) y[rows[i]] -= update[i];
       }
@@ -122,14 +121,13 @@ struct SparseCholesky::Impl {
     // L^T x = y, in reverse.
     for (int k = nsuper - 1; k >= 0; --k) {
       const int k1 = super[k], ncol = super[k + 1] - k1, nbelow = pi[k + 1] - pi[k] - ncol;
-      const Block block(diagonal.data() + diagonal_offset[k], ncol, ncol);
-      auto own = y.segment(k1, ncol);
+      float* own = y.data() + k1;
       if (nbelow > 0) {
         const int* rows = s + pi[k] + ncol;
         for (int i = 0; i < nbelow; ++i) update[i] = y[rows[i]];
-        transpose_multiply_subtract(below + below_offset[k], nbelow, ncol, update.data(), own.data());
+        transpose_multiply_subtract(below + below_offset[k], nbelow, ncol, update.data(), own);
       }
-      block.triangularView<Eigen::Lower>().transpose().solveInPlace(own);
+      packed_lower_transpose_solve(diagonal.data() + diagonal_offset[k], ncol, own);
     }
     solution.resize(n);
     for (int k = 0; k < n; ++k) solution[perm[k]] = static_cast<double>(y[k]);
@@ -146,7 +144,7 @@ struct SparseCholesky::Impl {
     below_offset.assign(nsuper + 1, 0);
     for (int k = 0; k < nsuper; ++k) {
       const std::size_t ncol = super[k + 1] - super[k], nrow = pi[k + 1] - pi[k];
-      diagonal_offset[k + 1] = diagonal_offset[k] + ncol * ncol;
+      diagonal_offset[k + 1] = diagonal_offset[k] + packed_triangle_size(ncol);
       below_offset[k + 1] = below_offset[k] + (nrow - ncol) * ncol;
     }
     const bool bfloat16 = factor->xsize >= kBfloat16MinEntries;
@@ -155,11 +153,10 @@ struct SparseCholesky::Impl {
     below_bfloat16.resize(bfloat16 ? below_offset[nsuper] : 0);
     for (int k = 0; k < nsuper; ++k) {
       const int ncol = super[k + 1] - super[k], nrow = pi[k + 1] - pi[k];
+      pack_lower_triangle(x + px[k], ncol, nrow, diagonal.data() + diagonal_offset[k]);
       for (int j = 0; j < ncol; ++j) {
         const double* column = x + px[k] + static_cast<std::size_t>(j) * nrow;
-        float* d = diagonal.data() + diagonal_offset[k] + static_cast<std::size_t>(j) * ncol;
         const std::size_t b = below_offset[k] + static_cast<std::size_t>(j) * (nrow - ncol);
-        for (int i = 0; i < ncol; ++i) d[i] = static_cast<float>(column[i]);
         if (bfloat16) {
           for (int i = ncol; i < nrow; ++i) below_bfloat16[b + i - ncol] = to_bfloat16(static_cast<float>(column[i]));
         } else {
