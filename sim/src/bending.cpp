@@ -5,9 +5,11 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <stdexcept>
 
 #include "drapegen/sim/dihedral.hpp"
+#include "drapegen/sim/fold_barrier.hpp"
 #include "drapegen/sim/psd_projection.hpp"
 
 namespace drapegen::sim {
@@ -150,13 +152,29 @@ double DihedralBending::update_lagged(const Eigen::Matrix3Xd& x) {
   return change;
 }
 
+bool DihedralBending::admissible_step(const Eigen::Matrix3Xd& from, const Eigen::Matrix3Xd& to) const {
+  for (const Hinge& h : hinges_) {
+    const double after = dihedral_angle(to.col(h.v0), to.col(h.v1), to.col(h.v2), to.col(h.v3));
+    const double gap_after = std::numbers::pi - std::abs(after);
+    if (gap_after >= FoldBarrier::kWidth) continue;
+    const double before = dihedral_angle(from.col(h.v0), from.col(h.v1), from.col(h.v2), from.col(h.v3));
+    const double gap_before = std::numbers::pi - std::abs(before);
+    // Folded through the wrap, or closing more than half the gap at once (the barrier grows only like -log of the
+    // gap, so one long step could land deep inside it, where the next steps must be tiny).
+    if (std::abs(after - before) > std::numbers::pi || gap_after < 0.5 * std::min(gap_before, FoldBarrier::kWidth)) return false;
+  }
+  return true;
+}
+
 double DihedralBending::energy(const Eigen::Matrix3Xd& x) const {
   double total = 0.0;
   for (std::size_t i = 0; i < hinges_.size(); ++i) {
     const Hinge& h = hinges_[i];
-    const double theta = dihedral_angle(x.col(h.v0), x.col(h.v1), x.col(h.v2), x.col(h.v3)) - rest_angle_[i];
+    const double angle = dihedral_angle(x.col(h.v0), x.col(h.v1), x.col(h.v2), x.col(h.v3));
+    const double theta = angle - rest_angle_[i];
     const double c = 2.0 / rest_[i].height_sum;
-    total += rest_[i].edge_length / c * laws_[i].work(c * std::abs(theta));
+    const double e = rest_[i].edge_length;
+    total += e / c * laws_[i].work(c * std::abs(theta)) + FoldBarrier::energy(angle, e * c * laws_[i].alpha);
   }
   return total;
 }
@@ -172,15 +190,16 @@ double DihedralBending::evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd* gr
     const Hinge& h = hinges_[i];
     const double c = 2.0 / rest_[i].height_sum;
     const double e = rest_[i].edge_length;
-    const double theta = (exact_second
-                              ? dihedral_angle_hessian(x.col(h.v0), x.col(h.v1), x.col(h.v2), x.col(h.v3), g, h2)
-                              : dihedral_angle_gradient(x.col(h.v0), x.col(h.v1), x.col(h.v2), x.col(h.v3), g)) -
-                         rest_angle_[i];
+    const double angle =
+        exact_second ? dihedral_angle_hessian(x.col(h.v0), x.col(h.v1), x.col(h.v2), x.col(h.v3), g, h2)
+                     : dihedral_angle_gradient(x.col(h.v0), x.col(h.v1), x.col(h.v2), x.col(h.v3), g);
+    const double theta = angle - rest_angle_[i];
     const double kappa = c * std::abs(theta);
     const TorqueLaw& law = laws_[i];
-    total += e / c * law.work(kappa);
-    const double de = std::copysign(e * law.torque(kappa), theta);  // dE / dtheta
-    const double d2e = e * c * law.stiffness(kappa);                 // d^2E / dtheta^2
+    double barrier_first = 0.0, barrier_second = 0.0;
+    total += e / c * law.work(kappa) + FoldBarrier::energy(angle, e * c * law.alpha, &barrier_first, &barrier_second);
+    const double de = std::copysign(e * law.torque(kappa), theta) + barrier_first;  // dE / dtheta
+    const double d2e = e * c * law.stiffness(kappa) + barrier_second;               // d^2E / dtheta^2
     if (gradient != nullptr) {
       for (int v = 0; v < 4; ++v) gradient->col((&h.v0)[v]) += de * g.segment<3>(3 * v);
     }

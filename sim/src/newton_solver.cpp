@@ -43,9 +43,14 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
-double total_energy(const std::vector<EnergyTerm*>& terms, const Eigen::Matrix3Xd& x) {
+/// The energy at the end of a straight step from `from` to `to`; infinite if a term rules the step out
+/// (EnergyTerm::admissible_step), so that the line search shortens it like any step that fails.
+double trial_energy(const std::vector<EnergyTerm*>& terms, const Eigen::Matrix3Xd& from, const Eigen::Matrix3Xd& to) {
   double e = 0.0;
-  for (const EnergyTerm* t : terms) e += t->energy(x);
+  for (const EnergyTerm* t : terms) {
+    if (!t->admissible_step(from, to)) return std::numeric_limits<double>::infinity();
+    e += t->energy(to);
+  }
   return e;
 }
 
@@ -108,7 +113,7 @@ SolveReport NewtonSolver::solve(const std::vector<EnergyTerm*>& terms, const std
       const int f = assembler.free_index(v);
       if (f >= 0) trial.col(v) += (t - 1.0) * step.segment<3>(3 * f);
     }
-    const double e_trial = total_energy(terms, trial);
+    const double e_trial = trial_energy(terms, x, trial);
     if (!(std::isfinite(e_trial) && e_trial < e1)) return 1.0;
     x.swap(trial);
     return t;
@@ -252,7 +257,7 @@ SolveReport NewtonSolver::solve(const std::vector<EnergyTerm*>& terms, const std
               const int f = assembler.free_index(v);
               if (f >= 0) trial.col(v) += t * step.segment<3>(3 * f);
             }
-            const double e_trial = total_energy(terms, trial);
+            const double e_trial = trial_energy(terms, x, trial);
             // Near convergence the energy change drops below round-off: accept a step whose predicted decrease
             // is at the level of machine precision.
             const bool round_off = report.residual < 10.0 * options_.tolerance &&

@@ -56,6 +56,9 @@ class DihedralBending final : public EnergyTerm {
 
   /// Recomputes each hinge's bending direction (curvature rule) and its torque law by Eq. 8.
   double update_lagged(const Eigen::Matrix3Xd& x) override;
+  /// False if a hinge's angle wraps (changes by more than pi) between the two states: folded through pi.
+  [[nodiscard]] bool admissible_step(const Eigen::Matrix3Xd& from, const Eigen::Matrix3Xd& to) const override;
+  /// Includes each hinge's fold barrier (fold_barrier.hpp).
   [[nodiscard]] double energy(const Eigen::Matrix3Xd& x) const override;
   double evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd* gradient, HessianSink* hessian) const override;
 

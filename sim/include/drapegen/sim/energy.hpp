@@ -42,6 +42,12 @@ class EnergyTerm {
   /// (0 for terms without such quantities). The energy is a fixed function of x between two calls.
   virtual double update_lagged(const Eigen::Matrix3Xd& /*x*/) { return 0.0; }
 
+  /// Whether a straight step from `from` to `to` stays where the energy is defined (the line search shortens steps
+  /// that do not): a hinge may not fold through the wrap of its dihedral angle at pi in one step (fold_barrier.hpp).
+  [[nodiscard]] virtual bool admissible_step(const Eigen::Matrix3Xd& /*from*/, const Eigen::Matrix3Xd& /*to*/) const {
+    return true;
+  }
+
   [[nodiscard]] virtual double energy(const Eigen::Matrix3Xd& x) const = 0;
   /// Returns the energy, adds the gradient into `gradient` (3 x N) when non-null and hands every element Hessian
   /// to `hessian` when non-null.
