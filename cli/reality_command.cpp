@@ -20,6 +20,7 @@ struct RealityOptions {
   double density = 300.0;
   int resolution = 30;
   std::uint64_t seed = 0;
+  int placement = 0;
   std::string out;
   bool noise = true;
   bool json = false;
@@ -44,6 +45,8 @@ int run_reality(const RealityOptions& o) {
   spec.density = o.density;
   spec.resolution = o.resolution;
   spec.seed = o.seed;
+  if (o.placement < 0 || o.placement > 1000) return fail("--placement must be between 0 and 1000");
+  spec.placement = o.placement;
   spec.noise = o.noise;
   for (const auto& text : o.effects) {
     auto e = diagnosis::parse_reality_effect(text);
@@ -85,6 +88,10 @@ Runner add_reality_command(CLI::App& app) {
   app.add_option("--density", o->density, "Areal density, g/m^2")->capture_default_str();
   app.add_option("--resolution", o->resolution, "Vertices per side of the simulated specimen")->capture_default_str();
   app.add_option("--seed", o->seed, "Seed of initial state, orientation, drift, camera and noise")->capture_default_str();
+  app.add_option("--placement", o->placement,
+                 "Placement K of the specimen: K > 0 re-drapes the same specimen (same fabric, effects and camera "
+                 "calibration error) from another initial state, orientation, drift and noise: a second capture of it")
+      ->capture_default_str();
   app.add_option("--out", o->out, "Capture directory (capture.json, view0..3.exr, truth.json, preview.png)")
       ->required();
   app.add_flag("!--no-noise", o->noise, "Clean depth (no sensor noise)");

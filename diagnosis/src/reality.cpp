@@ -91,17 +91,28 @@ sim::Expected<RealityEffect> parse_reality_effect(const std::string& text) {
 sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std::string& directory) {
   const auto start = std::chrono::steady_clock::now();
   if (spec.resolution < 5 || spec.resolution > 200) return sim::Error{"resolution must be 5 .. 200"};
+  if (spec.placement < 0 || spec.placement > 1000) return sim::Error{"placement must be 0 .. 1000"};
+  // `rng` draws the first placement and the sensor's error; a later placement takes its own draws from `moved` for
+  // what a re-placement changes, after drawing (and discarding) the first placement's from `rng`, so that the
+  // sensor's error stays the first placement's.
   renderer::Rng rng(renderer::mix_seed(spec.seed, 0x4EA1));
+  const bool replaced = spec.placement > 0;
+  renderer::Rng moved(renderer::mix_seed(spec.seed, 0x9A1E0000u + static_cast<std::uint64_t>(spec.placement)));
+  auto placement_draw = [&] {
+    const double first = rng.uniform();
+    return replaced ? moved.uniform() : first;
+  };
   sim::DrapeConfig config;
   config.fabric = sim::fabric_from_paper_units(spec.bending.alpha, spec.bending.beta, spec.density);
   if (sim::Status s = sim::validate(config.fabric, config.bending_model); !s) return s.error();
   config.specimen.vertices_x = config.specimen.vertices_y = spec.resolution;
   config.specimen.seed = spec.seed;
   config.initial.shape = sim::InitialShape::kSine;
-  config.initial.seed = spec.seed;
-  config.initial.rotation = 2.0 * M_PI * rng.uniform();
-  const double small = 2e-3 * rng.uniform();  // the data's augmentation range: up to 2 mm off centre
-  const double phi = 2.0 * M_PI * rng.uniform();
+  config.initial.seed = replaced ? renderer::mix_seed(spec.seed, 0x9A1E0000u + static_cast<std::uint64_t>(spec.placement))
+                                 : spec.seed;
+  config.initial.rotation = 2.0 * M_PI * placement_draw();
+  const double small = 2e-3 * placement_draw();  // the data's augmentation range: up to 2 mm off centre
+  const double phi = 2.0 * M_PI * placement_draw();
   config.initial.drift = small * Eigen::Vector2d(std::cos(phi), std::sin(phi));
 
   renderer::SensorError sensor;
@@ -133,7 +144,7 @@ sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std
       f.coefficient = e.strength;
       config.effects.friction = f;
     } else if (e.name == "misalign") {
-      const double a = 2.0 * M_PI * rng.uniform();
+      const double a = 2.0 * M_PI * placement_draw();
       config.initial.drift += e.strength * 1e-3 * Eigen::Vector2d(std::cos(a), std::sin(a));
     } else if (e.name == "pose") {
       sensor.rotation = e.strength * M_PI / 180.0 * random_unit(rng);
@@ -186,7 +197,9 @@ sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std
     auto clean = renderer->render(truth);
     if (!clean) return clean.error();
     renderer::DepthImage biased = sensor.any() ? sensor.apply(*clean, view.camera.intrinsics) : *clean;
-    view.depth = noise.any() ? noise.apply(biased, setup.noise_seed(v)) : biased;
+    const std::uint64_t noise_seed = replaced ? renderer::mix_seed(setup.noise_seed(v), 0x9A1E0000u + spec.placement)
+                                              : setup.noise_seed(v);
+    view.depth = noise.any() ? noise.apply(biased, noise_seed) : biased;
     view.depth.incidence.clear();
     if (sim::Status s = check_view(view); !s) return sim::Error{fmt::format("rendered {}", s.error().message)};
     preview[0].push_back(view.depth);
@@ -205,7 +218,8 @@ sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std
       {"density_g_per_m2", spec.density},
       {"resolution", spec.resolution},
       {"seed", spec.seed},
-      {"initial_state", {{"shape", "sine"}, {"seed", spec.seed}, {"rotation_rad", config.initial.rotation}}},
+      {"placement", spec.placement},
+      {"initial_state", {{"shape", "sine"}, {"seed", config.initial.seed}, {"rotation_rad", config.initial.rotation}}},
       {"drift_mm", {config.initial.drift.x() * 1e3, config.initial.drift.y() * 1e3}},
       {"sensor",
        {{"rotation_rad", {sensor.rotation.x(), sensor.rotation.y(), sensor.rotation.z()}},

@@ -37,6 +37,11 @@ struct RealitySpec {
   double density = 300.0;   // g/m^2
   int resolution = 30;      // the "real" specimen's mesh
   std::uint64_t seed = 0;   // initial state, orientation, drift, camera augmentation, noise
+  /// Placement of the specimen on the tester: 0 is the first; K > 0 re-drapes the same specimen (same mesh, fabric,
+  /// effects, misalignment distance and camera calibration error) from another initial state, orientation, drift,
+  /// misalignment direction and sensor noise: a second capture of one specimen, for validation held out of a fit.
+  /// Every placement starts from the unloaded specimen (no plastic history carries over).
+  int placement = 0;
   std::vector<RealityEffect> effects;
   bool noise = true;
 };

@@ -1,0 +1,92 @@
+// Placements of one specimen by the reality generator: a second capture of the same specimen keeps what belongs to
+// the specimen and the tester (mesh, fabric, effects, camera calibration and its error) and changes what a
+// re-placement changes (initial state, orientation, drift, misalignment direction, noise).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <unistd.h>
+
+#include "drapegen/diagnosis/capture.hpp"
+#include "drapegen/diagnosis/reality.hpp"
+
+namespace drapegen::diagnosis {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Placed {
+  Capture capture;
+  nlohmann::json truth;
+};
+
+Placed place(int placement, const fs::path& dir) {
+  RealitySpec spec;
+  spec.bending.alpha = {13923, 11455, 8821};
+  spec.bending.beta = {-35390, -29660, -22042};
+  spec.resolution = 12;
+  spec.seed = 21;
+  spec.placement = placement;
+  spec.effects = {*parse_reality_effect("misalign=15"), *parse_reality_effect("pose=2")};
+  auto r = generate_reality(spec, dir.string());
+  EXPECT_TRUE(r.has_value()) << (r ? "" : r.error().message);
+  if (!r) return {};
+  Placed p;
+  auto capture = read_capture(dir.string());
+  EXPECT_TRUE(capture.has_value()) << (capture ? "" : capture.error().message);
+  if (capture) p.capture = std::move(capture).value();
+  std::ifstream in(r->truth_path);
+  p.truth = nlohmann::json::parse(in);
+  return p;
+}
+
+TEST(Reality, ASecondPlacementKeepsTheSpecimenAndTheRigAndMovesTheDrape) {
+  const fs::path root = fs::temp_directory_path() / ("drapegen_reality_test_" + std::to_string(::getpid()));
+  fs::remove_all(root);
+  const Placed first = place(0, root / "first"), again = place(0, root / "again"), second = place(1, root / "second");
+  ASSERT_EQ(first.capture.views.size(), 4u);
+  ASSERT_EQ(second.capture.views.size(), 4u);
+  // Deterministic: placement 0 twice is the same capture.
+  EXPECT_EQ(first.capture.views[0].depth.depth, again.capture.views[0].depth.depth);
+  EXPECT_EQ(first.truth["placement"], 0);
+  EXPECT_EQ(second.truth["placement"], 1);
+  // The rig and its error are the tester's: the same calibration and the same (unknown) pose error.
+  for (int v = 0; v < 4; ++v) {
+    EXPECT_TRUE(first.capture.views[v].camera.world_to_camera.isApprox(second.capture.views[v].camera.world_to_camera))
+        << "view " << v;
+  }
+  EXPECT_EQ(first.truth["sensor"], second.truth["sensor"]);
+  EXPECT_EQ(first.truth["family"], second.truth["family"]);
+  EXPECT_EQ(first.truth["effects"], second.truth["effects"]);
+  // The placement is new: initial state, orientation and drift; the misalignment keeps its distance (15 mm plus
+  // the augmentation's up to 2 mm) but not its direction.
+  EXPECT_NE(first.truth["initial_state"]["seed"], second.truth["initial_state"]["seed"]);
+  EXPECT_NE(first.truth["initial_state"]["rotation_rad"], second.truth["initial_state"]["rotation_rad"]);
+  auto offset = [](const nlohmann::json& t) {
+    return std::hypot(t["drift_mm"][0].get<double>(), t["drift_mm"][1].get<double>());
+  };
+  EXPECT_NEAR(offset(first.truth), 15.0, 2.0);
+  EXPECT_NEAR(offset(second.truth), 15.0, 2.0);
+  EXPECT_NE(first.truth["drift_mm"], second.truth["drift_mm"]);
+  // And so is the drape the cameras see.
+  int differing = 0;
+  const auto& a = first.capture.views[0].depth.depth;
+  const auto& b = second.capture.views[0].depth.depth;
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) differing += std::abs(a[i] - b[i]) > 1e-3f;
+  EXPECT_GT(differing, static_cast<int>(a.size() / 100));
+  fs::remove_all(root);
+}
+
+TEST(Reality, RejectsANegativePlacement) {
+  RealitySpec spec;
+  spec.bending.alpha = {13923, 11455, 8821};
+  spec.placement = -1;
+  EXPECT_FALSE(generate_reality(spec, (fs::temp_directory_path() / "drapegen_reality_bad").string()).has_value());
+}
+
+}  // namespace
+}  // namespace drapegen::diagnosis
