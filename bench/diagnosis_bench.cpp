@@ -49,7 +49,7 @@ const std::map<std::string, std::pair<double, double>> kDefaultStrength = {
 int main(int argc, char** argv) {
   CLI::App app{"drapegen diagnosis benchmark: reality captures, diagnoses, confusion matrix"};
   std::string out = "out/diagnosis_bench", fabrics_path = DRAPEGEN_FABRIC_DATA_DEFAULT, drapegen;
-  int per_family = 5, controls = 5, jobs = 1, resolution = 60, diagnose_jobs = 1;
+  int per_family = 5, controls = 5, jobs = 1, resolution = 60, diagnose_jobs = 1, placements = 1;
   bool quick = false, generate_only = false, score_only = false;
   std::uint64_t seed = 1;
   std::vector<std::string> families{"yield", "shear", "curl", "friction", "misalignment", "sensor"};
@@ -68,6 +68,11 @@ int main(int argc, char** argv) {
   // cogs (docs/DIAGNOSIS.md, "Detectability").
   app.add_option("--resolution", resolution, "Reality mesh resolution")->capture_default_str();
   app.add_option("--seed", seed, "Seed of fabrics, strengths and captures")->capture_default_str();
+  app.add_option("--placements", placements,
+                 "Captures per specimen: placement 0 in captures/NAME, placement K > 0 (drapegen reality --placement) "
+                 "in captures/NAME.pK, truth in truth/NAME.pK.json; the diagnoses use placement 0 only")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 10));
   std::vector<std::string> strength_overrides;
   app.add_option("--strength", strength_overrides, "NAME=LO:HI: draw that effect's strength in [LO, HI]");
   app.add_flag("--quick", quick, "Diagnose with --quick");
@@ -135,22 +140,26 @@ int main(int argc, char** argv) {
   // 1. Generate (truth in OUT/truth/NAME.json; the capture directories hold no truth).
   if (!score_only) {
     for (const auto& c : cases) {
-      const fs::path dir = fs::path(out) / "captures" / c.name;
-      if (fs::exists(dir / "capture.json")) continue;
-      diagnosis::RealitySpec spec;
-      spec.bending = c.fabric.bending;
-      spec.density = c.fabric.density;
-      spec.resolution = resolution;
-      spec.seed = c.seed;
-      if (!c.effect.empty()) spec.effects.push_back({c.effect, c.strength});
-      auto r = diagnosis::generate_reality(spec, dir.string());
-      if (!r) {
-        std::cerr << "diagnosis_bench: " << c.name << ": " << r.error().message << "\n";
-        return 1;
+      for (int p = 0; p < placements; ++p) {
+        const std::string name = p == 0 ? c.name : fmt::format("{}.p{}", c.name, p);
+        const fs::path dir = fs::path(out) / "captures" / name;
+        if (fs::exists(dir / "capture.json")) continue;
+        diagnosis::RealitySpec spec;
+        spec.bending = c.fabric.bending;
+        spec.density = c.fabric.density;
+        spec.resolution = resolution;
+        spec.seed = c.seed;
+        spec.placement = p;
+        if (!c.effect.empty()) spec.effects.push_back({c.effect, c.strength});
+        auto r = diagnosis::generate_reality(spec, dir.string());
+        if (!r) {
+          std::cerr << "diagnosis_bench: " << name << ": " << r.error().message << "\n";
+          return 1;
+        }
+        fs::create_directories(fs::path(out) / "truth");
+        fs::rename(r->truth_path, fs::path(out) / "truth" / (name + ".json"));
+        std::cout << fmt::format("generated {} ({} {:.3g}) in {:.1f} s\n", name, c.effect, c.strength, r->seconds);
       }
-      fs::create_directories(fs::path(out) / "truth");
-      fs::rename(r->truth_path, fs::path(out) / "truth" / (c.name + ".json"));
-      std::cout << fmt::format("generated {} ({} {:.3g}) in {:.1f} s\n", c.name, c.effect, c.strength, r->seconds);
     }
   }
   if (generate_only) return 0;
