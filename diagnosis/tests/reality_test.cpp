@@ -30,6 +30,7 @@ Placed place(int placement, const fs::path& dir) {
   spec.resolution = 12;
   spec.seed = 21;
   spec.placement = placement;
+  spec.noise = false;  // so that a difference between two placements is the drape's, not the noise's
   spec.effects = {*parse_reality_effect("misalign=15"), *parse_reality_effect("pose=2")};
   auto r = generate_reality(spec, dir.string());
   EXPECT_TRUE(r.has_value()) << (r ? "" : r.error().message);
@@ -52,6 +53,14 @@ TEST(Reality, ASecondPlacementKeepsTheSpecimenAndTheRigAndMovesTheDrape) {
   // Deterministic: placement 0 twice is the same capture.
   EXPECT_EQ(first.capture.views[0].depth.depth, again.capture.views[0].depth.depth);
   EXPECT_EQ(first.truth["placement"], 0);
+  // Placement 0 is the capture the generator made before placements existed (values from the build of a979b0a, the
+  // same specification): the same draws in the same order.
+  EXPECT_NEAR(first.truth["initial_state"]["rotation_rad"].get<double>(), 0.1749647207392716, 1e-12);
+  EXPECT_NEAR(first.truth["drift_mm"][0].get<double>(), 14.580290290608785, 1e-9);
+  EXPECT_NEAR(first.truth["drift_mm"][1].get<double>(), -0.19503230291819967, 1e-9);
+  EXPECT_NEAR(first.truth["sensor"]["rotation_rad"][0].get<double>(), -0.010656690438273227, 1e-12);
+  EXPECT_NEAR(first.truth["sensor"]["rotation_rad"][1].get<double>(), 0.027208705510405388, 1e-12);
+  EXPECT_NEAR(first.truth["sensor"]["rotation_rad"][2].get<double>(), 0.019094265434880863, 1e-12);
   EXPECT_EQ(second.truth["placement"], 1);
   // The rig and its error are the tester's: the same calibration and the same (unknown) pose error.
   for (int v = 0; v < 4; ++v) {

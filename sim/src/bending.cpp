@@ -154,10 +154,13 @@ double DihedralBending::update_lagged(const Eigen::Matrix3Xd& x) {
 
 bool DihedralBending::admissible_step(const Eigen::Matrix3Xd& from, const Eigen::Matrix3Xd& to) const {
   for (const Hinge& h : hinges_) {
+    // A hinge that crossed the wrap ends near +-pi (past pi/2) on the other side, wherever it lands relative to the
+    // barrier; steps of less than pi are assumed, so a hinge that swings by more than pi through flat (from -1.7 to
+    // 1.7, say) is ruled out as well: that only shortens the step.
     const double after = dihedral_angle(to.col(h.v0), to.col(h.v1), to.col(h.v2), to.col(h.v3));
-    if (std::numbers::pi - std::abs(after) >= FoldBarrier::kWidth) continue;  // a wrap lands near +-pi
+    if (std::abs(after) < 0.5 * std::numbers::pi) continue;
     const double before = dihedral_angle(from.col(h.v0), from.col(h.v1), from.col(h.v2), from.col(h.v3));
-    if (std::abs(after - before) > std::numbers::pi) return false;  // folded through the wrap
+    if (std::abs(after - before) > std::numbers::pi) return false;
   }
   return true;
 }

@@ -102,6 +102,10 @@ TEST(FoldBarrier, LineSearchMayNotFoldThroughTheWrap) {
   EXPECT_FALSE(s.bending.admissible_step(c, d));  // 3.1 -> -3.0: through the wrap
   EXPECT_FALSE(s.bending.admissible_step(d, b));
   EXPECT_TRUE(s.bending.admissible_step(a, e));   // 2.0 -> -1.0: unfolded through flat, not through the wrap
+  // Through the wrap and out of the barrier on the other side: the energy at the end has no barrier term at all.
+  EXPECT_FALSE(s.bending.admissible_step(b, folded(s.mesh, h, -2.5)));
+  // A swing of more than pi through flat is taken for a wrap (conservative: the line search only shortens it).
+  EXPECT_FALSE(s.bending.admissible_step(folded(s.mesh, h, -1.7), folded(s.mesh, h, 1.7)));
   // What the line search sees: the energy is finite at both ends, but the step between them is ruled out.
   EXPECT_TRUE(std::isfinite(s.bending.energy(c)) && std::isfinite(s.bending.energy(d)));
 }

@@ -11,7 +11,9 @@
 //
 // twice continuously differentiable at g = width, convex in g, infinite at g = 0; so no hinge reaches the wrap and a
 // drape whose hinges stay below pi - width (nearly all: width 0.5 rad is a fold of 150 degrees at one edge) is
-// unchanged. k is an energy: the hinge takes k = e * c * alpha, its linear bending stiffness in theta.
+// unchanged. k is an energy: the hinge takes k = e * c * alpha, its linear bending stiffness in theta. A state with
+// a hinge exactly at +-pi (an input mesh folded flat onto itself) has infinite energy: the solve ends "diverged" at
+// its first iteration.
 
 namespace drapegen::sim {
 
