@@ -97,7 +97,9 @@ sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std
   // sensor's error stays the first placement's.
   renderer::Rng rng(renderer::mix_seed(spec.seed, 0x4EA1));
   const bool replaced = spec.placement > 0;
-  renderer::Rng moved(renderer::mix_seed(spec.seed, 0x9A1E0000u + static_cast<std::uint64_t>(spec.placement)));
+  const std::uint64_t placement_stream = 0x9A1E0000u + static_cast<std::uint64_t>(spec.placement);
+  const std::uint64_t placement_seed = renderer::mix_seed(spec.seed, placement_stream);
+  renderer::Rng moved(placement_seed);
   auto placement_draw = [&] {
     const double first = rng.uniform();
     return replaced ? moved.uniform() : first;
@@ -108,8 +110,7 @@ sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std
   config.specimen.vertices_x = config.specimen.vertices_y = spec.resolution;
   config.specimen.seed = spec.seed;
   config.initial.shape = sim::InitialShape::kSine;
-  config.initial.seed = replaced ? renderer::mix_seed(spec.seed, 0x9A1E0000u + static_cast<std::uint64_t>(spec.placement))
-                                 : spec.seed;
+  config.initial.seed = replaced ? placement_seed : spec.seed;
   config.initial.rotation = 2.0 * M_PI * placement_draw();
   const double small = 2e-3 * placement_draw();  // the data's augmentation range: up to 2 mm off centre
   const double phi = 2.0 * M_PI * placement_draw();
@@ -197,8 +198,8 @@ sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std
     auto clean = renderer->render(truth);
     if (!clean) return clean.error();
     renderer::DepthImage biased = sensor.any() ? sensor.apply(*clean, view.camera.intrinsics) : *clean;
-    const std::uint64_t noise_seed = replaced ? renderer::mix_seed(setup.noise_seed(v), 0x9A1E0000u + spec.placement)
-                                              : setup.noise_seed(v);
+    const std::uint64_t noise_seed =
+        replaced ? renderer::mix_seed(setup.noise_seed(v), placement_stream) : setup.noise_seed(v);
     view.depth = noise.any() ? noise.apply(biased, noise_seed) : biased;
     view.depth.incidence.clear();
     if (sim::Status s = check_view(view); !s) return sim::Error{fmt::format("rendered {}", s.error().message)};
