@@ -27,6 +27,7 @@ struct DiagnoseOptions {
   int refit_evaluations = 0;
   int jobs = 1;
   double shape_floor = -1.0;  // < 0: the settings' calibrated value
+  bool gap_only = false;
   bool verbose = false;
 };
 
@@ -57,6 +58,7 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (o.evaluations > 0) settings.baseline_optimiser.max_evaluations = o.evaluations;
   if (o.refit_evaluations > 0) settings.attribution.optimiser.max_evaluations = o.refit_evaluations;
   settings.attribution.jobs = o.jobs;
+  settings.attribute = !o.gap_only;
   if (o.shape_floor >= 0.0) settings.floors.shape_threshold = o.shape_floor;
   auto result = diagnosis::diagnose(*capture, settings);
   if (!result) return fail(result.error().message);
@@ -80,6 +82,8 @@ int run_diagnose(const DiagnoseOptions& o) {
       std::cout << "  verdict: within the floors (no effect named)\n";
     } else if (r.verdict == "unexplained") {
       std::cout << "  verdict: above the floors, no candidate shrinks it significantly\n";
+    } else if (r.verdict == "not attributed") {
+      std::cout << "  verdict: above the floors (attribution not run: --gap-only)\n";
     } else {
       std::cout << fmt::format("  verdict: {} (confidence {:.2f}, runner-up {}), shrinkage {:.0f}%\n", r.verdict,
                                r.attribution.confidence, r.runner_up, 100 * r.attribution.candidates[0].shrinkage);
@@ -112,6 +116,8 @@ Runner add_diagnose_command(CLI::App& app) {
                  fmt::format("Shape-distance floor (default and quick: calibrated {:.2f}; fine: {:.2f}; 0: the largest "
                              "floor sample)",
                              diagnosis::FloorSettings{}.shape_threshold, diagnosis::DiagnosisSettings::kFineShapeFloor));
+  app.add_flag("--gap-only", o->gap_only,
+               "Stop after the gap, floors and localisation (verdict \"not attributed\" above the floors)");
   app.add_flag("-v,--verbose", o->verbose, "Log progress on stderr");
   return [o] { return run_diagnose(*o); };
 }

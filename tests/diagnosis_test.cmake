@@ -80,6 +80,20 @@ foreach(f report.json report.md residual.png views.png)
 endforeach()
 message(STATUS "diagnosis: verdict ${verdict}, gap ${gap} mm, floor ${floor} mm, region ${region}")
 
+# --gap-only: the same gate, and no attribution (the capture is above the floors, so the verdict says so).
+execute_process(COMMAND ${DRAPEGEN} diagnose --capture ${WORK}/capture --quick --resolution 10 --states 2
+                        --evaluations 8 --gap-only --json
+                RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT code EQUAL 0)
+  message(FATAL_ERROR "diagnose --gap-only failed (${code}): ${out} ${err}")
+endif()
+string(JSON verdict GET "${out}" verdict)
+string(JSON ran GET "${out}" attribution ran)
+string(JSON ncand LENGTH "${out}" attribution candidates)
+if(NOT verdict STREQUAL "not attributed" OR ran OR NOT ncand EQUAL 0)
+  message(FATAL_ERROR "--gap-only: verdict '${verdict}', attribution ran ${ran}, ${ncand} candidates")
+endif()
+
 # Bad captures: one line each, exit 1.
 file(COPY ${WORK}/capture/ DESTINATION ${WORK}/missing)
 file(REMOVE ${WORK}/missing/view1.exr)

@@ -189,6 +189,8 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
   const auto attribution_start = std::chrono::steady_clock::now();
   if (r.within_floors) {
     r.verdict = "none";
+  } else if (!settings.attribute) {
+    r.verdict = "not attributed";
   } else {
     const FitSettings fit_settings = settings.fit;
     auto make_model = [&capture, fit_settings]() { return ForwardModel::create(capture, fit_settings); };
@@ -318,7 +320,7 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                           {"evaluations", c.evaluations},
                           {"seconds", c.seconds}});
   }
-  j["attribution"] = {{"ran", !r.within_floors},
+  j["attribution"] = {{"ran", !r.within_floors && r.verdict != "not attributed"},
                       {"bending_refit_bar",
                        {{"parameters", r.attribution.bar.parameters},
                         {"fit_score_mm", r.attribution.bar.fit_score * 1e3},

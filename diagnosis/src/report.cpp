@@ -100,6 +100,8 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
   md += fmt::format("# Sim-to-real gap diagnosis of `{}`\n\n", capture.directory);
   if (r.verdict == "none") {
     md += "**Verdict: the gap is within the floors** (sensor noise and multiple stable drapes); no effect is named.\n\n";
+  } else if (r.verdict == "not attributed") {
+    md += "**Verdict: a gap above the floors; attribution was not run** (`--gap-only`).\n\n";
   } else if (r.verdict == "unexplained") {
     md += fmt::format("**Verdict: a gap above the floors that no candidate effect shrinks by {:.0f}% or more** (best: {}).\n\n",
                       100 * 0.25, r.runner_up);

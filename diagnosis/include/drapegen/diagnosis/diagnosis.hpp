@@ -17,6 +17,9 @@ struct DiagnosisSettings {
   int guess_levels = 4;        // simulations for the initial guess (drape coefficient against alpha)
   FloorSettings floors;
   AttributionSettings attribution;
+  /// false: stop after the gap, floors and localisation (a capture above the floors gets the verdict
+  /// "not attributed"): a screening run, or a calibration of the floors, at a fraction of the cost.
+  bool attribute = true;
 
   /// Small budgets for tests and the --quick benchmark.
   [[nodiscard]] static DiagnosisSettings quick();
@@ -49,7 +52,8 @@ struct DiagnosisResult {
   Localisation localisation;
   ShapeSet fit_target;  // the capture's shape features
   Attribution attribution;
-  /// The verdict: the named effect ("none" within the floors, "unexplained" if no candidate shrinks it enough).
+  /// The verdict: the named effect ("none" within the floors, "unexplained" if no candidate shrinks it enough,
+  /// "not attributed" above the floors when DiagnosisSettings::attribute is false).
   std::string verdict;
   std::string runner_up;
   int simulations = 0;
