@@ -50,7 +50,7 @@ int main(int argc, char** argv) {
   CLI::App app{"drapegen diagnosis benchmark: reality captures, diagnoses, confusion matrix"};
   std::string out = "out/diagnosis_bench", fabrics_path = DRAPEGEN_FABRIC_DATA_DEFAULT, drapegen;
   int per_family = 5, controls = 5, jobs = 1, resolution = 60, diagnose_jobs = 1, placements = 1;
-  bool quick = false, generate_only = false, score_only = false;
+  bool quick = false, generate_only = false, score_only = false, held_out_placement = false;
   std::uint64_t seed = 1;
   std::vector<std::string> families{"yield", "shear", "curl", "friction", "misalignment", "sensor"};
   app.add_option("--out", out, "Benchmark directory")->capture_default_str();
@@ -70,7 +70,8 @@ int main(int argc, char** argv) {
   app.add_option("--seed", seed, "Seed of fabrics, strengths and captures")->capture_default_str();
   app.add_option("--placements", placements,
                  "Captures per specimen: placement 0 in captures/NAME, placement K > 0 (drapegen reality --placement) "
-                 "in captures/NAME.pK, truth in truth/NAME.pK.json; the diagnoses use placement 0 only")
+                 "in captures/NAME.pK, truth in truth/NAME.pK.json; the diagnoses use placement 0 only (and placement "
+                 "1 with --held-out-placement)")
       ->capture_default_str()
       ->check(CLI::Range(1, 10));
   std::vector<std::string> strength_overrides;
@@ -78,6 +79,8 @@ int main(int argc, char** argv) {
   app.add_flag("--quick", quick, "Diagnose with --quick");
   app.add_flag("--generate-only", generate_only, "Only generate the captures");
   app.add_flag("--score-only", score_only, "Only score existing diagnoses");
+  app.add_flag("--held-out-placement", held_out_placement,
+               "Diagnose with placement 1 (captures/NAME.p1, made with --placements 2) as the held-out capture");
   CLI11_PARSE(app, argc, argv);
   if (drapegen.empty()) drapegen = (fs::path(argv[0]).parent_path() / "drapegen").string();
   auto strength_range = kDefaultStrength;
@@ -177,10 +180,12 @@ int main(int argc, char** argv) {
           const fs::path result = fs::path(out) / "diagnoses" / (c.name + ".json");
           if (fs::exists(result) && fs::file_size(result) > 0) continue;
           fs::create_directories(result.parent_path());
+          const std::string second =
+              held_out_placement ? fmt::format(" --held-out-capture '{}.p1'", dir.string()) : std::string();
           const std::string cmd =
-              fmt::format("'{}' diagnose --capture '{}' --json{} --jobs {} {} > '{}.tmp' 2> '{}.err'", drapegen,
-                          dir.string(), quick ? " --quick" : "", diagnose_jobs, diagnose_args, result.string(),
-                          result.string());
+              fmt::format("'{}' diagnose --capture '{}'{} --json{} --jobs {} {} > '{}.tmp' 2> '{}.err'", drapegen,
+                          dir.string(), second, quick ? " --quick" : "", diagnose_jobs, diagnose_args,
+                          result.string(), result.string());
           const auto t0 = std::chrono::steady_clock::now();
           const int rc = std::system(cmd.c_str());
           const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

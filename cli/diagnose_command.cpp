@@ -1,6 +1,7 @@
 // drapegen diagnose: where the sim-to-real gap of a capture lies and which unmodelled effect explains it (issue 6).
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <nlohmann/json.hpp>
 
 #include <fmt/format.h>
@@ -17,6 +18,7 @@ namespace {
 
 struct DiagnoseOptions {
   std::string capture;
+  std::string held_out;
   std::string report;
   bool json = false;
   bool quick = false;
@@ -47,6 +49,13 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (o.verbose) sim::logger()->set_level(spdlog::level::debug);
   auto capture = diagnosis::read_capture(o.capture);
   if (!capture) return fail(capture.error().message);
+  std::optional<diagnosis::Capture> held_out;
+  if (!o.held_out.empty()) {
+    auto read = diagnosis::read_capture(o.held_out);
+    if (!read) return fail("held-out capture: " + read.error().message);
+    if (sim::Status s = diagnosis::check_same_specimen(*capture, *read); !s) return fail(s.error().message);
+    held_out = std::move(*read);
+  }
   if (!o.report.empty()) {
     if (sim::Status s = check_writable(o.report + ".probe"); !s) return fail(s.error().message, kExitIo);
   }
@@ -60,7 +69,7 @@ int run_diagnose(const DiagnoseOptions& o) {
   settings.attribution.jobs = o.jobs;
   settings.attribute = !o.gap_only;
   if (o.shape_floor >= 0.0) settings.floors.shape_threshold = o.shape_floor;
-  auto result = diagnosis::diagnose(*capture, settings);
+  auto result = diagnosis::diagnose(*capture, settings, held_out ? &*held_out : nullptr);
   if (!result) return fail(result.error().message);
   if (!o.report.empty()) {
     auto model = diagnosis::ForwardModel::create(*capture, settings.fit);
@@ -98,6 +107,9 @@ int run_diagnose(const DiagnoseOptions& o) {
 Runner add_diagnose_command(CLI::App& app) {
   auto o = std::make_shared<DiagnoseOptions>();
   app.add_option("--capture", o->capture, "Capture directory (docs/CAPTURE.md)")->required();
+  app.add_option("--held-out-capture", o->held_out,
+                 "A second capture of the same specimen (another placement), used in no fit: the gap and every "
+                 "candidate are validated on both captures");
   app.add_option("--report", o->report, "Write report.json, report.md and residual PNGs here");
   app.add_flag("--json", o->json, "Print the result as JSON");
   auto* quick = app.add_flag("--quick", o->quick, "Small budgets (16x16 mesh, 2 initial states, fewer evaluations)");

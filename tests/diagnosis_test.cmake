@@ -94,6 +94,38 @@ if(NOT verdict STREQUAL "not attributed" OR ran OR NOT ncand EQUAL 0)
   message(FATAL_ERROR "--gap-only: verdict '${verdict}', attribution ran ${ran}, ${ncand} candidates")
 endif()
 
+# A second placement of the specimen as the held-out capture: the gate tests the mean of both captures' terms, and
+# every candidate is validated on both (the depth bias is the rig's, so it is in both placements).
+execute_process(COMMAND ${DRAPEGEN} reality ${FABRIC} --effect bias=12 --resolution 14 --seed 4 --placement 1
+                        --out ${WORK}/capture.p1
+                RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT code EQUAL 0)
+  message(FATAL_ERROR "reality --placement 1 failed (${code}): ${out} ${err}")
+endif()
+file(REMOVE ${WORK}/capture.p1/truth.json)
+execute_process(COMMAND ${DRAPEGEN} diagnose --capture ${WORK}/capture --held-out-capture ${WORK}/capture.p1 --quick
+                        --resolution 10 --states 2 --evaluations 8 --refit-evaluations 4 --json
+                RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT code EQUAL 0)
+  message(FATAL_ERROR "diagnose --held-out-capture failed (${code}): ${out} ${err}")
+endif()
+string(JSON shape GET "${out}" gap_tests shape)
+string(JSON shape_a GET "${out}" gap_tests capture shape)
+string(JSON shape_b GET "${out}" gap_tests held_out_capture shape)
+string(JSON stable_b GET "${out}" gap_tests held_out_capture stable_mm)
+string(JSON ncand LENGTH "${out}" attribution candidates)
+if(NOT ncand EQUAL 6)
+  message(FATAL_ERROR "--held-out-capture: expected 6 candidates, got ${ncand}")
+endif()
+# Each candidate's validation against the held-out capture is reported (GET fails the test if it is missing).
+string(JSON cand_b GET "${out}" attribution candidates 0 validated held_out_capture stable_mm)
+if(stable_b LESS_EQUAL stable_floor)
+  message(FATAL_ERROR "the 12 mm bias is not above the stable floor in the held-out capture (${stable_b} mm)")
+endif()
+if((shape LESS shape_a AND shape LESS shape_b) OR (shape GREATER shape_a AND shape GREATER shape_b))
+  message(FATAL_ERROR "the gate's shape distance ${shape} is not between the captures' (${shape_a}, ${shape_b})")
+endif()
+
 # Bad captures: one line each, exit 1.
 file(COPY ${WORK}/capture/ DESTINATION ${WORK}/missing)
 file(REMOVE ${WORK}/missing/view1.exr)
@@ -106,6 +138,12 @@ file(WRITE ${WORK}/garbage/view2.exr "not an exr")
 expect_failure(1 "not a readable OpenEXR" diagnose --capture ${WORK}/garbage)
 expect_failure(1 "not a directory" diagnose --capture ${WORK}/does_not_exist)
 expect_failure(1 "excludes" diagnose --capture ${WORK}/capture --quick --fine)
+file(COPY ${WORK}/capture/ DESTINATION ${WORK}/heavier)
+file(READ ${WORK}/heavier/capture.json facts)
+string(JSON facts SET "${facts}" specimen density_g_per_m2 350)
+file(WRITE ${WORK}/heavier/capture.json "${facts}")
+expect_failure(1 "another specimen" diagnose --capture ${WORK}/capture --held-out-capture ${WORK}/heavier)
+expect_failure(1 "held-out capture: " diagnose --capture ${WORK}/capture --held-out-capture ${WORK}/does_not_exist)
 expect_failure(1 "unknown effect" reality ${FABRIC} --effect gravity=2 --out ${WORK}/bad)
 expect_failure(1 "given twice" reality ${FABRIC} --effect curl=10 --effect curl=20 --out ${WORK}/bad)
 expect_failure(1 "fewer than two vertex spacings" reality ${FABRIC} --effect curl=200,10 --resolution 14

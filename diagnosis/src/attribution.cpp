@@ -114,6 +114,12 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, std::optional<Effect> 
   auto validated = sim ? model.evaluate(refitted, validation_states(settings)) : model.rescore(fresh, refitted);
   if (!validated) return validated.error();
   c.validated = validated->best;
+  c.setup = refitted;
+  if (sim) {
+    for (auto& d : validated->states) c.validation_meshes.push_back(std::move(d.mesh));
+  } else {
+    c.validation_meshes = std::move(fresh);
+  }
   c.alpha_scale = sim && !bar ? std::exp(r.x[0]) : 1.0;
   c.parameters.assign(r.x.begin() + static_cast<std::ptrdiff_t>(first), r.x.end());
   c.evaluations = r.evaluations;
@@ -135,11 +141,11 @@ double gap_shrinkage(double excess_before, double excess_after) {
 }
 
 double bootstrap_confidence(const ForwardModel& model, const ScoredDrape& a, const ScoredDrape& b, int samples,
-                            int tile_px, std::uint64_t seed) {
+                            int tile_px, std::uint64_t seed, bool all_views) {
   const auto& fit_views = model.settings().fit_views;
   std::vector<double> d;  // per tile: b's energy - a's energy
   for (std::size_t v = 0; v < a.views.size() && v < b.views.size(); ++v) {
-    if (std::find(fit_views.begin(), fit_views.end(), static_cast<int>(v)) != fit_views.end()) continue;
+    if (!all_views && std::find(fit_views.begin(), fit_views.end(), static_cast<int>(v)) != fit_views.end()) continue;
     const auto& img = model.capture().views[v].depth;
     const int W = img.width, H = img.height;
     for (int ty = 0; ty < H; ty += tile_px) {
@@ -172,7 +178,8 @@ double bootstrap_confidence(const ForwardModel& model, const ScoredDrape& a, con
 sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& baseline, const Evaluation& fit,
                                      const Evaluation& validated, const Floors& floors,
                                      const AttributionSettings& settings,
-                                     const std::function<sim::Expected<std::unique_ptr<ForwardModel>>()>& make_model) {
+                                     const std::function<sim::Expected<std::unique_ptr<ForwardModel>>()>& make_model,
+                                     HeldOutCapture* held_out) {
   // Tasks: the candidates, then the bar (no effect: the baseline's bending refitted with the same budget).
   const std::size_t tasks = settings.candidates.size() + 1;
   auto task_effect = [&](std::size_t k) -> std::optional<Effect> {
@@ -213,23 +220,44 @@ sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& base
   }
   for (auto& r : results)
     if (!r || !*r) return r ? r->error() : sim::Error{"candidate refit did not run"};
+  // The held-out capture: each refitted setup's validation drapes scored against it (no simulation).
+  if (held_out) {
+    for (auto& r : results) {
+      CandidateResult& c = r->value();
+      auto e = held_out->model->rescore(c.validation_meshes, c.setup);
+      if (!e) return e.error();
+      c.validated_held_out = std::move(e->best);
+    }
+  }
+  // The gate's terms of a candidate (or the reference): its validation drape's, or with a held-out capture the mean of
+  // both captures'.
+  auto terms = [&](const ScoredDrape& d, const std::optional<ScoredDrape>& second) {
+    return gap_terms(d, second ? &*second : nullptr);
+  };
+  auto baseline_second = held_out ? std::optional<ScoredDrape>(held_out->validated.best) : std::nullopt;
   // Shrinkage: of the excess above the floors that made the gate fire (the same two tests), once the candidate is
   // added, measured from the validation states against the reference: the better (smaller excess) of the baseline
   // and the bar. So an effect counts only for what it adds beyond refitting the bending alone. The held-out view (not
-  // in any refit) must confirm it, i.e. not get worse than the reference's.
+  // in any refit), or the held-out capture, must confirm it, i.e. not get worse than the reference's.
   Attribution a;
   a.bar = std::move(results.back()->value());
-  a.bar.shrinkage = gap_shrinkage(excess_above_floors(validated.best, floors),
-                                  excess_above_floors(a.bar.validated, floors));
+  a.bar.shrinkage = gap_shrinkage(excess_above_floors(terms(validated.best, baseline_second), floors),
+                                  excess_above_floors(terms(a.bar.validated, a.bar.validated_held_out), floors));
   const bool bar_is_reference = a.bar.shrinkage > 0.0;
   const ScoredDrape& reference = bar_is_reference ? a.bar.validated : validated.best;
-  const double h0 = reference.held_out_score;
-  const double excess0 = excess_above_floors(reference, floors);
+  const std::optional<ScoredDrape>& reference_second = bar_is_reference ? a.bar.validated_held_out : baseline_second;
+  // What confirms: the held-out capture's score over all its views, or the held-out view's.
+  auto held_out_score = [&](const ScoredDrape& d, const std::optional<ScoredDrape>& second) {
+    return held_out ? second->all_score : d.held_out_score;
+  };
+  const double h0 = held_out_score(reference, reference_second);
+  const double excess0 = excess_above_floors(terms(reference, reference_second), floors);
   for (std::size_t k = 0; k + 1 < tasks; ++k) {
     CandidateResult c = std::move(results[k]->value());
-    c.shrinkage = gap_shrinkage(excess0, excess_above_floors(c.validated, floors));
-    c.held_out_shrinkage = h0 > 0.0 ? 1.0 - c.validated.held_out_score / h0 : 0.0;
-    c.confirmed = c.validated.held_out_score <= h0;
+    const double h = held_out_score(c.validated, c.validated_held_out);
+    c.shrinkage = gap_shrinkage(excess0, excess_above_floors(terms(c.validated, c.validated_held_out), floors));
+    c.held_out_shrinkage = h0 > 0.0 ? 1.0 - h / h0 : 0.0;
+    c.confirmed = h <= h0;
     a.candidates.push_back(std::move(c));
   }
   std::stable_sort(a.candidates.begin(), a.candidates.end(), [](const CandidateResult& x, const CandidateResult& y) {
@@ -239,10 +267,15 @@ sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& base
   });
   if (!a.candidates.empty()) {
     a.named = a.candidates[0].confirmed && a.candidates[0].shrinkage >= settings.significant_shrinkage;
-    a.confidence = a.candidates.size() > 1
-                       ? bootstrap_confidence(model, a.candidates[0].validated, a.candidates[1].validated,
-                                              settings.bootstrap_samples, settings.tile_px, 0xB007)
-                       : 1.0;
+    a.confidence = 1.0;
+    if (a.candidates.size() > 1) {
+      const CandidateResult &best = a.candidates[0], &runner_up = a.candidates[1];
+      a.confidence = held_out ? bootstrap_confidence(*held_out->model, *best.validated_held_out,
+                                                     *runner_up.validated_held_out, settings.bootstrap_samples,
+                                                     settings.tile_px, 0xB007, true)
+                              : bootstrap_confidence(model, best.validated, runner_up.validated,
+                                                     settings.bootstrap_samples, settings.tile_px, 0xB007);
+    }
   }
   return a;
 }

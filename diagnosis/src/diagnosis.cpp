@@ -6,6 +6,8 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 
+#include <fmt/format.h>
+
 #include "drapegen/sim/logging.hpp"
 
 namespace drapegen::diagnosis {
@@ -96,6 +98,24 @@ nlohmann::json spread_json(const ValidationSpread& s) {
           {"pairwise_groups_mm", pair_groups}};
 }
 
+/// A validation drape against the held-out capture (null without one).
+nlohmann::json held_out_json(const ScoredDrape* d) {
+  if (!d) return nullptr;
+  return {{"stable_mm", d->stable_all * 1e3}, {"shape", d->shape_all}, {"all_views_score_mm", d->all_score * 1e3},
+          {"best_validation_state", d->state}};
+}
+
+/// A refitted candidate (or the bar) from the validation states: its drape against the capture, against the held-out
+/// capture if any, and the gate's excess of the two.
+nlohmann::json validated_json(const CandidateResult& c, const Floors& floors) {
+  const ScoredDrape* second = c.validated_held_out ? &*c.validated_held_out : nullptr;
+  return {{"stable_mm", c.validated.stable_all * 1e3},
+          {"shape", c.validated.shape_all},
+          {"held_out_score_mm", c.validated.held_out_score * 1e3},
+          {"held_out_capture", held_out_json(second)},
+          {"excess_above_floors", excess_above_floors(gap_terms(c.validated, second), floors)}};
+}
+
 }  // namespace
 
 DiagnosisSettings DiagnosisSettings::quick() {
@@ -120,11 +140,39 @@ DiagnosisSettings DiagnosisSettings::fine() {
   return s;
 }
 
-sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisSettings& settings) {
+sim::Status check_same_specimen(const Capture& capture, const Capture& held_out) {
+  const SpecimenFacts &a = capture.specimen, &b = held_out.specimen;
+  auto differs = [](double x, double y) { return std::abs(x - y) > 1e-9 * std::max(1.0, std::abs(x)); };
+  if (differs(a.size_x, b.size_x) || differs(a.size_y, b.size_y) || differs(a.density, b.density) ||
+      differs(a.cylinder_diameter, b.cylinder_diameter)) {
+    return sim::Error{fmt::format("held-out capture {}: another specimen or tester ({}x{} mm, {} g/m^2, cylinder {} mm; "
+                                  "the capture: {}x{} mm, {} g/m^2, cylinder {} mm)",
+                                  held_out.directory, b.size_x * 1e3, b.size_y * 1e3, b.density,
+                                  b.cylinder_diameter * 1e3, a.size_x * 1e3, a.size_y * 1e3, a.density,
+                                  a.cylinder_diameter * 1e3)};
+  }
+  if (held_out.views.size() != capture.views.size()) {
+    return sim::Error{fmt::format("held-out capture {}: {} views, the capture has {}", held_out.directory,
+                                  held_out.views.size(), capture.views.size())};
+  }
+  return {};
+}
+
+sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisSettings& settings,
+                                        const Capture* held_out) {
   const auto start = std::chrono::steady_clock::now();
+  if (held_out) {
+    if (sim::Status s = check_same_specimen(capture, *held_out); !s) return s.error();
+  }
   auto created = ForwardModel::create(capture, settings.fit);
   if (!created) return created.error();
   ForwardModel& model = **created;
+  std::unique_ptr<ForwardModel> held_out_model;
+  if (held_out) {
+    auto m = ForwardModel::create(*held_out, settings.fit);
+    if (!m) return m.error();
+    held_out_model = std::move(*m);
+  }
   DiagnosisResult r;
 
   // 1. Baseline fit in the reduced space, from the drape-coefficient guess.
@@ -169,6 +217,13 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
   auto validated = model.evaluate(fitted, validation_states(settings.attribution));
   if (!validated) return validated.error();
   r.validated = std::move(*validated);
+  if (held_out_model) {  // the same drapes against the held-out capture
+    std::vector<sim::ClothMesh> meshes;
+    for (const auto& d : r.validated.states) meshes.push_back(d.mesh);
+    auto e = held_out_model->rescore(meshes, fitted);
+    if (!e) return e.error();
+    r.validated_held_out = std::move(*e);
+  }
   r.validation_spread = validation_spread(r.validated.states, model.target().shape.all);
   const ScoredDrape& gap = r.gap_drape();
   r.gap_all = gap.all_score;
@@ -177,7 +232,7 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
   // Within the floors: neither the stable-region term (sensor errors) nor the shape distance (physical effects)
   // exceeds what sensor noise and other stable drapes of the fitted fabric produce. The attribution's shrinkage is
   // measured on the same excess.
-  r.within_floors = excess_above_floors(gap, r.floors) == 0.0;
+  r.within_floors = excess_above_floors(r.gap(), r.floors) == 0.0;
   r.seconds_floors = since(floors_start);
 
   // 3. Where the gap sits.
@@ -194,7 +249,10 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
   } else {
     const FitSettings fit_settings = settings.fit;
     auto make_model = [&capture, fit_settings]() { return ForwardModel::create(capture, fit_settings); };
-    auto attribution = attribute(model, fitted, r.fit, r.validated, r.floors, settings.attribution, make_model);
+    std::optional<HeldOutCapture> second;
+    if (held_out_model) second = HeldOutCapture{held_out_model.get(), *r.validated_held_out};
+    auto attribution = attribute(model, fitted, r.fit, r.validated, r.floors, settings.attribution, make_model,
+                                 second ? &*second : nullptr);
     if (!attribution) return attribution.error();
     r.attribution = std::move(*attribution);
     const auto& c = r.attribution.candidates;
@@ -221,11 +279,15 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
     states.push_back({{"state", d.state}, {"stable_mm", d.stable_all * 1e3}, {"shape", d.shape_all},
                       {"fit_score_mm", d.fit_score * 1e3}, {"converged", d.converged}});
   }
-  j["gap_tests"] = {{"stable_mm", r.gap_drape().stable_all * 1e3},
+  // The gate's terms (with a held-out capture: the mean of both captures'), then each capture's own.
+  const GapTerms gap = r.gap();
+  j["gap_tests"] = {{"stable_mm", gap.stable * 1e3},
                     {"stable_floor_mm", r.floors.stable * 1e3},
-                    {"shape", r.gap_drape().shape_all},
+                    {"shape", gap.shape},
                     {"shape_floor", r.floors.shape},
-                    {"excess_above_floors", excess_above_floors(r.gap_drape(), r.floors)},
+                    {"excess_above_floors", excess_above_floors(gap, r.floors)},
+                    {"capture", {{"stable_mm", r.gap_drape().stable_all * 1e3}, {"shape", r.gap_drape().shape_all}}},
+                    {"held_out_capture", held_out_json(r.validated_held_out ? &r.validated_held_out->best : nullptr)},
                     {"validation_states", r.validated.states.size()},
                     {"best_validation_state", r.gap_drape().state},
                     {"validation_spread", spread_json(r.validation_spread)},
@@ -310,10 +372,7 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                           {"stable_mm", c.drape.stable_all * 1e3},
                           {"shape", c.drape.shape_all},
                           {"excess_above_floors", excess_above_floors(c.drape, r.floors)},
-                          {"validated", {{"stable_mm", c.validated.stable_all * 1e3},
-                                         {"shape", c.validated.shape_all},
-                                         {"held_out_score_mm", c.validated.held_out_score * 1e3},
-                                         {"excess_above_floors", excess_above_floors(c.validated, r.floors)}}},
+                          {"validated", validated_json(c, r.floors)},
                           {"shrinkage", c.shrinkage},
                           {"held_out_shrinkage", c.held_out_shrinkage},
                           {"confirmed", c.confirmed},
@@ -324,11 +383,8 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                       {"bending_refit_bar",
                        {{"parameters", r.attribution.bar.parameters},
                         {"fit_score_mm", r.attribution.bar.fit_score * 1e3},
-                        {"validated", {{"stable_mm", r.attribution.bar.validated.stable_all * 1e3},
-                                       {"shape", r.attribution.bar.validated.shape_all},
-                                       {"held_out_score_mm", r.attribution.bar.validated.held_out_score * 1e3},
-                                       {"excess_above_floors",
-                                        r.within_floors ? 0.0 : excess_above_floors(r.attribution.bar.validated, r.floors)}}},
+                        {"validated", r.within_floors ? nlohmann::json(nullptr)
+                                                      : validated_json(r.attribution.bar, r.floors)},
                         {"shrinkage", r.attribution.bar.shrinkage}}},
                       {"named", r.attribution.named},
                       {"confidence", r.attribution.confidence},

@@ -69,10 +69,19 @@ std::vector<double> Floors::group_floor() const {
 
 double Floors::stable_floor() const { return largest(pooled(*this, &FloorSamples::stable)); }
 
-double excess_above_floors(const ScoredDrape& drape, const Floors& floors) {
+GapTerms gap_terms(const ScoredDrape& drape, const ScoredDrape* held_out_capture) {
+  if (!held_out_capture) return {drape.stable_all, drape.shape_all};
+  return {0.5 * (drape.stable_all + held_out_capture->stable_all), 0.5 * (drape.shape_all + held_out_capture->shape_all)};
+}
+
+double excess_above_floors(const GapTerms& gap, const Floors& floors) {
   // value - floor is positive exactly when value > floor, so the sum is 0 exactly when both tests pass.
   auto relative_excess = [](double value, double floor) { return value > floor ? (value - floor) / floor : 0.0; };
-  return relative_excess(drape.stable_all, floors.stable) + relative_excess(drape.shape_all, floors.shape);
+  return relative_excess(gap.stable, floors.stable) + relative_excess(gap.shape, floors.shape);
+}
+
+double excess_above_floors(const ScoredDrape& drape, const Floors& floors) {
+  return excess_above_floors(gap_terms(drape), floors);
 }
 
 sim::Expected<Floors> measure_floors(ForwardModel& model, const ModelSetup& fitted, const Evaluation& fit,

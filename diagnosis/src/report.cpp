@@ -116,9 +116,11 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
   md += fmt::format("| gap (baseline fit) | {:.2f} | {:.2f} |\n", r.gap_all * 1e3, r.gap_held_out * 1e3);
   md += fmt::format("| floor (x{:.2f} margin) | {:.2f} | {:.2f} |\n\n", r.floors.margin, r.floors.all * 1e3,
                     r.floors.held_out * 1e3);
-  md += fmt::format("Tests (all views): stable-region term {:.2f} mm against its floor {:.2f} mm; shape distance {:.2f} "
+  const GapTerms gap = r.gap();
+  md += fmt::format("Tests (all views{}): stable-region term {:.2f} mm against its floor {:.2f} mm; shape distance {:.2f} "
                     "against its floor {:.2f}.\n\n",
-                    r.gap_drape().stable_all * 1e3, r.floors.stable * 1e3, r.gap_drape().shape_all, r.floors.shape);
+                    r.validated_held_out ? ", mean of the capture and the held-out capture" : "", gap.stable * 1e3,
+                    r.floors.stable * 1e3, gap.shape, r.floors.shape);
   md += fmt::format("Fitted baseline: alpha = {:.0f}, {:.0f}, {:.0f} g mm^2/s^2; beta = {:.0f}, {:.0f}, {:.0f} g mm^3/s^2 "
                     "({} evaluations).\n\n",
                     r.fitted.alpha.warp, r.fitted.alpha.bias, r.fitted.alpha.weft, r.fitted.beta.warp,

@@ -6,6 +6,9 @@
 // initial states that no fit selected on (validation states): the fit's best score is the minimum of a multistable,
 // noisy objective over its evaluations, so a refit compared with it must beat the baseline's luckiest draw.
 // Confidence: a block bootstrap over the held-out view's residual tiles of the named effect against the runner-up.
+// With a held-out capture (a second placement of the specimen, in no fit), every validation drape is also scored
+// against it: the excess is that of the mean of both captures' gap terms (gap_terms), the confirmation and the
+// bootstrap use the held-out capture's views instead of the held-out view.
 
 #include <optional>
 #include <string>
@@ -32,6 +35,17 @@ struct CandidateResult {
   double seconds = 0.0;
   ScoredDrape drape;      // the refit's best drape (fit states)
   ScoredDrape validated;  // the refitted setup's best drape from the validation states: shrinkage, confirmation
+  /// The same validation drapes scored against the held-out capture (its best), if there is one.
+  std::optional<ScoredDrape> validated_held_out;
+  ModelSetup setup;                             // the refitted setup
+  std::vector<sim::ClothMesh> validation_meshes;  // its drapes from the validation states
+};
+
+/// A second capture of the specimen, held out of every fit: its forward model and the fitted baseline's validation
+/// drapes scored against it.
+struct HeldOutCapture {
+  ForwardModel* model = nullptr;
+  Evaluation validated;
 };
 
 struct AttributionSettings {
@@ -65,15 +79,16 @@ struct Attribution {
 [[nodiscard]] sim::Expected<Attribution> attribute(
     ForwardModel& model, const ModelSetup& baseline, const Evaluation& fit, const Evaluation& validated,
     const Floors& floors, const AttributionSettings& settings,
-    const std::function<sim::Expected<std::unique_ptr<ForwardModel>>()>& make_model = {});
+    const std::function<sim::Expected<std::unique_ptr<ForwardModel>>()>& make_model = {},
+    HeldOutCapture* held_out = nullptr);
 
 /// 1 - excess_after / excess_before (0 when excess_before is 0): 1 when the candidate brings the drape within the
 /// floors, 0 when it leaves the excess as it was, negative when it adds to it.
 [[nodiscard]] double gap_shrinkage(double excess_before, double excess_after);
 
-/// The probability, by block bootstrap over tiles of the held-out views, that `a`'s squared residuals are smaller
-/// than `b`'s in total.
+/// The probability, by block bootstrap over tiles of the held-out views (every view with `all_views`: a held-out
+/// capture), that `a`'s squared residuals are smaller than `b`'s in total.
 [[nodiscard]] double bootstrap_confidence(const ForwardModel& model, const ScoredDrape& a, const ScoredDrape& b,
-                                          int samples, int tile_px, std::uint64_t seed);
+                                          int samples, int tile_px, std::uint64_t seed, bool all_views = false);
 
 }  // namespace drapegen::diagnosis

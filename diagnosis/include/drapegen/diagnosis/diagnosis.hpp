@@ -2,6 +2,7 @@
 // The whole diagnosis of one capture: baseline fit, floors, localisation, attribution (docs/DIAGNOSIS.md).
 
 #include <nlohmann/json_fwd.hpp>
+#include <optional>
 #include <string>
 
 #include "drapegen/diagnosis/attribution.hpp"
@@ -44,6 +45,12 @@ struct DiagnosisResult {
   /// which no fit selected on (the fit's own best is the luckiest of its evaluations of a multistable objective).
   Evaluation validated;
   [[nodiscard]] const ScoredDrape& gap_drape() const { return validated.best; }
+  /// With a held-out capture (a second placement of the specimen, in no fit): the same validation drapes scored
+  /// against it. The gate then tests the mean of both captures' terms (gap_terms).
+  std::optional<Evaluation> validated_held_out;
+  [[nodiscard]] GapTerms gap() const {
+    return gap_terms(validated.best, validated_held_out ? &validated_held_out->best : nullptr);
+  }
   /// The validation drapes' distances to the capture and among themselves (the fitted fabric's multistability).
   ValidationSpread validation_spread;
   Floors floors;
@@ -61,7 +68,13 @@ struct DiagnosisResult {
   double seconds_fit = 0.0, seconds_floors = 0.0, seconds_attribution = 0.0;
 };
 
-[[nodiscard]] sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisSettings& settings);
+/// `held_out`: optionally a second capture of the same specimen (another placement on the tester), used in no fit: the
+/// gap and every candidate are validated on both captures (docs/DIAGNOSIS.md, "Held-out capture").
+[[nodiscard]] sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisSettings& settings,
+                                                      const Capture* held_out = nullptr);
+
+/// An error unless `held_out` can be a second capture of `capture`'s specimen (the same specimen facts and views).
+[[nodiscard]] sim::Status check_same_specimen(const Capture& capture, const Capture& held_out);
 
 [[nodiscard]] nlohmann::json to_json(const DiagnosisResult& result, const Capture& capture);
 

@@ -53,10 +53,20 @@ struct FloorSettings {
   double shape_threshold = 1.39;
 };
 
-/// How far `drape` is above the floors, in the terms of the gate "within the floors" (dimensionless): the excess of
+/// What the gate tests of a model drape: its stable-region term (m) and its shape distance, over all views. With a
+/// held-out capture of the same specimen (a second placement), the mean of the drape's terms against the capture and
+/// of the same setup's drape against the held-out capture: two independent draws of the specimen's stable drape.
+struct GapTerms {
+  double stable = 0.0;
+  double shape = 0.0;
+};
+[[nodiscard]] GapTerms gap_terms(const ScoredDrape& drape, const ScoredDrape* held_out_capture = nullptr);
+
+/// How far a drape is above the floors, in the terms of the gate "within the floors" (dimensionless): the excess of
 /// the stable-region term over `floors.stable` and of the shape distance over `floors.shape`, each relative to its
 /// floor and clipped at 0, summed. Zero exactly when the drape is within the floors (both tests pass); the floors
 /// must be positive.
+[[nodiscard]] double excess_above_floors(const GapTerms& gap, const Floors& floors);
 [[nodiscard]] double excess_above_floors(const ScoredDrape& drape, const Floors& floors);
 
 [[nodiscard]] sim::Expected<Floors> measure_floors(ForwardModel& model, const ModelSetup& fitted,
