@@ -68,7 +68,7 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (o.refit_evaluations > 0) settings.attribution.optimiser.max_evaluations = o.refit_evaluations;
   settings.attribution.jobs = o.jobs;
   settings.attribute = !o.gap_only;
-  if (o.shape_floor >= 0.0) settings.floors.shape_threshold = o.shape_floor;
+  if (o.shape_floor >= 0.0) settings.floors.shape_threshold = settings.held_out_shape_threshold = o.shape_floor;
   auto result = diagnosis::diagnose(*capture, settings, held_out ? &*held_out : nullptr);
   if (!result) return fail(result.error().message);
   if (!o.report.empty()) {

@@ -24,7 +24,8 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, std::optional<Effect> 
   const bool bar = !effect;
   EffectSpace space;
   if (bar) {
-    const ReducedBending r = to_reduced(baseline.bending), lower = reduced_lower(), upper = reduced_upper();
+    const ReducedBending r = to_reduced(baseline.bending), lower = reduced_lower(model.capture().specimen.density),
+                         upper = reduced_upper(model.capture().specimen.density);
     space = {{"ln_alpha", "ln_warp_over_weft", "ln_bias_over_mean", "minus_beta_over_alpha_mm"},
              {r.begin(), r.end()},
              {0.25, 0.2, 0.2, 0.5},

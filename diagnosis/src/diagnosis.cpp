@@ -24,12 +24,15 @@ ModelSetup baseline_setup(const ReducedBending& x) {
 }
 
 /// The initial guess: the drape coefficient of the capture's outline against that of isotropic drapes at a few
-/// stiffness levels (flat start), interpolated in ln(alpha).
+/// stiffness levels (flat start; alpha 1500 .. 100000 at 300 g/m^2, scaled with the density), interpolated in
+/// ln(alpha).
 sim::Expected<ReducedBending> initial_guess(ForwardModel& model, int levels) {
   const HemProfile& outline = model.outline();
   const double target = drape_coefficient(outline, model.capture().specimen);
-  const ReducedBending lo = reduced_lower(), hi = reduced_upper();
-  const double a0 = std::log(1000.0), a1 = std::log(60000.0);
+  const double density = model.capture().specimen.density;
+  const ReducedBending lo = reduced_lower(density), hi = reduced_upper(density);
+  const double scale = stiffness_scale(density);
+  const double a0 = std::log(1500.0 * scale), a1 = std::log(100000.0 * scale);
   std::vector<std::pair<double, double>> samples;  // (ln alpha, drape coefficient)
   for (int k = 0; k < levels; ++k) {
     const double la = levels > 1 ? a0 + (a1 - a0) * k / (levels - 1) : 0.5 * (a0 + a1);
@@ -137,6 +140,7 @@ DiagnosisSettings DiagnosisSettings::fine() {
   DiagnosisSettings s = quick();
   s.fit.resolution = kFineResolution;
   s.floors.shape_threshold = kFineShapeFloor;
+  s.held_out_shape_threshold = kFineHeldOutShapeFloor;
   return s;
 }
 
@@ -197,7 +201,7 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
     }
     return value;
   };
-  const ReducedBending lo = reduced_lower(), hi = reduced_upper();
+  const ReducedBending lo = reduced_lower(capture.specimen.density), hi = reduced_upper(capture.specimen.density);
   const NelderMeadResult nm = nelder_mead(objective, {guess->begin(), guess->end()}, {0.35, 0.4, 0.4, 1.0},
                                           {lo.begin(), lo.end()}, {hi.begin(), hi.end()}, settings.baseline_optimiser);
   if (error) return *error;
@@ -210,7 +214,11 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
 
   // 2. Floors and the gap.
   const auto floors_start = std::chrono::steady_clock::now();
-  auto floors = measure_floors(model, fitted, r.fit, settings.floors);
+  FloorSettings floor_settings = settings.floors;
+  if (held_out && settings.held_out_shape_threshold > 0.0) {
+    floor_settings.shape_threshold = settings.held_out_shape_threshold;
+  }
+  auto floors = measure_floors(model, fitted, r.fit, floor_settings);
   if (!floors) return floors.error();
   r.floors = *floors;
   // The gap: the fitted parameters simulated from fresh initial states (the fit's best score is biased low).

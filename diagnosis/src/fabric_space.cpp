@@ -27,7 +27,14 @@ ReducedBending to_reduced(const BendingParameters& p) {
   return x;
 }
 
-ReducedBending reduced_lower() { return {std::log(200.0), -1.5, -1.5, 0.0}; }
-ReducedBending reduced_upper() { return {std::log(200000.0), 1.5, 1.5, 6.0}; }
+double stiffness_scale(double density_g_per_m2) { return density_g_per_m2 / 300.0; }
+
+ReducedBending reduced_lower(double density_g_per_m2) {
+  return {std::log(200.0 * stiffness_scale(density_g_per_m2)), -1.5, -1.5, 0.0};
+}
+
+ReducedBending reduced_upper(double density_g_per_m2) {
+  return {std::log(300000.0 * stiffness_scale(density_g_per_m2)), 1.5, 1.5, 6.0};
+}
 
 }  // namespace drapegen::diagnosis

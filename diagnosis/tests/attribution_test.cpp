@@ -52,6 +52,20 @@ TEST(ExcessAboveFloors, IgnoresTheAllViewScore) {
   EXPECT_GT(baseline, 0.0);
 }
 
+TEST(GapTerms, AreTheMeanOfTheCaptureAndTheHeldOutCapture) {
+  const ScoredDrape a = drape_of(2e-3, 0.6), b = drape_of(4e-3, 1.4);
+  const GapTerms one = gap_terms(a);
+  EXPECT_EQ(one.stable, 2e-3);
+  EXPECT_EQ(one.shape, 0.6);
+  const GapTerms both = gap_terms(a, &b);
+  EXPECT_NEAR(both.stable, 3e-3, 1e-15);
+  EXPECT_NEAR(both.shape, 1.0, 1e-15);
+  // The gate on the mean: b alone is above a 1.15 shape floor, the mean of the two placements is not.
+  const Floors f = floors_of(5e-3, 1.15);
+  EXPECT_GT(excess_above_floors(b, f), 0.0);
+  EXPECT_EQ(excess_above_floors(both, f), 0.0);
+}
+
 TEST(GapShrinkage, CreditsRemovingTheReasonTheGateFired) {
   const Floors f = floors_of(2e-3, 1.15);
   const double before = excess_above_floors(drape_of(1e-3, 1.38), f);  // the gate fired on the shape test

@@ -97,3 +97,18 @@ TEST(FabricSpace, RoundTrip) {
   EXPECT_NEAR(x[3], 2.5, 1e-12);
   EXPECT_NEAR(std::exp(x[0]), std::cbrt(13923.0 * 11455 * 8821), 1e-6);
 }
+
+TEST(FabricSpace, TheStiffnessRangeScalesWithDensity) {
+  // The drape depends on alpha / density: every fabric of fabrics618 lies inside the box at its own density, the
+  // lightest and softest (29 g/m^2, alpha 350) as well as the heaviest and stiffest (870 g/m^2, alpha 115000).
+  for (const auto& [density, alpha] : {std::pair{28.9, 347.0}, std::pair{870.3, 115487.0}, std::pair{300.0, 1778.0}}) {
+    EXPECT_LT(reduced_lower(density)[0], std::log(alpha)) << density;
+    EXPECT_GT(reduced_upper(density)[0], std::log(alpha)) << density;
+  }
+  EXPECT_NEAR(reduced_lower(30.0)[0], reduced_lower(300.0)[0] + std::log(0.1), 1e-12);
+  EXPECT_NEAR(reduced_upper(600.0)[0], reduced_upper(300.0)[0] + std::log(2.0), 1e-12);
+  for (int k = 1; k < 4; ++k) {  // the shape coordinates do not depend on density
+    EXPECT_EQ(reduced_lower(30.0)[k], reduced_lower(300.0)[k]);
+    EXPECT_EQ(reduced_upper(30.0)[k], reduced_upper(300.0)[k]);
+  }
+}

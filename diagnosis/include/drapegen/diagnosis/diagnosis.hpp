@@ -21,6 +21,9 @@ struct DiagnosisSettings {
   /// false: stop after the gap, floors and localisation (a capture above the floors gets the verdict
   /// "not attributed"): a screening run, or a calibration of the floors, at a fraction of the cost.
   bool attribute = true;
+  /// The shape floor when a held-out capture is given (the gate then tests the mean of two captures' shape distances,
+  /// which spreads less over controls than one capture's); 0: floors.shape_threshold.
+  double held_out_shape_threshold = 0.0;
 
   /// Small budgets for tests and the --quick benchmark.
   [[nodiscard]] static DiagnosisSettings quick();
@@ -32,6 +35,9 @@ struct DiagnosisSettings {
   [[nodiscard]] static DiagnosisSettings fine();
   static constexpr int kFineResolution = 32;
   static constexpr double kFineShapeFloor = 1.17;
+  /// The same rule for the mean over the capture and a held-out capture (placement 1): 16 calibration controls
+  /// (--seed 2, 60x60 reality, --fine --held-out-capture), largest CALIBRATED_LARGEST, plus 10%.
+  static constexpr double kFineHeldOutShapeFloor = 1.17;
 };
 
 struct DiagnosisResult {

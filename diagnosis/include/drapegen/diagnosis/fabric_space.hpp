@@ -22,8 +22,14 @@ using ReducedBending = std::array<double, 4>;
 /// The reduced coordinates of `p` (x3 is the alpha-weighted mean ratio).
 [[nodiscard]] ReducedBending to_reduced(const BendingParameters& p);
 
-/// The search box: alpha 200 .. 200000, ratios e^+-1.5, -beta/alpha 0 .. 6 mm (fabrics618: up to about 5).
-[[nodiscard]] ReducedBending reduced_lower();
-[[nodiscard]] ReducedBending reduced_upper();
+/// The drape depends on alpha / density only (paper Section 5.1.2), so the stiffness range scales with the specimen's
+/// density: alpha from 200 to 300000 at the standard 300 g/m^2 (fabrics618: 1778 .. 148108 there), times
+/// density / 300. A fixed range of alpha held the lightest fabrics (29 g/m^2, alpha 350) above their stiffness.
+[[nodiscard]] double stiffness_scale(double density_g_per_m2);
+
+/// The search box: alpha 200 .. 300000 (times stiffness_scale), ratios e^+-1.5, -beta/alpha 0 .. 6 mm (fabrics618:
+/// up to about 5).
+[[nodiscard]] ReducedBending reduced_lower(double density_g_per_m2);
+[[nodiscard]] ReducedBending reduced_upper(double density_g_per_m2);
 
 }  // namespace drapegen::diagnosis
