@@ -53,7 +53,7 @@ int main(int argc, char** argv) {
   bool quick = false, generate_only = false, score_only = false, held_out_placement = false;
   std::uint64_t seed = 1;
   std::vector<std::string> families{"yield", "shear", "curl", "friction", "misalignment", "sensor"};
-  app.add_option("--out", out, "Benchmark directory")->capture_default_str();
+  app.add_option("--out", out, "Benchmark directory (diagnoses already in it are kept: a rerun resumes)")->capture_default_str();
   app.add_option("--fabrics", fabrics_path, "fabrics618.csv")->capture_default_str();
   app.add_option("--drapegen", drapegen, "The drapegen program (default: beside this program)");
   app.add_option("--per-family", per_family, "Captures per effect family")->capture_default_str();
@@ -166,6 +166,16 @@ int main(int argc, char** argv) {
     }
   }
   if (generate_only) return 0;
+  if (held_out_placement && !score_only) {
+    for (const auto& c : cases) {
+      const fs::path second = fs::path(out) / "captures" / (c.name + ".p1");
+      if (!fs::is_directory(second)) {
+        std::cerr << fmt::format("diagnosis_bench: --held-out-placement: {} is missing (generate with --placements 2)\n",
+                                 second.string());
+        return 2;
+      }
+    }
+  }
 
   // 2. Diagnose, J at a time.
   if (!score_only) {
@@ -199,7 +209,8 @@ int main(int argc, char** argv) {
   }
 
   // 3. Score.
-  const std::vector<std::string> columns{"none", "unexplained", "yield", "shear", "curl", "friction", "misalignment", "sensor"};
+  const std::vector<std::string> columns{"none",     "unexplained",  "not attributed", "yield", "shear",
+                                         "curl",     "friction",     "misalignment",   "sensor"};
   std::vector<std::string> rows{"none"};
   for (const auto& f : families) rows.push_back(f);
   std::map<std::string, std::map<std::string, int>> confusion;
@@ -253,8 +264,9 @@ int main(int argc, char** argv) {
   };
   const std::string options = fmt::format("{}{}{}", quick ? "--quick" : "", quick && !diagnose_args.empty() ? " " : "",
                                           diagnose_args);
-  std::string md = fmt::format("Cases scored: {} effect captures, {} controls (diagnose {}).\n\n", effect_total,
-                               control_total, options.empty() ? "defaults" : options);
+  std::string md = fmt::format("Cases scored: {} effect captures, {} controls (diagnose {}{}).\n\n", effect_total,
+                               control_total, options.empty() ? "defaults" : options,
+                               held_out_placement ? ", placement 1 as the held-out capture" : "");
   md += "| truth \\ verdict |";
   for (const auto& c : columns) md += " " + c + " |";
   md += "\n|---|";

@@ -125,9 +125,10 @@ Runner add_diagnose_command(CLI::App& app) {
                  "Evaluations per candidate refit (default 14, also with --quick and --fine)");
   app.add_option("--jobs", o->jobs, "Candidate refits in parallel threads (same result as --jobs 1)")->capture_default_str();
   app.add_option("--shape-floor", o->shape_floor,
-                 fmt::format("Shape-distance floor (default and quick: calibrated {:.2f}; fine: {:.2f}; 0: the largest "
-                             "floor sample)",
-                             diagnosis::FloorSettings{}.shape_threshold, diagnosis::DiagnosisSettings::kFineShapeFloor));
+                 fmt::format("Shape-distance floor (default and quick: calibrated {:.2f}; fine: {:.2f}, with "
+                             "--held-out-capture {:.2f}; 0: the largest floor sample)",
+                             diagnosis::FloorSettings{}.shape_threshold, diagnosis::DiagnosisSettings::kFineShapeFloor,
+                             diagnosis::DiagnosisSettings::kFineHeldOutShapeFloor));
   app.add_flag("--gap-only", o->gap_only,
                "Stop after the gap, floors and localisation (verdict \"not attributed\" above the floors)");
   app.add_flag("-v,--verbose", o->verbose, "Log progress on stderr");

@@ -48,19 +48,30 @@ def verdict(d, shape_floor, threshold, confirm=True):
     a = d["attribution"]
     if not a.get("ran"):
         raise SystemExit(f"{d['capture']}: attribution did not run; rerun with --shape-floor 0.001")
-    bar = a["bending_refit_bar"]["validated"]
-    bar_excess = excess(bar["stable_mm"], bar["shape"], sf, shape_floor)
+    # With a held-out capture (drapegen diagnose --held-out-capture) the gate's terms are the mean of both captures'
+    # and the confirmation compares the held-out capture's all-view score; otherwise the capture's and its held-out
+    # view's score.
+    def terms(v):
+        h = v.get("held_out_capture")
+        if h:
+            return 0.5 * (v["stable_mm"] + h["stable_mm"]), 0.5 * (v["shape"] + h["shape"]), h["all_views_score_mm"]
+        return v["stable_mm"], v["shape"], v["held_out_score_mm"]
+
+    bar_stable, bar_shape, bar_held = terms(a["bending_refit_bar"]["validated"])
+    bar_excess = excess(bar_stable, bar_shape, sf, shape_floor)
     if bar_excess < base:
-        ref_excess, ref_held = bar_excess, bar["held_out_score_mm"]
+        ref_excess, ref_held = bar_excess, bar_held
+    elif t.get("held_out_capture"):
+        ref_excess, ref_held = base, t["held_out_capture"]["all_views_score_mm"]
     else:
         ref_excess, ref_held = base, d["gap_mm"]["held_out_view"]
     ranked = []
     for c in a["candidates"]:
-        v = c["validated"]
-        e = excess(v["stable_mm"], v["shape"], sf, shape_floor)
+        stable, shape, held_score = terms(c["validated"])
+        e = excess(stable, shape, sf, shape_floor)
         shrink = 1.0 - e / ref_excess if ref_excess > 0 else 0.0
-        held = 1.0 - v["held_out_score_mm"] / ref_held if ref_held > 0 else 0.0
-        ranked.append((v["held_out_score_mm"] <= ref_held or not confirm, shrink, held, c["effect"]))
+        held = 1.0 - held_score / ref_held if ref_held > 0 else 0.0
+        ranked.append((held_score <= ref_held or not confirm, shrink, held, c["effect"]))
     ranked.sort(key=lambda r: (not r[0], -r[1], -r[2]))
     confirmed, shrink, _, effect = ranked[0]
     if confirmed and shrink >= threshold:

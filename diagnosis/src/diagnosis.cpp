@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <filesystem>
 #include <cmath>
 #include <limits>
 #include <nlohmann/json.hpp>
@@ -155,9 +156,10 @@ sim::Status check_same_specimen(const Capture& capture, const Capture& held_out)
                                   b.cylinder_diameter * 1e3, a.size_x * 1e3, a.size_y * 1e3, a.density,
                                   a.cylinder_diameter * 1e3)};
   }
-  if (held_out.views.size() != capture.views.size()) {
-    return sim::Error{fmt::format("held-out capture {}: {} views, the capture has {}", held_out.directory,
-                                  held_out.views.size(), capture.views.size())};
+  std::error_code ec;
+  if (std::filesystem::equivalent(capture.directory, held_out.directory, ec) && !ec) {
+    return sim::Error{fmt::format("held-out capture {}: the capture itself (a held-out capture is a second placement)",
+                                  held_out.directory)};
   }
   return {};
 }
@@ -367,6 +369,7 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                        {"fold_phase_rad", {{"capture", L.capture_fold_phase}, {"model", L.model_fold_phase}}},
                        {"drape_coefficient",
                         {{"capture", L.capture_drape_coefficient}, {"model", L.model_drape_coefficient}}}};
+  const bool ran = !r.within_floors && r.verdict != "not attributed";
   nlohmann::json candidates = nlohmann::json::array();
   for (const auto& c : r.attribution.candidates) {
     nlohmann::json params = nlohmann::json::object();
@@ -387,12 +390,12 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                           {"evaluations", c.evaluations},
                           {"seconds", c.seconds}});
   }
-  j["attribution"] = {{"ran", !r.within_floors && r.verdict != "not attributed"},
+  j["attribution"] = {{"ran", ran},
+                      {"confirmed_on", r.validated_held_out ? "held_out_capture" : "held_out_view"},
                       {"bending_refit_bar",
                        {{"parameters", r.attribution.bar.parameters},
                         {"fit_score_mm", r.attribution.bar.fit_score * 1e3},
-                        {"validated", r.within_floors ? nlohmann::json(nullptr)
-                                                      : validated_json(r.attribution.bar, r.floors)},
+                        {"validated", ran ? validated_json(r.attribution.bar, r.floors) : nlohmann::json(nullptr)},
                         {"shrinkage", r.attribution.bar.shrinkage}}},
                       {"named", r.attribution.named},
                       {"confidence", r.attribution.confidence},

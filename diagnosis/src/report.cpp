@@ -153,14 +153,21 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
         "from the camera, blue: nearer; saturated at +-" + fmt::format("{:.0f}", range * 1e3) + " mm; black: no return).\n\n"
         "![views](views.png)\n\nTop: the capture; bottom: the fitted baseline.\n\n";
   if (!r.attribution.candidates.empty()) {
-    md += "## Candidate effects (refitted on the fit views, confirmed on the held-out view)\n\n"
-          "| effect | all-view score (mm) | shrinkage of the excess above the floors | held-out score (mm) | held-out "
-          "shrinkage | confirmed | parameters |\n|---|---|---|---|---|---|---|\n";
+    const bool second = r.validated_held_out.has_value();
+    md += second ? "## Candidate effects (refitted on the fit views, confirmed on the held-out capture)\n\n"
+                   "| effect | all-view score (mm) | shrinkage of the excess above the floors (mean of both captures) | "
+                   "held-out capture's score (mm) | its shrinkage | confirmed | parameters |\n"
+                 : "## Candidate effects (refitted on the fit views, confirmed on the held-out view)\n\n"
+                   "| effect | all-view score (mm) | shrinkage of the excess above the floors | held-out view's score (mm) "
+                   "| its shrinkage | confirmed | parameters |\n";
+    md += "|---|---|---|---|---|---|---|\n";
     for (const auto& c : r.attribution.candidates) {
       std::string params;
       for (std::size_t k = 0; k < c.names.size(); ++k) params += fmt::format("{}={:.3g} ", c.names[k], c.parameters[k]);
+      // The scores the confirmation compared: the validated drape's, on the held-out capture or the held-out view.
+      const double held = second && c.validated_held_out ? c.validated_held_out->all_score : c.validated.held_out_score;
       md += fmt::format("| {} | {:.2f} | {:.0f}% | {:.2f} | {:.0f}% | {} | {}alpha x{:.2f} |\n", effect_name(c.effect),
-                        c.all_score * 1e3, 100 * c.shrinkage, c.held_out_score * 1e3, 100 * c.held_out_shrinkage,
+                        c.validated.all_score * 1e3, 100 * c.shrinkage, held * 1e3, 100 * c.held_out_shrinkage,
                         c.confirmed ? "yes" : "no", params, c.alpha_scale);
     }
     if (after) md += "\n![after](residual_after.png)\n\nResidual after adding the named effect.\n";
