@@ -20,13 +20,17 @@ function(expect_failure code_expected needle)
   endif()
 endfunction()
 
+# Runs drapegen with the arguments after `out_var`; stops the test unless it exits 0; its stdout goes to `out_var`.
+function(run_ok out_var)
+  execute_process(COMMAND ${DRAPEGEN} ${ARGN} RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT code EQUAL 0)
+    message(FATAL_ERROR "'${ARGN}' failed (${code}): ${out} ${err}")
+  endif()
+  set(${out_var} "${out}" PARENT_SCOPE)
+endfunction()
+
 set(FABRIC --alpha 13923,11455,8821 --beta=-35390,-29660,-22042 --density 300)
-execute_process(COMMAND ${DRAPEGEN} reality ${FABRIC} --effect bias=12 --resolution 14 --seed 4
-                        --out ${WORK}/capture --json
-                RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
-if(NOT code EQUAL 0)
-  message(FATAL_ERROR "reality failed (${code}): ${out} ${err}")
-endif()
+run_ok(out reality ${FABRIC} --effect bias=12 --resolution 14 --seed 4 --out ${WORK}/capture --json)
 foreach(f capture.json view0.exr view1.exr view2.exr view3.exr truth.json preview.png)
   if(NOT EXISTS ${WORK}/capture/${f})
     message(FATAL_ERROR "reality did not write ${f}")
@@ -40,12 +44,8 @@ endif()
 # The diagnosis must not need (or see) the truth.
 file(RENAME ${WORK}/capture/truth.json ${WORK}/truth.json)
 
-execute_process(COMMAND ${DRAPEGEN} diagnose --capture ${WORK}/capture --quick --resolution 10 --states 2
-                        --evaluations 8 --refit-evaluations 4 --json --report ${WORK}/report
-                RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
-if(NOT code EQUAL 0)
-  message(FATAL_ERROR "diagnose failed (${code}): ${out} ${err}")
-endif()
+run_ok(out diagnose --capture ${WORK}/capture --quick --resolution 10 --states 2 --evaluations 8 --refit-evaluations 4
+       --json --report ${WORK}/report)
 string(JSON verdict GET "${out}" verdict)
 string(JSON gap GET "${out}" gap_mm all_views)
 string(JSON floor GET "${out}" floors all_views_mm)
@@ -81,12 +81,7 @@ endforeach()
 message(STATUS "diagnosis: verdict ${verdict}, gap ${gap} mm, floor ${floor} mm, region ${region}")
 
 # --gap-only: the same gate, and no attribution (the capture is above the floors, so the verdict says so).
-execute_process(COMMAND ${DRAPEGEN} diagnose --capture ${WORK}/capture --quick --resolution 10 --states 2
-                        --evaluations 8 --gap-only --json
-                RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
-if(NOT code EQUAL 0)
-  message(FATAL_ERROR "diagnose --gap-only failed (${code}): ${out} ${err}")
-endif()
+run_ok(out diagnose --capture ${WORK}/capture --quick --resolution 10 --states 2 --evaluations 8 --gap-only --json)
 string(JSON verdict GET "${out}" verdict)
 string(JSON ran GET "${out}" attribution ran)
 string(JSON ncand LENGTH "${out}" attribution candidates)
@@ -96,19 +91,10 @@ endif()
 
 # A second placement of the specimen as the held-out capture: the gate tests the mean of both captures' terms, and
 # every candidate is validated on both (the depth bias is the rig's, so it is in both placements).
-execute_process(COMMAND ${DRAPEGEN} reality ${FABRIC} --effect bias=12 --resolution 14 --seed 4 --placement 1
-                        --out ${WORK}/capture.p1
-                RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
-if(NOT code EQUAL 0)
-  message(FATAL_ERROR "reality --placement 1 failed (${code}): ${out} ${err}")
-endif()
+run_ok(out reality ${FABRIC} --effect bias=12 --resolution 14 --seed 4 --placement 1 --out ${WORK}/capture.p1)
 file(REMOVE ${WORK}/capture.p1/truth.json)
-execute_process(COMMAND ${DRAPEGEN} diagnose --capture ${WORK}/capture --held-out-capture ${WORK}/capture.p1 --quick
-                        --resolution 10 --states 2 --evaluations 8 --refit-evaluations 4 --json
-                RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
-if(NOT code EQUAL 0)
-  message(FATAL_ERROR "diagnose --held-out-capture failed (${code}): ${out} ${err}")
-endif()
+run_ok(out diagnose --capture ${WORK}/capture --held-out-capture ${WORK}/capture.p1 --quick --resolution 10 --states 2
+       --evaluations 8 --refit-evaluations 4 --json)
 string(JSON shape GET "${out}" gap_tests shape)
 string(JSON shape_a GET "${out}" gap_tests capture shape)
 string(JSON shape_b GET "${out}" gap_tests held_out_capture shape)
