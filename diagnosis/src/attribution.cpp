@@ -137,6 +137,10 @@ std::vector<sim::InitialStateSpec> validation_states(const AttributionSettings& 
   return fit_initial_states(settings.validation_states, settings.validation_seed);
 }
 
+double confirmation_score(const ScoredDrape& drape, const ScoredDrape* held_out_capture) {
+  return held_out_capture ? held_out_capture->all_score : drape.held_out_score;
+}
+
 double gap_shrinkage(double excess_before, double excess_after) {
   return excess_before > 0.0 ? 1.0 - excess_after / excess_before : 0.0;
 }
@@ -231,32 +235,25 @@ sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& base
     }
   }
   // The gate's terms of a candidate (or the reference): its validation drape's, or with a held-out capture the mean of
-  // both captures'.
-  auto terms = [&](const ScoredDrape& d, const std::optional<ScoredDrape>& second) {
-    return gap_terms(d, second ? &*second : nullptr);
-  };
-  auto baseline_second = held_out ? std::optional<ScoredDrape>(held_out->validated.best) : std::nullopt;
+  // both captures' (gap_terms).
+  const ScoredDrape* baseline_second = held_out ? held_out->baseline : nullptr;
   // Shrinkage: of the excess above the floors that made the gate fire (the same two tests), once the candidate is
   // added, measured from the validation states against the reference: the better (smaller excess) of the baseline
   // and the bar. So an effect counts only for what it adds beyond refitting the bending alone. The held-out view (not
   // in any refit), or the held-out capture, must confirm it, i.e. not get worse than the reference's.
   Attribution a;
   a.bar = std::move(results.back()->value());
-  a.bar.shrinkage = gap_shrinkage(excess_above_floors(terms(validated.best, baseline_second), floors),
-                                  excess_above_floors(terms(a.bar.validated, a.bar.validated_held_out), floors));
+  a.bar.shrinkage = gap_shrinkage(excess_above_floors(gap_terms(validated.best, baseline_second), floors),
+                                  excess_above_floors(gap_terms(a.bar.validated, a.bar.held_out_drape()), floors));
   const bool bar_is_reference = a.bar.shrinkage > 0.0;
   const ScoredDrape& reference = bar_is_reference ? a.bar.validated : validated.best;
-  const std::optional<ScoredDrape>& reference_second = bar_is_reference ? a.bar.validated_held_out : baseline_second;
-  // What confirms: the held-out capture's score over all its views, or the held-out view's.
-  auto held_out_score = [&](const ScoredDrape& d, const std::optional<ScoredDrape>& second) {
-    return held_out ? second->all_score : d.held_out_score;
-  };
-  const double h0 = held_out_score(reference, reference_second);
-  const double excess0 = excess_above_floors(terms(reference, reference_second), floors);
+  const ScoredDrape* reference_second = bar_is_reference ? a.bar.held_out_drape() : baseline_second;
+  const double h0 = confirmation_score(reference, reference_second);
+  const double excess0 = excess_above_floors(gap_terms(reference, reference_second), floors);
   for (std::size_t k = 0; k + 1 < tasks; ++k) {
     CandidateResult c = std::move(results[k]->value());
-    const double h = held_out_score(c.validated, c.validated_held_out);
-    c.shrinkage = gap_shrinkage(excess0, excess_above_floors(terms(c.validated, c.validated_held_out), floors));
+    const double h = confirmation_score(c.validated, c.held_out_drape());
+    c.shrinkage = gap_shrinkage(excess0, excess_above_floors(gap_terms(c.validated, c.held_out_drape()), floors));
     c.held_out_shrinkage = h0 > 0.0 ? 1.0 - h / h0 : 0.0;
     c.confirmed = h <= h0;
     a.candidates.push_back(std::move(c));

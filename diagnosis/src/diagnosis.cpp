@@ -112,7 +112,7 @@ nlohmann::json held_out_json(const ScoredDrape* d) {
 /// A refitted candidate (or the bar) from the validation states: its drape against the capture, against the held-out
 /// capture if any, and the gate's excess of the two.
 nlohmann::json validated_json(const CandidateResult& c, const Floors& floors) {
-  const ScoredDrape* second = c.validated_held_out ? &*c.validated_held_out : nullptr;
+  const ScoredDrape* second = c.held_out_drape();
   return {{"stable_mm", c.validated.stable_all * 1e3},
           {"shape", c.validated.shape_all},
           {"held_out_score_mm", c.validated.held_out_score * 1e3},
@@ -259,10 +259,9 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
   } else {
     const FitSettings fit_settings = settings.fit;
     auto make_model = [&capture, fit_settings]() { return ForwardModel::create(capture, fit_settings); };
-    std::optional<HeldOutCapture> second;
-    if (held_out_model) second = HeldOutCapture{held_out_model.get(), *r.validated_held_out};
+    HeldOutCapture second{held_out_model.get(), r.held_out_gap_drape()};
     auto attribution = attribute(model, fitted, r.fit, r.validated, r.floors, settings.attribution, make_model,
-                                 second ? &*second : nullptr);
+                                 held_out_model ? &second : nullptr);
     if (!attribution) return attribution.error();
     r.attribution = std::move(*attribution);
     const auto& c = r.attribution.candidates;
@@ -297,7 +296,7 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                     {"shape_floor", r.floors.shape},
                     {"excess_above_floors", excess_above_floors(gap, r.floors)},
                     {"capture", {{"stable_mm", r.gap_drape().stable_all * 1e3}, {"shape", r.gap_drape().shape_all}}},
-                    {"held_out_capture", held_out_json(r.validated_held_out ? &r.validated_held_out->best : nullptr)},
+                    {"held_out_capture", held_out_json(r.held_out_gap_drape())},
                     {"validation_states", r.validated.states.size()},
                     {"best_validation_state", r.gap_drape().state},
                     {"validation_spread", spread_json(r.validation_spread)},

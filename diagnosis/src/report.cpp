@@ -165,7 +165,7 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
       std::string params;
       for (std::size_t k = 0; k < c.names.size(); ++k) params += fmt::format("{}={:.3g} ", c.names[k], c.parameters[k]);
       // The scores the confirmation compared: the validated drape's, on the held-out capture or the held-out view.
-      const double held = second && c.validated_held_out ? c.validated_held_out->all_score : c.validated.held_out_score;
+      const double held = confirmation_score(c.validated, c.held_out_drape());
       md += fmt::format("| {} | {:.2f} | {:.0f}% | {:.2f} | {:.0f}% | {} | {}alpha x{:.2f} |\n", effect_name(c.effect),
                         c.validated.all_score * 1e3, 100 * c.shrinkage, held * 1e3, 100 * c.held_out_shrinkage,
                         c.confirmed ? "yes" : "no", params, c.alpha_scale);

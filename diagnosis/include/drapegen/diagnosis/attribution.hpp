@@ -37,16 +37,23 @@ struct CandidateResult {
   ScoredDrape validated;  // the refitted setup's best drape from the validation states: shrinkage, confirmation
   /// The same validation drapes scored against the held-out capture (its best), if there is one.
   std::optional<ScoredDrape> validated_held_out;
+  [[nodiscard]] const ScoredDrape* held_out_drape() const {
+    return validated_held_out ? &*validated_held_out : nullptr;
+  }
   ModelSetup setup;                             // the refitted setup
   std::vector<sim::ClothMesh> validation_meshes;  // its drapes from the validation states
 };
 
-/// A second capture of the specimen, held out of every fit: its forward model and the fitted baseline's validation
-/// drapes scored against it.
+/// A second capture of the specimen, held out of every fit: its forward model and the fitted baseline's best
+/// validation drape scored against it.
 struct HeldOutCapture {
   ForwardModel* model = nullptr;
-  Evaluation validated;
+  const ScoredDrape* baseline = nullptr;
 };
+
+/// What the confirmation compares of a validated drape: its score over all views of the held-out capture if there
+/// is one (`held_out_capture`, the same setup's drape scored against it), else its score over the held-out view.
+[[nodiscard]] double confirmation_score(const ScoredDrape& drape, const ScoredDrape* held_out_capture);
 
 struct AttributionSettings {
   NelderMeadOptions optimiser{.max_evaluations = 14};

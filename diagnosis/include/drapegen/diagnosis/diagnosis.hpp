@@ -54,9 +54,11 @@ struct DiagnosisResult {
   /// With a held-out capture (a second placement of the specimen, in no fit): the same validation drapes scored
   /// against it. The gate then tests the mean of both captures' terms (gap_terms).
   std::optional<Evaluation> validated_held_out;
-  [[nodiscard]] GapTerms gap() const {
-    return gap_terms(validated.best, validated_held_out ? &validated_held_out->best : nullptr);
+  /// Its best drape against the held-out capture (null without one).
+  [[nodiscard]] const ScoredDrape* held_out_gap_drape() const {
+    return validated_held_out ? &validated_held_out->best : nullptr;
   }
+  [[nodiscard]] GapTerms gap() const { return gap_terms(validated.best, held_out_gap_drape()); }
   /// The validation drapes' distances to the capture and among themselves (the fitted fabric's multistability).
   ValidationSpread validation_spread;
   Floors floors;
