@@ -14,6 +14,7 @@
 #include <fmt/format.h>
 
 #include "drapegen/sim/drape.hpp"
+#include "drapegen/sim/ply.hpp"
 
 namespace {
 
@@ -67,12 +68,12 @@ int main(int argc, char** argv) {
   app.add_option("--pcg-iterations", pcg_iterations, "SolverOptions::max_pcg_iterations (0: factorise every step)")
       ->capture_default_str();
   app.add_option("--pcg-tolerance", pcg_tolerance, "SolverOptions::pcg_tolerance")->capture_default_str();
-  double outer_below = drapegen::sim::SolverOptions{}.lagged_outer_below;
+  double outer_below = drapegen::sim::DrapeConfig{}.solver.lagged_outer_below;
   double refactor_fraction = drapegen::sim::SolverOptions{}.pcg_refactor_fraction;
   app.add_option("--pcg-refactor", refactor_fraction, "SolverOptions::pcg_refactor_fraction")->capture_default_str();
   double gn_above = drapegen::sim::DrapeConfig{}.solver.gauss_newton_above;
   app.add_option("--gn-above", gn_above, "SolverOptions::gauss_newton_above")->capture_default_str();
-  app.add_option("--outer-below", outer_below, "SolverOptions::lagged_outer_below")->capture_default_str();
+  app.add_option("--outer-below", outer_below, "SolverOptions::lagged_outer_below (effects with lagged forces use at most 3)")->capture_default_str();
   double exact_below = drapegen::sim::SolverOptions{}.exact_hessian_below;
   int max_iterations = drapegen::sim::SolverOptions{}.max_iterations;
   app.add_option("--exact-below", exact_below, "SolverOptions::exact_hessian_below")->capture_default_str();
@@ -94,6 +95,9 @@ int main(int argc, char** argv) {
   app.add_option("--fabrics", fabrics, "fabrics at evenly spaced quantiles of mean alpha")->capture_default_str();
   app.add_option("--inits", inits, "initial states")->delimiter(',')->capture_default_str();
   app.add_flag("--json", json, "one JSON object per drape");
+  std::string save_dir;
+  app.add_option("--save", save_dir,
+                 "write each draped mesh to DIR/fabric<index>_<init>.ply (for comparing two builds' drapes)");
   bool verbose = false;
   app.add_flag("--verbose", verbose, "print every Newton iteration on stderr");
   CLI11_PARSE(app, argc, argv);
@@ -140,6 +144,14 @@ int main(int argc, char** argv) {
       if (!result) {
         std::cerr << "error: " << result.error().message << "\n";
         return 1;
+      }
+      if (!save_dir.empty()) {
+        const auto saved =
+            drapegen::sim::write_ply(fmt::format("{}/fabric{}_{}.ply", save_dir, index, init), result->mesh);
+        if (!saved) {
+          std::cerr << "error: " << saved.error().message << "\n";
+          return 1;
+        }
       }
       const auto& r = result->report;
       const auto& c = result->coarse_report;

@@ -85,7 +85,12 @@ Expected<DrapeResult> simulate_drape(const DrapeConfig& config,
     }
     result.fixed_vertices = static_cast<int>(std::count(fixed.begin(), fixed.end(), true));
 
-    NewtonSolver solver(config.solver);
+    SolverOptions options = config.solver;
+    if (config.effects.bending_yield_curvature || config.effects.friction) {
+      // Plastic flow and the friction force are lagged forces: update them only near equilibrium (DrapeConfig).
+      options.lagged_outer_below = std::min(options.lagged_outer_below, SolverOptions{}.lagged_outer_below);
+    }
+    NewtonSolver solver(options);
     if (progress) solver.set_progress(progress);
     std::vector<EnergyTerm*> terms{membrane.get()};
     for (const auto& term : bending) terms.push_back(term.get());

@@ -29,7 +29,14 @@ struct DrapeConfig {
   /// The bending Hessian without the tau * d^2(theta) term wherever the solver does not try the exact one: fewer
   /// iterations than the eigen-projected element Hessian in our measurements (50x50, 9 drapes: 758 iterations
   /// against 878 with Gauss-Newton only above a residual of 10 and 1169 without it), and cheaper.
-  SolverOptions solver{.gauss_newton_above = 0.0};
+  ///
+  /// The outer loop of the lagged anisotropy directions starts at a residual of 30 vertex weights instead of 3: the
+  /// directions follow the shape, which has formed by then, and each update made at a residual under 3 threw Newton
+  /// back to ~200 and cost it ~25 iterations. docs/BENCHMARKS.md (session 10): 100x100, fabrics 154-617 of the
+  /// benchmark, 12 drapes: 525 full-resolution iterations against 670, the drapes 0.01-0.33 mm apart (mean vertex
+  /// distance; at most 2.2 mm). Effects whose lagged state is a force (plastic flow, friction's normal force) keep
+  /// the solver's default (3): simulate_drape uses the smaller of the two when one of them is on.
+  SolverOptions solver{.gauss_newton_above = 0.0, .lagged_outer_below = 30.0};
   double gravity = kStandardGravity;
   /// Hold the vertices that start on the platform top (static friction, Section 5.2.1). Ignored with
   /// effects.friction, which replaces it.
