@@ -27,6 +27,7 @@ struct DiagnoseOptions {
   int states = 0;
   int evaluations = 0;
   int refit_evaluations = 0;
+  int refit_scan = -1;  // < 0: the settings' value
   int jobs = 1;
   double shape_floor = -1.0;  // < 0: the settings' calibrated value
   bool gap_only = false;
@@ -46,6 +47,7 @@ int run_diagnose(const DiagnoseOptions& o) {
     return fail("--evaluations and --refit-evaluations must be 1 .. 10000");
   }
   if (o.shape_floor > 100.0) return fail("--shape-floor must be 0 (from the floor samples) .. 100");
+  if (o.refit_scan == 1 || o.refit_scan > 100) return fail("--refit-scan must be 0 (off) or 2 .. 100");
   if (o.verbose) sim::logger()->set_level(spdlog::level::debug);
   auto capture = diagnosis::read_capture(o.capture);
   if (!capture) return fail(capture.error().message);
@@ -65,6 +67,11 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (o.states > 0) settings.fit.initial_states = o.states;
   if (o.evaluations > 0) settings.baseline_optimiser.max_evaluations = o.evaluations;
   if (o.refit_evaluations > 0) settings.attribution.optimiser.max_evaluations = o.refit_evaluations;
+  if (o.refit_scan >= 0) settings.attribution.scan_levels = o.refit_scan;
+  if (settings.attribution.scan_levels >= settings.attribution.optimiser.max_evaluations) {
+    return fail(fmt::format("--refit-scan ({}) must be below the refit's evaluations ({})",
+                            settings.attribution.scan_levels, settings.attribution.optimiser.max_evaluations));
+  }
   settings.attribution.jobs = o.jobs;
   settings.attribute = !o.gap_only;
   if (o.shape_floor >= 0.0) settings.floors.shape_threshold = settings.held_out_shape_threshold = o.shape_floor;
@@ -122,6 +129,9 @@ Runner add_diagnose_command(CLI::App& app) {
   app.add_option("--evaluations", o->evaluations, "Baseline fit evaluations (default 40; quick and fine 20)");
   app.add_option("--refit-evaluations", o->refit_evaluations,
                  "Evaluations per candidate refit (default 14, also with --quick and --fine)");
+  app.add_option("--refit-scan", o->refit_scan,
+                 "Refits of one-parameter effects (yield, shear, curl, friction) start with this many strengths over "
+                 "the effect's range, then refine from the best within --refit-evaluations (default 0: off)");
   app.add_option("--jobs", o->jobs, "Candidate refits in parallel threads (same result as --jobs 1)")->capture_default_str();
   app.add_option("--shape-floor", o->shape_floor,
                  fmt::format("Shape-distance floor (default and quick: calibrated {:.2f}; fine: {:.2f}, with "

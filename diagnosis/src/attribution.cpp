@@ -105,8 +105,29 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, std::optional<Effect> 
   };
   NelderMeadOptions options = settings.optimiser;
   if (!sim) options.max_evaluations = settings.sensor_evaluations;
-  const NelderMeadResult r = nelder_mead(f, x0, step, lo, hi, options);
+  int scanned = 0;
+  if (sim && !bar && space.start.size() == 1 && settings.scan_levels >= 2 &&
+      settings.scan_levels < options.max_evaluations) {
+    // A scan of the strength over its range, the bending as fitted; the simplex refines from the best level. A
+    // simplex from one fixed start rarely moved the strength within the budget (docs/DIAGNOSIS.md, session 10).
+    std::vector<double> x = x0;
+    double best_level = x0[first], best_value = std::numeric_limits<double>::infinity();
+    for (int k = 0; k < settings.scan_levels; ++k) {
+      x[first] = lo[first] + (hi[first] - lo[first]) * k / (settings.scan_levels - 1);
+      const double value = f(x);
+      if (value < best_value) best_value = value, best_level = x[first];
+    }
+    if (error) return *error;
+    x0[first] = best_level;
+    // The simplex's first step along the strength: a third of a level spacing, towards the range's middle.
+    const double spacing = (hi[first] - lo[first]) / (settings.scan_levels - 1);
+    step[first] = (best_level < 0.5 * (lo[first] + hi[first]) ? 1.0 : -1.0) * spacing / 3.0;
+    scanned = settings.scan_levels;
+    options.max_evaluations -= scanned;
+  }
+  NelderMeadResult r = nelder_mead(f, x0, step, lo, hi, options);
   if (error) return *error;
+  r.evaluations += scanned;
   // The refitted setup from the validation states (the sensor candidate re-renders the baseline's drapes from them).
   const ModelSetup refitted = setup_of(r.x);
   std::vector<sim::ClothMesh> fresh;

@@ -64,6 +64,10 @@ struct AttributionSettings {
   /// Fresh initial states (flat, then sine) from which the gap is measured at the fitted parameters (the gate) and
   /// each refitted candidate is compared with it.
   int validation_states = 10;
+  /// Effects with one parameter that need simulation (yield, shear, curl, friction): first evaluate this many
+  /// strengths evenly spaced over the parameter's range (bending as fitted), then refine (bending scale and strength)
+  /// from the best with the rest of the budget. 0: the simplex from the effect's fixed start (effect_space) alone.
+  int scan_levels = 0;
   std::uint64_t validation_seed = 2000;
   int jobs = 1;                     // candidate refits in parallel (one forward model per thread)
   std::vector<Effect> candidates{std::begin(kAllEffects), std::end(kAllEffects)};
