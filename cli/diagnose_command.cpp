@@ -47,7 +47,9 @@ int run_diagnose(const DiagnoseOptions& o) {
     return fail("--evaluations and --refit-evaluations must be 1 .. 10000");
   }
   if (o.shape_floor > 100.0) return fail("--shape-floor must be 0 (from the floor samples) .. 100");
-  if (o.refit_scan == 1 || o.refit_scan > 100) return fail("--refit-scan must be 0 (off) or 2 .. 100");
+  if (o.refit_scan < -1 || o.refit_scan == 1 || o.refit_scan > 100) {
+    return fail("--refit-scan must be 0 (off) or 2 .. 100");
+  }
   if (o.verbose) sim::logger()->set_level(spdlog::level::debug);
   auto capture = diagnosis::read_capture(o.capture);
   if (!capture) return fail(capture.error().message);
@@ -68,8 +70,8 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (o.evaluations > 0) settings.baseline_optimiser.max_evaluations = o.evaluations;
   if (o.refit_evaluations > 0) settings.attribution.optimiser.max_evaluations = o.refit_evaluations;
   if (o.refit_scan >= 0) settings.attribution.scan_levels = o.refit_scan;
-  if (settings.attribution.scan_levels >= settings.attribution.optimiser.max_evaluations) {
-    return fail(fmt::format("--refit-scan ({}) must be below the refit's evaluations ({})",
+  if (settings.attribution.scan_levels > settings.attribution.optimiser.max_evaluations - 3) {
+    return fail(fmt::format("--refit-scan ({}) must leave the refit's simplex 3 of its {} evaluations",
                             settings.attribution.scan_levels, settings.attribution.optimiser.max_evaluations));
   }
   settings.attribution.jobs = o.jobs;
@@ -131,7 +133,8 @@ Runner add_diagnose_command(CLI::App& app) {
                  "Evaluations per candidate refit (default 14, also with --quick and --fine)");
   app.add_option("--refit-scan", o->refit_scan,
                  "Refits of one-parameter effects (yield, shear, curl, friction) start with this many strengths over "
-                 "the effect's range, then refine from the best within --refit-evaluations (default 0: off)");
+                 "the effect's range (bending as fitted), then refine from the best within --refit-evaluations, which must leave "
+                 "3 for that (default 0: off; report.json lists the scan per candidate)");
   app.add_option("--jobs", o->jobs, "Candidate refits in parallel threads (same result as --jobs 1)")->capture_default_str();
   app.add_option("--shape-floor", o->shape_floor,
                  fmt::format("Shape-distance floor (default and quick: calibrated {:.2f}; fine: {:.2f}, with "

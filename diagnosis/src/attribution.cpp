@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 #include <mutex>
+#include <optional>
+#include <utility>
 #include <thread>
 
 #include <fmt/ranges.h>
@@ -14,6 +16,9 @@
 
 namespace drapegen::diagnosis {
 namespace {
+
+/// New evaluations the simplex keeps after a strength scan (its two new vertices and one move, at least).
+constexpr int kSimplexAfterScan = 3;
 
 /// Refits `effect` (with the bending scale free), or with no effect (the bar) the baseline's own bending parameters in
 /// the fit's reduced coordinates, on the fit states; then evaluates the refitted setup from the validation states.
@@ -87,8 +92,11 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, std::optional<Effect> 
     apply_effect(*effect, std::vector<double>(x.begin() + static_cast<std::ptrdiff_t>(first), x.end()), setup);
     return setup;
   };
+  // The scan's best point, which the simplex evaluates first: its value is known (evaluations are deterministic).
+  std::optional<std::pair<std::vector<double>, double>> known;
   auto f = [&](const std::vector<double>& x) -> double {
     if (error) return std::numeric_limits<double>::infinity();
+    if (known && known->first == x) return known->second;
     const ModelSetup setup = setup_of(x);
     auto e = sim ? model.evaluate(setup) : model.rescore(meshes, setup);
     if (!e) {
@@ -107,27 +115,30 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, std::optional<Effect> 
   if (!sim) options.max_evaluations = settings.sensor_evaluations;
   int scanned = 0;
   if (sim && !bar && space.start.size() == 1 && settings.scan_levels >= 2 &&
-      settings.scan_levels < options.max_evaluations) {
+      settings.scan_levels <= options.max_evaluations - kSimplexAfterScan) {
     // A scan of the strength over its range, the bending as fitted; the simplex refines from the best level. A
     // simplex from one fixed start rarely moved the strength within the budget (docs/DIAGNOSIS.md, session 10).
     std::vector<double> x = x0;
-    double best_level = x0[first], best_value = std::numeric_limits<double>::infinity();
+    double best_value = std::numeric_limits<double>::infinity();
     for (int k = 0; k < settings.scan_levels; ++k) {
-      x[first] = lo[first] + (hi[first] - lo[first]) * k / (settings.scan_levels - 1);
+      x[first] = k + 1 == settings.scan_levels ? hi[first]
+                                               : lo[first] + (hi[first] - lo[first]) * k / (settings.scan_levels - 1);
       const double value = f(x);
-      if (value < best_value) best_value = value, best_level = x[first];
+      if (error) return *error;
+      c.scan.emplace_back(x[first], value);
+      if (value < best_value) best_value = value, known = {x, value};
     }
-    if (error) return *error;
-    x0[first] = best_level;
+    x0 = known->first;
     // The simplex's first step along the strength: a third of a level spacing, towards the range's middle.
     const double spacing = (hi[first] - lo[first]) / (settings.scan_levels - 1);
-    step[first] = (best_level < 0.5 * (lo[first] + hi[first]) ? 1.0 : -1.0) * spacing / 3.0;
+    step[first] = (x0[first] < 0.5 * (lo[first] + hi[first]) ? 1.0 : -1.0) * spacing / 3.0;
     scanned = settings.scan_levels;
-    options.max_evaluations -= scanned;
+    // The simplex's first evaluation, the best level, is known: the budget of simulations stays the same.
+    options.max_evaluations -= scanned - 1;
   }
   NelderMeadResult r = nelder_mead(f, x0, step, lo, hi, options);
   if (error) return *error;
-  r.evaluations += scanned;
+  if (scanned > 0) r.evaluations += scanned - 1;
   // The refitted setup from the validation states (the sensor candidate re-renders the baseline's drapes from them).
   const ModelSetup refitted = setup_of(r.x);
   std::vector<sim::ClothMesh> fresh;

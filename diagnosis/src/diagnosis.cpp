@@ -373,6 +373,8 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
   for (const auto& c : r.attribution.candidates) {
     nlohmann::json params = nlohmann::json::object();
     for (std::size_t k = 0; k < c.names.size() && k < c.parameters.size(); ++k) params[c.names[k]] = c.parameters[k];
+    nlohmann::json scan = nlohmann::json::array();
+    for (const auto& [level, score] : c.scan) scan.push_back({{"parameter", level}, {"fit_score_mm", score * 1e3}});
     candidates.push_back({{"effect", effect_name(c.effect)},
                           {"parameters", params},
                           {"alpha_scale", c.alpha_scale},
@@ -387,6 +389,7 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                           {"held_out_shrinkage", c.held_out_shrinkage},
                           {"confirmed", c.confirmed},
                           {"evaluations", c.evaluations},
+                          {"scan", scan},
                           {"seconds", c.seconds}});
   }
   j["attribution"] = {{"ran", ran},

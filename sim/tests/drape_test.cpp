@@ -332,5 +332,19 @@ TEST(DrapePhysics, TheOuterLoopThresholdLeavesTheDrapeInPlace) {
   EXPECT_EQ(a.measures.folds, b.measures.folds);
 }
 
+// Plastic flow is a lagged force: with a yield curvature the drape's outer loop keeps the solver's threshold (3)
+// whatever DrapeConfig asks, so that the flow is computed near equilibrium: the two thresholds give the same drape.
+TEST(DrapePhysics, PlasticFlowKeepsTheStrictOuterLoop) {
+  DrapeConfig a = config(16, false);
+  a.effects.bending_yield_curvature = 20.0;
+  DrapeConfig b = a;
+  b.solver.lagged_outer_below = SolverOptions{}.lagged_outer_below;
+  ASSERT_NE(a.solver.lagged_outer_below, b.solver.lagged_outer_below);
+  const DrapeResult ra = drape(a, "yield, DrapeConfig's threshold");
+  const DrapeResult rb = drape(b, "yield, threshold 3");
+  EXPECT_EQ(max_distance_mm(ra.mesh.positions, rb.mesh.positions), 0.0);
+  EXPECT_EQ(ra.report.iterations, rb.report.iterations);
+}
+
 }  // namespace
 }  // namespace drapegen::sim

@@ -12,6 +12,7 @@
 
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "drapegen/diagnosis/candidate_effect.hpp"
@@ -32,6 +33,8 @@ struct CandidateResult {
   double held_out_shrinkage = 0.0;  // 1 - held_out_after / held_out_before (the view not in the refit)
   bool confirmed = false;           // the held-out view does not get worse
   int evaluations = 0;
+  /// The strength scan (AttributionSettings::scan_levels), if one ran: (parameter, fit score) per level.
+  std::vector<std::pair<double, double>> scan;
   double seconds = 0.0;
   ScoredDrape drape;      // the refit's best drape (fit states)
   ScoredDrape validated;  // the refitted setup's best drape from the validation states: shrinkage, confirmation
@@ -66,7 +69,9 @@ struct AttributionSettings {
   int validation_states = 10;
   /// Effects with one parameter that need simulation (yield, shear, curl, friction): first evaluate this many
   /// strengths evenly spaced over the parameter's range (bending as fitted), then refine (bending scale and strength)
-  /// from the best with the rest of the budget. 0: the simplex from the effect's fixed start (effect_space) alone.
+  /// from the best with the rest of the same budget (optimiser.max_evaluations simulations in all). 0: the simplex
+  /// from the effect's fixed start (effect_space) alone; so is a value above the budget - 3 (the simplex needs three
+  /// new evaluations to move).
   int scan_levels = 0;
   std::uint64_t validation_seed = 2000;
   int jobs = 1;                     // candidate refits in parallel (one forward model per thread)

@@ -33,7 +33,7 @@ struct DrapeConfig {
   /// The outer loop of the lagged anisotropy directions starts at a residual of 30 vertex weights instead of 3: the
   /// directions follow the shape, which has formed by then, and each update made at a residual under 3 threw Newton
   /// back to ~200 and cost it ~25 iterations. docs/BENCHMARKS.md (session 10): 100x100, fabrics 154-617 of the
-  /// benchmark, 12 drapes: 525 full-resolution iterations against 670, the drapes 0.01-0.33 mm apart (mean vertex
+  /// benchmark, 12 drapes: 525 full-resolution iterations against 670, the drapes 0.001-0.33 mm apart (mean vertex
   /// distance; at most 2.2 mm). Effects whose lagged state is a force (plastic flow, friction's normal force) keep
   /// the solver's default (3): simulate_drape uses the smaller of the two when one of them is on.
   SolverOptions solver{.gauss_newton_above = 0.0, .lagged_outer_below = 30.0};
