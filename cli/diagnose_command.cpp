@@ -70,9 +70,10 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (o.evaluations > 0) settings.baseline_optimiser.max_evaluations = o.evaluations;
   if (o.refit_evaluations > 0) settings.attribution.optimiser.max_evaluations = o.refit_evaluations;
   if (o.refit_scan >= 0) settings.attribution.scan_levels = o.refit_scan;
-  if (settings.attribution.scan_levels > settings.attribution.optimiser.max_evaluations - 3) {
-    return fail(fmt::format("--refit-scan ({}) must leave the refit's simplex 3 of its {} evaluations",
-                            settings.attribution.scan_levels, settings.attribution.optimiser.max_evaluations));
+  constexpr int kKeep = diagnosis::AttributionSettings::kSimplexAfterScan;
+  if (settings.attribution.scan_levels > settings.attribution.optimiser.max_evaluations - kKeep) {
+    return fail(fmt::format("--refit-scan ({}) must leave the refit's simplex {} of its {} evaluations",
+                            settings.attribution.scan_levels, kKeep, settings.attribution.optimiser.max_evaluations));
   }
   settings.attribution.jobs = o.jobs;
   settings.attribute = !o.gap_only;
@@ -132,9 +133,11 @@ Runner add_diagnose_command(CLI::App& app) {
   app.add_option("--refit-evaluations", o->refit_evaluations,
                  "Evaluations per candidate refit (default 14, also with --quick and --fine)");
   app.add_option("--refit-scan", o->refit_scan,
-                 "Refits of one-parameter effects (yield, shear, curl, friction) start with this many strengths over "
-                 "the effect's range (bending as fitted), then refine from the best within --refit-evaluations, which must leave "
-                 "3 for that (default 0: off; report.json lists the scan per candidate)");
+                 fmt::format("Refits of one-parameter effects (yield, shear, curl, friction) start with this many "
+                             "strengths over the effect's range (bending as fitted), then refine from the best within "
+                             "--refit-evaluations, which must leave {} for that (default 0: off; report.json lists the "
+                             "scan per candidate)",
+                             diagnosis::AttributionSettings::kSimplexAfterScan));
   app.add_option("--jobs", o->jobs, "Candidate refits in parallel threads (same result as --jobs 1)")->capture_default_str();
   app.add_option("--shape-floor", o->shape_floor,
                  fmt::format("Shape-distance floor (default and quick: calibrated {:.2f}; fine: {:.2f}, with "

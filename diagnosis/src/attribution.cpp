@@ -17,9 +17,6 @@
 namespace drapegen::diagnosis {
 namespace {
 
-/// New evaluations the simplex keeps after a strength scan (its two new vertices and one move, at least).
-constexpr int kSimplexAfterScan = 3;
-
 /// Refits `effect` (with the bending scale free), or with no effect (the bar) the baseline's own bending parameters in
 /// the fit's reduced coordinates, on the fit states; then evaluates the refitted setup from the validation states.
 sim::Expected<CandidateResult> refit(ForwardModel& model, std::optional<Effect> effect, const ModelSetup& baseline,
@@ -115,7 +112,7 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, std::optional<Effect> 
   if (!sim) options.max_evaluations = settings.sensor_evaluations;
   int scanned = 0;
   if (sim && !bar && space.start.size() == 1 && settings.scan_levels >= 2 &&
-      settings.scan_levels <= options.max_evaluations - kSimplexAfterScan) {
+      settings.scan_levels <= options.max_evaluations - AttributionSettings::kSimplexAfterScan) {
     // A scan of the strength over its range, the bending as fitted; the simplex refines from the best level. A
     // simplex from one fixed start rarely moved the strength within the budget (docs/DIAGNOSIS.md, session 10).
     std::vector<double> x = x0;

@@ -70,9 +70,10 @@ struct AttributionSettings {
   /// Effects with one parameter that need simulation (yield, shear, curl, friction): first evaluate this many
   /// strengths evenly spaced over the parameter's range (bending as fitted), then refine (bending scale and strength)
   /// from the best with the rest of the same budget (optimiser.max_evaluations simulations in all). 0: the simplex
-  /// from the effect's fixed start (effect_space) alone; so is a value above the budget - 3 (the simplex needs three
-  /// new evaluations to move).
+  /// from the effect's fixed start (effect_space) alone; so is a value above the budget - kSimplexAfterScan.
   int scan_levels = 0;
+  /// New evaluations the simplex keeps after a strength scan (its two new vertices and one move, at least).
+  static constexpr int kSimplexAfterScan = 3;
   std::uint64_t validation_seed = 2000;
   int jobs = 1;                     // candidate refits in parallel (one forward model per thread)
   std::vector<Effect> candidates{std::begin(kAllEffects), std::end(kAllEffects)};
