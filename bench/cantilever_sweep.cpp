@@ -25,6 +25,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "drapegen/sim/blas_kernels.hpp"
 #include "drapegen/sim/anisotropy.hpp"
 #include "drapegen/sim/cantilever.hpp"
 #include "drapegen/sim/cantilever_fit.hpp"
@@ -120,6 +121,7 @@ double wall_seconds(std::chrono::steady_clock::time_point start) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  drapegen::sim::relaunch_with_blas_kernels(argv);  // the kernels drapegen runs on (blas_kernels.hpp)
   const Options o = parse(argc, argv);
   constexpr double g = 9.81;
   const double width = o.width > 0.0 ? o.width : 2.0 * o.length;

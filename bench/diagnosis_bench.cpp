@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
+#include "drapegen/sim/blas_kernels.hpp"
 #include "drapegen/diagnosis/reality.hpp"
 #include "drapegen/renderer/random.hpp"
 #include "drapegen/sampler/fabric_data.hpp"
@@ -47,6 +48,7 @@ const std::map<std::string, std::pair<double, double>> kDefaultStrength = {
 }  // namespace
 
 int main(int argc, char** argv) {
+  drapegen::sim::relaunch_with_blas_kernels(argv);  // the kernels drapegen runs on (blas_kernels.hpp)
   CLI::App app{"drapegen diagnosis benchmark: reality captures, diagnoses, confusion matrix"};
   std::string out = "out/diagnosis_bench", fabrics_path = DRAPEGEN_FABRIC_DATA_DEFAULT, drapegen;
   int per_family = 5, controls = 5, jobs = 1, resolution = 60, diagnose_jobs = 1, placements = 1;
@@ -249,7 +251,15 @@ int main(int argc, char** argv) {
       for (const auto& r : t["regions"]) region_ok = region_ok || r.get<std::string>() == region;
       region_match += region_ok;
     }
-    per_case.push_back({{"case", c.name}, {"family", family}, {"effect", c.effect}, {"strength", c.strength},
+    // The effect and its strength as generated (the truth file), not as this run would draw them: a run may score
+    // captures an earlier run generated with other --controls or --seed, whose draws differ.
+    std::string effect;
+    double strength = 0.0;
+    if (t.contains("effects") && t["effects"].is_array() && !t["effects"].empty()) {
+      effect = t["effects"][0].value("name", "");
+      strength = t["effects"][0].value("strength", 0.0);
+    }
+    per_case.push_back({{"case", c.name}, {"family", family}, {"effect", effect}, {"strength", strength},
                         {"verdict", verdict}, {"runner_up", d.value("runner_up", "")},
                         {"confidence", d.value("confidence", 0.0)}, {"region", region}, {"region_ok", region_ok},
                         {"gap_mm", d["gap_mm"]["all_views"]}, {"floor_mm", d["floors"]["all_views_mm"]},

@@ -13,6 +13,7 @@
 
 #include <fmt/format.h>
 
+#include "drapegen/sim/blas_kernels.hpp"
 #include "drapegen/sim/drape.hpp"
 #include "drapegen/sim/ply.hpp"
 
@@ -57,6 +58,7 @@ double cpu_seconds() {
 }
 
 int main(int argc, char** argv) {
+  drapegen::sim::relaunch_with_blas_kernels(argv);  // the kernels drapegen runs on (blas_kernels.hpp)
   CLI::App app{"drape timing benchmark"};
   std::string data = DRAPEGEN_FABRIC_DATA_DEFAULT;
   int resolution = 100, fabrics = 5;
@@ -184,9 +186,10 @@ int main(int argc, char** argv) {
   }
   std::cout << fmt::format(
       "summary: {}x{} vertices, {} drapes, {} converged; seconds median {:.2f} max {:.2f}; CPU seconds median {:.2f} "
-      "max {:.2f}; full-resolution iterations median {:.0f} max {:.0f}; factorisation share median {:.0f}%\n",
+      "max {:.2f}; full-resolution iterations median {:.0f} max {:.0f}; factorisation share median {:.0f}%; BLAS {}\n",
       resolution, resolution, total, converged, median(seconds), *std::max_element(seconds.begin(), seconds.end()),
       median(cpu_times), *std::max_element(cpu_times.begin(), cpu_times.end()),
-      median(iterations), *std::max_element(iterations.begin(), iterations.end()), 100 * median(factor_share));
+      median(iterations), *std::max_element(iterations.begin(), iterations.end()), 100 * median(factor_share),
+      drapegen::sim::openblas_core_name().empty() ? "not OpenBLAS" : "OpenBLAS " + drapegen::sim::openblas_core_name());
   return converged == total ? 0 : 2;
 }

@@ -29,6 +29,7 @@
 
 #include <unistd.h>
 
+#include "drapegen/sim/blas_kernels.hpp"
 #include "drapegen/sim/bending.hpp"
 #include "drapegen/sim/dihedral.hpp"
 #include "drapegen/sim/drape.hpp"
@@ -574,6 +575,7 @@ void check_initial_states(Table& t, int n, const Options& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  drapegen::sim::relaunch_with_blas_kernels(argv);  // the kernels drapegen runs on (blas_kernels.hpp)
   Options options;
   CLI::App app{"physics checks of the drape (docs/BENCHMARKS.md): k/rho, rotation, sigma, mesh, initial states"};
   app.add_option("-r,--resolution", options.resolutions, "vertices per side (repeatable; default 60)");

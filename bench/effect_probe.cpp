@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 #include <iostream>
 
+#include "drapegen/sim/blas_kernels.hpp"
 #include "drapegen/diagnosis/reality.hpp"
 #include "drapegen/diagnosis/shape_features.hpp"
 #include "drapegen/sampler/fabric_data.hpp"
@@ -27,6 +28,7 @@ double median(std::vector<double> v) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  drapegen::sim::relaunch_with_blas_kernels(argv);  // the kernels drapegen runs on (blas_kernels.hpp)
   CLI::App app{"drapegen effect probe: effect vs control differences of the shape features"};
   std::string fabrics_path = DRAPEGEN_FABRIC_DATA_DEFAULT, work = "out/effect_probe";
   std::vector<int> fabric_rows{0, 2};

@@ -5,8 +5,11 @@
 #include <string>
 
 #include "commands.hpp"
+#include "drapegen/sim/blas_kernels.hpp"
 
 int main(int argc, char** argv) {
+  // Before anything else: on CPUs Debian's OpenBLAS does not know, start again on the kernels the CPU supports.
+  drapegen::sim::relaunch_with_blas_kernels(argv);
   CLI::App app{"drapegen - cloth drape simulation for learning fabric bending stiffness"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "drapegen 0.1.0");

@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 
 #include "commands.hpp"
+#include "drapegen/sim/blas_kernels.hpp"
 #include "drapegen/sim/drape.hpp"
 #include "drapegen/sim/logging.hpp"
 #include "drapegen/sim/ply.hpp"
@@ -154,6 +155,8 @@ int run_simulate(const SimulateOptions& o) {
   summary["density_g_per_m2"] = o.density;
   summary["init"] = o.init;
   summary["seed"] = o.seed;
+  const std::string blas = sim::openblas_core_name();
+  summary["blas_kernels"] = blas.empty() ? "not OpenBLAS" : "OpenBLAS " + blas;
   if (!o.effects.empty()) summary["effects"] = o.effects;
   if (!o.out.empty()) summary["mesh"] = o.out;
   if (o.json) {

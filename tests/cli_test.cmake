@@ -66,3 +66,25 @@ expect_failure(1 simulate --alpha 1000 --density 1e-320)
 expect_failure(1 cantilever --length 0.1 --alpha 1000 --segments 100000)
 expect_failure(1 cantilever --length -1 --alpha 1000)
 expect_failure(1 cantilever --length 0.1 --alpha 0)
+
+# The program runs on the BLAS kernels the CPU supports (blas_kernels.hpp): never on OpenBLAS's generic Prescott
+# kernels where the CPU has AVX2 and FMA, unless the user asked for them.
+execute_process(COMMAND ${CMAKE_COMMAND} -E env --unset=OPENBLAS_CORETYPE
+                        ${DRAPEGEN} simulate --alpha 30000 --resolution 6 --json
+                RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT code EQUAL 0)
+  message(FATAL_ERROR "simulate for the BLAS check failed (${code}): ${out} ${err}")
+endif()
+string(JSON blas GET "${out}" blas_kernels)
+file(READ /proc/cpuinfo cpuinfo LIMIT 20000)
+if(blas STREQUAL "OpenBLAS Prescott" AND cpuinfo MATCHES " avx2 " AND cpuinfo MATCHES " fma ")
+  message(FATAL_ERROR "drapegen runs on OpenBLAS's Prescott kernels on a CPU with AVX2 and FMA")
+endif()
+execute_process(COMMAND ${CMAKE_COMMAND} -E env OPENBLAS_CORETYPE=Prescott
+                        ${DRAPEGEN} simulate --alpha 30000 --resolution 6 --json
+                RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
+string(JSON blas GET "${out}" blas_kernels)
+if(NOT code EQUAL 0 OR (blas MATCHES "^OpenBLAS" AND NOT blas STREQUAL "OpenBLAS Prescott"))
+  message(FATAL_ERROR "the user's OPENBLAS_CORETYPE=Prescott was not kept: ${blas} (${code}) ${err}")
+endif()
+message(STATUS "BLAS kernels: ${blas}")

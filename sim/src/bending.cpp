@@ -152,28 +152,46 @@ double DihedralBending::update_lagged(const Eigen::Matrix3Xd& x) {
   return change;
 }
 
+namespace {
+
+double hinge_angle(const Eigen::Matrix3Xd& x, const Hinge& h) {
+  return dihedral_angle(x.col(h.v0), x.col(h.v1), x.col(h.v2), x.col(h.v3));
+}
+
+/// Whether a hinge whose angle is `after` at the end of a step folded through the wrap at +-pi on the way from
+/// `from`. A hinge that crossed the wrap ends near +-pi (past pi/2) on the other side, wherever it lands relative to
+/// the barrier; steps of less than pi are assumed, so a hinge that swings by more than pi through flat (from -1.7 to
+/// 1.7, say) is ruled out as well: that only shortens the step.
+bool wrapped(double after, const Eigen::Matrix3Xd& from, const Hinge& h) {
+  return std::abs(after) >= 0.5 * std::numbers::pi && std::abs(after - hinge_angle(from, h)) > std::numbers::pi;
+}
+
+}  // namespace
+
 bool DihedralBending::admissible_step(const Eigen::Matrix3Xd& from, const Eigen::Matrix3Xd& to) const {
-  for (const Hinge& h : hinges_) {
-    // A hinge that crossed the wrap ends near +-pi (past pi/2) on the other side, wherever it lands relative to the
-    // barrier; steps of less than pi are assumed, so a hinge that swings by more than pi through flat (from -1.7 to
-    // 1.7, say) is ruled out as well: that only shortens the step.
-    const double after = dihedral_angle(to.col(h.v0), to.col(h.v1), to.col(h.v2), to.col(h.v3));
-    if (std::abs(after) < 0.5 * std::numbers::pi) continue;
-    const double before = dihedral_angle(from.col(h.v0), from.col(h.v1), from.col(h.v2), from.col(h.v3));
-    if (std::abs(after - before) > std::numbers::pi) return false;
-  }
-  return true;
+  return std::none_of(hinges_.begin(), hinges_.end(),
+                      [&](const Hinge& h) { return wrapped(hinge_angle(to, h), from, h); });
+}
+
+double DihedralBending::hinge_energy(std::size_t i, double angle) const {
+  const double theta = angle - rest_angle_[i];
+  const double c = 2.0 / rest_[i].height_sum;
+  const double e = rest_[i].edge_length;
+  return e / c * laws_[i].work(c * std::abs(theta)) + FoldBarrier::energy(angle, e * c * laws_[i].alpha);
 }
 
 double DihedralBending::energy(const Eigen::Matrix3Xd& x) const {
   double total = 0.0;
+  for (std::size_t i = 0; i < hinges_.size(); ++i) total += hinge_energy(i, hinge_angle(x, hinges_[i]));
+  return total;
+}
+
+double DihedralBending::step_energy(const Eigen::Matrix3Xd& from, const Eigen::Matrix3Xd& to) const {
+  double total = 0.0;
   for (std::size_t i = 0; i < hinges_.size(); ++i) {
-    const Hinge& h = hinges_[i];
-    const double angle = dihedral_angle(x.col(h.v0), x.col(h.v1), x.col(h.v2), x.col(h.v3));
-    const double theta = angle - rest_angle_[i];
-    const double c = 2.0 / rest_[i].height_sum;
-    const double e = rest_[i].edge_length;
-    total += e / c * laws_[i].work(c * std::abs(theta)) + FoldBarrier::energy(angle, e * c * laws_[i].alpha);
+    const double angle = hinge_angle(to, hinges_[i]);
+    if (wrapped(angle, from, hinges_[i])) return std::numeric_limits<double>::infinity();
+    total += hinge_energy(i, angle);
   }
   return total;
 }

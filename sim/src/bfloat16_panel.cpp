@@ -1,6 +1,5 @@
 #include "drapegen/sim/bfloat16_panel.hpp"
 
-#include <bit>
 #include <cstddef>
 
 #if defined(__SSE2__)
@@ -8,14 +7,6 @@
 #endif
 
 namespace drapegen::sim {
-
-std::uint16_t to_bfloat16(float x) {
-  std::uint32_t bits = std::bit_cast<std::uint32_t>(x);
-  bits += 0x7FFFu + ((bits >> 16) & 1u);
-  return static_cast<std::uint16_t>(bits >> 16);
-}
-
-float from_bfloat16(std::uint16_t b) { return std::bit_cast<float>(static_cast<std::uint32_t>(b) << 16); }
 
 namespace {
 

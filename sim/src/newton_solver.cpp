@@ -44,12 +44,12 @@ using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
 /// The energy at the end of a straight step from `from` to `to`; infinite if a term rules the step out
-/// (EnergyTerm::admissible_step), so that the line search shortens it like any step that fails.
+/// (EnergyTerm::step_energy), so that the line search shortens it like any step that fails.
 double trial_energy(const std::vector<EnergyTerm*>& terms, const Eigen::Matrix3Xd& from, const Eigen::Matrix3Xd& to) {
   double e = 0.0;
   for (const EnergyTerm* t : terms) {
-    if (!t->admissible_step(from, to)) return std::numeric_limits<double>::infinity();
-    e += t->energy(to);
+    e += t->step_energy(from, to);
+    if (e == std::numeric_limits<double>::infinity()) break;
   }
   return e;
 }

@@ -108,6 +108,9 @@ TEST(FoldBarrier, LineSearchMayNotFoldThroughTheWrap) {
   EXPECT_FALSE(s.bending.admissible_step(folded(s.mesh, h, -1.7), folded(s.mesh, h, 1.7)));
   // What the line search sees: the energy is finite at both ends, but the step between them is ruled out.
   EXPECT_TRUE(std::isfinite(s.bending.energy(c)) && std::isfinite(s.bending.energy(d)));
+  EXPECT_EQ(s.bending.step_energy(c, d), std::numeric_limits<double>::infinity());
+  EXPECT_EQ(s.bending.step_energy(a, c), s.bending.energy(c));  // an admissible step: the energy at its end
+  EXPECT_EQ(s.bending.step_energy(c, a), s.bending.energy(a));
 }
 
 }  // namespace

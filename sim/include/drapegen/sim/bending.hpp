@@ -57,9 +57,11 @@ class DihedralBending final : public EnergyTerm {
   /// Recomputes each hinge's bending direction (curvature rule) and its torque law by Eq. 8.
   double update_lagged(const Eigen::Matrix3Xd& x) override;
   /// False if a hinge's angle wraps (changes by more than pi) between the two states: folded through pi.
-  [[nodiscard]] bool admissible_step(const Eigen::Matrix3Xd& from, const Eigen::Matrix3Xd& to) const override;
+  [[nodiscard]] bool admissible_step(const Eigen::Matrix3Xd& from, const Eigen::Matrix3Xd& to) const;
   /// Includes each hinge's fold barrier (fold_barrier.hpp).
   [[nodiscard]] double energy(const Eigen::Matrix3Xd& x) const override;
+  /// energy(to), or +infinity unless admissible_step(from, to); each hinge's angle at `to` is computed once.
+  [[nodiscard]] double step_energy(const Eigen::Matrix3Xd& from, const Eigen::Matrix3Xd& to) const override;
   double evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd* gradient, HessianSink* hessian) const override;
 
   [[nodiscard]] const std::vector<TorqueLaw>& laws() const { return laws_; }
@@ -78,6 +80,8 @@ class DihedralBending final : public EnergyTerm {
  private:
   /// Sets every hinge's torque law from its bending angle; returns the largest relative change of alpha or beta.
   double assign_laws();
+  /// Hinge i's energy at dihedral angle `angle`, fold barrier included.
+  [[nodiscard]] double hinge_energy(std::size_t i, double angle) const;
 
   const ClothMesh* mesh_;
   const Topology* topology_;

@@ -42,13 +42,13 @@ class EnergyTerm {
   /// (0 for terms without such quantities). The energy is a fixed function of x between two calls.
   virtual double update_lagged(const Eigen::Matrix3Xd& /*x*/) { return 0.0; }
 
-  /// Whether a straight step from `from` to `to` stays where the energy is defined (the line search shortens steps
-  /// that do not): a hinge may not fold through the wrap of its dihedral angle at pi in one step (fold_barrier.hpp).
-  [[nodiscard]] virtual bool admissible_step(const Eigen::Matrix3Xd& /*from*/, const Eigen::Matrix3Xd& /*to*/) const {
-    return true;
-  }
-
   [[nodiscard]] virtual double energy(const Eigen::Matrix3Xd& x) const = 0;
+  /// The energy at the end `to` of a straight step from `from`, or +infinity when the step leaves the region where
+  /// the energy is defined (the line search shortens such steps): a hinge may not fold through the wrap of its
+  /// dihedral angle at pi in one step (fold_barrier.hpp). One pass: the line search's cost per trial.
+  [[nodiscard]] virtual double step_energy(const Eigen::Matrix3Xd& /*from*/, const Eigen::Matrix3Xd& to) const {
+    return energy(to);
+  }
   /// Returns the energy, adds the gradient into `gradient` (3 x N) when non-null and hands every element Hessian
   /// to `hessian` when non-null.
   virtual double evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd* gradient, HessianSink* hessian) const = 0;
