@@ -123,19 +123,36 @@ double HessianAssembler::assemble(const Eigen::Matrix3Xd& x, HessianMode mode, E
 }
 
 void HessianAssembler::multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y, double shift) const {
-  const int n = dof_count();
+  // By 3x3 blocks (the pattern is one of vertex blocks: the three columns of a free vertex share their rows): one row
+  // index per block instead of nine, and the block's two products (below and above the diagonal) from one load.
   y = shift * x;
-  for (int j = 0; j < n; ++j) {
-    const double xj = x[j];
-    double yj = 0.0;
-    // The first stored entry of every column is its diagonal.
-    yj += values_[colptr_[j]] * xj;
-    for (int p = colptr_[j] + 1; p < colptr_[j + 1]; ++p) {
-      const int i = rowind_[p];
-      y[i] += values_[p] * xj;
-      yj += values_[p] * x[i];
+  const double* v = values_.data();
+  for (int j = 0; j < free_count_; ++j) {
+    const int p0 = colptr_[3 * j], p1 = colptr_[3 * j + 1], p2 = colptr_[3 * j + 2];
+    const double xj0 = x[3 * j], xj1 = x[3 * j + 1], xj2 = x[3 * j + 2];
+    // The diagonal block's lower triangle: column 0 holds rows 0-2, column 1 rows 1-2, column 2 row 2.
+    double yj0 = v[p0] * xj0 + v[p0 + 1] * xj1 + v[p0 + 2] * xj2;
+    double yj1 = v[p0 + 1] * xj0 + v[p1] * xj1 + v[p1 + 1] * xj2;
+    double yj2 = v[p0 + 2] * xj0 + v[p1 + 1] * xj1 + v[p2] * xj2;
+    // Then the blocks below it, column c of block k at column c's start + (3 - c) + 3 k.
+    const double* c0 = v + p0 + 3;
+    const double* c1 = v + p1 + 2;
+    const double* c2 = v + p2 + 1;
+    const int* rows = rowind_.data() + p0 + 3;
+    const int blocks = (p1 - p0 - 3) / 3;
+    for (int k = 0; k < blocks; ++k, c0 += 3, c1 += 3, c2 += 3) {
+      const int i = rows[3 * k];
+      const double xi0 = x[i], xi1 = x[i + 1], xi2 = x[i + 2];
+      y[i] += c0[0] * xj0 + c1[0] * xj1 + c2[0] * xj2;
+      y[i + 1] += c0[1] * xj0 + c1[1] * xj1 + c2[1] * xj2;
+      y[i + 2] += c0[2] * xj0 + c1[2] * xj1 + c2[2] * xj2;
+      yj0 += c0[0] * xi0 + c0[1] * xi1 + c0[2] * xi2;
+      yj1 += c1[0] * xi0 + c1[1] * xi1 + c1[2] * xi2;
+      yj2 += c2[0] * xi0 + c2[1] * xi1 + c2[2] * xi2;
     }
-    y[j] += yj;
+    y[3 * j] += yj0;
+    y[3 * j + 1] += yj1;
+    y[3 * j + 2] += yj2;
   }
 }
 
