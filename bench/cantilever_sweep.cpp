@@ -25,8 +25,8 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
-#include "drapegen/sim/blas_kernels.hpp"
 #include "drapegen/sim/anisotropy.hpp"
+#include "drapegen/sim/blas_kernels.hpp"
 #include "drapegen/sim/cantilever.hpp"
 #include "drapegen/sim/cantilever_fit.hpp"
 #include "drapegen/sim/elastica.hpp"

@@ -18,10 +18,10 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
-#include "drapegen/sim/blas_kernels.hpp"
 #include "drapegen/diagnosis/reality.hpp"
 #include "drapegen/renderer/random.hpp"
 #include "drapegen/sampler/fabric_data.hpp"
+#include "drapegen/sim/blas_kernels.hpp"
 
 namespace fs = std::filesystem;
 using namespace drapegen;

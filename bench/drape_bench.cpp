@@ -190,6 +190,6 @@ int main(int argc, char** argv) {
       resolution, resolution, total, converged, median(seconds), *std::max_element(seconds.begin(), seconds.end()),
       median(cpu_times), *std::max_element(cpu_times.begin(), cpu_times.end()),
       median(iterations), *std::max_element(iterations.begin(), iterations.end()), 100 * median(factor_share),
-      drapegen::sim::openblas_core_name().empty() ? "not OpenBLAS" : "OpenBLAS " + drapegen::sim::openblas_core_name());
+      drapegen::sim::blas_kernels_description());
   return converged == total ? 0 : 2;
 }

@@ -29,8 +29,8 @@
 
 #include <unistd.h>
 
-#include "drapegen/sim/blas_kernels.hpp"
 #include "drapegen/sim/bending.hpp"
+#include "drapegen/sim/blas_kernels.hpp"
 #include "drapegen/sim/dihedral.hpp"
 #include "drapegen/sim/drape.hpp"
 #include "drapegen/sim/measures.hpp"

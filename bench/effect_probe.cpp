@@ -9,10 +9,10 @@
 #include <fmt/format.h>
 #include <iostream>
 
-#include "drapegen/sim/blas_kernels.hpp"
 #include "drapegen/diagnosis/reality.hpp"
 #include "drapegen/diagnosis/shape_features.hpp"
 #include "drapegen/sampler/fabric_data.hpp"
+#include "drapegen/sim/blas_kernels.hpp"
 
 namespace fs = std::filesystem;
 using namespace drapegen;

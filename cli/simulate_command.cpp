@@ -155,8 +155,7 @@ int run_simulate(const SimulateOptions& o) {
   summary["density_g_per_m2"] = o.density;
   summary["init"] = o.init;
   summary["seed"] = o.seed;
-  const std::string blas = sim::openblas_core_name();
-  summary["blas_kernels"] = blas.empty() ? "not OpenBLAS" : "OpenBLAS " + blas;
+  summary["blas_kernels"] = sim::blas_kernels_description();
   if (!o.effects.empty()) summary["effects"] = o.effects;
   if (!o.out.empty()) summary["mesh"] = o.out;
   if (o.json) {

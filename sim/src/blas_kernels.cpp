@@ -1,6 +1,7 @@
 #include "drapegen/sim/blas_kernels.hpp"
 
 #include <dlfcn.h>
+#include <sys/auxv.h>
 #include <unistd.h>
 
 #include <cstdlib>
@@ -33,14 +34,27 @@ std::string openblas_coretype_to_request(std::string_view core_name, const char*
   return cpu.avx512 ? "SkylakeX" : "Haswell";
 }
 
+std::string blas_kernels_description() {
+  const std::string core = openblas_core_name();
+  return core.empty() ? "not OpenBLAS" : "OpenBLAS " + core;
+}
+
 void relaunch_with_blas_kernels(char** argv) {
   const std::string coretype =
       openblas_coretype_to_request(openblas_core_name(), std::getenv("OPENBLAS_CORETYPE"), cpu_vector_units());
   if (coretype.empty() || argv == nullptr || argv[0] == nullptr) return;
+  // Only a program the kernel started through its ELF interpreter is /proc/self/exe: one started as
+  // `ld-linux.so PROGRAM ...` is the loader there (AT_BASE 0), and restarting that would run the wrong program.
+  if (getauxval(AT_BASE) == 0) return;
+  // The program's own path rather than /proc/self/exe, so that the restarted process keeps its name (ps, pkill).
+  char path[4096];
+  const ssize_t length = readlink("/proc/self/exe", path, sizeof(path) - 1);
+  if (length <= 0) return;
+  path[length] = '\0';
   if (setenv("OPENBLAS_CORETYPE", coretype.c_str(), 1) != 0) return;
-  execv("/proc/self/exe", argv);
-  // Still here: the restart failed (no /proc, say). Carry on with the kernels there are; leave the variable set so
-  // that programs this one starts do not try again either.
+  execv(path, argv);
+  // Still here: the restart failed (the file was replaced, say). Carry on with the kernels there are; leave the
+  // variable set so that programs this one starts do not try again either.
 }
 
 }  // namespace drapegen::sim

@@ -49,7 +49,7 @@ double trial_energy(const std::vector<EnergyTerm*>& terms, const Eigen::Matrix3X
   double e = 0.0;
   for (const EnergyTerm* t : terms) {
     e += t->step_energy(from, to);
-    if (e == std::numeric_limits<double>::infinity()) break;
+    if (!std::isfinite(e)) break;  // ruled out (or not a number): the line search shortens the step
   }
   return e;
 }

@@ -4,8 +4,8 @@
 
 #include <algorithm>
 #include <cstdint>
-#include <cstring>
 #include <mutex>
+#include <utility>
 #include <vector>
 
 #ifdef DRAPEGEN_HAVE_OPENMP
@@ -80,8 +80,13 @@ struct SparseCholesky::Impl {
   bool parallel = false;
   cholmod_common common{};
   cholmod_factor* factor = nullptr;
-  std::vector<int> colptr, rowind;
+  // The matrix CHOLMOD factorises: the lower triangle of P A P^T, P the fill-reducing order of the first analysis,
+  // in compressed columns. Handed over already permuted, it is factorised as it stands (natural ordering, lower
+  // triangle); the assembler's own layout would cost CHOLMOD two transposes per factorisation (3% of a drape).
+  // order[k]: the DOF at position k; scatter[p]: where the assembler's value p goes.
+  std::vector<int> colptr, rowind, order, scatter;
   std::vector<double> values;
+  Eigen::VectorXd permuted_rhs;
   bool analysed = false;
   // The preconditioner's compact copy of a supernodal factor, made on first use after each factorisation (empty
   // until then): per supernode, its diagonal block packed in single precision (packed_triangle.hpp) and the rows below it in single precision or,
@@ -99,7 +104,7 @@ struct SparseCholesky::Impl {
     const int* super = static_cast<const int*>(factor->super);
     const int* pi = static_cast<const int*>(factor->pi);
     const int* s = static_cast<const int*>(factor->s);
-    const int* perm = static_cast<const int*>(factor->Perm);
+    const int* perm = order.data();
     const int nsuper = static_cast<int>(factor->nsuper);
     const int n = static_cast<int>(factor->n);
     work.resize(n);
@@ -181,13 +186,71 @@ struct SparseCholesky::Impl {
     cholmod_finish(&common);
   }
 
-  cholmod_sparse view() {
+  /// Finds the fill-reducing order of the assembler's pattern (nested dissection, postordered), builds the
+  /// permuted pattern and the scatter map, and analyses the permuted pattern in its natural order. False on failure.
+  bool analyse(const HessianAssembler& matrix) {
+    const int n = matrix.dof_count();
+    const std::vector<int>& cp = matrix.column_pointers();
+    const std::vector<int>& ri = matrix.row_indices();
+    cholmod_sparse a = view_of(cp, ri, matrix.values());
+    cholmod_factor* ordering = cholmod_analyze(&a, &common);
+    if (ordering == nullptr || common.status < CHOLMOD_OK) return false;
+    const int method = common.method[common.selected].ordering;
+    order.assign(static_cast<const int*>(ordering->Perm), static_cast<const int*>(ordering->Perm) + n);
+    cholmod_free_factor(&ordering, &common);
+    std::vector<int> position(n);
+    for (int k = 0; k < n; ++k) position[order[k]] = k;
+    // Entry (i, j) of the lower triangle goes to (max, min) of its new positions: count per new column, then fill.
+    colptr.assign(n + 1, 0);
+    for (int j = 0; j < n; ++j) {
+      for (int p = cp[j]; p < cp[j + 1]; ++p) ++colptr[std::min(position[ri[p]], position[j]) + 1];
+    }
+    for (int k = 0; k < n; ++k) colptr[k + 1] += colptr[k];
+    std::vector<std::pair<int, int>> entries(cp[n]);  // (new row, assembler index), by new column
+    std::vector<int> next(colptr.begin(), colptr.end() - 1);
+    for (int j = 0; j < n; ++j) {
+      for (int p = cp[j]; p < cp[j + 1]; ++p) {
+        const int r = position[ri[p]], c = position[j];
+        entries[next[std::min(r, c)]++] = {std::max(r, c), p};
+      }
+    }
+    rowind.resize(cp[n]);
+    scatter.resize(cp[n]);
+    for (int k = 0; k < n; ++k) {
+      std::sort(entries.begin() + colptr[k], entries.begin() + colptr[k + 1]);
+      for (int q = colptr[k]; q < colptr[k + 1]; ++q) {
+        rowind[q] = entries[q].first;
+        scatter[entries[q].second] = q;
+      }
+    }
+    values.assign(cp[n], 0.0);
+    // The permuted matrix is already in elimination order (postordered by the first analysis): keep it.
+    const int saved_nmethods = common.nmethods, saved_ordering = common.method[0].ordering;
+    const int saved_postorder = common.postorder;
+    common.nmethods = 1;
+    common.method[0].ordering = CHOLMOD_NATURAL;
+    common.postorder = 0;
+    cholmod_sparse b = view();
+    factor = cholmod_analyze(&b, &common);
+    common.nmethods = saved_nmethods;
+    common.method[0].ordering = saved_ordering;
+    common.postorder = saved_postorder;
+    if (factor == nullptr || common.status < CHOLMOD_OK || factor->ordering != CHOLMOD_NATURAL) {
+      if (factor != nullptr) cholmod_free_factor(&factor, &common);
+      return false;
+    }
+    logger()->debug("cholmod: n {} nnz(A) {} nnz(L) {:.0f} xsize {} nsuper {} flops {:.3g} supernodal {} ordering {}",
+                    n, cp[n], common.lnz, factor->xsize, factor->nsuper, common.fl, factor->is_super, method);
+    return true;
+  }
+
+  static cholmod_sparse view_of(const std::vector<int>& cp, const std::vector<int>& ri, const std::vector<double>& x) {
     cholmod_sparse a{};
-    a.nrow = a.ncol = colptr.size() - 1;
-    a.nzmax = values.size();
-    a.p = colptr.data();
-    a.i = rowind.data();
-    a.x = values.data();
+    a.nrow = a.ncol = cp.size() - 1;
+    a.nzmax = x.size();
+    a.p = const_cast<int*>(cp.data());
+    a.i = const_cast<int*>(ri.data());
+    a.x = const_cast<double*>(x.data());
     a.stype = -1;  // lower triangle stored
     a.itype = CHOLMOD_INT;
     a.xtype = CHOLMOD_REAL;
@@ -196,6 +259,8 @@ struct SparseCholesky::Impl {
     a.packed = 1;
     return a;
   }
+
+  cholmod_sparse view() { return view_of(colptr, rowind, values); }
 };
 
 SparseCholesky::SparseCholesky(bool parallel) : impl_(std::make_unique<Impl>()) { impl_->parallel = parallel; }
@@ -203,24 +268,18 @@ SparseCholesky::~SparseCholesky() = default;
 
 FactorStatus SparseCholesky::factorize(const HessianAssembler& matrix, double shift) {
   Impl& m = *impl_;
-  if (!m.analysed) {
-    m.colptr = matrix.column_pointers();
-    m.rowind = matrix.row_indices();
-  }
-  m.values = matrix.values();
-  if (shift != 0.0) {
-    for (int p : matrix.diagonal_positions()) m.values[p] += shift;
-  }
-  cholmod_sparse a = m.view();
   const std::lock_guard blas(blas_mutex());
   const SerialOpenMp serial(!m.parallel);
   if (!m.analysed) {
-    m.factor = cholmod_analyze(&a, &m.common);
-    if (m.factor == nullptr || m.common.status < CHOLMOD_OK) return FactorStatus::kFailed;
+    if (!m.analyse(matrix)) return FactorStatus::kFailed;
     m.analysed = true;
-    logger()->debug("cholmod: n {} nnz(A) {} nnz(L) {:.0f} xsize {} nsuper {} flops {:.3g} supernodal {} ordering {}", a.nrow, a.nzmax,
-                    m.common.lnz, m.factor->xsize, m.factor->nsuper, m.common.fl, m.factor->is_super, m.common.method[m.common.selected].ordering);
   }
+  const std::vector<double>& values = matrix.values();
+  for (std::size_t p = 0; p < values.size(); ++p) m.values[m.scatter[p]] = values[p];
+  if (shift != 0.0) {
+    for (int p : matrix.diagonal_positions()) m.values[m.scatter[p]] += shift;
+  }
+  cholmod_sparse a = m.view();
   m.diagonal.clear();
   const int ok = cholmod_factorize(&a, m.factor, &m.common);
   if (m.common.status == CHOLMOD_NOT_POSDEF) return FactorStatus::kNotPositiveDefinite;
@@ -230,13 +289,16 @@ FactorStatus SparseCholesky::factorize(const HessianAssembler& matrix, double sh
 
 bool SparseCholesky::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution) {
   Impl& m = *impl_;
-  if (m.factor == nullptr) return false;
+  if (m.factor == nullptr || rhs.size() != static_cast<Eigen::Index>(m.order.size())) return false;
+  // The factor is of P A P^T: solve (P A P^T) y = P rhs, then the solution is P^T y.
+  m.permuted_rhs.resize(rhs.size());
+  for (Eigen::Index k = 0; k < rhs.size(); ++k) m.permuted_rhs[k] = rhs[m.order[k]];
   cholmod_dense b{};
   b.nrow = static_cast<size_t>(rhs.size());
   b.ncol = 1;
   b.nzmax = b.nrow;
   b.d = b.nrow;
-  b.x = const_cast<double*>(rhs.data());
+  b.x = m.permuted_rhs.data();
   b.xtype = CHOLMOD_REAL;
   b.dtype = CHOLMOD_DOUBLE;
   cholmod_dense* x = nullptr;
@@ -246,7 +308,8 @@ bool SparseCholesky::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution
   }
   if (x == nullptr) return false;
   solution.resize(rhs.size());
-  std::memcpy(solution.data(), x->x, sizeof(double) * static_cast<size_t>(rhs.size()));
+  const double* y = static_cast<const double*>(x->x);
+  for (Eigen::Index k = 0; k < rhs.size(); ++k) solution[m.order[k]] = y[k];
   cholmod_free_dense(&x, &m.common);
   return solution.allFinite();
 }

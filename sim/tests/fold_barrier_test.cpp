@@ -91,6 +91,27 @@ TEST(FoldBarrier, BendingDerivativesInsideTheBarrier) {
   }
 }
 
+TEST(FoldBarrier, StepEnergyIsTheEnergyAtTheEndOfAnAdmissibleStep) {
+  const ClothMesh mesh = make_specimen(SpecimenSpec{0.03, 0.03, 4, 4, 0.0, Triangulation::kAlternating, 0, 0.0});
+  const Topology topology = build_topology(mesh);
+  const DihedralBending bending{mesh, topology, DihedralModuli{{1e-5, 2e-5, 3e-5}, {-1e-8, -2e-8, -1e-8}},
+                                AnisotropyRule::kCurvature};
+  ASSERT_GT(topology.hinges.size(), 10u);
+  Eigen::Matrix3Xd wavy = mesh.positions;
+  for (int v = 0; v < mesh.vertex_count(); ++v) {
+    wavy(2, v) += 0.003 * std::sin(150.0 * wavy(0, v)) * std::cos(110.0 * wavy(1, v));
+  }
+  // Both ways between a flat and a wavy state: exactly the energy at the end (same hinges, same order of the sum).
+  EXPECT_EQ(bending.step_energy(mesh.positions, wavy), bending.energy(wavy));
+  EXPECT_EQ(bending.step_energy(wavy, mesh.positions), bending.energy(mesh.positions));
+  // A wrap in the last hinge, not the first, rules the step out as well.
+  const Hinge& h = topology.hinges.back();
+  const Eigen::Matrix3Xd near_pi = folded(mesh, h, 3.1), past_pi = folded(mesh, h, -3.0);
+  EXPECT_FALSE(bending.admissible_step(near_pi, past_pi));
+  EXPECT_EQ(bending.step_energy(near_pi, past_pi), std::numeric_limits<double>::infinity());
+  EXPECT_EQ(bending.step_energy(folded(mesh, h, 2.0), near_pi), bending.energy(near_pi));
+}
+
 TEST(FoldBarrier, LineSearchMayNotFoldThroughTheWrap) {
   OneHinge s;
   const Hinge& h = s.topology.hinges[0];

@@ -3,10 +3,13 @@
 //
 // CHOLMOD's supernodal factorisation spends most of its time in BLAS (dgemm, dtrsm). Debian 12's OpenBLAS (0.3.21,
 // built for every x86-64 generation at once) picks its kernels from the CPU model when it is loaded, and on Intel
-// models it does not know (Sapphire and Emerald Rapids, for one) it falls back to its generic SSE3 "Prescott"
-// kernels (OpenMathLib/OpenBLAS#4267, fixed in 0.3.25): the factorisations of a 100x100 drape then take ~1.4x as
-// long (docs/BENCHMARKS.md). OpenBLAS reads the environment variable OPENBLAS_CORETYPE once, when it is loaded, so
-// only a fresh start of the program can change the choice: relaunch_with_blas_kernels() does that for a main().
+// models it does not know (the development machine's Xeon, family 6 model 207, for one) it falls back to its
+// generic SSE3 "Prescott" kernels (the fallback of OpenMathLib/OpenBLAS#4267, fixed in 0.3.25): the factorisations
+// of a 100x100 drape then take ~1.5x as long (docs/BENCHMARKS.md). OpenBLAS reads the environment variable
+// OPENBLAS_CORETYPE once, when it is loaded, so only a fresh start of the program can change the choice:
+// relaunch_with_blas_kernels() does that for a main(). Setting OPENBLAS_CORETYPE (to any value) turns the restart
+// off, e.g. for a debugger. The variable passes on to the programs drapegen starts (its local workers: the same
+// program on the same CPU).
 
 #include <string>
 #include <string_view>
@@ -16,6 +19,8 @@ namespace drapegen::sim {
 /// OpenBLAS's name for the kernels this process runs ("Haswell", "SkylakeX", "Prescott", ...), or an empty string
 /// when the BLAS in use is not OpenBLAS.
 [[nodiscard]] std::string openblas_core_name();
+/// "OpenBLAS <core name>", or "not OpenBLAS": for reports.
+[[nodiscard]] std::string blas_kernels_description();
 
 /// What the CPU offers that OpenBLAS's kernels use.
 struct CpuVectorUnits {
@@ -34,8 +39,9 @@ struct CpuVectorUnits {
 
 /// For a program's main(), before it does anything else: when openblas_coretype_to_request() names kernels for this
 /// process, sets OPENBLAS_CORETYPE and replaces the process by the same program with the same arguments (execv of
-/// /proc/self/exe), which then runs on those kernels. Returns, having changed nothing, when no change is due or the
-/// restart is impossible (the restarted process has OPENBLAS_CORETYPE set, so it never restarts again).
+/// the file /proc/self/exe names; same process id), which then runs on those kernels. Returns, having changed
+/// nothing, when no change is due or the restart is impossible or unsafe (a program started through the dynamic
+/// loader by hand). The restarted process has OPENBLAS_CORETYPE set, so it never restarts again.
 void relaunch_with_blas_kernels(char** argv);
 
 }  // namespace drapegen::sim
