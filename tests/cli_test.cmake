@@ -71,26 +71,24 @@ expect_failure(1 cantilever --length 0.1 --alpha 0)
 # kernels where the CPU has AVX2 and FMA, unless the user asked for them. Only for an x86-64 OpenBLAS that chooses
 # its kernels at run time (DYNAMIC_ARCH: mixed-case core names such as "Haswell"; other builds report their build
 # target in capitals and ignore OPENBLAS_CORETYPE).
-execute_process(COMMAND ${CMAKE_COMMAND} -E env --unset=OPENBLAS_CORETYPE
-                        ${DRAPEGEN} simulate --alpha 30000 --resolution 6 --json
-                RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
-if(NOT code EQUAL 0)
-  message(FATAL_ERROR "simulate for the BLAS check failed (${code}): ${out} ${err}")
-endif()
-string(JSON blas GET "${out}" blas_kernels)
+function(blas_kernels_with environment result)
+  execute_process(COMMAND ${CMAKE_COMMAND} -E env ${environment} ${DRAPEGEN} simulate --alpha 30000 --resolution 6 --json
+                  RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT code EQUAL 0)
+    message(FATAL_ERROR "simulate for the BLAS check (${environment}) failed (${code}): ${out} ${err}")
+  endif()
+  string(JSON blas GET "${out}" blas_kernels)
+  set(${result} "${blas}" PARENT_SCOPE)
+endfunction()
+blas_kernels_with(--unset=OPENBLAS_CORETYPE blas)
 message(STATUS "BLAS kernels: ${blas}")
-if(CMAKE_HOST_SYSTEM_PROCESSOR MATCHES "x86_64|AMD64" AND blas MATCHES "^OpenBLAS [A-Z][a-z]" AND EXISTS /proc/cpuinfo)
+cmake_host_system_information(RESULT architecture QUERY OS_PLATFORM)  # (script mode has no CMAKE_HOST_SYSTEM_PROCESSOR)
+if(architecture MATCHES "x86_64|AMD64" AND blas MATCHES "^OpenBLAS [A-Z][a-z]" AND EXISTS /proc/cpuinfo)
   file(READ /proc/cpuinfo cpuinfo LIMIT 20000)
   if(blas STREQUAL "OpenBLAS Prescott" AND cpuinfo MATCHES " avx2 " AND cpuinfo MATCHES " fma ")
     message(FATAL_ERROR "drapegen runs on OpenBLAS's Prescott kernels on a CPU with AVX2 and FMA")
   endif()
-  execute_process(COMMAND ${CMAKE_COMMAND} -E env OPENBLAS_CORETYPE=Prescott
-                          ${DRAPEGEN} simulate --alpha 30000 --resolution 6 --json
-                  RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
-  if(NOT code EQUAL 0)
-    message(FATAL_ERROR "simulate with OPENBLAS_CORETYPE=Prescott failed (${code}): ${out} ${err}")
-  endif()
-  string(JSON blas GET "${out}" blas_kernels)
+  blas_kernels_with(OPENBLAS_CORETYPE=Prescott blas)
   if(NOT blas STREQUAL "OpenBLAS Prescott")
     message(FATAL_ERROR "the user's OPENBLAS_CORETYPE=Prescott was not kept: ${blas}")
   endif()
