@@ -270,8 +270,18 @@ void check_rotation(Table& t, int n, const Options& o) {
   std::swap(weft.fabric.alpha.warp, weft.fabric.alpha.weft);
   std::swap(weft.fabric.beta.warp, weft.fabric.beta.weft);
   const Run a = run("b: warp 4 x weft", warp), b = run("b: weft 4 x warp", weft);
-  const double swap = grid_transpose_defect(n, a.result.mesh.positions, b.result.mesh.positions) * kMm;
-  t.row(n, "b", "warp/weft swapped vs drape mirrored in x = y: max distance, mm", swap, "< 0.1", swap < 0.1);
+  // The mirrored problem numbers its DOFs differently, so its rounding differs; the default solver's inexact steps
+  // amplify that as far as the drape is determined (a restart from 1 um noise moves this one by ~1.7 mm, below), so
+  // the bound applies to exact Newton steps, as for k/rho (check a).
+  t.row(n, "b", "warp/weft swapped vs drape mirrored in x = y: max distance (default solver), mm",
+        grid_transpose_defect(n, a.result.mesh.positions, b.result.mesh.positions) * kMm);
+  DrapeConfig exact_warp = warp, exact_weft = weft;
+  exact_warp.solver.max_pcg_iterations = exact_weft.solver.max_pcg_iterations = 0;
+  const double swap = grid_transpose_defect(n, run("b: warp 4 x weft, exact Newton", exact_warp).result.mesh.positions,
+                                            run("b: weft 4 x warp, exact Newton", exact_weft).result.mesh.positions) *
+                      kMm;
+  t.row(n, "b", "warp/weft swapped vs drape mirrored in x = y: max distance (exact Newton steps), mm", swap, "< 0.1",
+        swap < 0.1);
   t.row(n, "b", "warp/weft swapped vs drape rotated 90 deg: max distance, mm",
         grid_rotation_defect(n, a.result.mesh.positions, b.result.mesh.positions) * kMm);
   t.row(n, "b", "warp 4x: mirror (x -> -x) symmetry defect of the drape, mm",
