@@ -56,6 +56,10 @@ bool DihedralModuli::isotropic() const {
 
 namespace {
 
+double hinge_angle(const Eigen::Matrix3Xd& x, const Hinge& h) {
+  return dihedral_angle(x.col(h.v0), x.col(h.v1), x.col(h.v2), x.col(h.v3));
+}
+
 void validate_directional(const DirectionalValues& v, const char* what, bool positive) {
   for (double x : {v.warp, v.bias, v.weft}) {
     if (!std::isfinite(x) || (positive && !(x > 0.0))) {
@@ -141,7 +145,7 @@ double DihedralBending::update_lagged(const Eigen::Matrix3Xd& x) {
       const Hinge& h = hinges_[i];
       const double c = 2.0 / rest_[i].height_sum;
       const double limit = std::min(yield_curvature_, laws_[i].peak_curvature()) / c;
-      const double theta = dihedral_angle(x.col(h.v0), x.col(h.v1), x.col(h.v2), x.col(h.v3));
+      const double theta = hinge_angle(x, h);
       const double elastic = theta - rest_angle_[i];
       if (std::abs(elastic) <= limit) continue;
       const double flow = elastic - std::copysign(limit, elastic);
@@ -153,10 +157,6 @@ double DihedralBending::update_lagged(const Eigen::Matrix3Xd& x) {
 }
 
 namespace {
-
-double hinge_angle(const Eigen::Matrix3Xd& x, const Hinge& h) {
-  return dihedral_angle(x.col(h.v0), x.col(h.v1), x.col(h.v2), x.col(h.v3));
-}
 
 /// Whether a hinge whose angle is `after` at the end of a step folded through the wrap at +-pi on the way from
 /// `from`. A hinge that crossed the wrap ends near +-pi (past pi/2) on the other side, wherever it lands relative to
