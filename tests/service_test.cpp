@@ -39,6 +39,7 @@ TEST(Service, EndToEndWithTwoWorkers) {
                 (dir / "stats").string());
   ASSERT_EQ(stats.wait(30s), 0) << stats.err();
   EXPECT_NE(stats.out().find("\"done\": 8"), std::string::npos) << stats.out();
+  EXPECT_NE(stats.out().find("\"bending_model\": \"dihedral\""), std::string::npos) << stats.out();
   EXPECT_TRUE(fs::exists(dir / "plots" / "drape_coefficient.svg"));
   // A second run into the same output refuses, naming --resume, in one line.
   Process again({"run", "--config", (dir / "run.toml").string()}, (dir / "again").string());

@@ -32,6 +32,7 @@ sim::Expected<v1::Job> make_job_message(const RunConfig& config, const storage::
   spec->set_orientations(config.orientations);
   spec->set_noise(config.noise);
   spec->set_renderer(config.renderer);
+  spec->set_bending_model(config.bending_model);
   spec->set_render_seed(rec.render_seed);
   spec->set_max_iterations(config.max_iterations);
   spec->set_tolerance(config.tolerance);

@@ -105,7 +105,7 @@ sim::Expected<RunConfig> parse_run_config(const std::string& toml_text, const st
   Reader r(root, source_name);
   r.only_keys(&root, "",
               {"seed", "samples", "states_per_sample", "orientations", "resolution", "noise", "renderer", "density",
-               "output", "model", "recipes", "solver", "network", "security", "retry", "progress", "testing"});
+               "bending_model", "output", "model", "recipes", "solver", "network", "security", "retry", "progress", "testing"});
   if (const toml::node* seed = root.get("seed")) {
     if (!seed->is_integer() || seed->as_integer()->get() < 0) {
       r.fail("seed", "must be a non-negative integer");
@@ -120,6 +120,7 @@ sim::Expected<RunConfig> parse_run_config(const std::string& toml_text, const st
   r.text(&root, "", "noise", c.noise, {"kinect", "none"});
   r.text(&root, "", "renderer", c.renderer, {"osmesa", "software"});
   r.real(&root, "", "density", c.density, 1.0, 1e5);
+  r.text(&root, "", "bending_model", c.bending_model, {"dihedral", "triangle"});
   r.text(&root, "", "output", c.output);
   r.text(&root, "", "model", c.model);
   if (r.ok() && c.output.empty()) r.fail("output", "must not be empty");
@@ -209,6 +210,7 @@ states_per_sample = 4   # initial states per vector (paper: 8)
 orientations = 2        # data points of 4 depth views per drape (paper: 12)
 resolution = 25         # vertices per side of the 300 mm specimen (paper: 100)
 noise = "kinect"
+bending_model = "dihedral"   # or "triangle": mesh-independent, about 3x slower (docs/PHYSICS.md)
 output = "out/local-run"
 
 [solver]

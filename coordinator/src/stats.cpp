@@ -7,6 +7,7 @@
 #include <fstream>
 #include <map>
 
+#include "drapegen/coordinator/run_config.hpp"
 #include "drapegen/sampler/fabric_data.hpp"
 #include "drapegen/sampler/parameters.hpp"
 #include "drapegen/sampler/vae_model.hpp"
@@ -66,6 +67,10 @@ sim::Expected<Data> gather(const std::string& manifest_path, const StatsOptions&
   s["manifest"] = manifest_path;
   s["run"] = {{"seed", run->seed}, {"state", run->state}, {"code_version", run->code_version},
               {"total_jobs", run->total_jobs}, {"samples", samples->size()}};
+  // The stored configuration was validated when the run was planned; one that no longer parses (a manifest of
+  // another version) leaves the model unnamed rather than guessed.
+  const auto config = parse_run_config(run->config_toml, manifest_path);
+  s["run"]["bending_model"] = config ? config->bending_model : std::string("unknown");
 
   std::map<std::string, std::int64_t> by_state, by_reason, attempts_by_reason;
   for (const auto& state : {"pending", "done", "failed"}) by_state[state] = 0;
@@ -248,9 +253,10 @@ sim::Expected<nlohmann::json> compute_stats(const std::string& manifest_path, co
 std::string format_stats(const nlohmann::json& s) {
   std::string out;
   const auto& states = s["jobs"]["by_state"];
-  out += fmt::format("manifest {} (run {}, seed {}): {} jobs: {} done, {} failed, {} pending\n",
+  out += fmt::format("manifest {} (run {}, seed {}, bending model {}): {} jobs: {} done, {} failed, {} pending\n",
                      s["manifest"].get<std::string>(), s["run"]["state"].get<std::string>(),
-                     s["run"]["seed"].get<std::uint64_t>(), s["run"]["total_jobs"].get<std::int64_t>(),
+                     s["run"]["seed"].get<std::uint64_t>(), s["run"]["bending_model"].get<std::string>(),
+                     s["run"]["total_jobs"].get<std::int64_t>(),
                      states["done"].get<std::int64_t>(), states["failed"].get<std::int64_t>(),
                      states["pending"].get<std::int64_t>());
   if (!s["jobs"]["failed_by_reason"].empty() || s["jobs"]["failed_attempts"].get<std::int64_t>() > 0) {

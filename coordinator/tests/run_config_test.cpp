@@ -21,6 +21,7 @@ resolution = 15
 noise = "none"
 renderer = "software"
 density = 250
+bending_model = "triangle"
 output = "x"
 model = ""
 [recipes]
@@ -53,6 +54,7 @@ poison_samples = [1, 2]
   EXPECT_EQ(c->noise, "none");
   EXPECT_EQ(c->renderer, "software");
   EXPECT_EQ(c->density, 250.0);
+  EXPECT_EQ(c->bending_model, "triangle");
   EXPECT_EQ(c->weight_fold, 0.5);
   EXPECT_EQ(c->max_self_intersections, 3);
   EXPECT_EQ(c->lease_s, 60.0);
@@ -67,6 +69,8 @@ TEST(RunConfig, NamesTheKeyOfEveryError) {
   EXPECT_EQ(error_of("sampels = 3"), "run.toml: sampels: unknown key");
   EXPECT_EQ(error_of("noise = \"loud\""), "run.toml: noise: 'loud' is not one of kinect, none");
   EXPECT_EQ(error_of("renderer = \"gpu\""), "run.toml: renderer: 'gpu' is not one of osmesa, software");
+  EXPECT_EQ(error_of("bending_model = \"quadratic\""),
+            "run.toml: bending_model: 'quadratic' is not one of dihedral, triangle");
   EXPECT_EQ(error_of("[solver]\ntolerance = \"small\""), "run.toml: solver.tolerance: must be a number");
   EXPECT_EQ(error_of("[network]\nbind = \"http://x\""),
             "run.toml: network.bind: must be a tcp:// or ipc:// endpoint, e.g. tcp://127.0.0.1:5555");

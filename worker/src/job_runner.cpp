@@ -56,6 +56,11 @@ sim::Expected<sim::DrapeConfig> drape_config(const v1::JobSpec& spec, const std:
   if (!recipe) return recipe.error();
   const auto& p = spec.parameters();
   sim::DrapeConfig config;
+  if (spec.bending_model() == "triangle") {
+    config.bending_model = sim::BendingModel::kNonlinearTriangle;
+  } else if (!spec.bending_model().empty() && spec.bending_model() != "dihedral") {
+    return sim::Error{fmt::format("unknown bending model '{}' (dihedral or triangle)", spec.bending_model())};
+  }
   config.fabric = sim::fabric_from_paper_units({p.alpha_warp(), p.alpha_bias(), p.alpha_weft()},
                                                {p.beta_warp(), p.beta_bias(), p.beta_weft()}, p.density_g_per_m2());
   if (sim::Status s = sim::validate(config.fabric, config.bending_model); !s) return s.error();

@@ -113,6 +113,39 @@ TEST(JobRunner, RendersWithTheJobsRenderer) {
   EXPECT_GT(agree, 0.99 * compared) << agree << " of " << compared;
 }
 
+// The job names its bending model: "triangle" drapes with per-triangle curvature tensors (another converged drape
+// of the same job), "dihedral" and an empty name are the paper's model, and any other name is an invalid job.
+TEST(JobRunner, DrapesWithTheJobsBendingModel) {
+  const auto config_for = [](const char* model) {
+    v1::Job job = tiny_job(v1::JOB_MODE_DRAPE);
+    job.mutable_spec()->set_bending_model(model);
+    return drape_config(job.spec(), "");
+  };
+  ASSERT_TRUE(config_for("") && config_for("dihedral") && config_for("triangle"));
+  EXPECT_EQ(config_for("")->bending_model, sim::BendingModel::kNonlinearDihedral);
+  EXPECT_EQ(config_for("dihedral")->bending_model, sim::BendingModel::kNonlinearDihedral);
+  EXPECT_EQ(config_for("triangle")->bending_model, sim::BendingModel::kNonlinearTriangle);
+  ASSERT_FALSE(config_for("quadratic"));
+  EXPECT_EQ(config_for("quadratic").error().message, "unknown bending model 'quadratic' (dihedral or triangle)");
+
+  JobRunner runner(scratch());
+  v1::Job job = tiny_job(v1::JOB_MODE_DRAPE);
+  job.mutable_spec()->set_bending_model("quadratic");
+  const auto refused = runner.run(job);
+  ASSERT_EQ(refused.body_case(), v1::Envelope::kFailure);
+  EXPECT_EQ(refused.failure().reason(), v1::FAILURE_REASON_INVALID_JOB);
+
+  job.mutable_spec()->set_bending_model("triangle");
+  const auto triangle = runner.run(job);
+  ASSERT_EQ(triangle.body_case(), v1::Envelope::kResult) << triangle.failure().message();
+  EXPECT_EQ(triangle.result().metrics().outcome(), "converged");
+  const auto dihedral = runner.run(tiny_job(v1::JOB_MODE_DRAPE));
+  ASSERT_EQ(dihedral.body_case(), v1::Envelope::kResult);
+  EXPECT_NE(triangle.result().mesh_ply(), dihedral.result().mesh_ply());
+  EXPECT_GT(triangle.result().metrics().drape_coefficient(), 0.1);
+  EXPECT_LT(triangle.result().metrics().drape_coefficient(), 1.0);
+}
+
 TEST(JobRunner, PoisonDiverges) {
   JobRunner runner(scratch());
   const auto answer = runner.run(tiny_job(v1::JOB_MODE_POISON));

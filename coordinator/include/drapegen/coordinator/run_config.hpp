@@ -19,6 +19,7 @@ struct RunConfig {
   std::string noise = "kinect";  // kinect | none
   std::string renderer = "osmesa";  // osmesa | software (docs/RENDERER.md)
   double density = 300.0;        // g/m^2 the sampled moduli are simulated at
+  std::string bending_model = "dihedral";  // dihedral (paper Eq. 1-3, per hinge) | triangle (per-triangle curvature)
   std::string output = "drapegen-run";  // output directory (manifest.sqlite, data/)
   std::string model;             // VAE model file; empty: the one committed with the source
   // [recipes]
