@@ -28,6 +28,7 @@ struct DiagnoseOptions {
   int evaluations = 0;
   int refit_evaluations = 0;
   int refit_scan = -1;  // < 0: the settings' value
+  int starts = -1;      // < 0: the settings' value
   int jobs = 1;
   double shape_floor = -1.0;  // < 0: the settings' calibrated value
   bool gap_only = false;
@@ -47,6 +48,7 @@ int run_diagnose(const DiagnoseOptions& o) {
     return fail("--evaluations and --refit-evaluations must be 1 .. 10000");
   }
   if (o.shape_floor > 100.0) return fail("--shape-floor must be 0 (from the floor samples) .. 100");
+  if (o.starts < -1 || o.starts > 100) return fail("--starts must be 0 (the guess alone) .. 100");
   if (o.refit_scan < -1 || o.refit_scan == 1 || o.refit_scan > 100) {
     return fail("--refit-scan must be 0 (off) or 2 .. 100");
   }
@@ -70,6 +72,7 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (o.evaluations > 0) settings.baseline_optimiser.max_evaluations = o.evaluations;
   if (o.refit_evaluations > 0) settings.attribution.optimiser.max_evaluations = o.refit_evaluations;
   if (o.refit_scan >= 0) settings.attribution.scan_levels = o.refit_scan;
+  if (o.starts >= 0) settings.start_levels = o.starts;
   constexpr int kKeep = diagnosis::AttributionSettings::kSimplexAfterScan;
   if (settings.attribution.scan_levels > settings.attribution.optimiser.max_evaluations - kKeep) {
     return fail(fmt::format("--refit-scan ({}) must leave the refit's simplex {} of its {} evaluations",
@@ -129,7 +132,15 @@ Runner add_diagnose_command(CLI::App& app) {
   app.add_option("--resolution", o->resolution, "Fitting mesh vertices per side (default 20; quick 16; fine " +
                                                     std::to_string(diagnosis::DiagnosisSettings::kFineResolution) + ")");
   app.add_option("--states", o->states, "Initial states per evaluation (default 3; quick and fine 2)");
-  app.add_option("--evaluations", o->evaluations, "Baseline fit evaluations (default 40; quick and fine 20)");
+  app.add_option("--evaluations", o->evaluations,
+                 "Baseline fit evaluations per simplex (default 40; quick and fine 20; a second one with --starts)");
+  app.add_option("--starts", o->starts,
+                 fmt::format("After the simplex from the drape-coefficient guess, score the guess's alpha and N levels "
+                             "over the search box, each at {} softening ratios, and run a second simplex from the best "
+                             "if it beats the first's end; the better fit counts (default and fine {}, quick 0: the "
+                             "guess's simplex alone)",
+                             diagnosis::DiagnosisSettings{}.start_ratios_mm.size(),
+                             diagnosis::DiagnosisSettings{}.start_levels));
   app.add_option("--refit-evaluations", o->refit_evaluations,
                  "Evaluations per candidate refit (default 14, also with --quick and --fine)");
   app.add_option("--refit-scan", o->refit_scan,

@@ -88,6 +88,27 @@ string(JSON ncand LENGTH "${out}" attribution candidates)
 if(NOT verdict STREQUAL "not attributed" OR ran OR NOT ncand EQUAL 0)
   message(FATAL_ERROR "--gap-only: verdict '${verdict}', attribution ran ${ran}, ${ncand} candidates")
 endif()
+string(JSON starts GET "${out}" baseline start_evaluations)
+string(JSON guess_only_score GET "${out}" baseline fit_score_mm)
+if(NOT starts EQUAL 0)
+  message(FATAL_ERROR "--quick scores no starts besides the guess: ${starts}")
+endif()
+
+# --starts 1: after the guess's simplex, the guess's alpha and one level, each at both softening ratios (4 starts),
+# are scored; a second simplex from the best runs if it beats the first's end, and the better fit counts: never worse
+# than the guess's simplex alone (the run above, same budgets) nor than the best start.
+run_ok(out diagnose --capture ${WORK}/capture --quick --resolution 10 --states 2 --evaluations 8 --gap-only --starts 1
+       --json)
+string(JSON starts GET "${out}" baseline start_evaluations)
+string(JSON best_start GET "${out}" baseline best_start_score_mm)
+string(JSON score GET "${out}" baseline fit_score_mm)
+string(JSON restarted GET "${out}" baseline restarted)
+if(NOT starts EQUAL 4 OR score GREATER best_start OR score GREATER guess_only_score)
+  message(FATAL_ERROR "--starts 1: ${starts} starts (expected 4), fit ${score} mm against its best start ${best_start} "
+                      "mm and the guess's simplex alone ${guess_only_score} mm")
+endif()
+message(STATUS "diagnosis --starts 1: fit ${score} mm (best start ${best_start} mm, second simplex ${restarted}; guess alone ${guess_only_score} mm)")
+expect_failure(1 "--starts must be" diagnose --capture ${WORK}/capture --starts -2)
 
 # A second placement of the specimen as the held-out capture: the gate tests the mean of both captures' terms, and
 # every candidate is validated on both (the depth bias is the rig's, so it is in both placements).

@@ -1,0 +1,145 @@
+// Does the baseline fit absorb an effect, or does the coarse fitting mesh hide it? For each diagnosed capture of a
+// benchmark run, the capture is scored (as the diagnosis scores its gap: the validation states, --fine's forward
+// model) against three setups:
+//   fitted  the diagnosis's fitted bending, no effect (reproduces the reported gap);
+//   truth   the true bending (truth file), no effect;
+//   oracle  the true bending with the true effect (simulated effects only: yield, shear, curl, friction).
+// If "truth" is far above the floor and "fitted" within it, the fit absorbed the effect into the bending parameters;
+// if even "oracle" is not below "fitted", the fitting mesh and the multistability hide the effect from any refit.
+// Reads the truth files, so it is a benchmark tool, never part of the diagnosis.
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <filesystem>
+#include <fmt/format.h>
+#include <fstream>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "drapegen/diagnosis/candidate_effect.hpp"
+#include "drapegen/diagnosis/diagnosis.hpp"
+#include "drapegen/diagnosis/forward_model.hpp"
+#include "drapegen/sim/blas_kernels.hpp"
+
+namespace fs = std::filesystem;
+using namespace drapegen;
+using nlohmann::json;
+
+namespace {
+
+sim::Expected<json> read_json(const fs::path& path) {
+  std::ifstream in(path);
+  if (!in) return sim::Error{"cannot read " + path.string()};
+  json j = json::parse(in, nullptr, false);
+  if (j.is_discarded()) return sim::Error{"not JSON: " + path.string()};
+  return j;
+}
+
+diagnosis::BendingParameters bending_of(const json& j) {
+  diagnosis::BendingParameters b;
+  b.alpha = {j.at("alpha")[0].get<double>(), j.at("alpha")[1].get<double>(), j.at("alpha")[2].get<double>()};
+  b.beta = {j.at("beta")[0].get<double>(), j.at("beta")[1].get<double>(), j.at("beta")[2].get<double>()};
+  return b;
+}
+
+/// The true effect in the refit's parameters (effect_space), for the effects a simulation carries.
+std::optional<std::pair<diagnosis::Effect, std::vector<double>>> true_effect(const json& truth) {
+  if (!truth.contains("effects") || truth["effects"].empty()) return std::nullopt;
+  const std::string name = truth["effects"][0].at("name").get<std::string>();
+  const double s = truth["effects"][0].at("strength").get<double>();
+  if (name == "yield") return std::pair{diagnosis::Effect::kYield, std::vector<double>{std::log(s)}};
+  if (name == "shear") return std::pair{diagnosis::Effect::kShear, std::vector<double>{std::log(s)}};
+  if (name == "curl") return std::pair{diagnosis::Effect::kCurl, std::vector<double>{s}};
+  if (name == "friction") return std::pair{diagnosis::Effect::kFriction, std::vector<double>{std::log(s)}};
+  return std::nullopt;
+}
+
+struct Scores {
+  double best_shape = 0.0, best_stable = 0.0, median_shape = 0.0;
+};
+
+sim::Expected<Scores> score(diagnosis::ForwardModel& model, const diagnosis::ModelSetup& setup,
+                            const std::vector<sim::InitialStateSpec>& states) {
+  auto e = model.evaluate(setup, states);
+  if (!e) return e.error();
+  std::vector<double> shapes;
+  for (const auto& s : e->states) shapes.push_back(s.shape_all);
+  std::sort(shapes.begin(), shapes.end());
+  return Scores{e->best.shape_all, e->best.stable_all * 1e3, shapes[shapes.size() / 2]};
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  drapegen::sim::relaunch_with_blas_kernels(argv);  // the kernels drapegen runs on (blas_kernels.hpp)
+  CLI::App app{"drapegen absorption probe: a capture against its fitted, true and true-with-effect setups"};
+  std::string run;
+  std::vector<std::string> cases;
+  app.add_option("--run", run, "A drapegen_diagnosis_bench output (captures/, truth/, diagnoses/)")->required();
+  app.add_option("--cases", cases, "Case names (default: every diagnosed case)");
+  CLI11_PARSE(app, argc, argv);
+  if (cases.empty()) {
+    // Every placement-0 capture that has a truth file (captures/NAME.pK are other placements).
+    std::error_code ec;
+    for (const auto& entry : fs::directory_iterator(fs::path(run) / "captures", ec)) {
+      const std::string name = entry.path().filename().string();
+      if (entry.is_directory() && name.find('.') == std::string::npos &&
+          fs::exists(fs::path(run) / "truth" / (name + ".json"))) {
+        cases.push_back(name);
+      }
+    }
+    if (ec) {
+      std::cerr << "absorption_probe: error: " << ec.message() << ": " << run << "/captures\n";
+      return 1;
+    }
+    std::sort(cases.begin(), cases.end());
+  }
+  const auto settings = diagnosis::DiagnosisSettings::fine();
+  const auto states = diagnosis::validation_states(settings.attribution);
+  std::cout << "shape distance over all views (best of " << states.size()
+            << " validation states, median in brackets), stable term mm; --fine forward model ("
+            << settings.fit.resolution << "x" << settings.fit.resolution << ")\n";
+  std::cout << fmt::format("{:<16} {:>8} {:>22} {:>22} {:>22} {:>9}\n", "case", "strength", "fitted", "truth", "oracle",
+                           "reported");
+  for (const auto& name : cases) {
+    const auto truth = read_json(fs::path(run) / "truth" / (name + ".json"));
+    // Without a diagnosis (captures generated only), the fitted column stays empty.
+    const auto report = read_json(fs::path(run) / "diagnoses" / (name + ".json"));
+    auto capture = diagnosis::read_capture((fs::path(run) / "captures" / name).string());
+    if (!truth || !capture) {
+      std::cerr << "absorption_probe: " << name << ": " << (!truth ? truth.error().message : capture.error().message)
+                << "\n";
+      continue;
+    }
+    auto model = diagnosis::ForwardModel::create(*capture, settings.fit);
+    if (!model) {
+      std::cerr << "absorption_probe: " << name << ": " << model.error().message << "\n";
+      continue;
+    }
+    const auto cell = [](const sim::Expected<Scores>& s) {
+      return s ? fmt::format("{:.2f} [{:.2f}] {:.1f}", s->best_shape, s->median_shape, s->best_stable)
+               : std::string("error");
+    };
+    diagnosis::ModelSetup truth_setup;
+    truth_setup.bending = bending_of(*truth);
+    std::string fitted = "-", reported = "-";
+    if (report) {
+      diagnosis::ModelSetup setup;
+      setup.bending = bending_of((*report)["baseline"]["fitted"]);
+      fitted = cell(score(**model, setup, states));
+      reported = fmt::format("{:.2f}", (*report)["gap_tests"]["capture"]["shape"].get<double>());
+    }
+    const auto b = score(**model, truth_setup, states);
+    std::string oracle = "-";
+    if (const auto effect = true_effect(*truth)) {
+      diagnosis::ModelSetup with = truth_setup;
+      diagnosis::apply_effect(effect->first, effect->second, with);
+      oracle = cell(score(**model, with, states));
+    }
+    const double strength =
+        truth->contains("effects") && !(*truth)["effects"].empty() ? (*truth)["effects"][0]["strength"].get<double>() : 0.0;
+    std::cout << fmt::format("{:<16} {:>8.3g} {:>22} {:>22} {:>22} {:>9}\n", name, strength, fitted, cell(b), oracle,
+                             reported)
+              << std::flush;
+  }
+  return 0;
+}
