@@ -43,9 +43,9 @@ diagnosis::BendingParameters bending_of(const json& j) {
 
 /// The true effect in the refit's parameters (effect_space), for the effects a simulation carries.
 std::optional<std::pair<diagnosis::Effect, std::vector<double>>> true_effect(const json& truth) {
-  if (!truth.contains("effects") || truth["effects"].empty()) return std::nullopt;
-  const std::string name = truth["effects"][0].at("name").get<std::string>();
-  const double s = truth["effects"][0].at("strength").get<double>();
+  if (!truth.contains("effects") || truth.at("effects").empty()) return std::nullopt;
+  const std::string name = truth.at("effects").at(0).at("name").get<std::string>();
+  const double s = truth.at("effects").at(0).at("strength").get<double>();
   if (name == "yield") return std::pair{diagnosis::Effect::kYield, std::vector<double>{std::log(s)}};
   if (name == "shear") return std::pair{diagnosis::Effect::kShear, std::vector<double>{std::log(s)}};
   if (name == "curl") return std::pair{diagnosis::Effect::kCurl, std::vector<double>{s}};
@@ -65,6 +65,47 @@ sim::Expected<Scores> score(diagnosis::ForwardModel& model, const diagnosis::Mod
   for (const auto& s : e->states) shapes.push_back(s.shape_all);
   std::sort(shapes.begin(), shapes.end());
   return Scores{e->best.shape_all, e->best.stable_all * 1e3, shapes[shapes.size() / 2]};
+}
+
+/// One row: the capture against its fitted (if diagnosed), true and oracle setups.
+sim::Status probe_case(const fs::path& run, const std::string& name, const diagnosis::DiagnosisSettings& settings,
+                       const std::vector<sim::InitialStateSpec>& states) {
+  const auto truth = read_json(run / "truth" / (name + ".json"));
+  if (!truth) return truth.error();
+  // Without a diagnosis (captures generated only), the fitted column stays empty.
+  const auto report = read_json(run / "diagnoses" / (name + ".json"));
+  auto capture = diagnosis::read_capture((run / "captures" / name).string());
+  if (!capture) return capture.error();
+  auto model = diagnosis::ForwardModel::create(*capture, settings.fit);
+  if (!model) return model.error();
+  const auto cell = [](const sim::Expected<Scores>& s) {
+    return s ? fmt::format("{:.2f} [{:.2f}] {:.1f}", s->best_shape, s->median_shape, s->best_stable)
+             : std::string("error");
+  };
+  std::string fitted = "-", reported = "-";
+  if (report) {
+    diagnosis::ModelSetup setup;
+    setup.bending = bending_of(report->at("baseline").at("fitted"));
+    fitted = cell(score(**model, setup, states));
+    reported = fmt::format("{:.2f}", report->at("gap_tests").at("capture").at("shape").get<double>());
+  }
+  diagnosis::ModelSetup truth_setup;
+  truth_setup.bending = bending_of(*truth);
+  const auto without = score(**model, truth_setup, states);
+  if (!without) return without.error();
+  std::string oracle = "-";
+  if (const auto effect = true_effect(*truth)) {
+    diagnosis::ModelSetup with = truth_setup;
+    diagnosis::apply_effect(effect->first, effect->second, with);
+    oracle = cell(score(**model, with, states));
+  }
+  const double strength = truth->contains("effects") && !truth->at("effects").empty()
+                              ? truth->at("effects").at(0).at("strength").get<double>()
+                              : 0.0;
+  std::cout << fmt::format("{:<16} {:>8.3g} {:>22} {:>22} {:>22} {:>9}\n", name, strength, fitted, cell(without),
+                           oracle, reported)
+            << std::flush;
+  return {};
 }
 
 }  // namespace
@@ -100,46 +141,18 @@ int main(int argc, char** argv) {
             << settings.fit.resolution << "x" << settings.fit.resolution << ")\n";
   std::cout << fmt::format("{:<16} {:>8} {:>22} {:>22} {:>22} {:>9}\n", "case", "strength", "fitted", "truth", "oracle",
                            "reported");
+  int failed = 0;
   for (const auto& name : cases) {
-    const auto truth = read_json(fs::path(run) / "truth" / (name + ".json"));
-    // Without a diagnosis (captures generated only), the fitted column stays empty.
-    const auto report = read_json(fs::path(run) / "diagnoses" / (name + ".json"));
-    auto capture = diagnosis::read_capture((fs::path(run) / "captures" / name).string());
-    if (!truth || !capture) {
-      std::cerr << "absorption_probe: " << name << ": " << (!truth ? truth.error().message : capture.error().message)
-                << "\n";
-      continue;
+    try {
+      if (sim::Status s = probe_case(fs::path(run), name, settings, states); !s) {
+        std::cerr << "absorption_probe: " << name << ": " << s.error().message << "\n";
+        ++failed;
+      }
+    } catch (const json::exception& e) {  // a truth or report file without the expected fields
+      std::cerr << "absorption_probe: " << name << ": " << e.what() << "\n";
+      ++failed;
     }
-    auto model = diagnosis::ForwardModel::create(*capture, settings.fit);
-    if (!model) {
-      std::cerr << "absorption_probe: " << name << ": " << model.error().message << "\n";
-      continue;
-    }
-    const auto cell = [](const sim::Expected<Scores>& s) {
-      return s ? fmt::format("{:.2f} [{:.2f}] {:.1f}", s->best_shape, s->median_shape, s->best_stable)
-               : std::string("error");
-    };
-    diagnosis::ModelSetup truth_setup;
-    truth_setup.bending = bending_of(*truth);
-    std::string fitted = "-", reported = "-";
-    if (report) {
-      diagnosis::ModelSetup setup;
-      setup.bending = bending_of((*report)["baseline"]["fitted"]);
-      fitted = cell(score(**model, setup, states));
-      reported = fmt::format("{:.2f}", (*report)["gap_tests"]["capture"]["shape"].get<double>());
-    }
-    const auto b = score(**model, truth_setup, states);
-    std::string oracle = "-";
-    if (const auto effect = true_effect(*truth)) {
-      diagnosis::ModelSetup with = truth_setup;
-      diagnosis::apply_effect(effect->first, effect->second, with);
-      oracle = cell(score(**model, with, states));
-    }
-    const double strength =
-        truth->contains("effects") && !(*truth)["effects"].empty() ? (*truth)["effects"][0]["strength"].get<double>() : 0.0;
-    std::cout << fmt::format("{:<16} {:>8.3g} {:>22} {:>22} {:>22} {:>9}\n", name, strength, fitted, cell(b), oracle,
-                             reported)
-              << std::flush;
   }
-  return 0;
+  if (failed > 0) std::cerr << "absorption_probe: " << failed << " of " << cases.size() << " cases failed\n";
+  return failed > 0 ? 1 : 0;
 }

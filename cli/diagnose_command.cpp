@@ -28,7 +28,7 @@ struct DiagnoseOptions {
   int evaluations = 0;
   int refit_evaluations = 0;
   int refit_scan = -1;  // < 0: the settings' value
-  int starts = -1;      // < 0: the settings' value
+  std::optional<int> starts;  // unset: the settings' value
   int jobs = 1;
   double shape_floor = -1.0;  // < 0: the settings' calibrated value
   bool gap_only = false;
@@ -48,7 +48,7 @@ int run_diagnose(const DiagnoseOptions& o) {
     return fail("--evaluations and --refit-evaluations must be 1 .. 10000");
   }
   if (o.shape_floor > 100.0) return fail("--shape-floor must be 0 (from the floor samples) .. 100");
-  if (o.starts < -1 || o.starts > 100) return fail("--starts must be 0 (the guess alone) .. 100");
+  if (o.starts && (*o.starts < 0 || *o.starts > 100)) return fail("--starts must be 0 (the guess alone) .. 100");
   if (o.refit_scan < -1 || o.refit_scan == 1 || o.refit_scan > 100) {
     return fail("--refit-scan must be 0 (off) or 2 .. 100");
   }
@@ -72,7 +72,7 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (o.evaluations > 0) settings.baseline_optimiser.max_evaluations = o.evaluations;
   if (o.refit_evaluations > 0) settings.attribution.optimiser.max_evaluations = o.refit_evaluations;
   if (o.refit_scan >= 0) settings.attribution.scan_levels = o.refit_scan;
-  if (o.starts >= 0) settings.start_levels = o.starts;
+  if (o.starts) settings.start_levels = *o.starts;
   constexpr int kKeep = diagnosis::AttributionSettings::kSimplexAfterScan;
   if (settings.attribution.scan_levels > settings.attribution.optimiser.max_evaluations - kKeep) {
     return fail(fmt::format("--refit-scan ({}) must leave the refit's simplex {} of its {} evaluations",
@@ -136,9 +136,9 @@ Runner add_diagnose_command(CLI::App& app) {
                  "Baseline fit evaluations per simplex (default 40; quick and fine 20; a second one with --starts)");
   app.add_option("--starts", o->starts,
                  fmt::format("After the simplex from the drape-coefficient guess, score the guess's alpha and N levels "
-                             "over the search box, each at {} softening ratios, and run a second simplex from the best "
-                             "if it beats the first's end; the better fit counts (default and fine {}, quick 0: the "
-                             "guess's simplex alone)",
+                             "over the search box, each at {} softening ratios; if the best beats the first simplex's "
+                             "end, a second simplex from it is the fit (default {}: the guess's simplex alone; "
+                             "docs/DIAGNOSIS.md, \"A second start\")",
                              diagnosis::DiagnosisSettings{}.start_ratios_mm.size(),
                              diagnosis::DiagnosisSettings{}.start_levels));
   app.add_option("--refit-evaluations", o->refit_evaluations,

@@ -91,21 +91,32 @@ endif()
 string(JSON starts GET "${out}" baseline start_evaluations)
 string(JSON guess_only_score GET "${out}" baseline fit_score_mm)
 if(NOT starts EQUAL 0)
-  message(FATAL_ERROR "--quick scores no starts besides the guess: ${starts}")
+  message(FATAL_ERROR "by default the fit scores no starts besides the guess: ${starts}")
 endif()
 
 # --starts 1: after the guess's simplex, the guess's alpha and one level, each at both softening ratios (4 starts),
-# are scored; a second simplex from the best runs if it beats the first's end, and the better fit counts: never worse
-# than the guess's simplex alone (the run above, same budgets) nor than the best start.
+# are scored. If the best of them beats the first simplex's end (the run above, same budgets), a second simplex from
+# it is the fit: it starts at a start of the grid (softening ratio 1.8 or 3.6 mm) and ends at or below that start;
+# else the fit is the first simplex's, unchanged by the starts (the guess's ratio 2.5 mm, the same score).
 run_ok(out diagnose --capture ${WORK}/capture --quick --resolution 10 --states 2 --evaluations 8 --gap-only --starts 1
        --json)
 string(JSON starts GET "${out}" baseline start_evaluations)
 string(JSON best_start GET "${out}" baseline best_start_score_mm)
 string(JSON score GET "${out}" baseline fit_score_mm)
 string(JSON restarted GET "${out}" baseline restarted)
-if(NOT starts EQUAL 4 OR score GREATER best_start OR score GREATER guess_only_score)
-  message(FATAL_ERROR "--starts 1: ${starts} starts (expected 4), fit ${score} mm against its best start ${best_start} "
-                      "mm and the guess's simplex alone ${guess_only_score} mm")
+string(JSON start_ratio GET "${out}" baseline start_reduced 3)
+if(NOT starts EQUAL 4)
+  message(FATAL_ERROR "--starts 1: ${starts} starts scored, expected 4")
+endif()
+if(restarted)
+  if(NOT (best_start LESS guess_only_score) OR score GREATER best_start OR
+     NOT (start_ratio EQUAL 1.8 OR start_ratio EQUAL 3.6))
+    message(FATAL_ERROR "--starts 1, second simplex: fit ${score} mm from a start at ratio ${start_ratio} scoring "
+                        "${best_start} mm, the first simplex ended at ${guess_only_score} mm")
+  endif()
+elseif(best_start LESS guess_only_score OR NOT score EQUAL guess_only_score OR NOT start_ratio EQUAL 2.5)
+  message(FATAL_ERROR "--starts 1, no second simplex: fit ${score} mm (the first simplex alone: ${guess_only_score} "
+                      "mm), best start ${best_start} mm, start ratio ${start_ratio}")
 endif()
 message(STATUS "diagnosis --starts 1: fit ${score} mm (best start ${best_start} mm, second simplex ${restarted}; guess alone ${guess_only_score} mm)")
 expect_failure(1 "--starts must be" diagnose --capture ${WORK}/capture --starts -2)

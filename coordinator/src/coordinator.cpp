@@ -392,6 +392,19 @@ struct Coordinator::Impl {
                                 r.exr_size(), config.orientations));
       return on_failure(w, f);
     }
+    // A worker that does not know the run's bending model (older than the field) drapes with the paper's: its result
+    // would be mislabelled data, so it counts as a failed attempt and the job goes to another worker.
+    const std::string& model = r.metrics().bending_model();
+    if (!noop && (model.empty() ? std::string("dihedral") : model) != config.bending_model) {
+      v1::Failure f;
+      f.set_job_id(r.job_id());
+      f.set_attempt(r.attempt());
+      f.set_reason(v1::FAILURE_REASON_INVALID_JOB);
+      f.set_message(fmt::format("worker {} computed the drape with the {} bending model, the run asks for {} (a worker "
+                                "older than this run's drapegen?)",
+                                w.name, model.empty() ? "dihedral (unnamed)" : model, config.bending_model));
+      return on_failure(w, f);
+    }
     // Files first (temporary file, fsync, rename); the directory is synced before the manifest commits.
     std::vector<storage::FileRecord> files;
     std::int64_t bytes = 0;

@@ -210,7 +210,7 @@ states_per_sample = 4   # initial states per vector (paper: 8)
 orientations = 2        # data points of 4 depth views per drape (paper: 12)
 resolution = 25         # vertices per side of the 300 mm specimen (paper: 100)
 noise = "kinect"
-bending_model = "dihedral"   # or "triangle": mesh-independent, 1-4x slower (docs/PHYSICS.md)
+bending_model = "dihedral"   # or "triangle": mesh-independent, about 2x slower (docs/PHYSICS.md)
 output = "out/local-run"
 
 [solver]

@@ -131,7 +131,6 @@ DiagnosisSettings DiagnosisSettings::quick() {
   s.fit.max_newton_iterations = 150;
   s.baseline_optimiser.max_evaluations = 20;
   s.guess_levels = 3;
-  s.start_levels = 0;
   s.floors.noise_seeds = 2;
   s.floors.extra_states = 3;
   s.attribution.optimiser.max_evaluations = 14;
@@ -142,7 +141,6 @@ DiagnosisSettings DiagnosisSettings::quick() {
 
 DiagnosisSettings DiagnosisSettings::fine() {
   DiagnosisSettings s = quick();
-  s.start_levels = DiagnosisSettings{}.start_levels;
   s.fit.resolution = kFineResolution;
   s.floors.shape_threshold = kFineShapeFloor;
   s.held_out_shape_threshold = kFineHeldOutShapeFloor;
@@ -191,8 +189,10 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
   r.initial_guess = from_reduced(*guess);
   std::optional<sim::Error> error;
   double best = std::numeric_limits<double>::infinity();
+  std::optional<std::pair<std::vector<double>, double>> known_start;  // a point scored already, and its score
   auto objective = [&](const std::vector<double>& x) -> double {
     if (error) return std::numeric_limits<double>::infinity();
+    if (known_start && x == known_start->first) return known_start->second;
     auto e = model.evaluate(baseline_setup({x[0], x[1], x[2], x[3]}));
     if (!e) {
       error = e.error();
@@ -241,15 +241,14 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
     }
     r.best_start_score = best_start;
     if (best_start < nm.f) {
-      NelderMeadResult second = simplex(best_x);
+      // Its minimum includes its start, so it ends below the first simplex's: it is the fit.
+      known_start = {{best_x.begin(), best_x.end()}, best_start};  // not simulated again
+      nm = simplex(best_x);
       if (error) return *error;
-      r.baseline_evaluations += second.evaluations;
-      r.baseline_history.insert(r.baseline_history.end(), second.history.begin(), second.history.end());
+      r.baseline_evaluations += nm.evaluations;
+      r.baseline_history.insert(r.baseline_history.end(), nm.history.begin(), nm.history.end());
       r.restarted = true;
-      if (second.f < nm.f) {
-        nm = std::move(second);
-        r.start = best_x;
-      }
+      r.start = best_x;
     }
   }
   r.fitted_reduced = {nm.x[0], nm.x[1], nm.x[2], nm.x[3]};

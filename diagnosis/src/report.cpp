@@ -122,9 +122,12 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
                     r.validated_held_out ? ", mean of the capture and the held-out capture" : "", gap.stable * 1e3,
                     r.floors.stable * 1e3, gap.shape, r.floors.shape);
   md += fmt::format("Fitted baseline: alpha = {:.0f}, {:.0f}, {:.0f} g mm^2/s^2; beta = {:.0f}, {:.0f}, {:.0f} g mm^3/s^2 "
-                    "({} evaluations).\n\n",
+                    "({} simplex evaluations{}).\n\n",
                     r.fitted.alpha.warp, r.fitted.alpha.bias, r.fitted.alpha.weft, r.fitted.beta.warp,
-                    r.fitted.beta.bias, r.fitted.beta.weft, r.baseline_evaluations);
+                    r.fitted.beta.bias, r.fitted.beta.weft, r.baseline_evaluations,
+                    r.start_evaluations == 0 ? std::string()
+                    : fmt::format(", {} starts{}", r.start_evaluations,
+                                  r.restarted ? "; the second simplex, from the best start, is the fit" : ""));
   md += "## Where the gap sits\n\nShape features, capture against the fitted baseline, over the largest floor sample:\n\n"
         "| feature group | region | ratio to floor |\n|---|---|---|\n";
   for (std::size_t k = 0; k < r.localisation.group_ratio.size(); ++k) {

@@ -30,6 +30,9 @@ sim::Status check_spec(const v1::JobSpec& s) {
   if (!s.renderer().empty() && s.renderer() != "osmesa" && s.renderer() != "software") {
     return sim::Error{"job: renderer must be osmesa or software"};
   }
+  if (!s.bending_model().empty() && s.bending_model() != "dihedral" && s.bending_model() != "triangle") {
+    return sim::Error{"job: bending_model must be dihedral or triangle"};
+  }
   if (s.max_iterations() < 1) return sim::Error{"job: max_iterations must be >= 1"};
   if (!(s.tolerance() > 0) || !std::isfinite(s.tolerance())) return sim::Error{"job: tolerance must be > 0"};
   if (s.max_self_intersections() < 0) return sim::Error{"job: max_self_intersections must be >= 0"};

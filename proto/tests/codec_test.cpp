@@ -79,6 +79,13 @@ TEST(Codec, ChecksFieldRules) {
     e.mutable_job()->mutable_spec()->set_renderer(renderer);
     EXPECT_TRUE(decode(encode(e))) << renderer;
   }
+  e = valid_job();
+  e.mutable_job()->mutable_spec()->set_bending_model("quadratic");
+  EXPECT_FALSE(decode(encode(e)));
+  for (const char* model : {"", "dihedral", "triangle"}) {  // empty: a job from before the field, the paper's model
+    e.mutable_job()->mutable_spec()->set_bending_model(model);
+    EXPECT_TRUE(decode(encode(e))) << model;
+  }
   v1::Envelope f;
   f.mutable_failure()->set_job_id(3);
   f.mutable_failure()->set_attempt(1);

@@ -135,6 +135,7 @@ v1::Envelope JobRunner::compute(const v1::Job& job) {
   metrics.set_folds(drape->measures.folds);
   metrics.set_self_intersections(drape->measures.self_intersections);
   metrics.set_sim_seconds(seconds_since(sim_start));
+  metrics.set_bending_model(config->bending_model == sim::BendingModel::kNonlinearTriangle ? "triangle" : "dihedral");
   // A solve that ends with a non-finite residual or energy diverged, whatever the solver called its stop.
   const bool non_finite = !std::isfinite(drape->report.residual) || !std::isfinite(drape->report.energy);
   if (non_finite && drape->report.outcome != sim::SolveOutcome::kConverged) {
