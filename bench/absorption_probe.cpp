@@ -9,11 +9,13 @@
 // Reads the truth files, so it is a benchmark tool, never part of the diagnosis.
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fmt/format.h>
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "drapegen/diagnosis/candidate_effect.hpp"
 #include "drapegen/diagnosis/diagnosis.hpp"
@@ -116,7 +118,7 @@ int main(int argc, char** argv) {
   std::string run;
   std::vector<std::string> cases;
   app.add_option("--run", run, "A drapegen_diagnosis_bench output (captures/, truth/, diagnoses/)")->required();
-  app.add_option("--cases", cases, "Case names (default: every diagnosed case)");
+  app.add_option("--cases", cases, "Case names (default: every placement-0 capture with a truth file)");
   CLI11_PARSE(app, argc, argv);
   if (cases.empty()) {
     // Every placement-0 capture that has a truth file (captures/NAME.pK are other placements).
