@@ -36,7 +36,7 @@ struct SimulateOptions {
   std::string band = "0.99,1.01";
   bool structured = false;
   std::optional<sim::Triangulation> mesh;  // a structured grid (--mesh); none: the perturbed triangulation
-  int max_iterations = 400;
+  int max_iterations = sim::SolverOptions{}.max_iterations;
   double tolerance = 1e-3;
   bool verbose = false;
   std::vector<std::string> effects;

@@ -214,7 +214,7 @@ bending_model = "dihedral"   # or "triangle": mesh-independent, about 2x slower 
 output = "out/local-run"
 
 [solver]
-max_iterations = 400
+max_iterations = 600
 tolerance = 1e-3
 max_self_intersections = 1000000   # coarse meshes: record self-intersections, do not reject them
 

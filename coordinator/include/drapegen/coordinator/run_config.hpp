@@ -26,7 +26,7 @@ struct RunConfig {
   double weight_sine = 1.0, weight_fold = 1.0, weight_drape = 1.0;
   double max_drift_mm = 3.0;
   // [solver]
-  int max_iterations = 400;
+  int max_iterations = 600;
   double tolerance = 1e-3;
   int coarse_start_resolution = 25;
   int max_self_intersections = 0;
