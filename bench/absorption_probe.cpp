@@ -43,11 +43,18 @@ diagnosis::BendingParameters bending_of(const json& j) {
   return b;
 }
 
+/// The truth file's (first) effect: its name and strength; none for a control.
+std::optional<std::pair<std::string, double>> first_effect(const json& truth) {
+  if (!truth.contains("effects") || truth.at("effects").empty()) return std::nullopt;
+  const json& e = truth.at("effects").at(0);
+  return std::pair{e.at("name").get<std::string>(), e.at("strength").get<double>()};
+}
+
 /// The true effect in the refit's parameters (effect_space), for the effects a simulation carries.
 std::optional<std::pair<diagnosis::Effect, std::vector<double>>> true_effect(const json& truth) {
-  if (!truth.contains("effects") || truth.at("effects").empty()) return std::nullopt;
-  const std::string name = truth.at("effects").at(0).at("name").get<std::string>();
-  const double s = truth.at("effects").at(0).at("strength").get<double>();
+  const auto effect = first_effect(truth);
+  if (!effect) return std::nullopt;
+  const auto& [name, s] = *effect;
   if (name == "yield") return std::pair{diagnosis::Effect::kYield, std::vector<double>{std::log(s)}};
   if (name == "shear") return std::pair{diagnosis::Effect::kShear, std::vector<double>{std::log(s)}};
   if (name == "curl") return std::pair{diagnosis::Effect::kCurl, std::vector<double>{s}};
@@ -96,14 +103,13 @@ sim::Status probe_case(const fs::path& run, const std::string& name, const diagn
   const auto without = score(**model, truth_setup, states);
   if (!without) return without.error();
   std::string oracle = "-";
-  if (const auto effect = true_effect(*truth)) {
+  if (const auto simulated = true_effect(*truth)) {
     diagnosis::ModelSetup with = truth_setup;
-    diagnosis::apply_effect(effect->first, effect->second, with);
+    diagnosis::apply_effect(simulated->first, simulated->second, with);
     oracle = cell(score(**model, with, states));
   }
-  const double strength = truth->contains("effects") && !truth->at("effects").empty()
-                              ? truth->at("effects").at(0).at("strength").get<double>()
-                              : 0.0;
+  const auto effect = first_effect(*truth);
+  const double strength = effect ? effect->second : 0.0;
   std::cout << fmt::format("{:<16} {:>8.3g} {:>22} {:>22} {:>22} {:>9}\n", name, strength, fitted, cell(without),
                            oracle, reported)
             << std::flush;

@@ -57,7 +57,9 @@ sim::Expected<ReducedBending> initial_guess(ForwardModel& model, int levels) {
       }
     }
   }
-  for (const auto& [x, d] : samples) sim::logger()->debug("initial guess: alpha {:.0f} -> drape coefficient {:.3f}", std::exp(x), d);
+  for (const auto& [x, d] : samples) {
+    sim::logger()->debug("initial guess: alpha {:.0f} -> drape coefficient {:.3f}", std::exp(x), d);
+  }
   sim::logger()->debug("initial guess: the capture's drape coefficient {:.3f} -> alpha {:.0f}", target, std::exp(la));
   return ReducedBending{std::clamp(la, lo[0], hi[0]), 0.0, 0.0, 2.5};
 }
