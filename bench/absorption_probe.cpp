@@ -14,6 +14,7 @@
 #include <fmt/format.h>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <optional>
 
@@ -64,16 +65,70 @@ std::optional<std::pair<diagnosis::Effect, std::vector<double>>> true_effect(con
 
 struct Scores {
   double best_shape = 0.0, best_stable = 0.0, median_shape = 0.0;
+  /// The mean features of the captures (placements 0 and 1, or 0 alone) against the mean over the states' drapes.
+  double mean_shape = 0.0, mean_shape_p0 = 0.0;
 };
 
+/// Entry by entry mean of feature vectors (entries missing or NaN in one are left out of that entry's mean).
+std::vector<double> mean_entries(const std::vector<const std::vector<double>*>& v) {
+  std::size_t n = 0;
+  for (const auto* x : v) n = std::max(n, x->size());
+  std::vector<double> m(n, std::numeric_limits<double>::quiet_NaN());
+  for (std::size_t i = 0; i < n; ++i) {
+    double sum = 0.0;
+    int count = 0;
+    for (const auto* x : v) {
+      if (i < x->size() && std::isfinite((*x)[i])) {
+        sum += (*x)[i];
+        ++count;
+      }
+    }
+    if (count > 0) m[i] = sum / count;
+  }
+  return m;
+}
+
+diagnosis::ShapeFeatures mean_features(const std::vector<const diagnosis::ShapeFeatures*>& f) {
+  diagnosis::ShapeFeatures m;
+  const auto field = [&](auto member) {
+    std::vector<const std::vector<double>*> v;
+    for (const auto* x : f) v.push_back(&(x->*member));
+    return mean_entries(v);
+  };
+  m.harmonics = field(&diagnosis::ShapeFeatures::harmonics);
+  m.off_centre = field(&diagnosis::ShapeFeatures::off_centre);
+  m.sorted_radii = field(&diagnosis::ShapeFeatures::sorted_radii);
+  m.hem_height = field(&diagnosis::ShapeFeatures::hem_height);
+  m.skirt_height = field(&diagnosis::ShapeFeatures::skirt_height);
+  m.skirt_spread = field(&diagnosis::ShapeFeatures::skirt_spread);
+  m.valid = true;
+  for (const auto* x : f) {
+    m.folds += x->folds / static_cast<double>(f.size());
+    m.valid = m.valid && x->valid;
+  }
+  return m;
+}
+
 sim::Expected<Scores> score(diagnosis::ForwardModel& model, const diagnosis::ModelSetup& setup,
-                            const std::vector<sim::InitialStateSpec>& states) {
+                            const std::vector<sim::InitialStateSpec>& states,
+                            const diagnosis::ShapeFeatures* second_capture) {
   auto e = model.evaluate(setup, states);
   if (!e) return e.error();
   std::vector<double> shapes;
-  for (const auto& s : e->states) shapes.push_back(s.shape_all);
+  std::vector<const diagnosis::ShapeFeatures*> drapes;
+  for (const auto& s : e->states) {
+    shapes.push_back(s.shape_all);
+    drapes.push_back(&s.shape.all);
+  }
   std::sort(shapes.begin(), shapes.end());
-  return Scores{e->best.shape_all, e->best.stable_all * 1e3, shapes[shapes.size() / 2]};
+  const auto model_mean = mean_features(drapes);
+  const auto scales = diagnosis::default_feature_scales();
+  const auto& first = model.target().shape.all;
+  Scores r{e->best.shape_all, e->best.stable_all * 1e3, shapes[shapes.size() / 2]};
+  r.mean_shape_p0 = diagnosis::feature_distance(first, model_mean, scales);
+  r.mean_shape = second_capture ? diagnosis::feature_distance(mean_features({&first, second_capture}), model_mean, scales)
+                                : r.mean_shape_p0;
+  return r;
 }
 
 /// One row: the capture against its fitted (if diagnosed), true and oracle setups.
@@ -87,30 +142,41 @@ sim::Status probe_case(const fs::path& run, const std::string& name, const diagn
   if (!capture) return capture.error();
   auto model = diagnosis::ForwardModel::create(*capture, settings.fit);
   if (!model) return model.error();
+  // The second placement, if the run has one: its shape features (in its own cameras).
+  std::optional<diagnosis::ShapeFeatures> second;
+  if (fs::exists(run / "captures" / (name + ".p1"))) {
+    auto c1 = diagnosis::read_capture((run / "captures" / (name + ".p1")).string());
+    if (!c1) return c1.error();
+    auto m1 = diagnosis::ForwardModel::create(*c1, settings.fit);
+    if (!m1) return m1.error();
+    second = (*m1)->target().shape.all;
+  }
+  const diagnosis::ShapeFeatures* p1 = second ? &*second : nullptr;
   const auto cell = [](const sim::Expected<Scores>& s) {
-    return s ? fmt::format("{:.2f} [{:.2f}] {:.1f}", s->best_shape, s->median_shape, s->best_stable)
+    return s ? fmt::format("{:.2f} [{:.2f}] {:.1f} m{:.2f}/{:.2f}", s->best_shape, s->median_shape, s->best_stable,
+                           s->mean_shape, s->mean_shape_p0)
              : std::string("error");
   };
   std::string fitted = "-", reported = "-";
   if (report) {
     diagnosis::ModelSetup setup;
     setup.bending = bending_of(report->at("baseline").at("fitted"));
-    fitted = cell(score(**model, setup, states));
+    fitted = cell(score(**model, setup, states, p1));
     reported = fmt::format("{:.2f}", report->at("gap_tests").at("capture").at("shape").get<double>());
   }
   diagnosis::ModelSetup truth_setup;
   truth_setup.bending = bending_of(*truth);
-  const auto without = score(**model, truth_setup, states);
+  const auto without = score(**model, truth_setup, states, p1);
   if (!without) return without.error();
   std::string oracle = "-";
   if (const auto simulated = true_effect(*truth)) {
     diagnosis::ModelSetup with = truth_setup;
     diagnosis::apply_effect(simulated->first, simulated->second, with);
-    oracle = cell(score(**model, with, states));
+    oracle = cell(score(**model, with, states, p1));
   }
   const auto effect = first_effect(*truth);
   const double strength = effect ? effect->second : 0.0;
-  std::cout << fmt::format("{:<16} {:>8.3g} {:>22} {:>22} {:>22} {:>9}\n", name, strength, fitted, cell(without),
+  std::cout << fmt::format("{:<16} {:>8.3g} {:>34} {:>34} {:>34} {:>9}\n", name, strength, fitted, cell(without),
                            oracle, reported)
             << std::flush;
   return {};
@@ -125,6 +191,10 @@ int main(int argc, char** argv) {
   std::vector<std::string> cases;
   app.add_option("--run", run, "A drapegen_diagnosis_bench output (captures/, truth/, diagnoses/)")->required();
   app.add_option("--cases", cases, "Case names (default: every placement-0 capture with a truth file)");
+  auto settings = diagnosis::DiagnosisSettings::fine();
+  app.add_option("--resolution", settings.fit.resolution,
+                 "Vertices per side of the forward model's mesh (default: --fine's)")
+      ->check(CLI::Range(8, 200));
   CLI11_PARSE(app, argc, argv);
   if (cases.empty()) {
     // Every placement-0 capture that has a truth file (captures/NAME.pK are other placements).
@@ -142,12 +212,11 @@ int main(int argc, char** argv) {
     }
     std::sort(cases.begin(), cases.end());
   }
-  const auto settings = diagnosis::DiagnosisSettings::fine();
   const auto states = diagnosis::validation_states(settings.attribution);
   std::cout << "shape distance over all views (best of " << states.size()
-            << " validation states, median in brackets), stable term mm; --fine forward model ("
+            << " validation states, median in brackets), stable term mm; forward model ("
             << settings.fit.resolution << "x" << settings.fit.resolution << ")\n";
-  std::cout << fmt::format("{:<16} {:>8} {:>22} {:>22} {:>22} {:>9}\n", "case", "strength", "fitted", "truth", "oracle",
+  std::cout << fmt::format("{:<16} {:>8} {:>34} {:>34} {:>34} {:>9}\n", "case", "strength", "fitted", "truth", "oracle",
                            "reported");
   int failed = 0;
   for (const auto& name : cases) {

@@ -15,6 +15,7 @@
 #include <iostream>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <nlohmann/json.hpp>
 #include <thread>
 
@@ -22,6 +23,7 @@
 #include "drapegen/renderer/random.hpp"
 #include "drapegen/sampler/fabric_data.hpp"
 #include "drapegen/sim/blas_kernels.hpp"
+#include "visibility_screen.hpp"
 
 namespace fs = std::filesystem;
 using namespace drapegen;
@@ -78,6 +80,13 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 10));
   std::vector<std::string> strength_overrides;
   app.add_option("--strength", strength_overrides, "NAME=LO:HI: draw that effect's strength in [LO, HI]");
+  int screen_draws = 0;
+  app.add_option("--visible-only", screen_draws,
+                 "Screen every effect capture (visibility_screen.hpp: the true fabric without the effect must leave an "
+                 "excess above the floors) and draw another fabric, strength and seed until it passes, at most N draws "
+                 "(the last is kept either way); the draws are logged in OUT/screen/NAME.json (0: no screen)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 100));
   app.add_flag("--quick", quick, "Diagnose with --quick");
   app.add_flag("--generate-only", generate_only, "Only generate the captures");
   app.add_flag("--score-only", score_only, "Only score existing diagnoses");
@@ -143,28 +152,102 @@ int main(int argc, char** argv) {
 
   fs::create_directories(out);
   // 1. Generate (truth in OUT/truth/NAME.json; the capture directories hold no truth).
-  if (!score_only) {
-    for (const auto& c : cases) {
-      for (int p = 0; p < placements; ++p) {
-        const std::string name = p == 0 ? c.name : fmt::format("{}.p{}", c.name, p);
-        const fs::path dir = fs::path(out) / "captures" / name;
-        if (fs::exists(dir / "capture.json")) continue;
-        diagnosis::RealitySpec spec;
-        spec.bending = c.fabric.bending;
-        spec.density = c.fabric.density;
-        spec.resolution = resolution;
-        spec.seed = c.seed;
-        spec.placement = p;
-        if (!c.effect.empty()) spec.effects.push_back({c.effect, c.strength});
-        auto r = diagnosis::generate_reality(spec, dir.string());
-        if (!r) {
-          std::cerr << "diagnosis_bench: " << name << ": " << r.error().message << "\n";
-          return 1;
-        }
-        fs::create_directories(fs::path(out) / "truth");
-        fs::rename(r->truth_path, fs::path(out) / "truth" / (name + ".json"));
-        std::cout << fmt::format("generated {} ({} {:.3g}) in {:.1f} s\n", name, c.effect, c.strength, r->seconds);
+  const auto generate = [&](const Case& c, const fs::path& root) -> bool {
+    for (int p = 0; p < placements; ++p) {
+      const std::string name = p == 0 ? c.name : fmt::format("{}.p{}", c.name, p);
+      const fs::path dir = root / "captures" / name;
+      if (fs::exists(dir / "capture.json")) continue;
+      diagnosis::RealitySpec spec;
+      spec.bending = c.fabric.bending;
+      spec.density = c.fabric.density;
+      spec.resolution = resolution;
+      spec.seed = c.seed;
+      spec.placement = p;
+      if (!c.effect.empty()) spec.effects.push_back({c.effect, c.strength});
+      auto r = diagnosis::generate_reality(spec, dir.string());
+      if (!r) {
+        std::cerr << "diagnosis_bench: " << name << ": " << r.error().message << "\n";
+        return false;
       }
+      fs::create_directories(root / "truth");
+      fs::rename(r->truth_path, root / "truth" / (name + ".json"));
+      std::cout << fmt::format("generated {} ({} {:.3g}) in {:.1f} s\n", name, c.effect, c.strength, r->seconds);
+    }
+    return true;
+  };
+  // Another draw of an effect case: fabric, strength and seed from a stream of its own (draw 0 is the case as drawn).
+  const auto redraw = [&](const Case& c, int draw) {
+    Case d = c;
+    if (draw == 0) return d;
+    renderer::Rng r(c.seed * 1000003ULL + static_cast<std::uint64_t>(draw));
+    d.seed = c.seed + 100000ULL * static_cast<std::uint64_t>(draw);
+    d.fabric = fabrics[static_cast<std::size_t>(r.uniform() * fabrics.size()) % fabrics.size()];
+    const auto [lo, hi] = strength_range.at(c.effect);
+    d.strength = lo + (hi - lo) * r.uniform();
+    return d;
+  };
+  // The screen of one draw generated under `root`: its record, or nothing on an error.
+  const auto screen = [&](const Case& d, const fs::path& root, int k) -> std::optional<nlohmann::json> {
+    const fs::path first = root / "captures" / d.name;
+    const std::string second = placements > 1 ? (root / "captures" / (d.name + ".p1")).string() : std::string();
+    auto v = bench::effect_visibility(first.string(), second, d.fabric.bending);
+    if (!v) {
+      std::cerr << "diagnosis_bench: screen " << d.name << ": " << v.error().message << "\n";
+      return std::nullopt;
+    }
+    std::cout << fmt::format("screen {} draw {}: {} {:.3g}, {:.0f} g/m^2: true fabric's shape {:.2f} / {:.2f}, stable "
+                             "{:.1f} / {:.1f} mm: {}\n",
+                             d.name, k, d.effect.empty() ? "none" : d.effect, d.strength, d.fabric.density, v->shape,
+                             v->shape_floor, v->stable_mm, v->stable_floor_mm,
+                             v->visible() ? "visible" : "within the floors")
+              << std::flush;
+    return nlohmann::json{
+        {"draw", k}, {"seed", d.seed}, {"density", d.fabric.density}, {"strength", d.strength},
+        {"alpha", {d.fabric.bending.alpha.warp, d.fabric.bending.alpha.bias, d.fabric.bending.alpha.weft}},
+        {"excess", v->excess}, {"stable_mm", v->stable_mm}, {"stable_floor_mm", v->stable_floor_mm},
+        {"shape", v->shape}, {"shape_floor", v->shape_floor}, {"visible", v->visible()}};
+  };
+  // The screen: draws until the true fabric without the effect leaves an excess above the floors. A control is
+  // screened once and kept (the share of controls it passes is the screen's false-positive rate).
+  const auto generate_visible = [&](const Case& c) -> bool {
+    nlohmann::json draws = nlohmann::json::array();
+    if (c.effect.empty()) {
+      if (!generate(c, out)) return false;
+      auto record = screen(c, out, 0);
+      if (!record) return false;
+      draws.push_back(*record);
+    }
+    for (int k = 0; k < screen_draws && !c.effect.empty(); ++k) {
+      const Case d = redraw(c, k);
+      const fs::path root = fs::path(out) / "screen" / fmt::format("{}.d{}", c.name, k);
+      if (!generate(d, root)) return false;
+      auto record = screen(d, root, k);
+      if (!record) return false;
+      draws.push_back(*record);
+      if ((*record)["visible"].get<bool>() || k + 1 == screen_draws) {
+        // Placement 0's capture last: its presence marks the case as generated (a rerun resumes from it).
+        for (int p = placements - 1; p >= 0; --p) {
+          const std::string name = p == 0 ? c.name : fmt::format("{}.p{}", c.name, p);
+          fs::rename(root / "truth" / (name + ".json"), fs::path(out) / "truth" / (name + ".json"));
+          fs::remove_all(fs::path(out) / "captures" / name);  // left by an interrupted move of this draw
+          fs::rename(root / "captures" / name, fs::path(out) / "captures" / name);
+        }
+        break;
+      }
+    }
+    std::ofstream(fs::path(out) / "screen" / (c.name + ".json")) << draws.dump(2) << "\n";
+    return true;
+  };
+  if (!score_only) {
+    fs::create_directories(fs::path(out) / "captures");
+    fs::create_directories(fs::path(out) / "truth");
+    if (screen_draws > 0) fs::create_directories(fs::path(out) / "screen");
+    for (const auto& c : cases) {
+      // A case generated already keeps its draw (a rerun resumes), a control its screen record.
+      const bool done = c.effect.empty() ? fs::exists(fs::path(out) / "screen" / (c.name + ".json"))
+                                         : fs::exists(fs::path(out) / "captures" / c.name / "capture.json");
+      const bool ok = screen_draws > 0 && !done ? generate_visible(c) : generate(c, out);
+      if (!ok) return 1;
     }
   }
   if (generate_only) return 0;
@@ -217,6 +300,9 @@ int main(int argc, char** argv) {
   for (const auto& f : families) rows.push_back(f);
   std::map<std::string, std::map<std::string, int>> confusion;
   int effect_total = 0, effect_correct = 0, control_total = 0, control_within = 0, region_total = 0, region_match = 0;
+  // The screen (--visible-only): per family, draws made and draws visible; the verdicts on visible captures.
+  std::map<std::string, std::pair<int, int>> screen_draws_by_family;
+  int visible_total = 0, visible_correct = 0;
   std::vector<double> shrinkages, named_shrinkages, seconds;
   nlohmann::json per_case = nlohmann::json::array();
   for (const auto& c : cases) {
@@ -232,6 +318,22 @@ int main(int argc, char** argv) {
     }
     const std::string verdict = d.value("verdict", "?");
     const std::string family = t.value("family", "none");
+    nlohmann::json screened = nullptr;  // the kept draw's visibility, if the case was screened
+    if (const fs::path log = fs::path(out) / "screen" / (c.name + ".json"); fs::exists(log)) {
+      try {
+        const auto draws = nlohmann::json::parse(std::ifstream(log));
+        for (const auto& draw : draws) {
+          screen_draws_by_family[family].first++;
+          screen_draws_by_family[family].second += draw.value("visible", false);
+        }
+        if (!draws.empty()) screened = draws.back().value("visible", false);
+      } catch (const std::exception&) {
+      }
+    }
+    if (family != "none" && screened.is_boolean() && screened.get<bool>()) {
+      ++visible_total;
+      visible_correct += verdict == family;
+    }
     const std::string region = d["localisation"].value("region", "?");
     confusion[family][verdict]++;
     seconds.push_back(d["runtime"].value("seconds", 0.0));
@@ -265,6 +367,7 @@ int main(int argc, char** argv) {
                         {"gap_mm", d["gap_mm"]["all_views"]}, {"floor_mm", d["floors"]["all_views_mm"]},
                         {"tests", d.value("gap_tests", nlohmann::json::object())},
                         {"shrinkage", family == "none" ? nlohmann::json(nullptr) : nlohmann::json(shrink)},
+                        {"visible", screened},
                         {"seconds", d["runtime"]["seconds"]}});
   }
   auto median = [](std::vector<double> v) {
@@ -289,6 +392,13 @@ int main(int argc, char** argv) {
   }
   md += fmt::format("\n- top-1 correct on effect captures: {}/{} ({:.0f}%)\n", effect_correct, effect_total,
                     effect_total ? 100.0 * effect_correct / effect_total : 0.0);
+  if (!screen_draws_by_family.empty()) {
+    md += fmt::format("- top-1 correct on the effect captures the screen passed (visible): {}/{}; screen draws "
+                      "visible / made per family (none: controls the screen passes, its false positives):",
+                      visible_correct, visible_total);
+    for (const auto& [family, n] : screen_draws_by_family) md += fmt::format(" {} {}/{},", family, n.second, n.first);
+    md.back() = '\n';
+  }
   md += fmt::format("- controls within the floors: {}/{} ({:.0f}%)\n", control_within, control_total,
                     control_total ? 100.0 * control_within / control_total : 0.0);
   md += fmt::format("- median shrinkage of the excess above the floors once the named effect is added (0 when "
