@@ -254,5 +254,55 @@ TEST(Service, ExpiredLeasesAreRequeued) {
   EXPECT_NE(coordinator.err().find("after its lease expired"), std::string::npos) << coordinator.err();
 }
 
+// A worker older than the bending-model field drapes with the paper's model whatever the run asks, and says nothing
+// about it: the coordinator refuses its result (an invalid_job failure, no files kept) and another worker does the job.
+TEST(Service, ResultOfAnotherBendingModelIsRefused) {
+  const fs::path dir = test_dir("model_mismatch");
+  const fs::path out = dir / "run";
+  write_text(dir / "run.toml", small_config(out, 1, 1, "bending_model = \"triangle\"\n"));
+  const fs::path manifest = out / "manifest.sqlite";
+  Process coordinator({"run", "--config", (dir / "run.toml").string()}, (dir / "coordinator").string());
+  const std::string endpoint = wait_endpoint(out, coordinator, 30s);
+  ASSERT_FALSE(endpoint.empty()) << coordinator.err();
+  zmq::context_t context(1);
+  {
+    FakeWorker old(context, endpoint);
+    v1::Envelope hello = ready("old");
+    hello.mutable_ready()->set_interval_ms(100);  // lost soon after it goes silent (it may be leased the retry)
+    old.send(hello);
+    auto job = old.expect(v1::Envelope::kJob, 5s);
+    ASSERT_TRUE(job);
+    EXPECT_EQ(job->job().spec().bending_model(), "triangle");
+    // A complete result (mesh and one file per orientation) without Metrics.bending_model.
+    v1::Envelope e = result(job->job().job_id(), job->job().attempt());
+    e.mutable_result()->mutable_metrics()->set_outcome("converged");
+    e.mutable_result()->set_mesh_ply("ply");
+    for (int k = 0; k < 2; ++k) e.mutable_result()->add_exr("exr");
+    old.send(e);
+    const auto refused = [&] {
+      auto r = storage::ManifestReader::open(manifest.string());
+      if (!r) return false;
+      auto f = r->failures();
+      return f && !f->empty();
+    };
+    const auto until = std::chrono::steady_clock::now() + 10s;
+    while (!refused() && std::chrono::steady_clock::now() < until) std::this_thread::sleep_for(10ms);
+    ASSERT_TRUE(refused()) << coordinator.err();
+  }  // the old worker goes away
+  Process worker = start_worker(endpoint, dir, 1);
+  ASSERT_EQ(coordinator.wait(120s), 0) << coordinator.err();
+  check_manifest(manifest, 2);
+  auto reader = storage::ManifestReader::open(manifest.string());
+  ASSERT_TRUE(reader);
+  const auto failures = all(reader->failures());
+  ASSERT_GE(failures.size(), 1u);
+  EXPECT_EQ(failures[0].reason, "invalid_job");
+  EXPECT_EQ(failures[0].worker, "old");
+  EXPECT_NE(failures[0].message.find("dihedral (unnamed)"), std::string::npos) << failures[0].message;
+  EXPECT_NE(failures[0].message.find("triangle"), std::string::npos) << failures[0].message;
+  for (const auto& j : all(reader->jobs())) EXPECT_EQ(j.state, storage::JobState::kDone);
+  EXPECT_EQ(all(reader->results()).size(), 1u);
+}
+
 }  // namespace
 }  // namespace drapegen::test

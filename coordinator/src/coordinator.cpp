@@ -395,7 +395,7 @@ struct Coordinator::Impl {
     // A worker that does not know the run's bending model (older than the field) drapes with the paper's: its result
     // would be mislabelled data, so it counts as a failed attempt and the job goes to another worker.
     const std::string& model = r.metrics().bending_model();
-    if (!noop && (model.empty() ? std::string("dihedral") : model) != config.bending_model) {
+    if (!noop && proto::bending_model_name(model) != config.bending_model) {
       v1::Failure f;
       f.set_job_id(r.job_id());
       f.set_attempt(r.attempt());

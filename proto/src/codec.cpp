@@ -30,7 +30,7 @@ sim::Status check_spec(const v1::JobSpec& s) {
   if (!s.renderer().empty() && s.renderer() != "osmesa" && s.renderer() != "software") {
     return sim::Error{"job: renderer must be osmesa or software"};
   }
-  if (!s.bending_model().empty() && s.bending_model() != "dihedral" && s.bending_model() != "triangle") {
+  if (const auto model = bending_model_name(s.bending_model()); model != "dihedral" && model != "triangle") {
     return sim::Error{"job: bending_model must be dihedral or triangle"};
   }
   if (s.max_iterations() < 1) return sim::Error{"job: max_iterations must be >= 1"};
@@ -105,6 +105,8 @@ sim::Status check(const v1::Envelope& e) {
   }
   return sim::Error{"envelope without a body"};
 }
+
+std::string_view bending_model_name(std::string_view field) { return field.empty() ? "dihedral" : field; }
 
 const char* body_name(const v1::Envelope& e) {
   switch (e.body_case()) {

@@ -86,6 +86,9 @@ TEST(Codec, ChecksFieldRules) {
     e.mutable_job()->mutable_spec()->set_bending_model(model);
     EXPECT_TRUE(decode(encode(e))) << model;
   }
+  EXPECT_EQ(bending_model_name(""), "dihedral");  // the one place that rule is spelled (worker, coordinator use it)
+  EXPECT_EQ(bending_model_name("triangle"), "triangle");
+  EXPECT_EQ(bending_model_name("quadratic"), "quadratic");
   v1::Envelope f;
   f.mutable_failure()->set_job_id(3);
   f.mutable_failure()->set_attempt(1);

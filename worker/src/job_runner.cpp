@@ -8,6 +8,7 @@
 #include <limits>
 #include <sstream>
 
+#include "drapegen/proto/codec.hpp"
 #include "drapegen/proto/recipe.hpp"
 #include "drapegen/renderer/data_point.hpp"
 #include "drapegen/renderer/make_renderer.hpp"
@@ -56,9 +57,9 @@ sim::Expected<sim::DrapeConfig> drape_config(const v1::JobSpec& spec, const std:
   if (!recipe) return recipe.error();
   const auto& p = spec.parameters();
   sim::DrapeConfig config;
-  if (spec.bending_model() == "triangle") {
+  if (const auto model = proto::bending_model_name(spec.bending_model()); model == "triangle") {
     config.bending_model = sim::BendingModel::kNonlinearTriangle;
-  } else if (!spec.bending_model().empty() && spec.bending_model() != "dihedral") {
+  } else if (model != "dihedral") {
     return sim::Error{fmt::format("unknown bending model '{}' (dihedral or triangle)", spec.bending_model())};
   }
   config.fabric = sim::fabric_from_paper_units({p.alpha_warp(), p.alpha_bias(), p.alpha_weft()},

@@ -33,6 +33,10 @@ inline constexpr std::size_t kMaxFrameBytes = 256u << 20;
 /// resolution and orientation count, finite parameters, a known failure reason, ...
 [[nodiscard]] sim::Status check(const v1::Envelope& envelope);
 
+/// The bending model a JobSpec or Metrics names: an empty field (a message from before the field existed) means the
+/// paper's "dihedral"; any other value is returned as is (check() accepts "dihedral" and "triangle").
+[[nodiscard]] std::string_view bending_model_name(std::string_view field);
+
 /// The body's name ("ready", "job", ...; "none" without one), for logs.
 [[nodiscard]] const char* body_name(const v1::Envelope& envelope);
 
