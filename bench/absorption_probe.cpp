@@ -6,6 +6,8 @@
 //   oracle  the true bending with the true effect (simulated effects only: yield, shear, curl, friction).
 // If "truth" is far above the floor and "fitted" within it, the fit absorbed the effect into the bending parameters;
 // if even "oracle" is not below "fitted", the fitting mesh and the multistability hide the effect from any refit.
+// Each cell also gives (after "m") the captures' mean shape features (placements 0 and 1 / placement 0 alone) against
+// the mean over the validation drapes. --resolution changes the forward model's mesh (default --fine's).
 // Reads the truth files, so it is a benchmark tool, never part of the diagnosis.
 #include <CLI/CLI.hpp>
 #include <algorithm>

@@ -3,6 +3,8 @@
 // at a time), and scores the verdicts against the truth files: confusion matrix, top-1 accuracy, controls within
 // the floors, median shrinkage, region match, runtime. The diagnosis never sees the truth: it runs on a copy of
 // each capture directory without truth.json.
+// With --visible-only N, each effect capture is first screened (visibility_screen.hpp) and drawn again until its
+// effect is visible at all to the diagnosis's gap test.
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <atomic>
