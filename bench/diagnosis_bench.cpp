@@ -49,6 +49,30 @@ const std::map<std::string, std::pair<double, double>> kDefaultStrength = {
     {"yield", {10.0, 25.0}}, {"shear", {0.3, 1.0}},       {"curl", {100.0, 300.0}}, {"friction", {0.02, 0.1}},
     {"misalign", {15.0, 30.0}}, {"pose", {1.0, 2.0}},     {"bias", {5.0, 10.0}},  {"multipath", {15.0, 30.0}}};
 
+/// Writes `text` to `path` through a temporary file (a reader never sees half of it); false with a message on failure.
+bool write_file(const fs::path& path, const std::string& text) {
+  const fs::path tmp = path.string() + ".tmp";
+  {
+    std::ofstream f(tmp, std::ios::binary);
+    f << text;
+    if (!f.flush()) {
+      std::cerr << "diagnosis_bench: cannot write " << tmp.string() << "\n";
+      return false;
+    }
+  }
+  std::error_code ec;
+  fs::rename(tmp, path, ec);
+  if (ec) std::cerr << "diagnosis_bench: cannot write " << path.string() << ": " << ec.message() << "\n";
+  return !ec;
+}
+
+/// Moves `from` to `to`, replacing it; if `from` is gone but `to` exists, an earlier run moved it already.
+void move_into(const fs::path& from, const fs::path& to) {
+  if (!fs::exists(from) && fs::exists(to)) return;
+  fs::remove_all(to);
+  fs::rename(from, to);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -84,9 +108,11 @@ int main(int argc, char** argv) {
   app.add_option("--strength", strength_overrides, "NAME=LO:HI: draw that effect's strength in [LO, HI]");
   int screen_draws = 0;
   app.add_option("--visible-only", screen_draws,
-                 "Screen every effect capture (visibility_screen.hpp: the true fabric without the effect must leave an "
-                 "excess above the floors) and draw another fabric, strength and seed until it passes, at most N draws "
-                 "(the last is kept either way); the draws are logged in OUT/screen/NAME.json (0: no screen)")
+                 "Screen every effect capture (visibility_screen.hpp: gated as `drapegen diagnose --fine` gates its "
+                 "gap, with placement 1 as the held-out capture if generated, the true fabric without the effect must "
+                 "leave an excess above the floors) and draw another fabric, strength and seed until it passes, at "
+                 "most N draws (the last is kept either way); the draws are logged in OUT/screen/NAME.json; controls "
+                 "are screened once and kept (0: no screen)")
       ->capture_default_str()
       ->check(CLI::Range(0, 100));
   app.add_flag("--quick", quick, "Diagnose with --quick");
@@ -227,18 +253,24 @@ int main(int argc, char** argv) {
       if (!record) return false;
       draws.push_back(*record);
       if ((*record)["visible"].get<bool>() || k + 1 == screen_draws) {
-        // Placement 0's capture last: its presence marks the case as generated (a rerun resumes from it).
-        for (int p = placements - 1; p >= 0; --p) {
-          const std::string name = p == 0 ? c.name : fmt::format("{}.p{}", c.name, p);
-          fs::rename(root / "truth" / (name + ".json"), fs::path(out) / "truth" / (name + ".json"));
-          fs::remove_all(fs::path(out) / "captures" / name);  // left by an interrupted move of this draw
-          fs::rename(root / "captures" / name, fs::path(out) / "captures" / name);
+        // The log first, then the kept draw's files, placement 0's capture last: its presence marks the case as
+        // generated. A run stopped in between screens the case again on resume (the same draws) and completes the
+        // move: a file already moved stays.
+        if (!write_file(fs::path(out) / "screen" / (c.name + ".json"), draws.dump(2) + "\n")) return false;
+        try {
+          for (int p = placements - 1; p >= 0; --p) {
+            const std::string name = p == 0 ? c.name : fmt::format("{}.p{}", c.name, p);
+            move_into(root / "truth" / (name + ".json"), fs::path(out) / "truth" / (name + ".json"));
+            move_into(root / "captures" / name, fs::path(out) / "captures" / name);
+          }
+        } catch (const fs::filesystem_error& e) {
+          std::cerr << "diagnosis_bench: screen " << c.name << ": " << e.what() << "\n";
+          return false;
         }
-        break;
+        return true;
       }
     }
-    std::ofstream(fs::path(out) / "screen" / (c.name + ".json")) << draws.dump(2) << "\n";
-    return true;
+    return write_file(fs::path(out) / "screen" / (c.name + ".json"), draws.dump(2) + "\n");
   };
   if (!score_only) {
     fs::create_directories(fs::path(out) / "captures");

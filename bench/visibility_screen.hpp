@@ -1,9 +1,10 @@
 #pragma once
-// Is an effect in a benchmark capture visible at all? The capture (and its second placement, if any) is gated exactly
-// as the diagnosis gates its gap (--fine's forward model, the validation states, the floors and the shape floor), but
-// against the specimen's true bending without the effect instead of a fitted one: if even the true fabric leaves no
-// excess above the floors, no fit of the baseline can leave one, and no gap test can name the effect. Reads the truth,
-// so it is a benchmark tool (diagnosis_bench --visible-only), never part of the diagnosis.
+// Is an effect in a benchmark capture visible at all? The capture (and its second placement, if any) is gated as
+// `drapegen diagnose --fine --held-out-capture` gates its gap (the forward model, validation states, floors and shape
+// floor of DiagnosisSettings::fine()), but against the specimen's true bending without the effect instead of a fitted
+// one: if even the true fabric leaves no excess above the floors, the effect does not stand out from the fabric's own
+// multistability. (A fit can still end above the floors, or absorb a visible effect: the screen does not predict the
+// verdict.) Reads the truth, so it is a benchmark tool (diagnosis_bench --visible-only), never part of the diagnosis.
 
 #include <string>
 

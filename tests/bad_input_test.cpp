@@ -259,7 +259,8 @@ TEST(Service, ExpiredLeasesAreRequeued) {
 TEST(Service, ResultOfAnotherBendingModelIsRefused) {
   const fs::path dir = test_dir("model_mismatch");
   const fs::path out = dir / "run";
-  write_text(dir / "run.toml", small_config(out, 1, 1, "bending_model = \"triangle\"\n"));
+  // Attempts to spare: the retry may be leased back to the old worker before it goes away.
+  write_text(dir / "run.toml", small_config(out, 1, 1, "bending_model = \"triangle\"\n[retry]\nmax_attempts = 5\n"));
   const fs::path manifest = out / "manifest.sqlite";
   Process coordinator({"run", "--config", (dir / "run.toml").string()}, (dir / "coordinator").string());
   const std::string endpoint = wait_endpoint(out, coordinator, 30s);
@@ -268,7 +269,8 @@ TEST(Service, ResultOfAnotherBendingModelIsRefused) {
   {
     FakeWorker old(context, endpoint);
     v1::Envelope hello = ready("old");
-    hello.mutable_ready()->set_interval_ms(100);  // lost soon after it goes silent (it may be leased the retry)
+    // Lost 2 s after it goes silent (it may be leased the retry): long enough to answer on a busy machine.
+    hello.mutable_ready()->set_interval_ms(500);
     old.send(hello);
     auto job = old.expect(v1::Envelope::kJob, 5s);
     ASSERT_TRUE(job);
@@ -283,7 +285,7 @@ TEST(Service, ResultOfAnotherBendingModelIsRefused) {
       auto r = storage::ManifestReader::open(manifest.string());
       if (!r) return false;
       auto f = r->failures();
-      return f && !f->empty();
+      return f && !f->empty() && f->front().reason == "invalid_job";
     };
     const auto until = std::chrono::steady_clock::now() + 10s;
     while (!refused() && std::chrono::steady_clock::now() < until) std::this_thread::sleep_for(10ms);
