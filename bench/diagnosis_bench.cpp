@@ -149,6 +149,14 @@ int main(int argc, char** argv) {
     std::cerr << "diagnosis_bench: error: no fabrics in " << fabrics_path << "\n";
     return 1;
   }
+  // A fabric of fabrics618 and an effect's strength, drawn from `r` (for the cases as drawn and for the screen's draws).
+  const auto draw_fabric = [&](renderer::Rng& r) {
+    return fabrics[static_cast<std::size_t>(r.uniform() * fabrics.size()) % fabrics.size()];
+  };
+  const auto draw_strength = [&](const std::string& effect, renderer::Rng& r) {
+    const auto [lo, hi] = strength_range.at(effect);
+    return lo + (hi - lo) * r.uniform();
+  };
   renderer::Rng rng(seed);
   std::vector<Case> cases;
   int sensor_kind = 0;
@@ -156,7 +164,7 @@ int main(int argc, char** argv) {
     Case c;
     c.family = family;
     c.seed = seed * 1000 + cases.size();
-    c.fabric = fabrics[static_cast<std::size_t>(rng.uniform() * fabrics.size()) % fabrics.size()];
+    c.fabric = draw_fabric(rng);
     if (family == "none") {
       c.effect = "";
     } else if (family == "sensor") {
@@ -167,10 +175,7 @@ int main(int argc, char** argv) {
     } else {
       c.effect = family;
     }
-    if (!c.effect.empty()) {
-      const auto [lo, hi] = strength_range.at(c.effect);
-      c.strength = lo + (hi - lo) * rng.uniform();
-    }
+    if (!c.effect.empty()) c.strength = draw_strength(c.effect, rng);
     c.name = fmt::format("{}_{:02d}", family, index);
     cases.push_back(c);
   };
@@ -209,9 +214,8 @@ int main(int argc, char** argv) {
     if (draw == 0) return d;
     renderer::Rng r(c.seed * 1000003ULL + static_cast<std::uint64_t>(draw));
     d.seed = c.seed + 100000ULL * static_cast<std::uint64_t>(draw);
-    d.fabric = fabrics[static_cast<std::size_t>(r.uniform() * fabrics.size()) % fabrics.size()];
-    const auto [lo, hi] = strength_range.at(c.effect);
-    d.strength = lo + (hi - lo) * r.uniform();
+    d.fabric = draw_fabric(r);
+    d.strength = draw_strength(c.effect, r);
     return d;
   };
   // The screen of one draw generated under `root`: its record, or nothing on an error.
