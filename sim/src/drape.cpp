@@ -1,5 +1,7 @@
 #include "drapegen/sim/drape.hpp"
 
+#include <fmt/format.h>
+
 #include <memory>
 #include <nlohmann/json.hpp>
 
@@ -19,22 +21,30 @@ std::vector<std::unique_ptr<EnergyTerm>> make_bending(const ClothMesh& mesh, con
   const PhysicalEffects& fx = config.effects;
   std::vector<std::unique_ptr<EnergyTerm>> terms;
   if (config.bending_model == BendingModel::kQuadratic) {
-    if (fx.edge_curl || fx.bending_yield_curvature) {
-      throw std::invalid_argument("edge curl and bending plasticity need the dihedral bending model");
+    if (fx.edge_curl || fx.bending_yield_curvature || config.rest_angles.size() > 0) {
+      throw std::invalid_argument("edge curl, bending plasticity and rest angles need the dihedral bending model");
     }
     terms.push_back(std::make_unique<QuadraticBending>(mesh, topology, fabric.gamma, config.anisotropy));
     return terms;
   }
   const DihedralModuli moduli{fabric.alpha, fabric.beta};
   if (config.bending_model == BendingModel::kNonlinearTriangle) {
-    if (fx.edge_curl || fx.bending_yield_curvature) {
-      throw std::invalid_argument("edge curl and bending plasticity need the dihedral bending model");
+    if (fx.edge_curl || fx.bending_yield_curvature || config.rest_angles.size() > 0) {
+      throw std::invalid_argument("edge curl, bending plasticity and rest angles need the dihedral bending model");
     }
     terms.push_back(std::make_unique<TriangleCurvatureBending>(mesh, topology, moduli, config.anisotropy));
     return terms;
   }
   auto hinges = std::make_unique<DihedralBending>(mesh, topology, moduli, config.anisotropy);
-  if (fx.edge_curl) hinges->set_rest_angles(edge_curl_rest_angles(mesh, topology, *fx.edge_curl));
+  if (config.rest_angles.size() > 0) {
+    if (config.rest_angles.size() != static_cast<Eigen::Index>(topology.hinges.size())) {
+      throw std::invalid_argument(fmt::format("rest angles: {} given, the specimen has {} hinges (another specimen?)",
+                                              config.rest_angles.size(), topology.hinges.size()));
+    }
+    hinges->set_rest_angles(config.rest_angles);
+  } else if (fx.edge_curl) {
+    hinges->set_rest_angles(edge_curl_rest_angles(mesh, topology, *fx.edge_curl));
+  }
   if (fx.bending_yield_curvature) hinges->set_yield_curvature(*fx.bending_yield_curvature);
   terms.push_back(std::move(hinges));
   return terms;
@@ -99,7 +109,8 @@ Expected<DrapeResult> simulate_drape(const DrapeConfig& config,
     if (friction) terms.push_back(friction.get());
     Eigen::Matrix3Xd x = mesh.positions;
     const int coarse = config.coarse_start_resolution;
-    if (coarse >= 3 && initial.shape != InitialShape::kMesh && config.specimen.vertices_x >= 2 * coarse &&
+    if (coarse >= 3 && initial.shape != InitialShape::kMesh && config.rest_angles.size() == 0 &&
+        config.specimen.vertices_x >= 2 * coarse &&
         config.specimen.vertices_y >= 2 * coarse) {
       // A cascade: each level starts from the drape of one at half its resolution, down to `coarse`.
       DrapeConfig coarse_config = config;
@@ -118,6 +129,9 @@ Expected<DrapeResult> simulate_drape(const DrapeConfig& config,
     }
     result.report = solver.solve(terms, fixed, gravity.vertex_weights().maxCoeff(), x);
     mesh.positions = x;
+    if (const auto* hinges = dynamic_cast<const DihedralBending*>(bending.front().get())) {
+      result.rest_angles = hinges->rest_angles();
+    }
     result.measures = measure_drape(mesh, config.platform);
   } catch (const std::invalid_argument& e) {
     return Error{e.what()};

@@ -15,6 +15,7 @@
 #include "drapegen/sim/newton_solver.hpp"
 #include "drapegen/sim/platform.hpp"
 #include "drapegen/sim/platform_friction.hpp"
+#include "drapegen/sim/ply.hpp"
 #include "drapegen/sim/specimen.hpp"
 #include "drapegen/sim/trellis_membrane.hpp"
 
@@ -285,6 +286,74 @@ TEST(Effects, PlasticityActsFromAFlatStartOnAnIsotropicFabric) {
   }
   std::printf("[ drape    ] smallest fold gap %.3f rad\n", smallest_gap);
   EXPECT_GT(smallest_gap, 0.05);
+}
+
+TEST(Effects, AYieldedSpecimenKeepsItsSetWhenReleased) {
+  // Lifted off the tester, a specimen whose hinges yielded keeps the creases they took (its plastic set); an elastic
+  // one springs back flat. "Released" here: the drape's mesh under a thousandth of gravity, the top still held.
+  const DrapeConfig base = drape_config();
+  const DrapeResult elastic = drape(base, "elastic");
+  DrapeConfig plastic = base;
+  plastic.effects.bending_yield_curvature = 30.0;
+  const DrapeResult yielded = drape(plastic, "bending yield at 30 /m");
+  ASSERT_EQ(elastic.rest_angles.size(), yielded.rest_angles.size());
+  ASSERT_GT(yielded.rest_angles.size(), 0);
+  EXPECT_EQ(elastic.rest_angles.cwiseAbs().maxCoeff(), 0.0);
+  const double set = yielded.rest_angles.cwiseAbs().maxCoeff();
+  EXPECT_GT(set, 0.1);
+
+  auto release = [&](const DrapeConfig& config, const DrapeResult& from, const char* label) {
+    const std::string path = testing::TempDir() + "/released_" + label[0] + ".ply";
+    EXPECT_TRUE(static_cast<bool>(write_ply(path, from.mesh)));
+    DrapeConfig c = config;
+    c.gravity = kStandardGravity * 1e-3;
+    c.initial.shape = InitialShape::kMesh;
+    c.initial.mesh_path = path;
+    c.rest_angles = from.rest_angles;
+    return drape(c, label);
+  };
+  const double top = 0.0;  // the platform top disk lies in z = 0
+  const DrapeResult kept = release(plastic, yielded, "yielded, released with its set");
+  const DrapeResult flat = release(base, elastic, "elastic, released");
+  const double depth_draped = top - yielded.measures.lowest_point, depth_kept = top - kept.measures.lowest_point,
+               depth_flat = top - flat.measures.lowest_point;
+  std::printf("[ set      ] largest set %.3f rad; skirt depth: draped %.1f mm, yielded released %.1f mm, elastic "
+              "released %.1f mm\n", set, depth_draped * kMm, depth_kept * kMm, depth_flat * kMm);
+  EXPECT_GT(depth_kept, 0.3 * depth_draped);
+  EXPECT_LT(depth_flat, 0.15 * depth_draped);
+  const double set_change = (kept.rest_angles - yielded.rest_angles).norm() / yielded.rest_angles.norm();
+  std::printf("[ set      ] the release changes the set by %.1f%%\n", 100.0 * set_change);
+  EXPECT_LT(set_change, 0.1);
+
+  // Laid again as before, the set specimen takes the same drape (the set is that drape's); laid from another state,
+  // it drapes otherwise than a fresh specimen laid so (its creases pull).
+  auto mean_distance = [](const DrapeResult& x, const DrapeResult& y) {
+    return (x.mesh.positions - y.mesh.positions).colwise().norm().mean();
+  };
+  DrapeConfig again = plastic;
+  again.rest_angles = yielded.rest_angles;
+  const double same = mean_distance(drape(again, "yield 30 /m, laid again as before"), yielded);
+  DrapeConfig turned = plastic;
+  turned.initial.shape = InitialShape::kSine;
+  turned.initial.seed = 7;
+  turned.initial.rotation = 1.0;
+  const DrapeResult fresh = drape(turned, "yield 30 /m, sine, turned, fresh");
+  turned.rest_angles = yielded.rest_angles;
+  const double other = mean_distance(drape(turned, "yield 30 /m, sine, turned, with set"), fresh);
+  std::printf("[ set      ] mean vertex distance: laid again as before %.2f mm; laid otherwise, set vs fresh %.2f mm\n",
+              same * kMm, other * kMm);
+  EXPECT_LT(same, 0.5e-3);
+  EXPECT_GT(other, 2e-3);
+
+  DrapeConfig wrong = plastic;
+  wrong.rest_angles = Eigen::VectorXd::Zero(7);
+  const Expected<DrapeResult> refused = simulate_drape(wrong);
+  ASSERT_FALSE(refused.has_value());
+  EXPECT_NE(refused.error().message.find("hinges"), std::string::npos) << refused.error().message;
+  DrapeConfig quadratic = turned;
+  quadratic.bending_model = BendingModel::kQuadratic;
+  quadratic.effects = {};
+  EXPECT_FALSE(simulate_drape(quadratic).has_value());
 }
 
 }  // namespace

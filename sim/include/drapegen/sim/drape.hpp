@@ -43,6 +43,11 @@ struct DrapeConfig {
   bool adhesion = true;
   /// Effects beyond the paper's model (none by default). Edge curl and bending plasticity need the dihedral model.
   PhysicalEffects effects;
+  /// The dihedral hinges' rest angles the specimen starts with (empty: flat, or the edge curl's): the plastic set of
+  /// an earlier drape of the same specimen (DrapeResult::rest_angles, same SpecimenSpec), lifted and laid again. A
+  /// real specimen keeps the creases its yielded hinges took; released, it relaxes to them, not to flat. Replaces the
+  /// edge curl's rest angles (the set includes them) and turns the coarse start off (the set lives on this mesh).
+  Eigen::VectorXd rest_angles;
   /// Solve first on specimens of half the resolution, recursively down to this many vertices per side, from the same
   /// initial state, and start each finer solve from the coarser drape (0: off; ignored for mesh initial states and
   /// specimens with fewer than twice this many vertices per side).
@@ -63,6 +68,9 @@ struct DrapeResult {
   SolveReport coarse_report;  // the coarse start (iterations 0 if none)
   DrapeMeasures measures;
   int fixed_vertices = 0;
+  /// The dihedral hinges' rest angles after the solve (plastic flow moves them; empty for the other bending models):
+  /// DrapeConfig::rest_angles of the specimen's next drape.
+  Eigen::VectorXd rest_angles;
 };
 
 /// Builds and solves the drape. Errors: invalid parameters or an unreadable initial mesh. A solve that does not
