@@ -45,7 +45,9 @@ int run_reality(const RealityOptions& o) {
   spec.density = o.density;
   spec.resolution = o.resolution;
   spec.seed = o.seed;
-  if (o.placement < 0 || o.placement > 1000) return fail("--placement must be between 0 and 1000");
+  if (o.placement < 0 || o.placement > diagnosis::kMaxPlacement) {
+    return fail(fmt::format("--placement must be between 0 and {}", diagnosis::kMaxPlacement));
+  }
   spec.placement = o.placement;
   spec.noise = o.noise;
   for (const auto& text : o.effects) {
@@ -90,7 +92,9 @@ Runner add_reality_command(CLI::App& app) {
   app.add_option("--seed", o->seed, "Seed of initial state, orientation, drift, camera and noise")->capture_default_str();
   app.add_option("--placement", o->placement,
                  "Placement K of the specimen: K > 0 re-drapes the same specimen (same fabric, effects and camera "
-                 "calibration error) from another initial state, orientation, drift and noise: a second capture of it")
+                 "calibration error) from another initial state, orientation, drift and noise: a second capture of it. A "
+                 "yielding specimen keeps its plastic set: placement K starts from the set placements 0..K-1 left "
+                 "(K + 1 drapes)")
       ->capture_default_str();
   app.add_option("--out", o->out, "Capture directory (capture.json, view0..3.exr, truth.json, preview.png)")
       ->required();

@@ -254,11 +254,24 @@ sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& base
   }
   for (auto& r : results)
     if (!r || !*r) return r ? r->error() : sim::Error{"candidate refit did not run"};
-  // The held-out capture: each refitted setup's validation drapes scored against it (no simulation).
+  // The held-out capture: each refitted setup's validation drapes scored against it (no simulation). A yielding
+  // candidate's specimen is on its second placement there, with the plastic set its first left: its held-out drapes
+  // are simulated again from the validation states, starting from the set of its best validation drape.
   if (held_out) {
+    const std::vector<sim::InitialStateSpec> states = validation_states(settings);
     for (auto& r : results) {
       CandidateResult& c = r->value();
-      auto e = held_out->model->rescore(c.validation_meshes, c.setup);
+      sim::Expected<Evaluation> e = sim::Error{""};
+      if (c.setup.effects.bending_yield_curvature) {
+        const sim::InitialStateSpec& first = states.at(static_cast<std::size_t>(c.validated.state));
+        ModelSetup second = c.setup;
+        auto mesh = held_out->model->simulate(c.setup, first, nullptr, &second.plastic_set.rest_angles);
+        if (!mesh) return mesh.error();
+        second.plastic_set.specimen_seed = first.seed;
+        e = held_out->model->evaluate(second, states);
+      } else {
+        e = held_out->model->rescore(c.validation_meshes, c.setup);
+      }
       if (!e) return e.error();
       c.validated_held_out = std::move(e->best);
     }

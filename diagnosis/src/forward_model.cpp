@@ -62,7 +62,7 @@ sim::Expected<std::unique_ptr<ForwardModel>> ForwardModel::create(const Capture&
 }
 
 sim::Expected<sim::ClothMesh> ForwardModel::simulate(const ModelSetup& setup, const sim::InitialStateSpec& state,
-                                                     bool* converged) {
+                                                     bool* converged, Eigen::VectorXd* rest_angles) {
   const auto start = std::chrono::steady_clock::now();
   sim::DrapeConfig config;
   config.fabric = sim::fabric_from_paper_units(setup.bending.alpha, setup.bending.beta, capture_.specimen.density);
@@ -71,7 +71,9 @@ sim::Expected<sim::ClothMesh> ForwardModel::simulate(const ModelSetup& setup, co
   config.specimen.size_x = capture_.specimen.size_x;
   config.specimen.size_y = capture_.specimen.size_y;
   config.specimen.vertices_x = config.specimen.vertices_y = settings_.resolution;
-  config.specimen.seed = state.seed;
+  const bool set = setup.plastic_set.rest_angles.size() > 0;
+  config.specimen.seed = set ? setup.plastic_set.specimen_seed : state.seed;
+  config.rest_angles = setup.plastic_set.rest_angles;
   config.initial = state;
   config.initial.platform_radius = config.platform.radius;
   config.initial.drift += setup.drift;
@@ -83,6 +85,7 @@ sim::Expected<sim::ClothMesh> ForwardModel::simulate(const ModelSetup& setup, co
   simulation_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!result) return result.error();
   if (converged != nullptr) *converged = result->report.outcome == sim::SolveOutcome::kConverged;
+  if (rest_angles != nullptr) *rest_angles = std::move(result->rest_angles);
   return std::move(result->mesh);
 }
 

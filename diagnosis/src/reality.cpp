@@ -33,6 +33,9 @@ Eigen::Vector3d random_unit(renderer::Rng& rng) {
   return v.norm() > 0.0 ? Eigen::Vector3d(v.normalized()) : Eigen::Vector3d::UnitX();
 }
 
+/// The random stream of placement K > 0 (its draws and its noise).
+std::uint64_t placement_stream(int placement) { return 0x9A1E0000u + static_cast<std::uint64_t>(placement); }
+
 }  // namespace
 
 std::string reality_family(const std::string& name) {
@@ -88,23 +91,32 @@ sim::Expected<RealityEffect> parse_reality_effect(const std::string& text) {
   return e;
 }
 
-sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std::string& directory) {
-  const auto start = std::chrono::steady_clock::now();
-  if (spec.resolution < 5 || spec.resolution > 200) return sim::Error{"resolution must be 5 .. 200"};
-  if (spec.placement < 0 || spec.placement > 1000) return sim::Error{"placement must be 0 .. 1000"};
+namespace {
+
+/// What one placement of the specimen is: the drape's configuration (without a plastic set), the sensor's error and
+/// the truth's description of the effects.
+struct Placement {
+  sim::DrapeConfig config;
+  renderer::SensorError sensor;
+  nlohmann::json effects = nlohmann::json::array();
+  std::string family = "none";
+  std::vector<std::string> regions{"global"};
+};
+
+sim::Expected<Placement> make_placement(const RealitySpec& spec, int placement) {
   // `rng` draws the first placement and the sensor's error; a later placement takes its own draws from `moved` for
   // what a re-placement changes, after drawing (and discarding) the first placement's from `rng`, so that the
   // sensor's error stays the first placement's.
   renderer::Rng rng(renderer::mix_seed(spec.seed, 0x4EA1));
-  const bool replaced = spec.placement > 0;
-  const std::uint64_t placement_stream = 0x9A1E0000u + static_cast<std::uint64_t>(spec.placement);
-  const std::uint64_t placement_seed = renderer::mix_seed(spec.seed, placement_stream);
+  const bool replaced = placement > 0;
+  const std::uint64_t placement_seed = renderer::mix_seed(spec.seed, placement_stream(placement));
   renderer::Rng moved(placement_seed);
   auto placement_draw = [&] {
     const double first = rng.uniform();
     return replaced ? moved.uniform() : first;
   };
-  sim::DrapeConfig config;
+  Placement p;
+  sim::DrapeConfig& config = p.config;
   config.fabric = sim::fabric_from_paper_units(spec.bending.alpha, spec.bending.beta, spec.density);
   if (sim::Status s = sim::validate(config.fabric, config.bending_model); !s) return s.error();
   config.specimen.vertices_x = config.specimen.vertices_y = spec.resolution;
@@ -116,20 +128,17 @@ sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std
   const double phi = 2.0 * M_PI * placement_draw();
   config.initial.drift = small * Eigen::Vector2d(std::cos(phi), std::sin(phi));
 
-  renderer::SensorError sensor;
-  nlohmann::json effects = nlohmann::json::array();
-  std::string family = "none";
-  std::vector<std::string> regions{"global"};
+  renderer::SensorError& sensor = p.sensor;
   for (const auto& e : spec.effects) {
-    effects.push_back({{"name", e.name}, {"strength", e.strength}});
-    if (family == "none") family = reality_family(e.name);
+    p.effects.push_back({{"name", e.name}, {"strength", e.strength}});
+    if (p.family == "none") p.family = reality_family(e.name);
     if (e.name == "yield") {
       config.effects.bending_yield_curvature = e.strength;
     } else if (e.name == "shear") {
       config.effects.shear_stiffness = e.strength;
     } else if (e.name == "curl") {
       const double curl_width_mm = e.width_mm > 0.0 ? e.width_mm : kCurlWidth * 1e3;
-      effects.back()["width_mm"] = curl_width_mm;
+      p.effects.back()["width_mm"] = curl_width_mm;
       // The band needs two vertex spacings at least, or the mesh cannot bend within it.
       const double spacing_mm = config.specimen.size_x * 1e3 / (spec.resolution - 1);
       if (curl_width_mm < 2.0 * spacing_mm) {
@@ -159,11 +168,45 @@ sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std
   if (!spec.effects.empty()) {
     const std::string& first = spec.effects.front().name;
     if (first == "multipath") {
-      regions = {"cylinder", "rim"};
+      p.regions = {"cylinder", "rim"};
     } else if (auto eff = parse_effect(reality_family(first))) {
-      regions.clear();
-      for (Region r : effect_regions(*eff)) regions.emplace_back(region_name(r));
+      p.regions.clear();
+      for (Region r : effect_regions(*eff)) p.regions.emplace_back(region_name(r));
     }
+  }
+  return p;
+}
+
+}  // namespace
+
+sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std::string& directory) {
+  const auto start = std::chrono::steady_clock::now();
+  if (spec.resolution < 5 || spec.resolution > 200) return sim::Error{"resolution must be 5 .. 200"};
+  if (spec.placement < 0 || spec.placement > kMaxPlacement) {
+    return sim::Error{fmt::format("placement must be 0 .. {}", kMaxPlacement)};
+  }
+  auto made = make_placement(spec, spec.placement);
+  if (!made) return made.error();
+  Placement& p = *made;
+  sim::DrapeConfig& config = p.config;
+  const renderer::SensorError& sensor = p.sensor;
+  const bool replaced = spec.placement > 0;
+
+  // A yielding specimen keeps its plastic set from one placement to the next (lifted and laid again): placement K
+  // starts from the set placements 0 .. K-1 left, each draped in turn.
+  double largest_set = 0.0;
+  if (config.effects.bending_yield_curvature && replaced) {
+    Eigen::VectorXd set;
+    for (int k = 0; k < spec.placement; ++k) {
+      auto earlier = make_placement(spec, k);
+      if (!earlier) return earlier.error();
+      earlier->config.rest_angles = set;
+      auto drape = sim::simulate_drape(earlier->config);
+      if (!drape) return sim::Error{fmt::format("placement {} (for its plastic set): {}", k, drape.error().message)};
+      set = std::move(drape->rest_angles);
+    }
+    largest_set = set.cwiseAbs().maxCoeff();
+    config.rest_angles = std::move(set);
   }
 
   auto drape = sim::simulate_drape(config);
@@ -199,7 +242,7 @@ sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std
     if (!clean) return clean.error();
     renderer::DepthImage biased = sensor.any() ? sensor.apply(*clean, view.camera.intrinsics) : *clean;
     const std::uint64_t noise_seed =
-        replaced ? renderer::mix_seed(setup.noise_seed(v), placement_stream) : setup.noise_seed(v);
+        replaced ? renderer::mix_seed(setup.noise_seed(v), placement_stream(spec.placement)) : setup.noise_seed(v);
     view.depth = noise.any() ? noise.apply(biased, noise_seed) : biased;
     view.depth.incidence.clear();
     if (sim::Status s = check_view(view); !s) return sim::Error{fmt::format("rendered {}", s.error().message)};
@@ -211,15 +254,17 @@ sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std
 
   nlohmann::json truth = {
       {"warning", "ground truth: the diagnosis never reads this file"},
-      {"family", family},
-      {"effects", effects},
-      {"regions", regions},
+      {"family", p.family},
+      {"effects", p.effects},
+      {"regions", p.regions},
       {"alpha", {spec.bending.alpha.warp, spec.bending.alpha.bias, spec.bending.alpha.weft}},
       {"beta", {spec.bending.beta.warp, spec.bending.beta.bias, spec.bending.beta.weft}},
       {"density_g_per_m2", spec.density},
       {"resolution", spec.resolution},
       {"seed", spec.seed},
       {"placement", spec.placement},
+      {"plastic_set", {{"from_placements", config.rest_angles.size() > 0 ? spec.placement : 0},
+                       {"largest_rest_angle_rad", largest_set}}},
       {"initial_state", {{"shape", "sine"}, {"seed", config.initial.seed}, {"rotation_rad", config.initial.rotation}}},
       {"drift_mm", {config.initial.drift.x() * 1e3, config.initial.drift.y() * 1e3}},
       {"sensor",

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 #include <unistd.h>
+#include <vector>
 
 #include "drapegen/diagnosis/capture.hpp"
 #include "drapegen/diagnosis/reality.hpp"
@@ -23,7 +24,8 @@ struct Placed {
   nlohmann::json truth;
 };
 
-Placed place(int placement, const fs::path& dir) {
+Placed place(int placement, const fs::path& dir,
+             const std::vector<std::string>& effects = {"misalign=15", "pose=2"}) {
   RealitySpec spec;
   spec.bending.alpha = {13923, 11455, 8821};
   spec.bending.beta = {-35390, -29660, -22042};
@@ -31,7 +33,7 @@ Placed place(int placement, const fs::path& dir) {
   spec.seed = 21;
   spec.placement = placement;
   spec.noise = false;  // so that a difference between two placements is the drape's, not the noise's
-  spec.effects = {*parse_reality_effect("misalign=15"), *parse_reality_effect("pose=2")};
+  for (const auto& e : effects) spec.effects.push_back(*parse_reality_effect(e));
   auto r = generate_reality(spec, dir.string());
   EXPECT_TRUE(r.has_value()) << (r ? "" : r.error().message);
   if (!r) return {};
@@ -90,10 +92,29 @@ TEST(Reality, ASecondPlacementKeepsTheSpecimenAndTheRigAndMovesTheDrape) {
   fs::remove_all(root);
 }
 
+TEST(Reality, AYieldingSpecimenCarriesItsPlasticSetToTheNextPlacement) {
+  const fs::path root = fs::temp_directory_path() / ("drapegen_reality_set_" + std::to_string(::getpid()));
+  fs::remove_all(root);
+  const Placed first = place(0, root / "first", {"yield=20"});
+  const Placed second = place(1, root / "second", {"yield=20"});
+  const Placed third = place(2, root / "third", {"yield=20"});
+  const Placed elastic = place(1, root / "elastic");
+  EXPECT_EQ(first.truth["plastic_set"]["from_placements"], 0);
+  EXPECT_EQ(second.truth["plastic_set"]["from_placements"], 1);
+  EXPECT_EQ(third.truth["plastic_set"]["from_placements"], 2);
+  EXPECT_EQ(elastic.truth["plastic_set"]["from_placements"], 0);
+  // A fold's worth of set (the first drape bends its hinges well past 20 /m).
+  EXPECT_GT(second.truth["plastic_set"]["largest_rest_angle_rad"].get<double>(), 0.1);
+  EXPECT_GT(third.truth["plastic_set"]["largest_rest_angle_rad"].get<double>(), 0.1);
+  fs::remove_all(root);
+}
+
 TEST(Reality, RejectsANegativePlacement) {
   RealitySpec spec;
   spec.bending.alpha = {13923, 11455, 8821};
   spec.placement = -1;
+  EXPECT_FALSE(generate_reality(spec, (fs::temp_directory_path() / "drapegen_reality_bad").string()).has_value());
+  spec.placement = kMaxPlacement + 1;
   EXPECT_FALSE(generate_reality(spec, (fs::temp_directory_path() / "drapegen_reality_bad").string()).has_value());
 }
 

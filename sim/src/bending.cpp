@@ -90,8 +90,11 @@ DihedralBending::DihedralBending(const ClothMesh& mesh, const Topology& topology
 }
 
 void DihedralBending::set_rest_angles(const Eigen::VectorXd& angles) {
-  if (angles.size() != rest_angle_.size() || !angles.allFinite() || angles.cwiseAbs().maxCoeff() >= 3.0) {
-    throw std::invalid_argument("bending: one finite rest angle below 3 rad per hinge expected");
+  // Within (-pi, pi), where a hinge's angle lives: plastic flow can set a hinge folded against the fold barrier
+  // (fold_barrier.hpp) close to pi, and that set is carried to the specimen's next drape.
+  if (angles.size() != rest_angle_.size() || !angles.allFinite() ||
+      (angles.size() > 0 && angles.cwiseAbs().maxCoeff() >= std::numbers::pi)) {
+    throw std::invalid_argument("bending: one finite rest angle within (-pi, pi) per hinge expected");
   }
   rest_angle_ = angles;
 }

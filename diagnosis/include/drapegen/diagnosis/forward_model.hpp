@@ -71,9 +71,12 @@ class ForwardModel {
   [[nodiscard]] static sim::Expected<std::unique_ptr<ForwardModel>> create(const Capture& capture,
                                                                            const FitSettings& settings);
 
-  /// Simulates `setup` from initial state `state` (fit_initial_states order, or any spec via the overload).
+  /// Simulates `setup` from initial state `state` (fit_initial_states order, or any spec via the overload). The
+  /// specimen's triangulation is drawn from the state's seed, or is the plastic set's specimen if the setup has one.
+  /// `rest_angles`: the hinges' rest angles after the drape (the plastic set it leaves).
   [[nodiscard]] sim::Expected<sim::ClothMesh> simulate(const ModelSetup& setup, const sim::InitialStateSpec& state,
-                                                       bool* converged = nullptr);
+                                                       bool* converged = nullptr,
+                                                       Eigen::VectorXd* rest_angles = nullptr);
   /// Turns `mesh` to match `target` (the capture's outline unless given), renders with setup.sensor, compares.
   [[nodiscard]] sim::Expected<ScoredDrape> score(const sim::ClothMesh& mesh, const ModelSetup& setup,
                                                  const Target& target);

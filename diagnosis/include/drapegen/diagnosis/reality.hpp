@@ -32,6 +32,8 @@ struct RealityEffect {
 /// multipath).
 [[nodiscard]] std::string reality_family(const std::string& effect_name);
 
+inline constexpr int kMaxPlacement = 100;
+
 struct RealitySpec {
   BendingParameters bending;
   double density = 300.0;   // g/m^2
@@ -40,7 +42,8 @@ struct RealitySpec {
   /// Placement of the specimen on the tester: 0 is the first; K > 0 re-drapes the same specimen (same mesh, fabric,
   /// effects, misalignment distance and camera calibration error) from another initial state, orientation, drift,
   /// misalignment direction and sensor noise: a second capture of one specimen, for validation held out of a fit.
-  /// Every placement starts from the unloaded specimen (no plastic history carries over).
+  /// A yielding specimen (yield) carries its plastic set from placement to placement: placement K starts from the
+  /// rest angles placements 0 .. K-1 left, draped in turn (K + 1 drapes in all). At most kMaxPlacement.
   int placement = 0;
   std::vector<RealityEffect> effects;
   bool noise = true;
