@@ -261,13 +261,15 @@ sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& base
     const std::vector<sim::InitialStateSpec> states = validation_states(settings);
     for (auto& r : results) {
       CandidateResult& c = r->value();
-      sim::Expected<Evaluation> e = sim::Error{""};
+      sim::Expected<Evaluation> e = sim::Error{"no held-out evaluation"};
       if (c.setup.effects.bending_yield_curvature) {
         const sim::InitialStateSpec& first = states.at(static_cast<std::size_t>(c.validated.state));
         ModelSetup second = c.setup;
         auto mesh = held_out->model->simulate(c.setup, first, nullptr, &second.plastic_set.rest_angles);
         if (!mesh) return mesh.error();
         second.plastic_set.specimen_seed = first.seed;
+        const Eigen::VectorXd& set = second.plastic_set.rest_angles;
+        c.held_out_plastic_set = set.size() > 0 ? set.cwiseAbs().maxCoeff() : 0.0;
         e = held_out->model->evaluate(second, states);
       } else {
         e = held_out->model->rescore(c.validation_meshes, c.setup);

@@ -121,6 +121,8 @@ nlohmann::json validated_json(const CandidateResult& c, const Floors& floors) {
           {"shape", c.validated.shape_all},
           {"held_out_score_mm", c.validated.held_out_score * 1e3},
           {"held_out_capture", held_out_json(second)},
+          {"held_out_plastic_set_rad",
+           c.held_out_plastic_set ? nlohmann::json(*c.held_out_plastic_set) : nlohmann::json(nullptr)},
           {"excess_above_floors", excess_above_floors(gap_terms(c.validated, second), floors)}};
 }
 

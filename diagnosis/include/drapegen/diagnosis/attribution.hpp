@@ -40,6 +40,8 @@ struct CandidateResult {
   ScoredDrape validated;  // the refitted setup's best drape from the validation states: shrinkage, confirmation
   /// The same validation drapes scored against the held-out capture (its best), if there is one.
   std::optional<ScoredDrape> validated_held_out;
+  /// A yielding candidate's held-out drapes start from a plastic set (attribute): its largest rest angle, rad.
+  std::optional<double> held_out_plastic_set;
   [[nodiscard]] const ScoredDrape* held_out_drape() const {
     return validated_held_out ? &*validated_held_out : nullptr;
   }
