@@ -7,16 +7,20 @@
 // If "truth" is far above the floor and "fitted" within it, the fit absorbed the effect into the bending parameters;
 // if even "oracle" is not below "fitted", the fitting mesh and the multistability hide the effect from any refit.
 // Each cell also gives (after "m") the captures' mean shape features (placements 0 and 1 / placement 0 alone) against
-// the mean over the validation drapes. --resolution changes the forward model's mesh (default --fine's).
+// the mean over the validation drapes. For a yield capture with a second placement, a second line scores that
+// placement against the truth, the oracle laid again unloaded and the oracle laid again with its plastic set.
+// --resolution changes the forward model's mesh (default --fine's).
 // Reads the truth files, so it is a benchmark tool, never part of the diagnosis.
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <fmt/format.h>
 #include <fstream>
 #include <iostream>
 #include <limits>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 
@@ -69,6 +73,7 @@ struct Scores {
   double best_shape = 0.0, best_stable = 0.0, median_shape = 0.0;
   /// The mean features of the captures (placements 0 and 1, or 0 alone) against the mean over the states' drapes.
   double mean_shape = 0.0, mean_shape_p0 = 0.0;
+  int best_state = 0;  // index into the states of the best drape
 };
 
 /// Entry by entry mean of feature vectors (entries missing or NaN in one are left out of that entry's mean).
@@ -127,10 +132,35 @@ sim::Expected<Scores> score(diagnosis::ForwardModel& model, const diagnosis::Mod
   const auto scales = diagnosis::default_feature_scales();
   const auto& first = model.target().shape.all;
   Scores r{e->best.shape_all, e->best.stable_all * 1e3, shapes[shapes.size() / 2]};
+  r.best_state = e->best.state;
   r.mean_shape_p0 = diagnosis::feature_distance(first, model_mean, scales);
   r.mean_shape = second_capture ? diagnosis::feature_distance(mean_features({&first, second_capture}), model_mean, scales)
                                 : r.mean_shape_p0;
   return r;
+}
+
+/// A yielding specimen's second placement (the held-out capture) against the true bending without the effect, the
+/// oracle as if the specimen were laid again unloaded, and the oracle laid again with the plastic set that its best
+/// drape against the capture (`oracle_best_state`) left: what the diagnosis's yield candidate does.
+sim::Status probe_yield_held_out(diagnosis::ForwardModel& held_out,
+                                 const diagnosis::ModelSetup& elastic, const std::vector<sim::InitialStateSpec>& states,
+                                 const diagnosis::ModelSetup& oracle, int oracle_best_state) {
+  const sim::InitialStateSpec& state = states.at(static_cast<std::size_t>(oracle_best_state));
+  diagnosis::ModelSetup creased = oracle;
+  auto mesh = held_out.simulate(oracle, state, nullptr, &creased.plastic_set.rest_angles);
+  if (!mesh) return mesh.error();
+  creased.plastic_set.specimen_seed = state.seed;
+  std::string cells;
+  const std::array<const diagnosis::ModelSetup*, 3> setups{&elastic, &oracle, &creased};
+  for (const diagnosis::ModelSetup* setup : setups) {
+    auto e = held_out.evaluate(*setup, states);
+    if (!e) return e.error();
+    cells += fmt::format(" {:.2f} [{:.2f}]", e->best.shape_all, e->best.stable_all * 1e3);
+  }
+  std::cout << fmt::format("  held-out capture: truth, oracle unloaded, oracle with its set (largest {:.2f} rad):{}\n",
+                           creased.plastic_set.rest_angles.cwiseAbs().maxCoeff(), cells)
+            << std::flush;
+  return {};
 }
 
 /// One row: the capture against its fitted (if diagnosed), true and oracle setups.
@@ -146,12 +176,14 @@ sim::Status probe_case(const fs::path& run, const std::string& name, const diagn
   if (!model) return model.error();
   // The second placement, if the run has one: its shape features (in its own cameras).
   std::optional<diagnosis::ShapeFeatures> second;
+  std::unique_ptr<diagnosis::ForwardModel> held_out;
   if (fs::exists(run / "captures" / (name + ".p1"))) {
     auto c1 = diagnosis::read_capture((run / "captures" / (name + ".p1")).string());
     if (!c1) return c1.error();
     auto m1 = diagnosis::ForwardModel::create(*c1, settings.fit);
     if (!m1) return m1.error();
-    second = (*m1)->target().shape.all;
+    held_out = std::move(*m1);
+    second = held_out->target().shape.all;
   }
   const diagnosis::ShapeFeatures* p1 = second ? &*second : nullptr;
   const auto cell = [](const sim::Expected<Scores>& s) {
@@ -171,16 +203,23 @@ sim::Status probe_case(const fs::path& run, const std::string& name, const diagn
   const auto without = score(**model, truth_setup, states, p1);
   if (!without) return without.error();
   std::string oracle = "-";
+  diagnosis::ModelSetup with = truth_setup;
+  std::optional<sim::Expected<Scores>> with_scores;
   if (const auto simulated = true_effect(*truth)) {
-    diagnosis::ModelSetup with = truth_setup;
     diagnosis::apply_effect(simulated->first, simulated->second, with);
-    oracle = cell(score(**model, with, states, p1));
+    with_scores = score(**model, with, states, p1);
+    oracle = cell(*with_scores);
   }
   const auto effect = first_effect(*truth);
   const double strength = effect ? effect->second : 0.0;
   std::cout << fmt::format("{:<16} {:>8.3g} {:>34} {:>34} {:>34} {:>9}\n", name, strength, fitted, cell(without),
                            oracle, reported)
             << std::flush;
+  if (held_out && effect && effect->first == "yield" && with_scores && *with_scores) {
+    if (sim::Status s = probe_yield_held_out(*held_out, truth_setup, states, with, (*with_scores)->best_state); !s) {
+      return s;
+    }
+  }
   return {};
 }
 
