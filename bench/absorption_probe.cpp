@@ -145,11 +145,9 @@ sim::Expected<Scores> score(diagnosis::ForwardModel& model, const diagnosis::Mod
 sim::Status probe_yield_held_out(diagnosis::ForwardModel& held_out,
                                  const diagnosis::ModelSetup& elastic, const std::vector<sim::InitialStateSpec>& states,
                                  const diagnosis::ModelSetup& oracle, int oracle_best_state) {
-  const sim::InitialStateSpec& state = states.at(static_cast<std::size_t>(oracle_best_state));
-  diagnosis::ModelSetup creased = oracle;
-  auto mesh = held_out.simulate(oracle, state, nullptr, &creased.plastic_set.rest_angles);
-  if (!mesh) return mesh.error();
-  creased.plastic_set.specimen_seed = state.seed;
+  auto laid = held_out.laid_again(oracle, states.at(static_cast<std::size_t>(oracle_best_state)));
+  if (!laid) return laid.error();
+  const diagnosis::ModelSetup& creased = *laid;
   std::string cells;
   const std::array<const diagnosis::ModelSetup*, 3> setups{&elastic, &oracle, &creased};
   for (const diagnosis::ModelSetup* setup : setups) {

@@ -263,14 +263,11 @@ sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& base
       CandidateResult& c = r->value();
       sim::Expected<Evaluation> e = sim::Error{"no held-out evaluation"};
       if (c.setup.effects.bending_yield_curvature) {
-        const sim::InitialStateSpec& first = states.at(static_cast<std::size_t>(c.validated.state));
-        ModelSetup second = c.setup;
-        auto mesh = held_out->model->simulate(c.setup, first, nullptr, &second.plastic_set.rest_angles);
-        if (!mesh) return mesh.error();
-        second.plastic_set.specimen_seed = first.seed;
-        const Eigen::VectorXd& set = second.plastic_set.rest_angles;
+        auto second = held_out->model->laid_again(c.setup, states.at(static_cast<std::size_t>(c.validated.state)));
+        if (!second) return second.error();
+        const Eigen::VectorXd& set = second->plastic_set.rest_angles;
         c.held_out_plastic_set = set.size() > 0 ? set.cwiseAbs().maxCoeff() : 0.0;
-        e = held_out->model->evaluate(second, states);
+        e = held_out->model->evaluate(*second, states);
       } else {
         e = held_out->model->rescore(c.validation_meshes, c.setup);
       }

@@ -89,6 +89,15 @@ sim::Expected<sim::ClothMesh> ForwardModel::simulate(const ModelSetup& setup, co
   return std::move(result->mesh);
 }
 
+sim::Expected<ModelSetup> ForwardModel::laid_again(const ModelSetup& setup, const sim::InitialStateSpec& state) {
+  ModelSetup next = setup;
+  auto mesh = simulate(setup, state, nullptr, &next.plastic_set.rest_angles);
+  if (!mesh) return mesh.error();
+  // The drape ran on the set's specimen if there was one, else on the state's.
+  if (setup.plastic_set.rest_angles.size() == 0) next.plastic_set.specimen_seed = state.seed;
+  return next;
+}
+
 sim::Expected<std::vector<renderer::DepthImage>> ForwardModel::render(const sim::ClothMesh& mesh, double angle,
                                                                       const renderer::SensorError& sensor) {
   sim::ClothMesh turned = mesh;

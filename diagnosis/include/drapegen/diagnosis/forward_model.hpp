@@ -77,6 +77,9 @@ class ForwardModel {
   [[nodiscard]] sim::Expected<sim::ClothMesh> simulate(const ModelSetup& setup, const sim::InitialStateSpec& state,
                                                        bool* converged = nullptr,
                                                        Eigen::VectorXd* rest_angles = nullptr);
+  /// The specimen lifted and laid again: `setup` with the plastic set (PlasticSet) that its drape from `state` leaves,
+  /// so that the next drape starts from it. An elastic setup's set is all zero.
+  [[nodiscard]] sim::Expected<ModelSetup> laid_again(const ModelSetup& setup, const sim::InitialStateSpec& state);
   /// Turns `mesh` to match `target` (the capture's outline unless given), renders with setup.sensor, compares.
   [[nodiscard]] sim::Expected<ScoredDrape> score(const sim::ClothMesh& mesh, const ModelSetup& setup,
                                                  const Target& target);
