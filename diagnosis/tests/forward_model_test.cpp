@@ -1,0 +1,59 @@
+// ForwardModel::laid_again: the specimen lifted after a drape and laid again keeps what the drape did to it.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+#include <unistd.h>
+
+#include "drapegen/diagnosis/capture.hpp"
+#include "drapegen/diagnosis/forward_model.hpp"
+#include "drapegen/diagnosis/reality.hpp"
+
+namespace drapegen::diagnosis {
+namespace {
+
+namespace fs = std::filesystem;
+
+TEST(ForwardModel, LaidAgainCarriesAYieldingSpecimensSetAndNothingOfAnElasticOne) {
+  const fs::path dir = fs::temp_directory_path() / ("drapegen_forward_laid_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  RealitySpec spec;
+  spec.bending.alpha = {13923, 11455, 8821};
+  spec.bending.beta = {-35390, -29660, -22042};
+  spec.resolution = 14;
+  spec.noise = false;
+  ASSERT_TRUE(generate_reality(spec, dir.string()).has_value());
+  auto capture = read_capture(dir.string());
+  ASSERT_TRUE(capture.has_value()) << capture.error().message;
+  FitSettings settings;
+  settings.resolution = 12;
+  auto model = ForwardModel::create(*capture, settings);
+  ASSERT_TRUE(model.has_value()) << model.error().message;
+  const auto states = fit_initial_states(2, 7);
+
+  ModelSetup elastic;
+  elastic.bending = spec.bending;
+  auto elastic_again = (*model)->laid_again(elastic, states[1]);
+  ASSERT_TRUE(elastic_again.has_value()) << elastic_again.error().message;
+  const Eigen::VectorXd& none = elastic_again->plastic_set.rest_angles;
+  ASSERT_GT(none.size(), 0);
+  EXPECT_EQ(none.cwiseAbs().maxCoeff(), 0.0);  // an elastic specimen springs back flat
+  EXPECT_EQ(elastic_again->plastic_set.specimen_seed, states[1].seed);
+
+  ModelSetup yielding = elastic;
+  yielding.effects.bending_yield_curvature = 10.0;  // 1/m: the drape's folds bend well past it
+  auto once = (*model)->laid_again(yielding, states[1]);
+  ASSERT_TRUE(once.has_value()) << once.error().message;
+  EXPECT_GT(once->plastic_set.rest_angles.cwiseAbs().maxCoeff(), 0.1);
+  EXPECT_EQ(once->plastic_set.specimen_seed, states[1].seed);
+  // Laid a second time from another state: still the first drape's specimen, its set grown from the first one's.
+  auto twice = (*model)->laid_again(*once, states[0]);
+  ASSERT_TRUE(twice.has_value()) << twice.error().message;
+  EXPECT_EQ(twice->plastic_set.specimen_seed, states[1].seed);
+  EXPECT_EQ(twice->plastic_set.rest_angles.size(), once->plastic_set.rest_angles.size());
+  EXPECT_GT((twice->plastic_set.rest_angles - once->plastic_set.rest_angles).cwiseAbs().maxCoeff(), 0.0);
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace drapegen::diagnosis
