@@ -264,7 +264,7 @@ sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& base
       sim::Expected<Evaluation> e = sim::Error{"no held-out evaluation"};
       if (c.setup.effects.bending_yield_curvature) {
         auto second = held_out->model->laid_again(c.setup, states.at(static_cast<std::size_t>(c.validated.state)));
-        if (!second) return second.error();
+        if (!second) return sim::Error{"held-out capture, yield candidate laid again: " + second.error().message};
         const Eigen::VectorXd& set = second->plastic_set.rest_angles;
         c.held_out_plastic_set = set.size() > 0 ? set.cwiseAbs().maxCoeff() : 0.0;
         e = held_out->model->evaluate(*second, states);

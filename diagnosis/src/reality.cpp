@@ -195,6 +195,7 @@ sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std
   // A yielding specimen keeps its plastic set from one placement to the next (lifted and laid again): placement K
   // starts from the set placements 0 .. K-1 left, each draped in turn.
   double largest_set = 0.0;
+  bool set_converged = true;  // every earlier placement's drape converged
   if (config.effects.bending_yield_curvature && replaced) {
     Eigen::VectorXd set;
     for (int k = 0; k < spec.placement; ++k) {
@@ -203,6 +204,7 @@ sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std
       earlier->config.rest_angles = set;
       auto drape = sim::simulate_drape(earlier->config);
       if (!drape) return sim::Error{fmt::format("placement {} (for its plastic set): {}", k, drape.error().message)};
+      set_converged = set_converged && drape->report.outcome == sim::SolveOutcome::kConverged;
       set = std::move(drape->rest_angles);
     }
     largest_set = set.cwiseAbs().maxCoeff();
@@ -210,7 +212,7 @@ sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std
   }
 
   auto drape = sim::simulate_drape(config);
-  if (!drape) return drape.error();
+  if (!drape) return sim::Error{fmt::format("placement {}: {}", spec.placement, drape.error().message)};
   const bool converged = drape->report.outcome == sim::SolveOutcome::kConverged;
 
   auto cloth = renderer::cloth_triangles(drape->mesh);
@@ -264,7 +266,8 @@ sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std
       {"seed", spec.seed},
       {"placement", spec.placement},
       {"plastic_set", {{"from_placements", config.rest_angles.size() > 0 ? spec.placement : 0},
-                       {"largest_rest_angle_rad", largest_set}}},
+                       {"largest_rest_angle_rad", largest_set},
+                       {"earlier_drapes_converged", set_converged}}},
       {"initial_state", {{"shape", "sine"}, {"seed", config.initial.seed}, {"rotation_rad", config.initial.rotation}}},
       {"drift_mm", {config.initial.drift.x() * 1e3, config.initial.drift.y() * 1e3}},
       {"sensor",

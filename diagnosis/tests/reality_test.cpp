@@ -106,6 +106,7 @@ TEST(Reality, AYieldingSpecimenCarriesItsPlasticSetToTheNextPlacement) {
   // A fold's worth of set (the first drape bends its hinges well past 20 /m).
   EXPECT_GT(second.truth["plastic_set"]["largest_rest_angle_rad"].get<double>(), 0.1);
   EXPECT_GT(third.truth["plastic_set"]["largest_rest_angle_rad"].get<double>(), 0.1);
+  EXPECT_TRUE(third.truth["plastic_set"]["earlier_drapes_converged"].get<bool>());
   fs::remove_all(root);
 }
 

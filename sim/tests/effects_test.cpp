@@ -350,10 +350,13 @@ TEST(Effects, AYieldedSpecimenKeepsItsSetWhenReleased) {
   const Expected<DrapeResult> refused = simulate_drape(wrong);
   ASSERT_FALSE(refused.has_value());
   EXPECT_NE(refused.error().message.find("hinges"), std::string::npos) << refused.error().message;
-  DrapeConfig quadratic = turned;
+  DrapeConfig quadratic = turned;  // a valid quadratic fabric, refused for its rest angles alone
   quadratic.bending_model = BendingModel::kQuadratic;
+  quadratic.fabric.gamma = {1e-5, 1e-5, 1e-5};
   quadratic.effects = {};
-  EXPECT_FALSE(simulate_drape(quadratic).has_value());
+  const Expected<DrapeResult> no_set = simulate_drape(quadratic);
+  ASSERT_FALSE(no_set.has_value());
+  EXPECT_NE(no_set.error().message.find("rest angles"), std::string::npos) << no_set.error().message;
 }
 
 }  // namespace

@@ -7,7 +7,7 @@
 // noisy objective over its evaluations, so a refit compared with it must beat the baseline's luckiest draw.
 // Confidence: a block bootstrap over the held-out view's residual tiles of the named effect against the runner-up.
 // With a held-out capture (a second placement of the specimen, in no fit), every validation drape is also scored
-// against it: the excess is that of the mean of both captures' gap terms (gap_terms), the confirmation and the
+// against it (the yield candidate's are draped again there, from the plastic set its best validation drape left): the excess is that of the mean of both captures' gap terms (gap_terms), the confirmation and the
 // bootstrap use the held-out capture's views instead of the held-out view.
 
 #include <optional>
@@ -38,7 +38,8 @@ struct CandidateResult {
   double seconds = 0.0;
   ScoredDrape drape;      // the refit's best drape (fit states)
   ScoredDrape validated;  // the refitted setup's best drape from the validation states: shrinkage, confirmation
-  /// The same validation drapes scored against the held-out capture (its best), if there is one.
+  /// The same validation drapes scored against the held-out capture (its best), if there is one; for a yielding
+  /// candidate, its drapes from the validation states laid again with the plastic set (ForwardModel::laid_again).
   std::optional<ScoredDrape> validated_held_out;
   /// A yielding candidate's held-out drapes start from a plastic set (attribute): its largest rest angle, rad.
   std::optional<double> held_out_plastic_set;

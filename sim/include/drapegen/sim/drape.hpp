@@ -44,7 +44,8 @@ struct DrapeConfig {
   /// Effects beyond the paper's model (none by default). Edge curl and bending plasticity need the dihedral model.
   PhysicalEffects effects;
   /// The dihedral hinges' rest angles the specimen starts with (empty: flat, or the edge curl's): the plastic set of
-  /// an earlier drape of the same specimen (DrapeResult::rest_angles, same SpecimenSpec), lifted and laid again. A
+  /// an earlier drape of the same specimen (DrapeResult::rest_angles; the caller keeps the SpecimenSpec: only the
+  /// hinge count is checked, and any triangulation of one grid has the same count), lifted and laid again. A
   /// real specimen keeps the creases its yielded hinges took; released, it relaxes to them, not to flat. Replaces the
   /// edge curl's rest angles (the set includes them) and turns the coarse start off (the set lives on this mesh).
   Eigen::VectorXd rest_angles;
