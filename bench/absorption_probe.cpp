@@ -8,7 +8,8 @@
 // if even "oracle" is not below "fitted", the fitting mesh and the multistability hide the effect from any refit.
 // Each cell also gives (after "m") the captures' mean shape features (placements 0 and 1 / placement 0 alone) against
 // the mean over the validation drapes. For a yield capture with a second placement, a second line scores that
-// placement against the truth, the oracle laid again unloaded and the oracle laid again with its plastic set.
+// placement against the truth, the oracle laid again unloaded and the oracle laid again with its plastic set, and
+// with --yield-levels the true bending at each yield curvature against both placements.
 // --resolution changes the forward model's mesh (default --fine's).
 // Reads the truth files, so it is a benchmark tool, never part of the diagnosis.
 #include <CLI/CLI.hpp>
@@ -161,9 +162,31 @@ sim::Status probe_yield_held_out(diagnosis::ForwardModel& held_out,
   return {};
 }
 
+/// Is the yield curvature observable on the two placements? The true bending with yield curvature K, for each K:
+/// its best drape against the capture, and laid again with that drape's set, its best against the second placement.
+sim::Status probe_yield_levels(diagnosis::ForwardModel& model, diagnosis::ForwardModel& held_out,
+                               const diagnosis::ModelSetup& elastic, const std::vector<sim::InitialStateSpec>& states,
+                               const std::vector<double>& levels) {
+  for (const double k : levels) {
+    diagnosis::ModelSetup setup = elastic;
+    setup.effects.bending_yield_curvature = k;
+    auto first = model.evaluate(setup, states);
+    if (!first) return first.error();
+    auto laid = held_out.laid_again(setup, states.at(static_cast<std::size_t>(first->best.state)));
+    if (!laid) return laid.error();
+    auto second = held_out.evaluate(*laid, states);
+    if (!second) return second.error();
+    std::cout << fmt::format("  yield {:>6.1f} /m: capture {:.2f}, second placement {:.2f}, mean {:.2f}\n", k,
+                             first->best.shape_all, second->best.shape_all,
+                             0.5 * (first->best.shape_all + second->best.shape_all))
+              << std::flush;
+  }
+  return {};
+}
+
 /// One row: the capture against its fitted (if diagnosed), true and oracle setups.
 sim::Status probe_case(const fs::path& run, const std::string& name, const diagnosis::DiagnosisSettings& settings,
-                       const std::vector<sim::InitialStateSpec>& states) {
+                       const std::vector<sim::InitialStateSpec>& states, const std::vector<double>& yield_levels) {
   const auto truth = read_json(run / "truth" / (name + ".json"));
   if (!truth) return truth.error();
   // Without a diagnosis (captures generated only), the fitted column stays empty.
@@ -217,6 +240,7 @@ sim::Status probe_case(const fs::path& run, const std::string& name, const diagn
     if (sim::Status s = probe_yield_held_out(*held_out, truth_setup, states, with, (*with_scores)->best_state); !s) {
       return s;
     }
+    if (sim::Status s = probe_yield_levels(**model, *held_out, truth_setup, states, yield_levels); !s) return s;
   }
   return {};
 }
@@ -234,6 +258,11 @@ int main(int argc, char** argv) {
   app.add_option("--resolution", settings.fit.resolution,
                  "Vertices per side of the forward model's mesh (default: --fine's)")
       ->check(CLI::Range(8, 200));
+  std::vector<double> yield_levels;
+  app.add_option("--yield-levels", yield_levels,
+                 "For yield captures with a second placement: the true bending with each of these yield curvatures "
+                 "(1/m), scored against the capture and, laid again with its set, against the second placement")
+      ->check(CLI::PositiveNumber);
   CLI11_PARSE(app, argc, argv);
   if (cases.empty()) {
     // Every placement-0 capture that has a truth file (captures/NAME.pK are other placements).
@@ -260,7 +289,7 @@ int main(int argc, char** argv) {
   int failed = 0;
   for (const auto& name : cases) {
     try {
-      if (sim::Status s = probe_case(fs::path(run), name, settings, states); !s) {
+      if (sim::Status s = probe_case(fs::path(run), name, settings, states, yield_levels); !s) {
         std::cerr << "absorption_probe: " << name << ": " << s.error().message << "\n";
         ++failed;
       }
