@@ -7,8 +7,9 @@
 // noisy objective over its evaluations, so a refit compared with it must beat the baseline's luckiest draw.
 // Confidence: a block bootstrap over the held-out view's residual tiles of the named effect against the runner-up.
 // With a held-out capture (a second placement of the specimen, in no fit), every validation drape is also scored
-// against it (the yield candidate's are draped again there, from the plastic set its best validation drape left): the excess is that of the mean of both captures' gap terms (gap_terms), the confirmation and the
-// bootstrap use the held-out capture's views instead of the held-out view.
+// against it (the yield candidate's are draped again there, from the plastic set its best validation drape left):
+// the excess is that of the mean of both captures' gap terms (gap_terms), the confirmation and the bootstrap use the
+// held-out capture's views instead of the held-out view.
 
 #include <optional>
 #include <string>
