@@ -80,7 +80,7 @@ int main(int argc, char** argv) {
   CLI::App app{"drapegen diagnosis benchmark: reality captures, diagnoses, confusion matrix"};
   std::string out = "out/diagnosis_bench", fabrics_path = DRAPEGEN_FABRIC_DATA_DEFAULT, drapegen;
   int per_family = 5, controls = 5, jobs = 1, resolution = 60, diagnose_jobs = 1, placements = 1;
-  bool quick = false, generate_only = false, score_only = false, held_out_placement = false;
+  bool quick = false, generate_only = false, score_only = false, held_out_placement = false, second_placement = false;
   std::uint64_t seed = 1;
   std::vector<std::string> families{"yield", "shear", "curl", "friction", "misalignment", "sensor"};
   app.add_option("--out", out, "Benchmark directory (diagnoses already in it are kept: a rerun resumes)")->capture_default_str();
@@ -120,6 +120,10 @@ int main(int argc, char** argv) {
   app.add_flag("--score-only", score_only, "Only score existing diagnoses");
   app.add_flag("--held-out-placement", held_out_placement,
                "Diagnose with placement 1 (captures/NAME.p1, made with --placements 2) as the held-out capture");
+  app.add_flag("--second-placement", second_placement,
+               "Diagnose with placement 1 as the second capture (in the candidate refits and the gate) and placement 2 "
+               "(captures/NAME.p2, made with --placements 3) as the held-out capture")
+      ->excludes("--held-out-placement");
   CLI11_PARSE(app, argc, argv);
   if (drapegen.empty()) drapegen = (fs::path(argv[0]).parent_path() / "drapegen").string();
   auto strength_range = kDefaultStrength;
@@ -289,13 +293,17 @@ int main(int argc, char** argv) {
     }
   }
   if (generate_only) return 0;
-  if (held_out_placement && !score_only) {
+  const int placements_used = second_placement ? 3 : held_out_placement ? 2 : 1;
+  if (!score_only) {
     for (const auto& c : cases) {
-      const fs::path second = fs::path(out) / "captures" / (c.name + ".p1");
-      if (!fs::is_directory(second)) {
-        std::cerr << fmt::format("diagnosis_bench: --held-out-placement: {} is missing (generate with --placements 2)\n",
-                                 second.string());
-        return 2;
+      for (int p = 1; p < placements_used; ++p) {
+        const fs::path other = fs::path(out) / "captures" / fmt::format("{}.p{}", c.name, p);
+        if (!fs::is_directory(other)) {
+          std::cerr << fmt::format("diagnosis_bench: {}: {} is missing (generate with --placements {})\n",
+                                   second_placement ? "--second-placement" : "--held-out-placement", other.string(),
+                                   placements_used);
+          return 2;
+        }
       }
     }
   }
@@ -314,7 +322,9 @@ int main(int argc, char** argv) {
           if (fs::exists(result) && fs::file_size(result) > 0) continue;
           fs::create_directories(result.parent_path());
           const std::string second =
-              held_out_placement ? fmt::format(" --held-out-capture '{}.p1'", dir.string()) : std::string();
+              second_placement     ? fmt::format(" --second-capture '{0}.p1' --held-out-capture '{0}.p2'", dir.string())
+              : held_out_placement ? fmt::format(" --held-out-capture '{}.p1'", dir.string())
+                                   : std::string();
           const std::string cmd =
               fmt::format("'{}' diagnose --capture '{}'{} --json{} --jobs {} {} > '{}.tmp' 2> '{}.err'", drapegen,
                           dir.string(), second, quick ? " --quick" : "", diagnose_jobs, diagnose_args,
@@ -417,7 +427,9 @@ int main(int argc, char** argv) {
                                           diagnose_args);
   std::string md = fmt::format("Cases scored: {} effect captures, {} controls (diagnose {}{}).\n\n", effect_total,
                                control_total, options.empty() ? "defaults" : options,
-                               held_out_placement ? ", placement 1 as the held-out capture" : "");
+                               second_placement     ? ", placement 1 as the second capture, 2 held out"
+                               : held_out_placement ? ", placement 1 as the held-out capture"
+                                                    : "");
   md += "| truth \\ verdict |";
   for (const auto& c : columns) md += " " + c + " |";
   md += "\n|---|";

@@ -2,6 +2,7 @@
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <tuple>
 #include <nlohmann/json.hpp>
 
 #include <fmt/format.h>
@@ -19,6 +20,7 @@ namespace {
 struct DiagnoseOptions {
   std::string capture;
   std::string held_out;
+  std::string second;
   std::string report;
   bool json = false;
   bool quick = false;
@@ -55,11 +57,13 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (o.verbose) sim::logger()->set_level(spdlog::level::debug);
   auto capture = diagnosis::read_capture(o.capture);
   if (!capture) return fail(capture.error().message);
-  std::optional<diagnosis::Capture> held_out;
-  if (!o.held_out.empty()) {
-    auto read = diagnosis::read_capture(o.held_out);
-    if (!read) return fail("held-out capture: " + read.error().message);
-    held_out = std::move(*read);
+  std::optional<diagnosis::Capture> held_out, second;
+  for (auto [path, into, role] : {std::tuple{&o.held_out, &held_out, "held-out capture"},
+                                  std::tuple{&o.second, &second, "second capture"}}) {
+    if (path->empty()) continue;
+    auto read = diagnosis::read_capture(*path);
+    if (!read) return fail(std::string(role) + ": " + read.error().message);
+    *into = std::move(*read);
   }
   if (!o.report.empty()) {
     if (sim::Status s = check_writable(o.report + ".probe"); !s) return fail(s.error().message, kExitIo);
@@ -81,7 +85,8 @@ int run_diagnose(const DiagnoseOptions& o) {
   settings.attribution.jobs = o.jobs;
   settings.attribute = !o.gap_only;
   if (o.shape_floor >= 0.0) settings.floors.shape_threshold = settings.held_out_shape_threshold = o.shape_floor;
-  auto result = diagnosis::diagnose(*capture, settings, held_out ? &*held_out : nullptr);
+  auto result = diagnosis::diagnose(*capture, settings,
+                                    {.second = second ? &*second : nullptr, .held_out = held_out ? &*held_out : nullptr});
   if (!result) return fail(result.error().message);
   if (!o.report.empty()) {
     auto model = diagnosis::ForwardModel::create(*capture, settings.fit);
@@ -120,8 +125,13 @@ Runner add_diagnose_command(CLI::App& app) {
   auto o = std::make_shared<DiagnoseOptions>();
   app.add_option("--capture", o->capture, "Capture directory (docs/CAPTURE.md)")->required();
   app.add_option("--held-out-capture", o->held_out,
-                 "A second capture of the same specimen (another placement), used in no fit: the gap and every "
-                 "candidate are validated on both captures");
+                 "Another capture of the same specimen (another placement), used in no fit: every candidate is "
+                 "confirmed on it; without --second-capture the gate tests the mean of both captures' terms too");
+  app.add_option("--second-capture", o->second,
+                 "Another capture of the same specimen (another placement, before the held-out one), in every "
+                 "candidate refit (the mean of both captures' fit scores; a yielding candidate is laid again on it "
+                 "with the plastic set its drape on the capture left) and in the gate (the mean of both captures' "
+                 "terms); not in the baseline fit");
   app.add_option("--report", o->report, "Write report.json, report.md and residual PNGs here");
   app.add_flag("--json", o->json, "Print the result as JSON");
   auto* quick = app.add_flag("--quick", o->quick, "Small budgets (16x16 mesh, 2 initial states, fewer evaluations)");
@@ -152,7 +162,7 @@ Runner add_diagnose_command(CLI::App& app) {
   app.add_option("--jobs", o->jobs, "Candidate refits in parallel threads (same result as --jobs 1)")->capture_default_str();
   app.add_option("--shape-floor", o->shape_floor,
                  fmt::format("Shape-distance floor (default and quick: calibrated {:.2f}; fine: {:.2f}, with "
-                             "--held-out-capture {:.2f}; 0: the largest floor sample)",
+                             "--held-out-capture or --second-capture {:.2f}; 0: the largest floor sample)",
                              diagnosis::FloorSettings{}.shape_threshold, diagnosis::DiagnosisSettings::kFineShapeFloor,
                              diagnosis::DiagnosisSettings::kFineHeldOutShapeFloor));
   app.add_flag("--gap-only", o->gap_only,

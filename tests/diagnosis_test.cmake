@@ -176,6 +176,58 @@ if(NOT scanned MATCHES "^6 3 1\\.0986[0-9]* 3\\.5450[0-9]* 5\\.9914")
   message(FATAL_ERROR "--refit-scan 3: yield refit (evaluations, scan size, levels) = '${scanned}'")
 endif()
 
+# Three placements: the second in the candidate refits and the gate, the third held out of every fit (the confirmation).
+run_ok(out reality ${FABRIC} --effect bias=12 --resolution 14 --seed 4 --placement 2 --out ${WORK}/capture.p2)
+file(REMOVE ${WORK}/capture.p2/truth.json)
+run_ok(out diagnose --capture ${WORK}/capture --second-capture ${WORK}/capture.p1 --held-out-capture ${WORK}/capture.p2
+       --quick --resolution 10 --states 2 --evaluations 8 --refit-evaluations 6 --json)
+string(JSON paired GET "${out}" gap_tests paired_with)
+string(JSON refitted_on GET "${out}" attribution refitted_on)
+string(JSON confirmed_on GET "${out}" attribution confirmed_on)
+if(NOT paired STREQUAL "second_capture" OR NOT refitted_on STREQUAL "capture_and_second_capture"
+   OR NOT confirmed_on STREQUAL "held_out_capture")
+  message(FATAL_ERROR "--second-capture: gate paired with '${paired}', refitted on '${refitted_on}', confirmed on "
+                      "'${confirmed_on}'")
+endif()
+# The gate's shape distance is the mean over the capture and the second capture, not the held-out one.
+string(JSON shape GET "${out}" gap_tests shape)
+string(JSON shape_a GET "${out}" gap_tests capture shape)
+string(JSON shape_b GET "${out}" gap_tests second_capture shape)
+string(JSON shape_c GET "${out}" gap_tests held_out_capture shape)
+if((shape LESS shape_a AND shape LESS shape_b) OR (shape GREATER shape_a AND shape GREATER shape_b))
+  message(FATAL_ERROR "the gate's shape distance ${shape} is not between the capture's and the second's (${shape_a}, "
+                      "${shape_b}; held out: ${shape_c})")
+endif()
+string(JSON ncand LENGTH "${out}" attribution candidates)
+math(EXPR last "${ncand} - 1")
+set(refits_on_both 0)
+foreach(i RANGE ${last})
+  string(JSON effect GET "${out}" attribution candidates ${i} effect)
+  string(JSON fit GET "${out}" attribution candidates ${i} fit_score_mm)
+  string(JSON objective GET "${out}" attribution candidates ${i} objective_mm)
+  # The refit's objective is the mean with the second capture's fit score, not the capture's alone.
+  if(NOT fit STREQUAL objective)
+    math(EXPR refits_on_both "${refits_on_both} + 1")
+  endif()
+  string(JSON second_type TYPE "${out}" attribution candidates ${i} validated second_plastic_set_rad)
+  string(JSON held_type TYPE "${out}" attribution candidates ${i} validated held_out_plastic_set_rad)
+  string(JSON held_stable GET "${out}" attribution candidates ${i} validated held_out_capture stable_mm)
+  # A yielding candidate is laid again on each later placement with the set the earlier ones left.
+  if((effect STREQUAL "yield") AND NOT (second_type STREQUAL "NUMBER" AND held_type STREQUAL "NUMBER"))
+    message(FATAL_ERROR "the yield candidate reports no plastic set on the second (${second_type}) or the held-out "
+                        "capture (${held_type})")
+  elseif(NOT (effect STREQUAL "yield") AND NOT (second_type STREQUAL "NULL" AND held_type STREQUAL "NULL"))
+    message(FATAL_ERROR "the ${effect} candidate reports a plastic set (${second_type}, ${held_type})")
+  endif()
+endforeach()
+if(NOT refits_on_both EQUAL ncand)
+  message(FATAL_ERROR "--second-capture: ${refits_on_both} of ${ncand} refits have an objective other than the "
+                      "capture's fit score")
+endif()
+expect_failure(1 "the second capture too" diagnose --capture ${WORK}/capture --second-capture ${WORK}/capture.p1
+               --held-out-capture ${WORK}/capture.p1/.)
+expect_failure(1 "second capture" diagnose --capture ${WORK}/capture --second-capture ${WORK}/does_not_exist)
+
 # Bad captures: one line each, exit 1.
 file(COPY ${WORK}/capture/ DESTINATION ${WORK}/missing)
 file(REMOVE ${WORK}/missing/view1.exr)
@@ -198,6 +250,8 @@ file(WRITE ${WORK}/heavier/capture.json "${facts}")
 expect_failure(1 "another specimen" diagnose --capture ${WORK}/capture --held-out-capture ${WORK}/heavier)
 expect_failure(1 "held-out capture: " diagnose --capture ${WORK}/capture --held-out-capture ${WORK}/does_not_exist)
 expect_failure(1 "the capture itself" diagnose --capture ${WORK}/capture --held-out-capture ${WORK}/capture/.)
+expect_failure(1 "second capture ${WORK}/heavier: another specimen" diagnose --capture ${WORK}/capture
+               --second-capture ${WORK}/heavier)
 expect_failure(1 "unknown effect" reality ${FABRIC} --effect gravity=2 --out ${WORK}/bad)
 expect_failure(1 "given twice" reality ${FABRIC} --effect curl=10 --effect curl=20 --out ${WORK}/bad)
 expect_failure(1 "fewer than two vertex spacings" reality ${FABRIC} --effect curl=200,10 --resolution 14

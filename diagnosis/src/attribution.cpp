@@ -17,11 +17,38 @@
 namespace drapegen::diagnosis {
 namespace {
 
+/// `setup`'s drapes `on` the capture scored against another placement: a yielding setup is laid again there from
+/// the state of its best drape (the specimen keeps the plastic set that drape left) and simulated from `states`; any
+/// other setup's drapes are scored again (turned to the placement's outline). `laid` receives the setup laid again.
+sim::Expected<Evaluation> on_next_placement(ForwardModel& next, const ModelSetup& setup, const Evaluation& on,
+                                            const std::vector<sim::InitialStateSpec>& states,
+                                            ModelSetup* laid = nullptr) {
+  if (setup.effects.bending_yield_curvature) {
+    auto again = next.laid_again(setup, states.at(static_cast<std::size_t>(on.best.state)));
+    if (!again) return sim::Error{"yield candidate laid again: " + again.error().message};
+    auto e = next.evaluate(*again, states);
+    if (laid) *laid = std::move(*again);
+    return e;
+  }
+  std::vector<sim::ClothMesh> meshes;
+  for (const auto& d : on.states) meshes.push_back(d.mesh);
+  if (laid) *laid = setup;
+  return next.rescore(meshes, setup);
+}
+
+/// The largest rest angle of a setup's plastic set (unset for a setup that does not yield).
+std::optional<double> largest_set(const ModelSetup& setup) {
+  if (!setup.effects.bending_yield_curvature) return std::nullopt;
+  const Eigen::VectorXd& set = setup.plastic_set.rest_angles;
+  return set.size() > 0 ? set.cwiseAbs().maxCoeff() : 0.0;
+}
+
 /// Refits `effect` (with the bending scale free), or with no effect (the bar) the baseline's own bending parameters in
-/// the fit's reduced coordinates, on the fit states; then evaluates the refitted setup from the validation states.
-sim::Expected<CandidateResult> refit(ForwardModel& model, std::optional<Effect> effect, const ModelSetup& baseline,
-                                     const Evaluation& fit, const Evaluation& baseline_validated,
-                                     const AttributionSettings& settings) {
+/// the fit's reduced coordinates, on the fit states (and the second capture, if given); then evaluates the refitted
+/// setup from the validation states on the capture and on the other placements.
+sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, ForwardModel* held_out,
+                                     std::optional<Effect> effect, const ModelSetup& baseline, const Evaluation& fit,
+                                     const Evaluation& baseline_validated, const AttributionSettings& settings) {
   const auto start = std::chrono::steady_clock::now();
   const bool bar = !effect;
   EffectSpace space;
@@ -100,13 +127,22 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, std::optional<Effect> 
       error = e.error();
       return std::numeric_limits<double>::infinity();
     }
+    double value = e->best.fit_score;
+    if (second) {  // the mean over both captures: a yielding setup is laid again on the second from its best drape
+      auto e2 = on_next_placement(*second, setup, *e, model.initial_states());
+      if (!e2) {
+        error = sim::Error{"second capture: " + e2.error().message};
+        return std::numeric_limits<double>::infinity();
+      }
+      value = 0.5 * (value + e2->best.fit_score);
+    }
     sim::logger()->debug("refit {}: {} -> {:.3f} mm (state {}, shape {:.2f})", bar ? "bending" : effect_name(*effect),
-                         fmt::join(x, ", "), e->best.fit_score * 1e3, e->best.state, e->best.shape_fit);
-    if (e->best.fit_score < best) {
-      best = e->best.fit_score;
+                         fmt::join(x, ", "), value * 1e3, e->best.state, e->best.shape_fit);
+    if (value < best) {
+      best = value;
       c.drape = e->best;
     }
-    return e->best.fit_score;
+    return value;
   };
   NelderMeadOptions options = settings.optimiser;
   if (!sim) options.max_evaluations = settings.sensor_evaluations;
@@ -141,18 +177,34 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, std::optional<Effect> 
   std::vector<sim::ClothMesh> fresh;
   if (!sim)
     for (const auto& s : baseline_validated.states) fresh.push_back(s.mesh);
-  auto validated = sim ? model.evaluate(refitted, validation_states(settings)) : model.rescore(fresh, refitted);
+  const std::vector<sim::InitialStateSpec> states = validation_states(settings);
+  auto validated = sim ? model.evaluate(refitted, states) : model.rescore(fresh, refitted);
   if (!validated) return validated.error();
+  // On the other placements in turn (the second, then the held-out one), each from the last.
+  ModelSetup laid = refitted;
+  const Evaluation* last = &*validated;
+  std::optional<Evaluation> on_second;
+  for (ForwardModel* next : {second, held_out}) {
+    if (!next) continue;
+    ModelSetup again;
+    auto e = on_next_placement(*next, laid, *last, states, &again);
+    if (!e) return sim::Error{std::string(next == second ? "second" : "held-out") + " capture: " + e.error().message};
+    OtherPlacement placement{e->best, largest_set(again)};
+    if (next == second) {
+      c.second = std::move(placement);
+      on_second = std::move(*e);
+      last = &*on_second;
+    } else {
+      c.held_out = std::move(placement);
+    }
+    laid = std::move(again);
+  }
   c.validated = validated->best;
   c.setup = refitted;
-  if (sim) {
-    for (auto& d : validated->states) c.validation_meshes.push_back(std::move(d.mesh));
-  } else {
-    c.validation_meshes = std::move(fresh);
-  }
   c.alpha_scale = sim && !bar ? std::exp(r.x[0]) : 1.0;
   c.parameters.assign(r.x.begin() + static_cast<std::ptrdiff_t>(first), r.x.end());
   c.evaluations = r.evaluations;
+  c.objective = best;
   c.fit_score = c.drape.fit_score;
   c.held_out_score = c.drape.held_out_score;
   c.all_score = c.drape.all_score;
@@ -211,9 +263,8 @@ double bootstrap_confidence(const ForwardModel& model, const ScoredDrape& a, con
 
 sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& baseline, const Evaluation& fit,
                                      const Evaluation& validated, const Floors& floors,
-                                     const AttributionSettings& settings,
-                                     const std::function<sim::Expected<std::unique_ptr<ForwardModel>>()>& make_model,
-                                     HeldOutCapture* held_out) {
+                                     const AttributionSettings& settings, const ModelFactory& make_model,
+                                     const OtherCaptures& others) {
   // Tasks: the candidates, then the bar (no effect: the baseline's bending refitted with the same budget).
   const std::size_t tasks = settings.candidates.size() + 1;
   auto task_effect = [&](std::size_t k) -> std::optional<Effect> {
@@ -222,28 +273,35 @@ sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& base
   std::vector<std::optional<sim::Expected<CandidateResult>>> results(tasks);
   const int jobs = std::max(1, std::min<int>(settings.jobs, static_cast<int>(tasks)));
   if (jobs == 1 || !make_model) {
-    for (std::size_t k = 0; k < tasks; ++k)
-      results[k] = refit(model, task_effect(k), baseline, fit, validated, settings);
+    for (std::size_t k = 0; k < tasks; ++k) {
+      results[k] = refit(model, others.second.model, others.held_out.model, task_effect(k), baseline, fit, validated,
+                         settings);
+    }
   } else {
     std::vector<std::thread> threads;
     std::mutex mutex;
     std::optional<sim::Error> error;
     for (int j = 0; j < jobs; ++j) {
       threads.emplace_back([&, j] {
-        std::unique_ptr<ForwardModel> own;
-        ForwardModel* m = &model;
-        if (j > 0) {
-          auto created = make_model();
+        // Thread 0 uses the given models, every other thread its own of each capture.
+        std::vector<std::unique_ptr<ForwardModel>> own;
+        auto model_of = [&](ForwardModel* given) -> ForwardModel* {
+          if (j == 0 || !given) return given;
+          auto created = make_model(given->capture());
           if (!created) {
             std::lock_guard lock(mutex);
             error = created.error();
-            return;
+            return nullptr;
           }
-          own = std::move(*created);
-          m = own.get();
-        }
+          own.push_back(std::move(*created));
+          return own.back().get();
+        };
+        ForwardModel* m = model_of(&model);
+        ForwardModel* second = model_of(others.second.model);
+        ForwardModel* held_out = model_of(others.held_out.model);
+        if (!m || (others.second && !second) || (others.held_out && !held_out)) return;
         for (std::size_t k = static_cast<std::size_t>(j); k < tasks; k += jobs) {
-          auto r = refit(*m, task_effect(k), baseline, fit, validated, settings);
+          auto r = refit(*m, second, held_out, task_effect(k), baseline, fit, validated, settings);
           std::lock_guard lock(mutex);
           results[k] = std::move(r);
         }
@@ -254,47 +312,28 @@ sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& base
   }
   for (auto& r : results)
     if (!r || !*r) return r ? r->error() : sim::Error{"candidate refit did not run"};
-  // The held-out capture: each refitted setup's validation drapes scored against it (no simulation). A yielding
-  // candidate's specimen is on its second placement there, with the plastic set its first left: its held-out drapes
-  // are simulated again from the validation states, starting from the set of its best validation drape.
-  if (held_out) {
-    const std::vector<sim::InitialStateSpec> states = validation_states(settings);
-    for (auto& r : results) {
-      CandidateResult& c = r->value();
-      sim::Expected<Evaluation> e = sim::Error{"no held-out evaluation"};
-      if (c.setup.effects.bending_yield_curvature) {
-        auto second = held_out->model->laid_again(c.setup, states.at(static_cast<std::size_t>(c.validated.state)));
-        if (!second) return sim::Error{"held-out capture, yield candidate laid again: " + second.error().message};
-        const Eigen::VectorXd& set = second->plastic_set.rest_angles;
-        c.held_out_plastic_set = set.size() > 0 ? set.cwiseAbs().maxCoeff() : 0.0;
-        e = held_out->model->evaluate(*second, states);
-      } else {
-        e = held_out->model->rescore(c.validation_meshes, c.setup);
-      }
-      if (!e) return e.error();
-      c.validated_held_out = std::move(e->best);
-    }
-  }
-  // The gate's terms of a candidate (or the reference): its validation drape's, or with a held-out capture the mean of
-  // both captures' (gap_terms).
-  const ScoredDrape* baseline_second = held_out ? held_out->baseline : nullptr;
+  // The gate's terms of a candidate (or the reference): its validation drape's, or the mean of it and the paired
+  // capture's (gap_terms). The baseline's drapes against the other placements are scored, not simulated again.
+  const ScoredDrape* baseline_paired = others.paired().baseline;
+  const ScoredDrape* baseline_held_out = others.held_out.baseline;
   // Shrinkage: of the excess above the floors that made the gate fire (the same two tests), once the candidate is
   // added, measured from the validation states against the reference: the better (smaller excess) of the baseline
   // and the bar. So an effect counts only for what it adds beyond refitting the bending alone. The held-out view (not
   // in any refit), or the held-out capture, must confirm it, i.e. not get worse than the reference's.
   Attribution a;
   a.bar = std::move(results.back()->value());
-  a.bar.shrinkage = gap_shrinkage(excess_above_floors(gap_terms(validated.best, baseline_second), floors),
-                                  excess_above_floors(gap_terms(a.bar.validated, a.bar.held_out_drape()), floors));
+  a.bar.shrinkage = gap_shrinkage(excess_above_floors(gap_terms(validated.best, baseline_paired), floors),
+                                  excess_above_floors(gap_terms(a.bar.validated, a.bar.paired_drape()), floors));
   const bool bar_is_reference = a.bar.shrinkage > 0.0;
   const ScoredDrape& reference = bar_is_reference ? a.bar.validated : validated.best;
-  const ScoredDrape* reference_second = bar_is_reference ? a.bar.held_out_drape() : baseline_second;
-  const double h0 = confirmation_score(reference, reference_second);
-  const double excess0 = excess_above_floors(gap_terms(reference, reference_second), floors);
+  const ScoredDrape* reference_paired = bar_is_reference ? a.bar.paired_drape() : baseline_paired;
+  const ScoredDrape* reference_held_out = bar_is_reference ? a.bar.held_out_drape() : baseline_held_out;
+  const double h0 = confirmation_score(reference, reference_held_out);
+  const double excess0 = excess_above_floors(gap_terms(reference, reference_paired), floors);
   for (std::size_t k = 0; k + 1 < tasks; ++k) {
     CandidateResult c = std::move(results[k]->value());
     const double h = confirmation_score(c.validated, c.held_out_drape());
-    c.shrinkage = gap_shrinkage(excess0, excess_above_floors(gap_terms(c.validated, c.held_out_drape()), floors));
+    c.shrinkage = gap_shrinkage(excess0, excess_above_floors(gap_terms(c.validated, c.paired_drape()), floors));
     c.held_out_shrinkage = h0 > 0.0 ? 1.0 - h / h0 : 0.0;
     c.confirmed = h <= h0;
     a.candidates.push_back(std::move(c));
@@ -309,11 +348,12 @@ sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& base
     a.confidence = 1.0;
     if (a.candidates.size() > 1) {
       const CandidateResult &best = a.candidates[0], &runner_up = a.candidates[1];
-      a.confidence = held_out ? bootstrap_confidence(*held_out->model, *best.validated_held_out,
-                                                     *runner_up.validated_held_out, settings.bootstrap_samples,
-                                                     settings.tile_px, 0xB007, true)
-                              : bootstrap_confidence(model, best.validated, runner_up.validated,
-                                                     settings.bootstrap_samples, settings.tile_px, 0xB007);
+      a.confidence = others.held_out
+                         ? bootstrap_confidence(*others.held_out.model, *best.held_out_drape(),
+                                                *runner_up.held_out_drape(), settings.bootstrap_samples,
+                                                settings.tile_px, 0xB007, true)
+                         : bootstrap_confidence(model, best.validated, runner_up.validated, settings.bootstrap_samples,
+                                                settings.tile_px, 0xB007);
     }
   }
   return a;

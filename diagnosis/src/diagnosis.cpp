@@ -106,24 +106,27 @@ nlohmann::json spread_json(const ValidationSpread& s) {
           {"pairwise_groups_mm", pair_groups}};
 }
 
-/// A validation drape against the held-out capture (null without one).
-nlohmann::json held_out_json(const ScoredDrape* d) {
+/// A validation drape against another placement (null without one).
+nlohmann::json placement_json(const ScoredDrape* d) {
   if (!d) return nullptr;
   return {{"stable_mm", d->stable_all * 1e3}, {"shape", d->shape_all}, {"all_views_score_mm", d->all_score * 1e3},
           {"best_validation_state", d->state}};
 }
 
-/// A refitted candidate (or the bar) from the validation states: its drape against the capture, against the held-out
-/// capture if any, and the gate's excess of the two.
+/// A refitted candidate (or the bar) from the validation states: its drape against the capture, against the other
+/// placements if any (with the plastic set a yielding candidate starts from there), and the gate's excess.
 nlohmann::json validated_json(const CandidateResult& c, const Floors& floors) {
-  const ScoredDrape* second = c.held_out_drape();
+  auto set_json = [](const std::optional<OtherPlacement>& p) {
+    return p && p->plastic_set ? nlohmann::json(*p->plastic_set) : nlohmann::json(nullptr);
+  };
   return {{"stable_mm", c.validated.stable_all * 1e3},
           {"shape", c.validated.shape_all},
           {"held_out_score_mm", c.validated.held_out_score * 1e3},
-          {"held_out_capture", held_out_json(second)},
-          {"held_out_plastic_set_rad",
-           c.held_out_plastic_set ? nlohmann::json(*c.held_out_plastic_set) : nlohmann::json(nullptr)},
-          {"excess_above_floors", excess_above_floors(gap_terms(c.validated, second), floors)}};
+          {"second_capture", placement_json(c.second ? &c.second->best : nullptr)},
+          {"second_plastic_set_rad", set_json(c.second)},
+          {"held_out_capture", placement_json(c.held_out_drape())},
+          {"held_out_plastic_set_rad", set_json(c.held_out)},
+          {"excess_above_floors", excess_above_floors(gap_terms(c.validated, c.paired_drape()), floors)}};
 }
 
 }  // namespace
@@ -151,39 +154,47 @@ DiagnosisSettings DiagnosisSettings::fine() {
   return s;
 }
 
-sim::Status check_same_specimen(const Capture& capture, const Capture& held_out) {
-  const SpecimenFacts &a = capture.specimen, &b = held_out.specimen;
+sim::Status check_same_specimen(const Capture& capture, const Capture& other, std::string_view role) {
+  const SpecimenFacts &a = capture.specimen, &b = other.specimen;
   auto differs = [](double x, double y) { return std::abs(x - y) > 1e-9 * std::max(1.0, std::abs(x)); };
   if (differs(a.size_x, b.size_x) || differs(a.size_y, b.size_y) || differs(a.density, b.density) ||
       differs(a.cylinder_diameter, b.cylinder_diameter)) {
-    return sim::Error{fmt::format("held-out capture {}: another specimen or tester ({}x{} mm, {} g/m^2, cylinder {} mm; "
+    return sim::Error{fmt::format("{} {}: another specimen or tester ({}x{} mm, {} g/m^2, cylinder {} mm; "
                                   "the capture: {}x{} mm, {} g/m^2, cylinder {} mm)",
-                                  held_out.directory, b.size_x * 1e3, b.size_y * 1e3, b.density,
+                                  role, other.directory, b.size_x * 1e3, b.size_y * 1e3, b.density,
                                   b.cylinder_diameter * 1e3, a.size_x * 1e3, a.size_y * 1e3, a.density,
                                   a.cylinder_diameter * 1e3)};
   }
   std::error_code ec;
-  if (std::filesystem::equivalent(capture.directory, held_out.directory, ec) && !ec) {
-    return sim::Error{fmt::format("held-out capture {}: the capture itself (a held-out capture is a second placement)",
-                                  held_out.directory)};
+  if (std::filesystem::equivalent(capture.directory, other.directory, ec) && !ec) {
+    return sim::Error{fmt::format("{} {}: the capture itself (it must be another placement)", role, other.directory)};
   }
   return {};
 }
 
 sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisSettings& settings,
-                                        const Capture* held_out) {
+                                        const OtherPlacements& others) {
   const auto start = std::chrono::steady_clock::now();
-  if (held_out) {
-    if (sim::Status s = check_same_specimen(capture, *held_out); !s) return s.error();
+  if (others.second) {
+    if (sim::Status s = check_same_specimen(capture, *others.second, "second capture"); !s) return s.error();
+  }
+  if (others.held_out) {
+    if (sim::Status s = check_same_specimen(capture, *others.held_out); !s) return s.error();
+    std::error_code ec;
+    if (others.second && std::filesystem::equivalent(others.second->directory, others.held_out->directory, ec) && !ec) {
+      return sim::Error{fmt::format("held-out capture {}: the second capture too (data in a fit is not held out)",
+                                    others.held_out->directory)};
+    }
   }
   auto created = ForwardModel::create(capture, settings.fit);
   if (!created) return created.error();
   ForwardModel& model = **created;
-  std::unique_ptr<ForwardModel> held_out_model;
-  if (held_out) {
-    auto m = ForwardModel::create(*held_out, settings.fit);
+  std::unique_ptr<ForwardModel> second_model, held_out_model;
+  for (auto [placement, made] : {std::pair{others.second, &second_model}, std::pair{others.held_out, &held_out_model}}) {
+    if (!placement) continue;
+    auto m = ForwardModel::create(*placement, settings.fit);
     if (!m) return m.error();
-    held_out_model = std::move(*m);
+    *made = std::move(*m);
   }
   DiagnosisResult r;
 
@@ -263,7 +274,7 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
   // 2. Floors and the gap.
   const auto floors_start = std::chrono::steady_clock::now();
   FloorSettings floor_settings = settings.floors;
-  if (held_out && settings.held_out_shape_threshold > 0.0) {
+  if ((others.second || others.held_out) && settings.held_out_shape_threshold > 0.0) {
     floor_settings.shape_threshold = settings.held_out_shape_threshold;
   }
   auto floors = measure_floors(model, fitted, r.fit, floor_settings);
@@ -273,12 +284,14 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
   auto validated = model.evaluate(fitted, validation_states(settings.attribution));
   if (!validated) return validated.error();
   r.validated = std::move(*validated);
-  if (held_out_model) {  // the same drapes against the held-out capture
-    std::vector<sim::ClothMesh> meshes;
-    for (const auto& d : r.validated.states) meshes.push_back(d.mesh);
-    auto e = held_out_model->rescore(meshes, fitted);
+  std::vector<sim::ClothMesh> meshes;  // the same drapes against the other placements
+  for (const auto& d : r.validated.states) meshes.push_back(d.mesh);
+  for (auto [m, into] : {std::pair{second_model.get(), &r.validated_second},
+                         std::pair{held_out_model.get(), &r.validated_held_out}}) {
+    if (!m) continue;
+    auto e = m->rescore(meshes, fitted);
     if (!e) return e.error();
-    r.validated_held_out = std::move(*e);
+    *into = std::move(*e);
   }
   r.validation_spread = validation_spread(r.validated.states, model.target().shape.all);
   const ScoredDrape& gap = r.gap_drape();
@@ -304,10 +317,12 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
     r.verdict = "not attributed";
   } else {
     const FitSettings fit_settings = settings.fit;
-    auto make_model = [&capture, fit_settings]() { return ForwardModel::create(capture, fit_settings); };
-    HeldOutCapture second{held_out_model.get(), r.held_out_gap_drape()};
+    auto make_model = [fit_settings](const Capture& c) { return ForwardModel::create(c, fit_settings); };
+    OtherCaptures other_captures;
+    if (second_model) other_captures.second = {second_model.get(), &r.validated_second->best};
+    if (held_out_model) other_captures.held_out = {held_out_model.get(), &r.validated_held_out->best};
     auto attribution = attribute(model, fitted, r.fit, r.validated, r.floors, settings.attribution, make_model,
-                                 held_out_model ? &second : nullptr);
+                                 other_captures);
     if (!attribution) return attribution.error();
     r.attribution = std::move(*attribution);
     const auto& c = r.attribution.candidates;
@@ -334,15 +349,20 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
     states.push_back({{"state", d.state}, {"stable_mm", d.stable_all * 1e3}, {"shape", d.shape_all},
                       {"fit_score_mm", d.fit_score * 1e3}, {"converged", d.converged}});
   }
-  // The gate's terms (with a held-out capture: the mean of both captures'), then each capture's own.
+  // The gate's terms (with a paired capture, the second else the held-out one: the mean of both captures'), then each
+  // capture's own.
   const GapTerms gap = r.gap();
   j["gap_tests"] = {{"stable_mm", gap.stable * 1e3},
                     {"stable_floor_mm", r.floors.stable * 1e3},
                     {"shape", gap.shape},
                     {"shape_floor", r.floors.shape},
                     {"excess_above_floors", excess_above_floors(gap, r.floors)},
+                    {"paired_with", r.validated_second     ? nlohmann::json("second_capture")
+                                    : r.validated_held_out ? nlohmann::json("held_out_capture")
+                                                           : nlohmann::json(nullptr)},
                     {"capture", {{"stable_mm", r.gap_drape().stable_all * 1e3}, {"shape", r.gap_drape().shape_all}}},
-                    {"held_out_capture", held_out_json(r.held_out_gap_drape())},
+                    {"second_capture", placement_json(r.validated_second ? &r.validated_second->best : nullptr)},
+                    {"held_out_capture", placement_json(r.validated_held_out ? &r.validated_held_out->best : nullptr)},
                     {"validation_states", r.validated.states.size()},
                     {"best_validation_state", r.gap_drape().state},
                     {"validation_spread", spread_json(r.validation_spread)},
@@ -431,6 +451,7 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                           {"parameters", params},
                           {"alpha_scale", c.alpha_scale},
                           {"fit_score_mm", c.fit_score * 1e3},
+                          {"objective_mm", c.objective * 1e3},
                           {"held_out_score_mm", c.held_out_score * 1e3},
                           {"all_views_score_mm", c.all_score * 1e3},
                           {"stable_mm", c.drape.stable_all * 1e3},
@@ -446,6 +467,7 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
   }
   j["attribution"] = {{"ran", ran},
                       {"confirmed_on", r.validated_held_out ? "held_out_capture" : "held_out_view"},
+                      {"refitted_on", r.validated_second ? "capture_and_second_capture" : "capture"},
                       {"bending_refit_bar",
                        {{"parameters", r.attribution.bar.parameters},
                         {"fit_score_mm", r.attribution.bar.fit_score * 1e3},

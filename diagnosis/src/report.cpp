@@ -119,7 +119,10 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
   const GapTerms gap = r.gap();
   md += fmt::format("Tests (all views{}): stable-region term {:.2f} mm against its floor {:.2f} mm; shape distance {:.2f} "
                     "against its floor {:.2f}.\n\n",
-                    r.validated_held_out ? ", mean of the capture and the held-out capture" : "", gap.stable * 1e3,
+                    r.validated_second     ? ", mean of the capture and the second capture"
+                    : r.validated_held_out ? ", mean of the capture and the held-out capture"
+                                           : "",
+                    gap.stable * 1e3,
                     r.floors.stable * 1e3, gap.shape, r.floors.shape);
   md += fmt::format("Fitted baseline: alpha = {:.0f}, {:.0f}, {:.0f} g mm^2/s^2; beta = {:.0f}, {:.0f}, {:.0f} g mm^3/s^2 "
                     "({} simplex evaluations{}).\n\n",
@@ -156,13 +159,16 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
         "from the camera, blue: nearer; saturated at +-" + fmt::format("{:.0f}", range * 1e3) + " mm; black: no return).\n\n"
         "![views](views.png)\n\nTop: the capture; bottom: the fitted baseline.\n\n";
   if (!r.attribution.candidates.empty()) {
-    const bool second = r.validated_held_out.has_value();
-    md += second ? "## Candidate effects (refitted on the fit views, confirmed on the held-out capture)\n\n"
-                   "| effect | all-view score (mm) | shrinkage of the excess above the floors (mean of both captures) | "
-                   "held-out capture's score (mm) | its shrinkage | confirmed | parameters |\n"
-                 : "## Candidate effects (refitted on the fit views, confirmed on the held-out view)\n\n"
-                   "| effect | all-view score (mm) | shrinkage of the excess above the floors | held-out view's score (mm) "
-                   "| its shrinkage | confirmed | parameters |\n";
+    const bool held_out = r.validated_held_out.has_value();
+    md += fmt::format("## Candidate effects (refitted on the fit views{}, confirmed on the held-out {})\n\n"
+                      "| effect | all-view score (mm) | shrinkage of the excess above the floors{} | held-out {}'s score "
+                      "(mm) | its shrinkage | confirmed | parameters |\n",
+                      r.validated_second ? " of the capture and the second capture" : "",
+                      held_out ? "capture" : "view",
+                      r.validated_second     ? " (mean of the capture and the second capture)"
+                      : r.validated_held_out ? " (mean of the capture and the held-out capture)"
+                                             : "",
+                      held_out ? "capture" : "view");
     md += "|---|---|---|---|---|---|---|\n";
     for (const auto& c : r.attribution.candidates) {
       std::string params;

@@ -6,11 +6,17 @@
 // initial states that no fit selected on (validation states): the fit's best score is the minimum of a multistable,
 // noisy objective over its evaluations, so a refit compared with it must beat the baseline's luckiest draw.
 // Confidence: a block bootstrap over the held-out view's residual tiles of the named effect against the runner-up.
-// With a held-out capture (a second placement of the specimen, in no fit), every validation drape is also scored
-// against it (the yield candidate's are draped again there, from the plastic set its best validation drape left):
-// the excess is that of the mean of both captures' gap terms (gap_terms), the confirmation and the bootstrap use the
-// held-out capture's views instead of the held-out view.
+//
+// Other placements of the specimen (OtherCaptures) take part where the capture's own data cannot tell:
+// - a second capture is in every candidate refit (the objective is the mean of both captures' fit scores) and in the
+//   gate (the excess is that of the mean of both captures' gap terms, gap_terms);
+// - a held-out capture is in no fit: the confirmation and the bootstrap use its views instead of the held-out view
+//   (and without a second capture, it is the gate's pair as well).
+// On every later placement a yielding candidate starts from the plastic set its drapes on the earlier ones left
+// (ForwardModel::laid_again); the other candidates' drapes are scored again, turned to the placement's outline.
 
+#include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <utility>
@@ -23,12 +29,22 @@
 
 namespace drapegen::diagnosis {
 
+/// A refitted setup's validation drapes against another placement of the specimen.
+struct OtherPlacement {
+  ScoredDrape best;  // the best of them against that capture
+  /// A yielding setup's drapes there start from the plastic set that its best drapes on the earlier placements left:
+  /// its largest rest angle, rad (unset for the other effects).
+  std::optional<double> plastic_set;
+};
+
 struct CandidateResult {
   Effect effect = Effect::kYield;
   std::vector<std::string> names;
   std::vector<double> parameters;   // as in effect_space
   double alpha_scale = 1.0;         // the refitted bending scale relative to the baseline fit
-  double fit_score = 0.0, held_out_score = 0.0, all_score = 0.0;
+  double fit_score = 0.0, held_out_score = 0.0, all_score = 0.0;  // of `drape`, against the capture
+  /// The refit's objective at its best: fit_score, or with a second capture the mean of both captures' fit scores.
+  double objective = 0.0;
   /// gap_shrinkage of excess_above_floors: the baseline's against this candidate's refitted drape.
   double shrinkage = 0.0;
   double held_out_shrinkage = 0.0;  // 1 - held_out_after / held_out_before (the view not in the refit)
@@ -39,24 +55,34 @@ struct CandidateResult {
   double seconds = 0.0;
   ScoredDrape drape;      // the refit's best drape (fit states)
   ScoredDrape validated;  // the refitted setup's best drape from the validation states: shrinkage, confirmation
-  /// The same validation drapes scored against the held-out capture (its best), if there is one; for a yielding
-  /// candidate, its drapes from the validation states laid again with the plastic set (ForwardModel::laid_again).
-  std::optional<ScoredDrape> validated_held_out;
-  /// A yielding candidate's held-out drapes start from a plastic set (attribute): its largest rest angle, rad.
-  std::optional<double> held_out_plastic_set;
-  [[nodiscard]] const ScoredDrape* held_out_drape() const {
-    return validated_held_out ? &*validated_held_out : nullptr;
+  /// The refitted setup from the validation states against the second and the held-out capture, if given.
+  std::optional<OtherPlacement> second, held_out;
+  /// The capture the gate pairs with the capture (gap_terms): the second, else the held-out one (null: neither).
+  [[nodiscard]] const ScoredDrape* paired_drape() const {
+    return second ? &second->best : held_out ? &held_out->best : nullptr;
   }
-  ModelSetup setup;                             // the refitted setup
-  std::vector<sim::ClothMesh> validation_meshes;  // its drapes from the validation states
+  [[nodiscard]] const ScoredDrape* held_out_drape() const { return held_out ? &held_out->best : nullptr; }
+  ModelSetup setup;  // the refitted setup
 };
 
-/// A second capture of the specimen, held out of every fit: its forward model and the fitted baseline's best
-/// validation drape scored against it.
-struct HeldOutCapture {
+/// Another placement of the specimen: its forward model and the fitted baseline's best validation drape scored
+/// against it (model null: not given).
+struct OtherCapture {
   ForwardModel* model = nullptr;
   const ScoredDrape* baseline = nullptr;
+  explicit operator bool() const { return model != nullptr; }
 };
+
+/// The placements besides the capture (file comment): the second is placement 1 and the held-out one placement 2
+/// when both are given; either alone is placement 1.
+struct OtherCaptures {
+  OtherCapture second;    // in every candidate refit and the gate
+  OtherCapture held_out;  // in no fit: confirmation, bootstrap (and the gate without a second)
+  [[nodiscard]] const OtherCapture& paired() const { return second ? second : held_out; }
+};
+
+/// Creates a forward model of a capture (the capture or another placement) for another thread.
+using ModelFactory = std::function<sim::Expected<std::unique_ptr<ForwardModel>>(const Capture&)>;
 
 /// What the confirmation compares of a validated drape: its score over all views of the held-out capture if there
 /// is one (`held_out_capture`, the same setup's drape scored against it), else its score over the held-out view.
@@ -96,12 +122,11 @@ struct Attribution {
 [[nodiscard]] std::vector<sim::InitialStateSpec> validation_states(const AttributionSettings& settings);
 
 /// `baseline` is the fitted setup, `fit` its evaluation (fit states) and `validated` its evaluation from the
-/// validation states; `floors` from measure_floors. make_model creates a forward model for another thread (jobs > 1).
-[[nodiscard]] sim::Expected<Attribution> attribute(
-    ForwardModel& model, const ModelSetup& baseline, const Evaluation& fit, const Evaluation& validated,
-    const Floors& floors, const AttributionSettings& settings,
-    const std::function<sim::Expected<std::unique_ptr<ForwardModel>>()>& make_model = {},
-    HeldOutCapture* held_out = nullptr);
+/// validation states; `floors` from measure_floors. make_model creates forward models for other threads (jobs > 1).
+[[nodiscard]] sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& baseline,
+                                                   const Evaluation& fit, const Evaluation& validated,
+                                                   const Floors& floors, const AttributionSettings& settings,
+                                                   const ModelFactory& make_model = {}, const OtherCaptures& others = {});
 
 /// 1 - excess_after / excess_before (0 when excess_before is 0): 1 when the candidate brings the drape within the
 /// floors, 0 when it leaves the excess as it was, negative when it adds to it.

@@ -5,6 +5,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include "drapegen/diagnosis/attribution.hpp"
 #include "drapegen/diagnosis/floors.hpp"
@@ -33,8 +34,8 @@ struct DiagnosisSettings {
   /// false: stop after the gap, floors and localisation (a capture above the floors gets the verdict
   /// "not attributed"): a screening run, or a calibration of the floors, at a fraction of the cost.
   bool attribute = true;
-  /// The shape floor when a held-out capture is given (the gate then tests the mean of two captures' shape distances,
-  /// which spreads less over controls than one capture's); 0: floors.shape_threshold.
+  /// The shape floor when the gate has a paired capture (a second or a held-out one: it then tests the mean of two
+  /// captures' shape distances, which spreads less over controls than one capture's); 0: floors.shape_threshold.
   double held_out_shape_threshold = 0.0;
 
   /// Small budgets for tests and the --quick benchmark.
@@ -67,14 +68,16 @@ struct DiagnosisResult {
   /// which no fit selected on (the fit's own best is the luckiest of its evaluations of a multistable objective).
   Evaluation validated;
   [[nodiscard]] const ScoredDrape& gap_drape() const { return validated.best; }
-  /// With a held-out capture (a second placement of the specimen, in no fit): the same validation drapes scored
-  /// against it. The gate then tests the mean of both captures' terms (gap_terms).
-  std::optional<Evaluation> validated_held_out;
-  /// Its best drape against the held-out capture (null without one).
-  [[nodiscard]] const ScoredDrape* held_out_gap_drape() const {
-    return validated_held_out ? &validated_held_out->best : nullptr;
+  /// With a second or a held-out capture (other placements of the specimen): the same validation drapes scored
+  /// against it. The gate tests the mean of the capture's terms and the paired capture's (gap_terms): the second
+  /// capture's, else the held-out capture's.
+  std::optional<Evaluation> validated_second, validated_held_out;
+  /// The best of them against the paired capture (null without one).
+  [[nodiscard]] const ScoredDrape* paired_gap_drape() const {
+    const auto& paired = validated_second ? validated_second : validated_held_out;
+    return paired ? &paired->best : nullptr;
   }
-  [[nodiscard]] GapTerms gap() const { return gap_terms(validated.best, held_out_gap_drape()); }
+  [[nodiscard]] GapTerms gap() const { return gap_terms(validated.best, paired_gap_drape()); }
   /// The validation drapes' distances to the capture and among themselves (the fitted fabric's multistability).
   ValidationSpread validation_spread;
   Floors floors;
@@ -92,14 +95,20 @@ struct DiagnosisResult {
   double seconds_fit = 0.0, seconds_floors = 0.0, seconds_attribution = 0.0;
 };
 
-/// `held_out`: optionally a second capture of the same specimen (another placement on the tester), used in no fit: the
-/// gap and every candidate are validated on both captures (docs/DIAGNOSIS.md, "Held-out capture").
-[[nodiscard]] sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisSettings& settings,
-                                                      const Capture* held_out = nullptr);
+/// Other placements of the capture's specimen on the tester (attribution.hpp, OtherCaptures); either may be null.
+struct OtherPlacements {
+  const Capture* second = nullptr;    // in the gate and every candidate refit (not the baseline fit)
+  const Capture* held_out = nullptr;  // in no fit: the confirmation (and the gate without a second)
+};
 
-/// An error unless `held_out` can be a second capture of `capture`'s specimen: the same specimen facts, and not the
-/// capture's own directory.
-[[nodiscard]] sim::Status check_same_specimen(const Capture& capture, const Capture& held_out);
+/// The whole diagnosis (docs/DIAGNOSIS.md; "Held-out capture" and "Second capture" for `others`).
+[[nodiscard]] sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisSettings& settings,
+                                                      const OtherPlacements& others = {});
+
+/// An error unless `other` can be another capture of `capture`'s specimen: the same specimen facts, and not the
+/// capture's own directory. `role` names it in the message ("held-out capture").
+[[nodiscard]] sim::Status check_same_specimen(const Capture& capture, const Capture& other,
+                                              std::string_view role = "held-out capture");
 
 [[nodiscard]] nlohmann::json to_json(const DiagnosisResult& result, const Capture& capture);
 
