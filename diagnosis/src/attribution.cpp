@@ -9,6 +9,7 @@
 #include <utility>
 #include <thread>
 
+#include <Eigen/Geometry>
 #include <fmt/ranges.h>
 
 #include "drapegen/renderer/random.hpp"
@@ -17,22 +18,47 @@
 namespace drapegen::diagnosis {
 namespace {
 
-/// `setup`'s drapes `on` the capture scored against another placement: a yielding setup is laid again there from
-/// the state of its best drape (the specimen keeps the plastic set that drape left) and simulated from `states`; any
-/// other setup's drapes are scored again (turned to the placement's outline). `laid` receives the setup laid again.
+/// The turns of a misaligned setup's drift tried on a later placement (where the specimen lies off centre by the same
+/// distance in a direction of its own): 0, 90, 180 and 270 degrees from the direction fitted on the capture.
+constexpr int kDriftTurns = 4;
+
+/// `setup`'s drapes `on` the capture scored against another placement, from `states` (those of `on`):
+/// - a yielding setup is laid again there from the state of its best drape (the specimen keeps the plastic set that
+///   drape left) and simulated from `states`;
+/// - a misaligned setup (drift) is placed off centre by the same distance in the best of kDriftTurns directions (each
+///   simulated from the state of the best drape on `on`), then simulated from `states`;
+/// - any other setup's drapes are scored again (turned to the placement's outline).
+/// `placed` receives the setup as placed there, `drift_turn` the chosen turn (misaligned setups only).
 sim::Expected<Evaluation> on_next_placement(ForwardModel& next, const ModelSetup& setup, const Evaluation& on,
-                                            const std::vector<sim::InitialStateSpec>& states,
-                                            ModelSetup* laid = nullptr) {
+                                            const std::vector<sim::InitialStateSpec>& states, ModelSetup& placed,
+                                            std::optional<double>* drift_turn = nullptr) {
+  const sim::InitialStateSpec& best_state = states.at(static_cast<std::size_t>(on.best.state));
   if (setup.effects.bending_yield_curvature) {
-    auto again = next.laid_again(setup, states.at(static_cast<std::size_t>(on.best.state)));
+    auto again = next.laid_again(setup, best_state);
     if (!again) return sim::Error{"yield candidate laid again: " + again.error().message};
-    auto e = next.evaluate(*again, states);
-    if (laid) *laid = std::move(*again);
-    return e;
+    placed = std::move(*again);
+    return next.evaluate(placed, states);
+  }
+  if (setup.drift.squaredNorm() > 0.0) {
+    double best = std::numeric_limits<double>::infinity(), best_turn = 0.0;
+    for (int k = 0; k < kDriftTurns; ++k) {
+      const double turn = 2.0 * M_PI * k / kDriftTurns;
+      ModelSetup turned = setup;
+      turned.drift = Eigen::Rotation2Dd(turn) * setup.drift;
+      auto mesh = next.simulate(turned, best_state);
+      if (!mesh) return mesh.error();
+      auto scored = next.score(*mesh, turned);
+      if (!scored) return scored.error();
+      if (scored->fit_score < best) best = scored->fit_score, best_turn = turn;
+    }
+    placed = setup;
+    placed.drift = Eigen::Rotation2Dd(best_turn) * setup.drift;
+    if (drift_turn) *drift_turn = best_turn;
+    return next.evaluate(placed, states);
   }
   std::vector<sim::ClothMesh> meshes;
   for (const auto& d : on.states) meshes.push_back(d.mesh);
-  if (laid) *laid = setup;
+  placed = setup;
   return next.rescore(meshes, setup);
 }
 
@@ -129,7 +155,8 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
     }
     double value = e->best.fit_score;
     if (second) {  // the mean over both captures: a yielding setup is laid again on the second from its best drape
-      auto e2 = on_next_placement(*second, setup, *e, model.initial_states());
+      ModelSetup placed;
+      auto e2 = on_next_placement(*second, setup, *e, model.initial_states(), placed);
       if (!e2) {
         error = sim::Error{"second capture: " + e2.error().message};
         return std::numeric_limits<double>::infinity();
@@ -180,16 +207,18 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
   const std::vector<sim::InitialStateSpec> states = validation_states(settings);
   auto validated = sim ? model.evaluate(refitted, states) : model.rescore(fresh, refitted);
   if (!validated) return validated.error();
-  // On the other placements in turn (the second, then the held-out one), each from the last.
+  // On the other placements in turn (the second, then the held-out one), each from the last (a misaligned setup's
+  // drift turned from the capture's direction, not from the last placement's).
   ModelSetup laid = refitted;
   const Evaluation* last = &*validated;
   std::optional<Evaluation> on_second;
   for (ForwardModel* next : {second, held_out}) {
     if (!next) continue;
     ModelSetup again;
-    auto e = on_next_placement(*next, laid, *last, states, &again);
+    std::optional<double> turn;
+    auto e = on_next_placement(*next, laid, *last, states, again, &turn);
     if (!e) return sim::Error{std::string(next == second ? "second" : "held-out") + " capture: " + e.error().message};
-    OtherPlacement placement{e->best, largest_set(again)};
+    OtherPlacement placement{e->best, largest_set(again), turn};
     if (next == second) {
       c.second = std::move(placement);
       on_second = std::move(*e);
@@ -198,6 +227,7 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
       c.held_out = std::move(placement);
     }
     laid = std::move(again);
+    laid.drift = refitted.drift;
   }
   c.validated = validated->best;
   c.setup = refitted;

@@ -119,13 +119,18 @@ nlohmann::json validated_json(const CandidateResult& c, const Floors& floors) {
   auto set_json = [](const std::optional<OtherPlacement>& p) {
     return p && p->plastic_set ? nlohmann::json(*p->plastic_set) : nlohmann::json(nullptr);
   };
+  auto turn_json = [](const std::optional<OtherPlacement>& p) {
+    return p && p->drift_turn ? nlohmann::json(*p->drift_turn * 180.0 / M_PI) : nlohmann::json(nullptr);
+  };
   return {{"stable_mm", c.validated.stable_all * 1e3},
           {"shape", c.validated.shape_all},
           {"held_out_score_mm", c.validated.held_out_score * 1e3},
           {"second_capture", placement_json(c.second ? &c.second->best : nullptr)},
           {"second_plastic_set_rad", set_json(c.second)},
+          {"second_drift_turn_deg", turn_json(c.second)},
           {"held_out_capture", placement_json(c.held_out_drape())},
           {"held_out_plastic_set_rad", set_json(c.held_out)},
+          {"held_out_drift_turn_deg", turn_json(c.held_out)},
           {"excess_above_floors", excess_above_floors(gap_terms(c.validated, c.paired_drape()), floors)}};
 }
 
@@ -446,7 +451,7 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
     nlohmann::json params = nlohmann::json::object();
     for (std::size_t k = 0; k < c.names.size() && k < c.parameters.size(); ++k) params[c.names[k]] = c.parameters[k];
     nlohmann::json scan = nlohmann::json::array();
-    for (const auto& [level, score] : c.scan) scan.push_back({{"parameter", level}, {"fit_score_mm", score * 1e3}});
+    for (const auto& [level, score] : c.scan) scan.push_back({{"parameter", level}, {"objective_mm", score * 1e3}});
     candidates.push_back({{"effect", effect_name(c.effect)},
                           {"parameters", params},
                           {"alpha_scale", c.alpha_scale},

@@ -13,7 +13,8 @@
 // - a held-out capture is in no fit: the confirmation and the bootstrap use its views instead of the held-out view
 //   (and without a second capture, it is the gate's pair as well).
 // On every later placement a yielding candidate starts from the plastic set its drapes on the earlier ones left
-// (ForwardModel::laid_again); the other candidates' drapes are scored again, turned to the placement's outline.
+// (ForwardModel::laid_again), a misaligned one lies off centre by its fitted distance in the best of four directions
+// (a placement's own); the other candidates' drapes are scored again, turned to the placement's outline.
 
 #include <functional>
 #include <memory>
@@ -35,6 +36,9 @@ struct OtherPlacement {
   /// A yielding setup's drapes there start from the plastic set that its best drapes on the earlier placements left:
   /// its largest rest angle, rad (unset for the other effects).
   std::optional<double> plastic_set;
+  /// A misaligned setup lies off centre there by the fitted distance in a direction of its own: the turn from the
+  /// direction fitted on the capture that fits it best (of four, 90 degrees apart), rad (unset for the other effects).
+  std::optional<double> drift_turn;
 };
 
 struct CandidateResult {
@@ -50,7 +54,7 @@ struct CandidateResult {
   double held_out_shrinkage = 0.0;  // 1 - held_out_after / held_out_before (the view not in the refit)
   bool confirmed = false;           // the held-out view does not get worse
   int evaluations = 0;
-  /// The strength scan (AttributionSettings::scan_levels), if one ran: (parameter, fit score) per level.
+  /// The strength scan (AttributionSettings::scan_levels), if one ran: (parameter, refit objective) per level.
   std::vector<std::pair<double, double>> scan;
   double seconds = 0.0;
   ScoredDrape drape;      // the refit's best drape (fit states)
