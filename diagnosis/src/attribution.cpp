@@ -9,7 +9,6 @@
 #include <utility>
 #include <thread>
 
-#include <Eigen/Geometry>
 #include <fmt/ranges.h>
 
 #include "drapegen/renderer/random.hpp"
@@ -18,20 +17,22 @@
 namespace drapegen::diagnosis {
 namespace {
 
-/// The turns of a misaligned setup's drift tried on a later placement (where the specimen lies off centre by the same
-/// distance in a direction of its own): 0, 90, 180 and 270 degrees from the direction fitted on the capture.
-constexpr int kDriftTurns = 4;
+/// The directions of a misaligned setup's drift tried on a later placement (where the specimen lies off centre by the
+/// same distance in a direction of its own): 0, 30, 60 and 90 degrees from the warp. The bending is orthotropic with
+/// one bias stiffness and the specimen square, so a drift at -theta or 180 - theta degrees drapes as one at theta
+/// (mirrored or turned, which the outline turn absorbs): these four cover every direction to within 15 degrees.
+constexpr int kDriftDirections = 4;
 
 /// `setup`'s drapes `on` the capture scored against another placement, from `states` (those of `on`):
 /// - a yielding setup is laid again there from the state of its best drape (the specimen keeps the plastic set that
 ///   drape left) and simulated from `states`;
-/// - a misaligned setup (drift) is placed off centre by the same distance in the best of kDriftTurns directions (each
-///   simulated from the state of the best drape on `on`), then simulated from `states`;
+/// - a misaligned setup (drift) is placed off centre by the same distance in the best of kDriftDirections directions
+///   (each simulated from the state of the best drape on `on`, scored by the fit score), then simulated from `states`;
 /// - any other setup's drapes are scored again (turned to the placement's outline).
-/// `placed` receives the setup as placed there, `drift_turn` the chosen turn (misaligned setups only).
+/// `placed` receives the setup as placed there, `drift_direction` the chosen direction (misaligned setups only).
 sim::Expected<Evaluation> on_next_placement(ForwardModel& next, const ModelSetup& setup, const Evaluation& on,
                                             const std::vector<sim::InitialStateSpec>& states, ModelSetup& placed,
-                                            std::optional<double>* drift_turn = nullptr) {
+                                            std::optional<double>* drift_direction = nullptr) {
   const sim::InitialStateSpec& best_state = states.at(static_cast<std::size_t>(on.best.state));
   if (setup.effects.bending_yield_curvature) {
     auto again = next.laid_again(setup, best_state);
@@ -40,20 +41,20 @@ sim::Expected<Evaluation> on_next_placement(ForwardModel& next, const ModelSetup
     return next.evaluate(placed, states);
   }
   if (setup.drift.squaredNorm() > 0.0) {
-    double best = std::numeric_limits<double>::infinity(), best_turn = 0.0;
-    for (int k = 0; k < kDriftTurns; ++k) {
-      const double turn = 2.0 * M_PI * k / kDriftTurns;
-      ModelSetup turned = setup;
-      turned.drift = Eigen::Rotation2Dd(turn) * setup.drift;
-      auto mesh = next.simulate(turned, best_state);
-      if (!mesh) return mesh.error();
-      auto scored = next.score(*mesh, turned);
-      if (!scored) return scored.error();
-      if (scored->fit_score < best) best = scored->fit_score, best_turn = turn;
-    }
+    const double distance = setup.drift.norm();
+    double best = std::numeric_limits<double>::infinity(), best_direction = 0.0;
     placed = setup;
-    placed.drift = Eigen::Rotation2Dd(best_turn) * setup.drift;
-    if (drift_turn) *drift_turn = best_turn;
+    for (int k = 0; k < kDriftDirections; ++k) {
+      const double direction = 0.5 * M_PI * k / (kDriftDirections - 1);
+      placed.drift = distance * Eigen::Vector2d(std::cos(direction), std::sin(direction));
+      auto mesh = next.simulate(placed, best_state);
+      if (!mesh) return mesh.error();
+      auto scored = next.score(*mesh, placed);
+      if (!scored) return scored.error();
+      if (scored->fit_score < best) best = scored->fit_score, best_direction = direction;
+    }
+    placed.drift = distance * Eigen::Vector2d(std::cos(best_direction), std::sin(best_direction));
+    if (drift_direction) *drift_direction = best_direction;
     return next.evaluate(placed, states);
   }
   std::vector<sim::ClothMesh> meshes;
@@ -207,18 +208,17 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
   const std::vector<sim::InitialStateSpec> states = validation_states(settings);
   auto validated = sim ? model.evaluate(refitted, states) : model.rescore(fresh, refitted);
   if (!validated) return validated.error();
-  // On the other placements in turn (the second, then the held-out one), each from the last (a misaligned setup's
-  // drift turned from the capture's direction, not from the last placement's).
+  // On the other placements in turn (the second, then the held-out one), each from the last.
   ModelSetup laid = refitted;
   const Evaluation* last = &*validated;
   std::optional<Evaluation> on_second;
   for (ForwardModel* next : {second, held_out}) {
     if (!next) continue;
     ModelSetup again;
-    std::optional<double> turn;
-    auto e = on_next_placement(*next, laid, *last, states, again, &turn);
+    std::optional<double> direction;
+    auto e = on_next_placement(*next, laid, *last, states, again, &direction);
     if (!e) return sim::Error{std::string(next == second ? "second" : "held-out") + " capture: " + e.error().message};
-    OtherPlacement placement{e->best, largest_set(again), turn};
+    OtherPlacement placement{e->best, largest_set(again), direction};
     if (next == second) {
       c.second = std::move(placement);
       on_second = std::move(*e);
@@ -227,7 +227,6 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
       c.held_out = std::move(placement);
     }
     laid = std::move(again);
-    laid.drift = refitted.drift;
   }
   c.validated = validated->best;
   c.setup = refitted;

@@ -119,18 +119,18 @@ nlohmann::json validated_json(const CandidateResult& c, const Floors& floors) {
   auto set_json = [](const std::optional<OtherPlacement>& p) {
     return p && p->plastic_set ? nlohmann::json(*p->plastic_set) : nlohmann::json(nullptr);
   };
-  auto turn_json = [](const std::optional<OtherPlacement>& p) {
-    return p && p->drift_turn ? nlohmann::json(*p->drift_turn * 180.0 / M_PI) : nlohmann::json(nullptr);
+  auto direction_json = [](const std::optional<OtherPlacement>& p) {
+    return p && p->drift_direction ? nlohmann::json(*p->drift_direction * 180.0 / M_PI) : nlohmann::json(nullptr);
   };
   return {{"stable_mm", c.validated.stable_all * 1e3},
           {"shape", c.validated.shape_all},
           {"held_out_score_mm", c.validated.held_out_score * 1e3},
           {"second_capture", placement_json(c.second ? &c.second->best : nullptr)},
           {"second_plastic_set_rad", set_json(c.second)},
-          {"second_drift_turn_deg", turn_json(c.second)},
+          {"second_drift_direction_deg", direction_json(c.second)},
           {"held_out_capture", placement_json(c.held_out_drape())},
           {"held_out_plastic_set_rad", set_json(c.held_out)},
-          {"held_out_drift_turn_deg", turn_json(c.held_out)},
+          {"held_out_drift_direction_deg", direction_json(c.held_out)},
           {"excess_above_floors", excess_above_floors(gap_terms(c.validated, c.paired_drape()), floors)}};
 }
 
@@ -335,7 +335,9 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
     if (c.size() > 1) r.runner_up = effect_name(c[r.attribution.named ? 1 : 0].effect);
   }
   r.seconds_attribution = since(attribution_start);
-  r.simulations = model.simulations();
+  r.simulations = model.simulations();  // the main thread's, on every placement's model
+  for (const auto& m : {second_model.get(), held_out_model.get()})
+    if (m) r.simulations += m->simulations();
   r.seconds = since(start);
   sim::logger()->info("diagnosis: verdict {} in {:.1f} s", r.verdict, r.seconds);
   return r;
@@ -476,6 +478,7 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                       {"bending_refit_bar",
                        {{"parameters", r.attribution.bar.parameters},
                         {"fit_score_mm", r.attribution.bar.fit_score * 1e3},
+                        {"objective_mm", r.attribution.bar.objective * 1e3},
                         {"validated", ran ? validated_json(r.attribution.bar, r.floors) : nlohmann::json(nullptr)},
                         {"shrinkage", r.attribution.bar.shrinkage}}},
                       {"named", r.attribution.named},

@@ -14,7 +14,8 @@
 //   (and without a second capture, it is the gate's pair as well).
 // On every later placement a yielding candidate starts from the plastic set its drapes on the earlier ones left
 // (ForwardModel::laid_again), a misaligned one lies off centre by its fitted distance in the best of four directions
-// (a placement's own); the other candidates' drapes are scored again, turned to the placement's outline.
+// (a placement's own, a nuisance parameter chosen on that placement's fit views as the outline turn is); the other
+// candidates' drapes are scored again, turned to the placement's outline.
 
 #include <functional>
 #include <memory>
@@ -36,9 +37,9 @@ struct OtherPlacement {
   /// A yielding setup's drapes there start from the plastic set that its best drapes on the earlier placements left:
   /// its largest rest angle, rad (unset for the other effects).
   std::optional<double> plastic_set;
-  /// A misaligned setup lies off centre there by the fitted distance in a direction of its own: the turn from the
-  /// direction fitted on the capture that fits it best (of four, 90 degrees apart), rad (unset for the other effects).
-  std::optional<double> drift_turn;
+  /// A misaligned setup lies off centre there by the fitted distance in a direction of its own: the one of 0, 30, 60
+  /// and 90 degrees from the warp that fits it best, rad (unset for the other effects).
+  std::optional<double> drift_direction;
 };
 
 struct CandidateResult {
