@@ -18,9 +18,9 @@ namespace drapegen::diagnosis {
 namespace {
 
 /// The directions of a misaligned setup's drift tried on a later placement (where the specimen lies off centre by the
-/// same distance in a direction of its own): 0, 30, 60 and 90 degrees from the warp. The bending is orthotropic with
-/// one bias stiffness and the specimen square, so a drift at -theta or 180 - theta degrees drapes as one at theta
-/// (mirrored or turned, which the outline turn absorbs): these four cover every direction to within 15 degrees.
+/// same distance in a direction of its own): 0, 45, 90 and 135 degrees from the warp. The bending is orthotropic and
+/// the specimen square, so a drift at theta + 180 degrees drapes as one at theta turned by 180 degrees (which the
+/// outline turn absorbs): these four cover every direction to within 22.5 degrees.
 constexpr int kDriftDirections = 4;
 
 /// `setup`'s drapes `on` the capture scored against another placement, from `states` (those of `on`):
@@ -45,7 +45,7 @@ sim::Expected<Evaluation> on_next_placement(ForwardModel& next, const ModelSetup
     double best = std::numeric_limits<double>::infinity(), best_direction = 0.0;
     placed = setup;
     for (int k = 0; k < kDriftDirections; ++k) {
-      const double direction = 0.5 * M_PI * k / (kDriftDirections - 1);
+      const double direction = M_PI * k / kDriftDirections;
       placed.drift = distance * Eigen::Vector2d(std::cos(direction), std::sin(direction));
       auto mesh = next.simulate(placed, best_state);
       if (!mesh) return mesh.error();

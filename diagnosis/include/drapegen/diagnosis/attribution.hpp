@@ -37,8 +37,8 @@ struct OtherPlacement {
   /// A yielding setup's drapes there start from the plastic set that its best drapes on the earlier placements left:
   /// its largest rest angle, rad (unset for the other effects).
   std::optional<double> plastic_set;
-  /// A misaligned setup lies off centre there by the fitted distance in a direction of its own: the one of 0, 30, 60
-  /// and 90 degrees from the warp that fits it best, rad (unset for the other effects).
+  /// A misaligned setup lies off centre there by the fitted distance in a direction of its own: the one of 0, 45, 90
+  /// and 135 degrees from the warp that fits it best, rad (unset for the other effects).
   std::optional<double> drift_direction;
 };
 
