@@ -35,9 +35,13 @@ sim::Expected<Evaluation> on_next_placement(ForwardModel& next, const ModelSetup
                                             std::optional<double>* drift_direction = nullptr) {
   const sim::InitialStateSpec& best_state = states.at(static_cast<std::size_t>(on.best.state));
   if (setup.effects.bending_yield_curvature) {
-    auto again = next.laid_again(setup, best_state);
-    if (!again) return sim::Error{"yield candidate laid again: " + again.error().message};
-    placed = std::move(*again);
+    if (on.best.left.rest_angles.size() > 0) {  // the set its best drape left, kept by evaluate
+      placed = ForwardModel::laid_again(setup, on.best);
+    } else {
+      auto again = next.laid_again(setup, best_state);
+      if (!again) return sim::Error{"yield candidate laid again: " + again.error().message};
+      placed = std::move(*again);
+    }
     return next.evaluate(placed, states);
   }
   if (setup.drift.squaredNorm() > 0.0) {

@@ -89,12 +89,27 @@ sim::Expected<sim::ClothMesh> ForwardModel::simulate(const ModelSetup& setup, co
   return std::move(result->mesh);
 }
 
+namespace {
+/// The set a drape of `setup` from `state` leaves: its rest angles, on the set's specimen if `setup` had one, else on
+/// the state's.
+PlasticSet set_left(const ModelSetup& setup, const sim::InitialStateSpec& state, Eigen::VectorXd rest_angles) {
+  const bool had = setup.plastic_set.rest_angles.size() > 0;
+  return {had ? setup.plastic_set.specimen_seed : state.seed, std::move(rest_angles)};
+}
+}  // namespace
+
 sim::Expected<ModelSetup> ForwardModel::laid_again(const ModelSetup& setup, const sim::InitialStateSpec& state) {
-  ModelSetup next = setup;
-  auto mesh = simulate(setup, state, nullptr, &next.plastic_set.rest_angles);
+  Eigen::VectorXd rest_angles;
+  auto mesh = simulate(setup, state, nullptr, &rest_angles);
   if (!mesh) return mesh.error();
-  // The drape ran on the set's specimen if there was one, else on the state's.
-  if (setup.plastic_set.rest_angles.size() == 0) next.plastic_set.specimen_seed = state.seed;
+  ModelSetup next = setup;
+  next.plastic_set = set_left(setup, state, std::move(rest_angles));
+  return next;
+}
+
+ModelSetup ForwardModel::laid_again(const ModelSetup& setup, const ScoredDrape& drape) {
+  ModelSetup next = setup;
+  next.plastic_set = drape.left;
   return next;
 }
 
@@ -214,12 +229,15 @@ sim::Expected<Evaluation> ForwardModel::evaluate(const ModelSetup& setup,
   double best = std::numeric_limits<double>::infinity();
   for (std::size_t k = 0; k < states.size(); ++k) {
     bool converged = true;
-    auto mesh = simulate(setup, states[k], &converged);
+    const bool yields = setup.effects.bending_yield_curvature.has_value();
+    Eigen::VectorXd rest_angles;
+    auto mesh = simulate(setup, states[k], &converged, yields ? &rest_angles : nullptr);
     if (!mesh) return mesh.error();
     auto scored = score(*mesh, setup);
     if (!scored) return scored.error();
     scored->state = static_cast<int>(k);
     scored->converged = converged;
+    if (yields) scored->left = set_left(setup, states[k], std::move(rest_angles));
     if (scored->fit_score < best) {
       best = scored->fit_score;
       e.best = *scored;

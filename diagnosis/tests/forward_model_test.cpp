@@ -1,4 +1,5 @@
-// ForwardModel::laid_again: the specimen lifted after a drape and laid again keeps what the drape did to it.
+// ForwardModel::laid_again: the specimen lifted after a drape and laid again keeps what the drape did to it (simulated
+// again, or kept by evaluate).
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -52,6 +53,17 @@ TEST(ForwardModel, LaidAgainCarriesAYieldingSpecimensSetAndNothingOfAnElasticOne
   EXPECT_EQ(twice->plastic_set.specimen_seed, states[1].seed);
   EXPECT_EQ(twice->plastic_set.rest_angles.size(), once->plastic_set.rest_angles.size());
   EXPECT_GT((twice->plastic_set.rest_angles - once->plastic_set.rest_angles).cwiseAbs().maxCoeff(), 0.0);
+
+  // evaluate keeps the set each yielding drape leaves, so laying it again needs no second simulation: the same set as
+  // laid_again's from that state; an elastic setup's drapes keep none.
+  auto evaluated = (*model)->evaluate(yielding, states);
+  ASSERT_TRUE(evaluated.has_value()) << evaluated.error().message;
+  const ModelSetup kept = ForwardModel::laid_again(yielding, evaluated->states[1]);
+  EXPECT_EQ(kept.plastic_set.specimen_seed, once->plastic_set.specimen_seed);
+  EXPECT_EQ(kept.plastic_set.rest_angles, once->plastic_set.rest_angles);
+  auto evaluated_elastic = (*model)->evaluate(elastic, states);
+  ASSERT_TRUE(evaluated_elastic.has_value()) << evaluated_elastic.error().message;
+  EXPECT_EQ(evaluated_elastic->best.left.rest_angles.size(), 0);
   fs::remove_all(dir);
 }
 

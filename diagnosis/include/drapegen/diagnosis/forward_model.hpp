@@ -59,6 +59,8 @@ struct ScoredDrape {
   double fit_score = 0.0;
   double held_out_score = 0.0;
   double all_score = 0.0;
+  /// A yielding setup's drape from ForwardModel::evaluate: the plastic set it leaves (empty otherwise).
+  PlasticSet left;
 };
 
 struct Evaluation {
@@ -80,6 +82,8 @@ class ForwardModel {
   /// The specimen lifted and laid again: `setup` with the plastic set (PlasticSet) that its drape from `state` leaves,
   /// so that the next drape starts from it. An elastic setup's set is all zero.
   [[nodiscard]] sim::Expected<ModelSetup> laid_again(const ModelSetup& setup, const sim::InitialStateSpec& state);
+  /// The same without simulating again: `setup` with the set that `drape`, its drape from evaluate, left.
+  [[nodiscard]] static ModelSetup laid_again(const ModelSetup& setup, const ScoredDrape& drape);
   /// Turns `mesh` to match `target` (the capture's outline unless given), renders with setup.sensor, compares.
   [[nodiscard]] sim::Expected<ScoredDrape> score(const sim::ClothMesh& mesh, const ModelSetup& setup,
                                                  const Target& target);
