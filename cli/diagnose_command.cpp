@@ -105,7 +105,8 @@ int run_diagnose(const DiagnoseOptions& o) {
                              r.gap_all * 1e3, r.gap_held_out * 1e3, r.floors.all * 1e3, r.floors.held_out * 1e3);
     std::cout << fmt::format("  localised: {}\n", diagnosis::region_name(r.localisation.dominant));
     if (r.verdict == "none") {
-      std::cout << "  verdict: within the floors (no effect named)\n";
+      std::cout << fmt::format("  verdict: within the floors{} (no effect named)\n",
+                               r.attribution.bar_within_floors ? " once the bending is refitted" : "");
     } else if (r.verdict == "unexplained") {
       std::cout << "  verdict: above the floors, no candidate shrinks it significantly\n";
     } else if (r.verdict == "not attributed") {

@@ -357,6 +357,7 @@ sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& base
   a.bar = std::move(results.back()->value());
   a.bar.shrinkage = gap_shrinkage(excess_above_floors(gap_terms(validated.best, baseline_paired), floors),
                                   excess_above_floors(gap_terms(a.bar.validated, a.bar.paired_drape()), floors));
+  a.bar_within_floors = excess_above_floors(gap_terms(a.bar.validated, a.bar.paired_drape()), floors) == 0.0;
   const bool bar_is_reference = a.bar.shrinkage > 0.0;
   const ScoredDrape& reference = bar_is_reference ? a.bar.validated : validated.best;
   const ScoredDrape* reference_paired = bar_is_reference ? a.bar.paired_drape() : baseline_paired;
@@ -377,7 +378,8 @@ sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& base
     return x.held_out_shrinkage > y.held_out_shrinkage;
   });
   if (!a.candidates.empty()) {
-    a.named = a.candidates[0].confirmed && a.candidates[0].shrinkage >= settings.significant_shrinkage;
+    a.named = !a.bar_within_floors && a.candidates[0].confirmed &&
+              a.candidates[0].shrinkage >= settings.significant_shrinkage;
     a.confidence = 1.0;
     if (a.candidates.size() > 1) {
       const CandidateResult &best = a.candidates[0], &runner_up = a.candidates[1];

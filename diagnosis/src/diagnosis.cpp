@@ -331,8 +331,12 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
     if (!attribution) return attribution.error();
     r.attribution = std::move(*attribution);
     const auto& c = r.attribution.candidates;
-    r.verdict = r.attribution.named ? std::string(effect_name(c[0].effect)) : "unexplained";
-    if (c.size() > 1) r.runner_up = effect_name(c[r.attribution.named ? 1 : 0].effect);
+    if (r.attribution.bar_within_floors) {
+      r.verdict = "none";  // within the floors once the bending is refitted: the gap was the baseline fit's
+    } else {
+      r.verdict = r.attribution.named ? std::string(effect_name(c[0].effect)) : "unexplained";
+      if (c.size() > 1) r.runner_up = effect_name(c[r.attribution.named ? 1 : 0].effect);
+    }
   }
   r.seconds_attribution = since(attribution_start);
   r.simulations = model.simulations();  // the main thread's, on every placement's model
@@ -350,6 +354,7 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
   j["runner_up"] = r.runner_up;
   j["confidence"] = r.attribution.confidence;
   j["within_floors"] = r.within_floors;
+  j["within_floors_after_bending_refit"] = r.attribution.bar_within_floors;
   j["gap_mm"] = {{"all_views", r.gap_all * 1e3}, {"fit_views", r.gap_fit * 1e3}, {"held_out_view", r.gap_held_out * 1e3}};
   nlohmann::json states = nlohmann::json::array();
   for (const auto& d : r.validated.states) {

@@ -121,6 +121,9 @@ struct Attribution {
   std::vector<CandidateResult> candidates;  // sorted by shrinkage, best first
   bool named = false;                       // the best is confirmed and shrinks the gap significantly
   double confidence = 0.0;                  // bootstrap P(best beats runner-up on the held-out view)
+  /// The bar's validated drape is within the floors (gate of the baseline's): the baseline model explains the capture
+  /// once its bending is refitted, so the gap was the baseline fit's, and no effect is named.
+  bool bar_within_floors = false;
 };
 
 /// The validation states: fresh initial states (flat, then sine) that no fit selects on.
