@@ -265,6 +265,17 @@ if(NOT refits_on_both EQUAL ncand)
   message(FATAL_ERROR "--second-capture: ${refits_on_both} of ${ncand} refits have an objective other than the "
                       "capture's fit score")
 endif()
+# A second capture alone: in the refits and the gate; the confirmation falls back to the capture's held-out view.
+run_ok(out diagnose --capture ${WORK}/capture --second-capture ${WORK}/capture.p1 --quick --resolution 10 --states 2
+       --evaluations 8 --refit-evaluations 6 --json)
+string(JSON paired GET "${out}" gap_tests paired_with)
+string(JSON refitted_on GET "${out}" attribution refitted_on)
+string(JSON confirmed_on GET "${out}" attribution confirmed_on)
+if(NOT paired STREQUAL "second_capture" OR NOT refitted_on STREQUAL "capture_and_second_capture"
+   OR NOT confirmed_on STREQUAL "held_out_view")
+  message(FATAL_ERROR "--second-capture alone: gate paired with '${paired}', refitted on '${refitted_on}', confirmed "
+                      "on '${confirmed_on}'")
+endif()
 expect_failure(1 "the second capture too" diagnose --capture ${WORK}/capture --second-capture ${WORK}/capture.p1
                --held-out-capture ${WORK}/capture.p1/.)
 expect_failure(1 "second capture" diagnose --capture ${WORK}/capture --second-capture ${WORK}/does_not_exist)
