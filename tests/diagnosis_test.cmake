@@ -29,6 +29,19 @@ function(run_ok out_var)
   set(${out_var} "${out}" PARENT_SCOPE)
 endfunction()
 
+# Stops the test unless the diagnosis `json` paired its gate with `paired`, refitted on `refitted_on` and confirmed on
+# `confirmed_on` (report.json's roles of the other placements); `label` names the run.
+function(expect_roles label json paired refitted_on confirmed_on)
+  string(JSON got_paired GET "${json}" gap_tests paired_with)
+  string(JSON got_refitted GET "${json}" attribution refitted_on)
+  string(JSON got_confirmed GET "${json}" attribution confirmed_on)
+  if(NOT "${got_paired}" STREQUAL "${paired}" OR NOT "${got_refitted}" STREQUAL "${refitted_on}"
+     OR NOT "${got_confirmed}" STREQUAL "${confirmed_on}")
+    message(FATAL_ERROR "${label}: gate paired with '${got_paired}', refitted on '${got_refitted}', confirmed on "
+                        "'${got_confirmed}' (expected '${paired}', '${refitted_on}', '${confirmed_on}')")
+  endif()
+endfunction()
+
 set(FABRIC --alpha 13923,11455,8821 --beta=-35390,-29660,-22042 --density 300)
 run_ok(out reality ${FABRIC} --effect bias=12 --resolution 14 --seed 4 --out ${WORK}/capture --json)
 foreach(f capture.json view0.exr view1.exr view2.exr view3.exr truth.json preview.png)
@@ -144,13 +157,12 @@ if(NOT ncand EQUAL 6)
   message(FATAL_ERROR "--held-out-capture: expected 6 candidates, got ${ncand}")
 endif()
 # Held out of every fit: the refits use the capture alone (their objective is its fit score), the gate pairs with it.
-string(JSON paired GET "${out}" gap_tests paired_with)
-string(JSON refitted_on GET "${out}" attribution refitted_on)
+expect_roles("--held-out-capture alone" "${out}" held_out_capture capture held_out_capture)
 string(JSON fit GET "${out}" attribution candidates 0 fit_score_mm)
 string(JSON objective GET "${out}" attribution candidates 0 objective_mm)
-if(NOT paired STREQUAL "held_out_capture" OR NOT refitted_on STREQUAL "capture" OR NOT fit EQUAL objective)
-  message(FATAL_ERROR "--held-out-capture alone: gate paired with '${paired}', refitted on '${refitted_on}', best "
-                      "candidate's objective ${objective} mm against its fit score ${fit} mm")
+if(NOT fit EQUAL objective)
+  message(FATAL_ERROR "--held-out-capture alone: best candidate's objective ${objective} mm against its fit score "
+                      "${fit} mm")
 endif()
 # Each candidate's validation against the held-out capture is reported (GET fails the test if it is missing).
 string(JSON cand_b GET "${out}" attribution candidates 0 validated held_out_capture stable_mm)
@@ -196,14 +208,7 @@ run_ok(out reality ${FABRIC} --effect bias=12 --resolution 14 --seed 4 --placeme
 file(REMOVE ${WORK}/capture.p2/truth.json)
 run_ok(out diagnose --capture ${WORK}/capture --second-capture ${WORK}/capture.p1 --held-out-capture ${WORK}/capture.p2
        --quick --resolution 10 --states 2 --evaluations 8 --refit-evaluations 6 --json)
-string(JSON paired GET "${out}" gap_tests paired_with)
-string(JSON refitted_on GET "${out}" attribution refitted_on)
-string(JSON confirmed_on GET "${out}" attribution confirmed_on)
-if(NOT paired STREQUAL "second_capture" OR NOT refitted_on STREQUAL "capture_and_second_capture"
-   OR NOT confirmed_on STREQUAL "held_out_capture")
-  message(FATAL_ERROR "--second-capture: gate paired with '${paired}', refitted on '${refitted_on}', confirmed on "
-                      "'${confirmed_on}'")
-endif()
+expect_roles("--second-capture" "${out}" second_capture capture_and_second_capture held_out_capture)
 # The gate's shape distance is the mean over the capture and the second capture, not the held-out one.
 string(JSON shape GET "${out}" gap_tests shape)
 string(JSON shape_a GET "${out}" gap_tests capture shape)
@@ -268,14 +273,7 @@ endif()
 # A second capture alone: in the refits and the gate; the confirmation falls back to the capture's held-out view.
 run_ok(out diagnose --capture ${WORK}/capture --second-capture ${WORK}/capture.p1 --quick --resolution 10 --states 2
        --evaluations 8 --refit-evaluations 6 --json)
-string(JSON paired GET "${out}" gap_tests paired_with)
-string(JSON refitted_on GET "${out}" attribution refitted_on)
-string(JSON confirmed_on GET "${out}" attribution confirmed_on)
-if(NOT paired STREQUAL "second_capture" OR NOT refitted_on STREQUAL "capture_and_second_capture"
-   OR NOT confirmed_on STREQUAL "held_out_view")
-  message(FATAL_ERROR "--second-capture alone: gate paired with '${paired}', refitted on '${refitted_on}', confirmed "
-                      "on '${confirmed_on}'")
-endif()
+expect_roles("--second-capture alone" "${out}" second_capture capture_and_second_capture held_out_view)
 expect_failure(1 "the second capture too" diagnose --capture ${WORK}/capture --second-capture ${WORK}/capture.p1
                --held-out-capture ${WORK}/capture.p1/.)
 expect_failure(1 "second capture" diagnose --capture ${WORK}/capture --second-capture ${WORK}/does_not_exist)
