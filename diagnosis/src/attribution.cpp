@@ -24,8 +24,8 @@ namespace {
 constexpr int kDriftDirections = 4;
 
 /// `setup`'s drapes `on` the capture scored against another placement, from `states` (those of `on`):
-/// - a yielding setup is laid again there from the state of its best drape (the specimen keeps the plastic set that
-///   drape left) and simulated from `states`;
+/// - a yielding setup is laid again there with the plastic set its best drape left (kept by evaluate) and simulated
+///   from `states`;
 /// - a misaligned setup (drift) is placed off centre by the same distance in the best of kDriftDirections directions
 ///   (each simulated from the state of the best drape on `on`, scored by the fit score), then simulated from `states`;
 /// - any other setup's drapes are scored again (turned to the placement's outline).
@@ -35,13 +35,9 @@ sim::Expected<Evaluation> on_next_placement(ForwardModel& next, const ModelSetup
                                             std::optional<double>* drift_direction = nullptr) {
   const sim::InitialStateSpec& best_state = states.at(static_cast<std::size_t>(on.best.state));
   if (setup.effects.bending_yield_curvature) {
-    if (on.best.left.rest_angles.size() > 0) {  // the set its best drape left, kept by evaluate
-      placed = ForwardModel::laid_again(setup, on.best);
-    } else {
-      auto again = next.laid_again(setup, best_state);
-      if (!again) return sim::Error{"yield candidate laid again: " + again.error().message};
-      placed = std::move(*again);
-    }
+    // The set its best drape left, kept by evaluate (a yielding setup's drapes are always simulated, never rescored).
+    if (on.best.left.rest_angles.size() == 0) return sim::Error{"yield candidate laid again: no plastic set kept"};
+    placed = ForwardModel::laid_again(setup, on.best);
     return next.evaluate(placed, states);
   }
   if (setup.drift.squaredNorm() > 0.0) {
