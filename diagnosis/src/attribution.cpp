@@ -70,33 +70,25 @@ std::optional<double> largest_set(const ModelSetup& setup) {
   return set.size() > 0 ? set.cwiseAbs().maxCoeff() : 0.0;
 }
 
-/// Refits `effect` (with the bending scale free), or with no effect (the bar) the baseline's own bending parameters in
-/// the fit's reduced coordinates, on the fit states (and the second capture, if given); then evaluates the refitted
-/// setup from the validation states on the capture and on the other placements.
+/// The bending scale's range in a refit: ln of the factor on alpha and beta (0.22 .. 4.5 times the baseline fit's).
+constexpr double kBendingScaleRange = 1.5;
+
+/// Refits `effect` with the bending scale free, or with no effect (the bar) the bending scale alone, on the fit
+/// states (and the second capture, if given); then evaluates the refitted setup from the validation states on the
+/// capture and on the other placements.
 sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, ForwardModel* held_out,
                                      std::optional<Effect> effect, const ModelSetup& baseline, const Evaluation& fit,
                                      const Evaluation& baseline_validated, const AttributionSettings& settings) {
   const auto start = std::chrono::steady_clock::now();
   const bool bar = !effect;
-  EffectSpace space;
-  if (bar) {
-    const ReducedBending r = to_reduced(baseline.bending), lower = reduced_lower(model.capture().specimen.density),
-                         upper = reduced_upper(model.capture().specimen.density);
-    space = {{"ln_alpha", "ln_warp_over_weft", "ln_bias_over_mean", "minus_beta_over_alpha_mm"},
-             {r.begin(), r.end()},
-             {0.25, 0.2, 0.2, 0.5},
-             {lower.begin(), lower.end()},
-             {upper.begin(), upper.end()}};
-  } else {
-    space = effect_space(*effect);
-  }
+  const EffectSpace space = bar ? EffectSpace{} : effect_space(*effect);
   CandidateResult c;
   c.effect = effect.value_or(Effect::kYield);
   c.names = space.names;
   std::vector<double> x0, step, lo, hi;
   const bool sim = bar || needs_simulation(*effect);
-  if (sim && !bar) {  // the bending scale stays free: an effect may trade off against stiffness
-    x0.push_back(0.0), step.push_back(0.25), lo.push_back(-1.5), hi.push_back(1.5);
+  if (sim) {  // the bending scale stays free: an effect may trade off against stiffness (and the bar refits it alone)
+    x0.push_back(0.0), step.push_back(0.25), lo.push_back(-kBendingScaleRange), hi.push_back(kBendingScaleRange);
   }
   const std::size_t first = x0.size();
   x0.insert(x0.end(), space.start.begin(), space.start.end());
@@ -127,20 +119,14 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
   double best = std::numeric_limits<double>::infinity();
   auto setup_of = [&](const std::vector<double>& x) {
     ModelSetup setup = baseline;
-    if (bar) {
-      setup.bending = from_reduced({x[0], x[1], x[2], x[3]});
-      return setup;
-    }
-    std::size_t first = 0;
     if (sim) {
       const double scale = std::exp(x[0]);
       auto& a = setup.bending.alpha;
       auto& b = setup.bending.beta;
       a = {a.warp * scale, a.bias * scale, a.weft * scale};
       b = {b.warp * scale, b.bias * scale, b.weft * scale};
-      first = 1;
     }
-    apply_effect(*effect, std::vector<double>(x.begin() + static_cast<std::ptrdiff_t>(first), x.end()), setup);
+    if (!bar) apply_effect(*effect, std::vector<double>(x.begin() + static_cast<std::ptrdiff_t>(first), x.end()), setup);
     return setup;
   };
   // The scan's best point, which the simplex evaluates first: its value is known (evaluations are deterministic).
@@ -174,26 +160,29 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
   };
   NelderMeadOptions options = settings.optimiser;
   if (!sim) options.max_evaluations = settings.sensor_evaluations;
+  // The scanned coordinate: the bar's bending scale (bar_scan_levels), or a one-parameter effect's strength, the
+  // bending as fitted (scan_levels). A simplex from one fixed start rarely moved the strength within the budget
+  // (docs/DIAGNOSIS.md, session 10), nor the bending scale (session 17: none_04's bar); the simplex refines from the
+  // best level.
+  const std::size_t axis = bar ? 0 : first;
+  const int levels = bar ? std::min(settings.bar_scan_levels, options.max_evaluations - AttributionSettings::kSimplexAfterScan)
+                         : sim && space.start.size() == 1 ? settings.scan_levels : 0;
   int scanned = 0;
-  if (sim && !bar && space.start.size() == 1 && settings.scan_levels >= 2 &&
-      settings.scan_levels <= options.max_evaluations - AttributionSettings::kSimplexAfterScan) {
-    // A scan of the strength over its range, the bending as fitted; the simplex refines from the best level. A
-    // simplex from one fixed start rarely moved the strength within the budget (docs/DIAGNOSIS.md, session 10).
+  if (levels >= 2 && levels <= options.max_evaluations - AttributionSettings::kSimplexAfterScan) {
     std::vector<double> x = x0;
     double best_value = std::numeric_limits<double>::infinity();
-    for (int k = 0; k < settings.scan_levels; ++k) {
-      x[first] = k + 1 == settings.scan_levels ? hi[first]
-                                               : lo[first] + (hi[first] - lo[first]) * k / (settings.scan_levels - 1);
+    for (int k = 0; k < levels; ++k) {
+      x[axis] = k + 1 == levels ? hi[axis] : lo[axis] + (hi[axis] - lo[axis]) * k / (levels - 1);
       const double value = f(x);
       if (error) return *error;
-      c.scan.emplace_back(x[first], value);
+      c.scan.emplace_back(x[axis], value);
       if (value < best_value) best_value = value, known = {x, value};
     }
     x0 = known->first;
-    // The simplex's first step along the strength: a third of a level spacing, towards the range's middle.
-    const double spacing = (hi[first] - lo[first]) / (settings.scan_levels - 1);
-    step[first] = (x0[first] < 0.5 * (lo[first] + hi[first]) ? 1.0 : -1.0) * spacing / 3.0;
-    scanned = settings.scan_levels;
+    // The simplex's first step along the scanned axis: a third of a level spacing, towards the range's middle.
+    const double spacing = (hi[axis] - lo[axis]) / (levels - 1);
+    step[axis] = (x0[axis] < 0.5 * (lo[axis] + hi[axis]) ? 1.0 : -1.0) * spacing / 3.0;
+    scanned = levels;
     // The simplex's first evaluation, the best level, is known: the budget of simulations stays the same.
     options.max_evaluations -= scanned - 1;
   }
@@ -230,7 +219,7 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
   }
   c.validated = validated->best;
   c.setup = refitted;
-  c.alpha_scale = sim && !bar ? std::exp(r.x[0]) : 1.0;
+  c.alpha_scale = sim ? std::exp(r.x[0]) : 1.0;
   c.parameters.assign(r.x.begin() + static_cast<std::ptrdiff_t>(first), r.x.end());
   c.evaluations = r.evaluations;
   c.objective = best;
@@ -294,7 +283,7 @@ sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& base
                                      const Evaluation& validated, const Floors& floors,
                                      const AttributionSettings& settings, const ModelFactory& make_model,
                                      const OtherCaptures& others) {
-  // Tasks: the candidates, then the bar (no effect: the baseline's bending refitted with the same budget).
+  // Tasks: the candidates, then the bar (no effect: the baseline's bending scale refitted with the same budget).
   const std::size_t tasks = settings.candidates.size() + 1;
   auto task_effect = [&](std::size_t k) -> std::optional<Effect> {
     return k < settings.candidates.size() ? std::optional<Effect>(settings.candidates[k]) : std::nullopt;

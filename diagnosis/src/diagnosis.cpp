@@ -134,6 +134,13 @@ nlohmann::json validated_json(const CandidateResult& c, const Floors& floors) {
           {"excess_above_floors", excess_above_floors(gap_terms(c.validated, c.paired_drape()), floors)}};
 }
 
+/// A refit's scan, if one ran: (parameter, objective) per level.
+nlohmann::json scan_json(const CandidateResult& c) {
+  nlohmann::json scan = nlohmann::json::array();
+  for (const auto& [level, score] : c.scan) scan.push_back({{"parameter", level}, {"objective_mm", score * 1e3}});
+  return scan;
+}
+
 }  // namespace
 
 DiagnosisSettings DiagnosisSettings::quick() {
@@ -457,8 +464,6 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
   for (const auto& c : r.attribution.candidates) {
     nlohmann::json params = nlohmann::json::object();
     for (std::size_t k = 0; k < c.names.size() && k < c.parameters.size(); ++k) params[c.names[k]] = c.parameters[k];
-    nlohmann::json scan = nlohmann::json::array();
-    for (const auto& [level, score] : c.scan) scan.push_back({{"parameter", level}, {"objective_mm", score * 1e3}});
     candidates.push_back({{"effect", effect_name(c.effect)},
                           {"parameters", params},
                           {"alpha_scale", c.alpha_scale},
@@ -474,14 +479,17 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                           {"held_out_shrinkage", c.held_out_shrinkage},
                           {"confirmed", c.confirmed},
                           {"evaluations", c.evaluations},
-                          {"scan", scan},
+                          {"scan", scan_json(c)},
                           {"seconds", c.seconds}});
   }
   j["attribution"] = {{"ran", ran},
                       {"confirmed_on", r.validated_held_out ? "held_out_capture" : "held_out_view"},
                       {"refitted_on", r.validated_second ? "capture_and_second_capture" : "capture"},
                       {"bending_refit_bar",
-                       {{"parameters", r.attribution.bar.parameters},
+                       {{"alpha_scale", r.attribution.bar.alpha_scale},
+                        {"bending", bending_json(r.attribution.bar.setup.bending)},
+                        {"scan", scan_json(r.attribution.bar)},
+                        {"evaluations", r.attribution.bar.evaluations},
                         {"fit_score_mm", r.attribution.bar.fit_score * 1e3},
                         {"objective_mm", r.attribution.bar.objective * 1e3},
                         {"validated", ran ? validated_json(r.attribution.bar, r.floors) : nlohmann::json(nullptr)},
