@@ -296,8 +296,9 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
   auto validated = model.evaluate(fitted, validation_states(settings.attribution));
   if (!validated) return validated.error();
   r.validated = std::move(*validated);
-  std::vector<sim::ClothMesh> meshes;  // the same drapes against the other placements
-  for (const auto& d : r.validated.states) meshes.push_back(d.mesh);
+  std::vector<sim::ClothMesh> meshes;  // the same drapes against the other placements (if any)
+  if (second_model || held_out_model)
+    for (const auto& d : r.validated.states) meshes.push_back(d.mesh);
   for (auto [m, into] : {std::pair{second_model.get(), &r.validated_second},
                          std::pair{held_out_model.get(), &r.validated_held_out}}) {
     if (!m) continue;
