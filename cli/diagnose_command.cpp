@@ -153,10 +153,8 @@ Runner add_diagnose_command(CLI::App& app) {
                              diagnosis::DiagnosisSettings{}.start_ratios_mm.size(),
                              diagnosis::DiagnosisSettings{}.start_levels));
   app.add_option("--refit-evaluations", o->refit_evaluations,
-                 fmt::format("Evaluations per candidate refit (default 14, also with --quick and --fine); the bar "
-                             "(the bending scale refitted alone) scans up to {} scales within them, leaving {}",
-                             diagnosis::AttributionSettings{}.bar_scan_levels,
-                             diagnosis::AttributionSettings::kSimplexAfterScan));
+                 "Evaluations per candidate refit and of the bar, the bending scale refitted alone (default 14, also "
+                 "with --quick and --fine)");
   app.add_option("--refit-scan", o->refit_scan,
                  fmt::format("Refits of one-parameter effects (yield, shear, curl, friction) start with this many "
                              "strengths over the effect's range (bending as fitted), then refine from the best within "

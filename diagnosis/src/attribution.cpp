@@ -160,29 +160,26 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
   };
   NelderMeadOptions options = settings.optimiser;
   if (!sim) options.max_evaluations = settings.sensor_evaluations;
-  // The scanned coordinate: the bar's bending scale (bar_scan_levels), or a one-parameter effect's strength, the
-  // bending as fitted (scan_levels). A simplex from one fixed start rarely moved the strength within the budget
-  // (docs/DIAGNOSIS.md, session 10), nor the bending scale (session 17: none_04's bar); the simplex refines from the
-  // best level.
-  const std::size_t axis = bar ? 0 : first;
-  const int levels = bar ? std::min(settings.bar_scan_levels, options.max_evaluations - AttributionSettings::kSimplexAfterScan)
-                         : sim && space.start.size() == 1 ? settings.scan_levels : 0;
   int scanned = 0;
-  if (levels >= 2 && levels <= options.max_evaluations - AttributionSettings::kSimplexAfterScan) {
+  if (sim && !bar && space.start.size() == 1 && settings.scan_levels >= 2 &&
+      settings.scan_levels <= options.max_evaluations - AttributionSettings::kSimplexAfterScan) {
+    // A scan of the strength over its range, the bending as fitted; the simplex refines from the best level. A
+    // simplex from one fixed start rarely moved the strength within the budget (docs/DIAGNOSIS.md, session 10).
     std::vector<double> x = x0;
     double best_value = std::numeric_limits<double>::infinity();
-    for (int k = 0; k < levels; ++k) {
-      x[axis] = k + 1 == levels ? hi[axis] : lo[axis] + (hi[axis] - lo[axis]) * k / (levels - 1);
+    for (int k = 0; k < settings.scan_levels; ++k) {
+      x[first] = k + 1 == settings.scan_levels ? hi[first]
+                                               : lo[first] + (hi[first] - lo[first]) * k / (settings.scan_levels - 1);
       const double value = f(x);
       if (error) return *error;
-      c.scan.emplace_back(x[axis], value);
+      c.scan.emplace_back(x[first], value);
       if (value < best_value) best_value = value, known = {x, value};
     }
     x0 = known->first;
-    // The simplex's first step along the scanned axis: a third of a level spacing, towards the range's middle.
-    const double spacing = (hi[axis] - lo[axis]) / (levels - 1);
-    step[axis] = (x0[axis] < 0.5 * (lo[axis] + hi[axis]) ? 1.0 : -1.0) * spacing / 3.0;
-    scanned = levels;
+    // The simplex's first step along the strength: a third of a level spacing, towards the range's middle.
+    const double spacing = (hi[first] - lo[first]) / (settings.scan_levels - 1);
+    step[first] = (x0[first] < 0.5 * (lo[first] + hi[first]) ? 1.0 : -1.0) * spacing / 3.0;
+    scanned = settings.scan_levels;
     // The simplex's first evaluation, the best level, is known: the budget of simulations stays the same.
     options.max_evaluations -= scanned - 1;
   }

@@ -489,7 +489,6 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                       {"bending_refit_bar",
                        {{"alpha_scale", r.attribution.bar.alpha_scale},
                         {"bending", bending_json(r.attribution.bar.setup.bending)},
-                        {"scan", scan_json(r.attribution.bar)},
                         {"evaluations", r.attribution.bar.evaluations},
                         {"fit_score_mm", r.attribution.bar.fit_score * 1e3},
                         {"objective_mm", r.attribution.bar.objective * 1e3},

@@ -55,8 +55,7 @@ struct CandidateResult {
   double held_out_shrinkage = 0.0;  // 1 - held_out_after / held_out_before (the view not in the refit)
   bool confirmed = false;           // the held-out view does not get worse
   int evaluations = 0;
-  /// The scan (of the strength, AttributionSettings::scan_levels, or the bar's of ln alpha_scale, bar_scan_levels),
-  /// if one ran: (parameter, refit objective) per level.
+  /// The strength scan (AttributionSettings::scan_levels), if one ran: (parameter, refit objective) per level.
   std::vector<std::pair<double, double>> scan;
   double seconds = 0.0;
   ScoredDrape drape;      // the refit's best drape (fit states)
@@ -108,11 +107,7 @@ struct AttributionSettings {
   /// from the best with the rest of the same budget (optimiser.max_evaluations simulations in all). 0: the simplex
   /// from the effect's fixed start (effect_space) alone; so is a value above the budget - kSimplexAfterScan.
   int scan_levels = 0;
-  /// The bar (the bending scale refitted alone) first evaluates this many scales evenly spaced in ln over its range
-  /// (0.22 .. 4.5 times the baseline fit's), fewer if the budget must keep kSimplexAfterScan, then refines from the
-  /// best within the same budget; below 2: the simplex alone.
-  int bar_scan_levels = 7;
-  /// New evaluations the simplex keeps after a scan (its two new vertices and one move, at least).
+  /// New evaluations the simplex keeps after a strength scan (its two new vertices and one move, at least).
   static constexpr int kSimplexAfterScan = 3;
   std::uint64_t validation_seed = 2000;
   int jobs = 1;                     // candidate refits in parallel (one forward model per thread)
@@ -121,8 +116,8 @@ struct AttributionSettings {
 
 struct Attribution {
   /// The bar: the baseline's bending scale alone refitted (a candidate with no effect: alpha and beta times a factor,
-  /// scanned, same budget), validated the same way; its shrinkage is against the baseline's. Candidates are measured
-  /// against the better of the two.
+  /// the same simplex and budget), validated the same way; its shrinkage is against the baseline's. Candidates are
+  /// measured against the better of the two.
   CandidateResult bar;
   std::vector<CandidateResult> candidates;  // sorted by shrinkage, best first
   bool named = false;                       // the best is confirmed and shrinks the gap significantly
