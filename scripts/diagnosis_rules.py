@@ -1,0 +1,128 @@
+#!/usr/bin/env python3
+"""Verdicts of alternative attribution rules, read off the report.json files of a diagnosis benchmark run made with
+three placements (`drapegen_diagnosis_bench --placements 3 --second-placement`); the truth files are read only to
+score. Hypotheses for the next evaluation, not the diagnosis's rule (docs/DIAGNOSIS.md, "Session 18"):
+
+- current: the verdict as run;
+- no_bar: the reference is the baseline's validated drape (no bar, no "none once the bending is refitted"), the
+  ranking and the confirmation otherwise as run;
+- no_bar_unconfirmed: the same without the held-out confirmation;
+- mean3: the shrinkage of the excess of the mean of the three placements' gap terms (the held-out one included),
+  confirmed candidates only, against the run's reference;
+- held_out_excess: the same on the held-out capture's terms alone;
+- held_out_rank: among the confirmed candidates that shrink the gate's excess by the threshold, the largest held-out
+  score shrinkage;
+- min_objective: the candidate whose refit objective (in-sample: the capture and the second capture) is the smallest;
+  it ignores the held-out data, which the issue's attribution must use: a diagnostic of the refits, not a rule.
+
+    scripts/diagnosis_rules.py out/s18all [more runs ...]
+"""
+import glob
+import json
+import os
+import sys
+
+THRESHOLD = 0.25  # AttributionSettings::significant_shrinkage
+RULES = ["current", "no_bar", "no_bar_unconfirmed", "mean3", "held_out_excess", "held_out_rank", "min_objective"]
+FAMILY = {"pose": "sensor", "bias": "sensor", "multipath": "sensor", "misalign": "misalignment"}
+
+
+def excess(stable, shape, stable_floor, shape_floor):
+    return max(0.0, stable - stable_floor) / stable_floor + max(0.0, shape - shape_floor) / shape_floor
+
+
+def shrink(before, after):
+    return 1.0 - after / before if before > 0 else 0.0
+
+
+def terms(v):
+    """A validated drape's (stable term, shape distance) per placement."""
+    return {"capture": (v["stable_mm"], v["shape"]),
+            "second": (v["second_capture"]["stable_mm"], v["second_capture"]["shape"]),
+            "held_out": (v["held_out_capture"]["stable_mm"], v["held_out_capture"]["shape"])}
+
+
+def first_largest(pairs):
+    """The effect of the first largest value (attribute()'s order breaks ties), or None."""
+    best = None
+    for value, effect in pairs:
+        if best is None or value > best[0]:
+            best = (value, effect)
+    return best
+
+
+def named(best, within):
+    if within:
+        return "none"
+    return best[1] if best and best[0] >= THRESHOLD else "unexplained"
+
+
+def verdicts(j):
+    g = j["gap_tests"]
+    a = j["attribution"]
+    cands = a.get("candidates", [])
+    if not cands:
+        return {r: j["verdict"] for r in RULES}
+    sf, shf = g["stable_floor_mm"], g["shape_floor"]
+    within = j.get("within_floors_after_bending_refit", False)
+    v = {"current": j["verdict"]}
+    e0 = g["excess_above_floors"]
+    h0 = g["held_out_capture"]["all_views_score_mm"]
+
+    def held(c):
+        return c["validated"]["held_out_capture"]["all_views_score_mm"]
+
+    def gate_shrink(c):
+        return shrink(e0, c["validated"]["excess_above_floors"])
+
+    ordered = sorted(cands, key=lambda c: (-gate_shrink(c), held(c)))  # attribute()'s order against the baseline
+    v["no_bar"] = named(first_largest((gate_shrink(c), c["effect"]) for c in ordered if held(c) <= h0), False)
+    v["no_bar_unconfirmed"] = named(first_largest((gate_shrink(c), c["effect"]) for c in ordered), False)
+    baseline = {"capture": (g["capture"]["stable_mm"], g["capture"]["shape"]),
+                "second": (g["second_capture"]["stable_mm"], g["second_capture"]["shape"]),
+                "held_out": (g["held_out_capture"]["stable_mm"], g["held_out_capture"]["shape"])}
+    bar = a["bending_refit_bar"]
+    reference = terms(bar["validated"]) if bar["shrinkage"] > 0 else baseline
+
+    def mean3(t):
+        return excess(sum(x[0] for x in t.values()) / 3, sum(x[1] for x in t.values()) / 3, sf, shf)
+
+    def held_out(t):
+        return excess(*t["held_out"], sf, shf)
+
+    for rule, ex in (("mean3", mean3), ("held_out_excess", held_out)):
+        v[rule] = named(first_largest((shrink(ex(reference), ex(terms(c["validated"]))), c["effect"])
+                                      for c in cands if c["confirmed"]), within)
+    ok = [c for c in cands if c["confirmed"] and c["shrinkage"] >= THRESHOLD]
+    v["held_out_rank"] = "none" if within else (
+        max(ok, key=lambda c: c["held_out_shrinkage"])["effect"] if ok else "unexplained")
+    v["min_objective"] = min(cands, key=lambda c: c["objective_mm"])["effect"]
+    return v
+
+
+def main(roots):
+    if not roots:
+        sys.exit(__doc__)
+    for root in roots:
+        rows = []
+        for f in sorted(glob.glob(os.path.join(root, "diagnoses", "*.json"))):
+            name = os.path.basename(f)[:-5]
+            with open(f) as fh:
+                j = json.load(fh)
+            with open(os.path.join(root, "truth", name + ".json")) as fh:
+                truth = json.load(fh)
+            family = FAMILY.get(truth["family"], truth["family"]) or "none"
+            rows.append((name, family, verdicts(j)))
+        print(f"{root}: {len(rows)} diagnoses")
+        print(f"{'case':16s} " + " ".join(f"{r:>18s}" for r in RULES))
+        for name, family, v in rows:
+            print(f"{name:16s} " + " ".join(f"{v[r]:>18s}" for r in RULES))
+        for r in RULES:
+            effects = [(fam, v[r]) for _, fam, v in rows if fam != "none"]
+            controls = [v[r] for _, fam, v in rows if fam == "none"]
+            print(f"{r:18s} top-1 {sum(f == x for f, x in effects)}/{len(effects)}, "
+                  f"controls none {sum(x == 'none' for x in controls)}/{len(controls)}")
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
