@@ -134,13 +134,6 @@ nlohmann::json validated_json(const CandidateResult& c, const Floors& floors) {
           {"excess_above_floors", excess_above_floors(gap_terms(c.validated, c.paired_drape()), floors)}};
 }
 
-/// A refit's scan, if one ran: (parameter, objective) per level.
-nlohmann::json scan_json(const CandidateResult& c) {
-  nlohmann::json scan = nlohmann::json::array();
-  for (const auto& [level, score] : c.scan) scan.push_back({{"parameter", level}, {"objective_mm", score * 1e3}});
-  return scan;
-}
-
 }  // namespace
 
 DiagnosisSettings DiagnosisSettings::quick() {
@@ -465,6 +458,8 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
   for (const auto& c : r.attribution.candidates) {
     nlohmann::json params = nlohmann::json::object();
     for (std::size_t k = 0; k < c.names.size() && k < c.parameters.size(); ++k) params[c.names[k]] = c.parameters[k];
+    nlohmann::json scan = nlohmann::json::array();
+    for (const auto& [level, score] : c.scan) scan.push_back({{"parameter", level}, {"objective_mm", score * 1e3}});
     candidates.push_back({{"effect", effect_name(c.effect)},
                           {"parameters", params},
                           {"alpha_scale", c.alpha_scale},
@@ -480,7 +475,7 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                           {"held_out_shrinkage", c.held_out_shrinkage},
                           {"confirmed", c.confirmed},
                           {"evaluations", c.evaluations},
-                          {"scan", scan_json(c)},
+                          {"scan", scan},
                           {"seconds", c.seconds}});
   }
   j["attribution"] = {{"ran", ran},
