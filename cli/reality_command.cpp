@@ -83,7 +83,7 @@ Runner add_reality_command(CLI::App& app) {
   auto o = std::make_shared<RealityOptions>();
   app.add_option("--effect", o->effects,
                  "NAME[=STRENGTH], repeatable: yield=K (1/m), shear=G (kg/s^2), curl=K[,W] (1/m over W mm, default 30), "
-                 "friction=MU, misalign=MM, pose=DEG, bias=MM, multipath=MM (none: a control)");
+                 "friction=MU, misalign=MM, pose=DEG, bias=MM, multipath=MM (without --effect: a control)");
   app.add_option("--alpha", o->alpha, "Linear bending moduli W,B,F, g*mm^2/s^2")->required();
   app.add_option("--beta", o->beta, "Quadratic bending moduli W,B,F, g*mm^3/s^2 (use --beta=-...)")
       ->capture_default_str();
