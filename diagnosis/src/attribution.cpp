@@ -337,15 +337,15 @@ sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& base
   // in any refit), or the held-out capture, must confirm it, i.e. not get worse than the reference's.
   Attribution a;
   a.bar = std::move(results.back()->value());
-  a.bar.shrinkage = gap_shrinkage(excess_above_floors(gap_terms(validated.best, baseline_paired), floors),
-                                  excess_above_floors(gap_terms(a.bar.validated, a.bar.paired_drape()), floors));
-  a.bar_within_floors = excess_above_floors(gap_terms(a.bar.validated, a.bar.paired_drape()), floors) == 0.0;
+  const double baseline_excess = excess_above_floors(gap_terms(validated.best, baseline_paired), floors);
+  const double bar_excess = excess_above_floors(gap_terms(a.bar.validated, a.bar.paired_drape()), floors);
+  a.bar.shrinkage = gap_shrinkage(baseline_excess, bar_excess);
+  a.bar_within_floors = bar_excess == 0.0;
   const bool bar_is_reference = a.bar.shrinkage > 0.0;
   const ScoredDrape& reference = bar_is_reference ? a.bar.validated : validated.best;
-  const ScoredDrape* reference_paired = bar_is_reference ? a.bar.paired_drape() : baseline_paired;
   const ScoredDrape* reference_held_out = bar_is_reference ? a.bar.held_out_drape() : baseline_held_out;
   const double h0 = confirmation_score(reference, reference_held_out);
-  const double excess0 = excess_above_floors(gap_terms(reference, reference_paired), floors);
+  const double excess0 = bar_is_reference ? bar_excess : baseline_excess;
   for (std::size_t k = 0; k + 1 < tasks; ++k) {
     CandidateResult c = std::move(results[k]->value());
     const double h = confirmation_score(c.validated, c.held_out_drape());
