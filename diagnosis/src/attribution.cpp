@@ -237,6 +237,13 @@ double confirmation_score(const ScoredDrape& drape, const ScoredDrape* held_out_
   return held_out_capture ? held_out_capture->all_score : drape.held_out_score;
 }
 
+bool ranks_before(const CandidateResult& x, const CandidateResult& y) {
+  if (x.confirmed != y.confirmed) return x.confirmed;
+  if (x.shrinkage != y.shrinkage) return x.shrinkage > y.shrinkage;
+  if (x.objective != y.objective) return x.objective < y.objective;
+  return x.held_out_shrinkage > y.held_out_shrinkage;
+}
+
 double gap_shrinkage(double excess_before, double excess_after) {
   return excess_before > 0.0 ? 1.0 - excess_after / excess_before : 0.0;
 }
@@ -354,11 +361,7 @@ sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& base
     c.confirmed = h <= h0;
     a.candidates.push_back(std::move(c));
   }
-  std::stable_sort(a.candidates.begin(), a.candidates.end(), [](const CandidateResult& x, const CandidateResult& y) {
-    if (x.confirmed != y.confirmed) return x.confirmed;
-    if (x.shrinkage != y.shrinkage) return x.shrinkage > y.shrinkage;
-    return x.held_out_shrinkage > y.held_out_shrinkage;
-  });
+  std::stable_sort(a.candidates.begin(), a.candidates.end(), ranks_before);
   if (!a.candidates.empty()) {
     a.named = !a.bar_within_floors && a.candidates[0].confirmed &&
               a.candidates[0].shrinkage >= settings.significant_shrinkage;

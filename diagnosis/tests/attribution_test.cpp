@@ -79,6 +79,35 @@ TEST(GapShrinkage, CreditsRemovingTheReasonTheGateFired) {
 
 TEST(GapShrinkage, IsZeroWhenThereWasNoExcess) { EXPECT_EQ(gap_shrinkage(0.0, 0.3), 0.0); }
 
+namespace {
+CandidateResult ranked(Effect effect, bool confirmed, double shrinkage, double objective, double held_out) {
+  CandidateResult c;
+  c.effect = effect;
+  c.confirmed = confirmed;
+  c.shrinkage = shrinkage;
+  c.objective = objective;
+  c.held_out_shrinkage = held_out;
+  return c;
+}
+}  // namespace
+
+TEST(RanksBefore, ConfirmedFirstThenShrinkageThenObjectiveAmongEqualShrinkages) {
+  // A confirmed candidate outranks an unconfirmed one whatever their shrinkages.
+  EXPECT_TRUE(ranks_before(ranked(Effect::kCurl, true, 0.3, 9e-3, 0.0), ranked(Effect::kShear, false, 1.0, 1e-3, 0.5)));
+  // The larger shrinkage first, whatever the objective.
+  EXPECT_TRUE(ranks_before(ranked(Effect::kCurl, true, 0.8, 9e-3, 0.0), ranked(Effect::kShear, true, 0.7, 1e-3, 0.5)));
+  // Both within the floors (shrinkage 1): the clipped excess cannot rank them, the smaller refit objective does,
+  // ahead of the held-out shrinkage (seed 6's friction captures, docs/DIAGNOSIS.md "Session 19").
+  const CandidateResult friction = ranked(Effect::kFriction, true, 1.0, 4.74e-3, 0.31);
+  const CandidateResult sensor = ranked(Effect::kSensor, true, 1.0, 5.50e-3, 0.32);
+  EXPECT_TRUE(ranks_before(friction, sensor));
+  EXPECT_FALSE(ranks_before(sensor, friction));
+  // Equal objectives as well: the larger held-out shrinkage.
+  EXPECT_TRUE(ranks_before(ranked(Effect::kCurl, true, 1.0, 5e-3, 0.4), ranked(Effect::kShear, true, 1.0, 5e-3, 0.3)));
+  // A strict weak order: nothing ranks before itself.
+  EXPECT_FALSE(ranks_before(friction, friction));
+}
+
 TEST(ValidationStates, AreFreshStatesNoFitOrFloorSelectsOn) {
   // The gap and every refitted candidate are judged from these: none may be one of the fit's states (flat and sine
   // from seed 1) or the floors' (sine from seed 1000), or the comparison inherits the fit's luckiest draw.

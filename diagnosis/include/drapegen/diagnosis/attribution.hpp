@@ -137,6 +137,12 @@ struct Attribution {
                                                    const Floors& floors, const AttributionSettings& settings,
                                                    const ModelFactory& make_model = {}, const OtherCaptures& others = {});
 
+/// The attribution's order of candidates (true: `x` ranks before `y`): confirmed ones first, then the larger shrinkage
+/// of the gate's excess; among equal shrinkages (in practice several candidates that each bring the excess to 0: the
+/// excess is clipped at the floors, so it cannot rank them) the smaller refit objective, then the larger held-out
+/// shrinkage.
+[[nodiscard]] bool ranks_before(const CandidateResult& x, const CandidateResult& y);
+
 /// 1 - excess_after / excess_before (0 when excess_before is 0): 1 when the candidate brings the drape within the
 /// floors, 0 when it leaves the excess as it was, negative when it adds to it.
 [[nodiscard]] double gap_shrinkage(double excess_before, double excess_after);
