@@ -1,8 +1,12 @@
 // drapegen diagnose: where the sim-to-real gap of a capture lies and which unmodelled effect explains it (issue 6).
+#include <algorithm>
+#include <cmath>
 #include <iostream>
 #include <memory>
 #include <optional>
 #include <tuple>
+#include <utility>
+#include <vector>
 #include <nlohmann/json.hpp>
 
 #include <fmt/format.h>
@@ -30,6 +34,8 @@ struct DiagnoseOptions {
   int evaluations = 0;
   int refit_evaluations = 0;
   int refit_scan = -1;  // < 0: the settings' value
+  int yield_trade = -1;  // < 0: the settings' value
+  std::vector<std::string> candidates;  // empty: every effect
   std::optional<int> starts;  // unset: the settings' value
   int jobs = 1;
   double shape_floor = -1.0;  // < 0: the settings' calibrated value
@@ -54,6 +60,19 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (o.refit_scan < -1 || o.refit_scan == 1 || o.refit_scan > 100) {
     return fail("--refit-scan must be 0 (off) or 2 .. 100");
   }
+  if (o.yield_trade < -1 || o.yield_trade == 1 || o.yield_trade > 100) {
+    return fail("--yield-trade must be 0 (off) or 2 .. 100");
+  }
+  std::vector<diagnosis::Effect> candidates;
+  for (const auto& name : o.candidates) {
+    const auto effect = diagnosis::parse_effect(name);
+    if (!effect) return fail(fmt::format("--candidates: unknown effect '{}' (yield, shear, curl, friction, "
+                                         "misalignment, sensor)", name));
+    if (std::find(candidates.begin(), candidates.end(), *effect) != candidates.end()) {
+      return fail(fmt::format("--candidates: '{}' given twice", name));
+    }
+    candidates.push_back(*effect);
+  }
   if (o.verbose) sim::logger()->set_level(spdlog::level::debug);
   auto capture = diagnosis::read_capture(o.capture);
   if (!capture) return fail(capture.error().message);
@@ -76,11 +95,16 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (o.evaluations > 0) settings.baseline_optimiser.max_evaluations = o.evaluations;
   if (o.refit_evaluations > 0) settings.attribution.optimiser.max_evaluations = o.refit_evaluations;
   if (o.refit_scan >= 0) settings.attribution.scan_levels = o.refit_scan;
+  if (o.yield_trade >= 0) settings.attribution.yield_trade_levels = o.yield_trade;
+  if (!candidates.empty()) settings.attribution.candidates = candidates;
   if (o.starts) settings.start_levels = *o.starts;
   constexpr int kKeep = diagnosis::AttributionSettings::kSimplexAfterScan;
-  if (settings.attribution.scan_levels > settings.attribution.optimiser.max_evaluations - kKeep) {
-    return fail(fmt::format("--refit-scan ({}) must leave the refit's simplex {} of its {} evaluations",
-                            settings.attribution.scan_levels, kKeep, settings.attribution.optimiser.max_evaluations));
+  for (auto [levels, option] : {std::pair{settings.attribution.scan_levels, "--refit-scan"},
+                                 std::pair{settings.attribution.yield_trade_levels, "--yield-trade"}}) {
+    if (levels > settings.attribution.optimiser.max_evaluations - kKeep) {
+      return fail(fmt::format("{} ({}) must leave the refit's simplex {} of its {} evaluations", option, levels, kKeep,
+                              settings.attribution.optimiser.max_evaluations));
+    }
   }
   settings.attribution.jobs = o.jobs;
   settings.attribute = !o.gap_only;
@@ -161,6 +185,18 @@ Runner add_diagnose_command(CLI::App& app) {
                              "--refit-evaluations, which must leave {} for that (default 0: off; report.json lists the "
                              "scan per candidate)",
                              diagnosis::AttributionSettings::kSimplexAfterScan));
+  app.add_option("--yield-trade", o->yield_trade,
+                 fmt::format("The yield refit starts with this many points along the trade of a stiffer bending (x1 "
+                             ".. x{:.0f}) against a lower yield curvature ({:.0f} /m / the scale), then refines from "
+                             "the best within --refit-evaluations, which must leave {} for that; replaces --refit-scan "
+                             "for yield (default 0: off; docs/DIAGNOSIS.md, \"Session 19\")",
+                             std::exp(diagnosis::AttributionSettings::kYieldScaleRange),
+                             diagnosis::AttributionSettings::kYieldTradeCurvature,
+                             diagnosis::AttributionSettings::kSimplexAfterScan));
+  app.add_option("--candidates", o->candidates,
+                 "The candidate effects to refit, comma-separated (default: yield, shear, curl, friction, "
+                 "misalignment, sensor)")
+      ->delimiter(',');
   app.add_option("--jobs", o->jobs, "Candidate refits in parallel threads (same result as --jobs 1)")->capture_default_str();
   app.add_option("--shape-floor", o->shape_floor,
                  fmt::format("Shape-distance floor (default and quick: calibrated {:.2f}; fine: {:.2f}, with "

@@ -214,6 +214,41 @@ if(bar_scale LESS 0.2231 OR bar_scale GREATER 4.4817)
   message(FATAL_ERROR "the bar's bending scale ${bar_scale} is outside exp(-1.5) .. exp(1.5)")
 endif()
 
+# --candidates restricts the refits; --yield-trade 3 starts the yield refit with three points along the trade of a
+# stiffer bending against a lower yield curvature: scales x1, x e^1.5, x e^3 at 100 /m over the scale (ln K = ln 100
+# - ln scale), then the simplex with the rest of the 6 simulations.
+run_ok(out diagnose --capture ${WORK}/capture --quick --resolution 10 --states 2 --evaluations 8 --refit-evaluations 6
+       --candidates yield --yield-trade 3 --json)
+string(JSON ncand LENGTH "${out}" attribution candidates)
+string(JSON effect GET "${out}" attribution candidates 0 effect)
+string(JSON evaluations GET "${out}" attribution candidates 0 evaluations)
+string(JSON nscan LENGTH "${out}" attribution candidates 0 scan)
+if(NOT ncand EQUAL 1 OR NOT effect STREQUAL "yield" OR NOT nscan EQUAL 3 OR evaluations GREATER 6)
+  message(FATAL_ERROR "--candidates yield --yield-trade 3: ${ncand} candidates (${effect}), scan of ${nscan}, "
+                      "${evaluations} evaluations")
+endif()
+# exp(0, 1.5, 3) = 1, 4.4817, 20.0855; ln 100 - (0, 1.5, 3) = 4.6052, 3.1052, 1.6052 (bounds +-0.0001)
+set(scale_bounds "0.9999 1.0001" "4.4816 4.4818" "20.0854 20.0856")
+set(level_bounds "4.6051 4.6053" "3.1051 3.1053" "1.6051 1.6053")
+foreach(k 0 1 2)
+  string(JSON scale GET "${out}" attribution candidates 0 scan ${k} alpha_scale)
+  string(JSON level GET "${out}" attribution candidates 0 scan ${k} parameter)
+  list(GET scale_bounds ${k} sb)
+  list(GET level_bounds ${k} lb)
+  separate_arguments(sb)
+  separate_arguments(lb)
+  list(GET sb 0 s_lo)
+  list(GET sb 1 s_hi)
+  list(GET lb 0 l_lo)
+  list(GET lb 1 l_hi)
+  if(scale LESS s_lo OR scale GREATER s_hi OR level LESS l_lo OR level GREATER l_hi)
+    message(FATAL_ERROR "--yield-trade 3: point ${k} at scale ${scale}, ln K ${level} (expected ${sb}, ${lb})")
+  endif()
+endforeach()
+expect_failure(1 "--yield-trade must be 0" diagnose --capture ${WORK}/capture --yield-trade 1)
+expect_failure(1 "unknown effect 'bogus'" diagnose --capture ${WORK}/capture --candidates yield,bogus)
+expect_failure(1 "'curl' given twice" diagnose --capture ${WORK}/capture --candidates curl,shear,curl)
+
 # Three placements: the second in the candidate refits and the gate, the third held out of every fit (the confirmation).
 run_ok(out reality ${FABRIC} --effect bias=12 --resolution 14 --seed 4 --placement 2 --out ${WORK}/capture.p2)
 file(REMOVE ${WORK}/capture.p2/truth.json)

@@ -160,27 +160,51 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
   };
   NelderMeadOptions options = settings.optimiser;
   if (!sim) options.max_evaluations = settings.sensor_evaluations;
-  int scanned = 0;
-  if (sim && !bar && space.start.size() == 1 && settings.scan_levels >= 2 &&
-      settings.scan_levels <= options.max_evaluations - AttributionSettings::kSimplexAfterScan) {
-    // A scan of the strength over its range, the bending as fitted; the simplex refines from the best level. A
-    // simplex from one fixed start rarely moved the strength within the budget (docs/DIAGNOSIS.md, session 10).
-    std::vector<double> x = x0;
+  // A scan before the simplex (the simplex refines from its best point): points and the axes the simplex then steps
+  // along by a third of the scan's spacing, towards the range's middle.
+  std::vector<std::vector<double>> scan;
+  std::vector<std::size_t> scanned_axes;
+  double spacing = 0.0;
+  const int room = options.max_evaluations - AttributionSettings::kSimplexAfterScan;
+  const bool one_parameter = sim && !bar && space.start.size() == 1;
+  if (one_parameter && effect == Effect::kYield && settings.yield_trade_levels >= 2 &&
+      settings.yield_trade_levels <= room) {
+    // Stiffer bending against a lower yield curvature (AttributionSettings::yield_trade_levels).
+    const int n = settings.yield_trade_levels;
+    hi[0] = AttributionSettings::kYieldScaleRange;
+    spacing = hi[0] / (n - 1);
+    for (int k = 0; k < n; ++k) {
+      std::vector<double> x = x0;
+      x[0] = k + 1 == n ? hi[0] : spacing * k;
+      x[first] = std::clamp(std::log(AttributionSettings::kYieldTradeCurvature) - x[0], lo[first], hi[first]);
+      scan.push_back(std::move(x));
+    }
+    scanned_axes = {0, first};
+  } else if (one_parameter && settings.scan_levels >= 2 && settings.scan_levels <= room) {
+    // The strength over its range, the bending as fitted. A simplex from one fixed start rarely moved the strength
+    // within the budget (docs/DIAGNOSIS.md, session 10).
+    const int n = settings.scan_levels;
+    spacing = (hi[first] - lo[first]) / (n - 1);
+    for (int k = 0; k < n; ++k) {
+      std::vector<double> x = x0;
+      x[first] = k + 1 == n ? hi[first] : lo[first] + spacing * k;
+      scan.push_back(std::move(x));
+    }
+    scanned_axes = {first};
+  }
+  const int scanned = static_cast<int>(scan.size());
+  if (scanned > 0) {
     double best_value = std::numeric_limits<double>::infinity();
-    for (int k = 0; k < settings.scan_levels; ++k) {
-      x[first] = k + 1 == settings.scan_levels ? hi[first]
-                                               : lo[first] + (hi[first] - lo[first]) * k / (settings.scan_levels - 1);
+    for (const auto& x : scan) {
       const double value = f(x);
       if (error) return *error;
-      c.scan.emplace_back(x[first], value);
+      c.scan.push_back({x[first], std::exp(x[0]), value});
       if (value < best_value) best_value = value, known = {x, value};
     }
     x0 = known->first;
-    // The simplex's first step along the strength: a third of a level spacing, towards the range's middle.
-    const double spacing = (hi[first] - lo[first]) / (settings.scan_levels - 1);
-    step[first] = (x0[first] < 0.5 * (lo[first] + hi[first]) ? 1.0 : -1.0) * spacing / 3.0;
-    scanned = settings.scan_levels;
-    // The simplex's first evaluation, the best level, is known: the budget of simulations stays the same.
+    for (std::size_t axis : scanned_axes)
+      step[axis] = (x0[axis] < 0.5 * (lo[axis] + hi[axis]) ? 1.0 : -1.0) * spacing / 3.0;
+    // The simplex's first evaluation, the best point, is known: the budget of simulations stays the same.
     options.max_evaluations -= scanned - 1;
   }
   NelderMeadResult r = nelder_mead(f, x0, step, lo, hi, options);

@@ -459,7 +459,9 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
     nlohmann::json params = nlohmann::json::object();
     for (std::size_t k = 0; k < c.names.size() && k < c.parameters.size(); ++k) params[c.names[k]] = c.parameters[k];
     nlohmann::json scan = nlohmann::json::array();
-    for (const auto& [level, score] : c.scan) scan.push_back({{"parameter", level}, {"objective_mm", score * 1e3}});
+    for (const auto& l : c.scan) {
+      scan.push_back({{"parameter", l.parameter}, {"alpha_scale", l.alpha_scale}, {"objective_mm", l.objective * 1e3}});
+    }
     candidates.push_back({{"effect", effect_name(c.effect)},
                           {"parameters", params},
                           {"alpha_scale", c.alpha_scale},

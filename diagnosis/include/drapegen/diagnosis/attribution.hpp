@@ -55,8 +55,12 @@ struct CandidateResult {
   double held_out_shrinkage = 0.0;  // 1 - held_out_after / held_out_before (the view not in the refit)
   bool confirmed = false;           // the held-out view does not get worse
   int evaluations = 0;
-  /// The strength scan (AttributionSettings::scan_levels), if one ran: (parameter, refit objective) per level.
-  std::vector<std::pair<double, double>> scan;
+  /// A scan's level: the effect's parameter (as in effect_space), the bending scale and the refit objective there.
+  struct ScanLevel {
+    double parameter = 0.0, alpha_scale = 1.0, objective = 0.0;
+  };
+  /// The scan that preceded the simplex, if one ran (AttributionSettings::scan_levels, yield_trade_levels).
+  std::vector<ScanLevel> scan;
   double seconds = 0.0;
   ScoredDrape drape;      // the refit's best drape (fit states)
   ScoredDrape validated;  // the refitted setup's best drape from the validation states: shrinkage, confirmation
@@ -109,6 +113,16 @@ struct AttributionSettings {
   int scan_levels = 0;
   /// New evaluations the simplex keeps after a strength scan (its two new vertices and one move, at least).
   static constexpr int kSimplexAfterScan = 3;
+  /// The yield refit first evaluates this many points along the trade of a stiffer bending against a lower yield
+  /// curvature (0: off, the simplex from effect_space's start; replaces scan_levels for yield): the bending scale
+  /// s from x1 to x exp(kYieldScaleRange) evenly in ln, the yield curvature kYieldTradeCurvature / s (the capped torque
+  /// alpha * s * K of the baseline's alpha stays the same). On one monotonic drape a yielding fabric drapes as a softer
+  /// elastic one, so the baseline fit of a yielding specimen stops soft (3-17 times on seeds 4-6) and the yield refit
+  /// must stiffen it as far while it yields: beyond the other candidates' x4.5. The simplex refines from the best point
+  /// (scale up to exp(kYieldScaleRange)) within the same budget.
+  int yield_trade_levels = 0;
+  static constexpr double kYieldScaleRange = 3.0;
+  static constexpr double kYieldTradeCurvature = 100.0;  // 1/m
   std::uint64_t validation_seed = 2000;
   int jobs = 1;                     // candidate refits in parallel (one forward model per thread)
   std::vector<Effect> candidates{std::begin(kAllEffects), std::end(kAllEffects)};
