@@ -4,6 +4,9 @@ three placements (`drapegen_diagnosis_bench --placements 3 --second-placement`);
 score. Hypotheses for the next evaluation, not the diagnosis's rule (docs/DIAGNOSIS.md, "Session 18"):
 
 - current: the verdict as run;
+- tie_objective: the verdict as run, but among confirmed candidates with the top shrinkage (in practice several
+  within the floors, shrinkage 1) the smallest refit objective (the rule since session 19; before, the larger
+  held-out shrinkage);
 - no_bar: the reference is the baseline's validated drape (no bar, no "none once the bending is refitted"), the
   ranking and the confirmation otherwise as run;
 - no_bar_unconfirmed: the same without the held-out confirmation;
@@ -23,7 +26,7 @@ import os
 import sys
 
 THRESHOLD = 0.25  # AttributionSettings::significant_shrinkage
-RULES = ["current", "no_bar", "no_bar_unconfirmed", "mean3", "held_out_excess", "held_out_rank", "min_objective"]
+RULES = ["current", "tie_objective", "no_bar", "no_bar_unconfirmed", "mean3", "held_out_excess", "held_out_rank", "min_objective"]
 FAMILY = {"pose": "sensor", "bias": "sensor", "multipath": "sensor", "misalign": "misalignment"}
 
 
@@ -66,6 +69,10 @@ def verdicts(j):
     sf, shf = g["stable_floor_mm"], g["shape_floor"]
     within = j.get("within_floors_after_bending_refit", False)
     v = {"current": j["verdict"]}
+    top = cands[0]
+    tied = [c for c in cands if c["confirmed"] and c["shrinkage"] == top["shrinkage"]]
+    v["tie_objective"] = min(tied, key=lambda c: c["objective_mm"])["effect"] if (
+        j["verdict"] not in ("none", "unexplained") and tied) else j["verdict"]
     e0 = g["excess_above_floors"]
     h0 = g["held_out_capture"]["all_views_score_mm"]
 
