@@ -26,6 +26,17 @@ ScoredDrape drape_of(double stable_all, double shape_all, double all_score = 0.0
   return d;
 }
 
+/// A refitted candidate with the terms the attribution ranks by (objective in m).
+CandidateResult ranked(Effect effect, bool confirmed, double shrinkage, double objective, double held_out) {
+  CandidateResult c;
+  c.effect = effect;
+  c.confirmed = confirmed;
+  c.shrinkage = shrinkage;
+  c.objective = objective;
+  c.held_out_shrinkage = held_out;
+  return c;
+}
+
 }  // namespace
 
 TEST(ExcessAboveFloors, IsZeroExactlyWhenBothTestsPass) {
@@ -78,18 +89,6 @@ TEST(GapShrinkage, CreditsRemovingTheReasonTheGateFired) {
 }
 
 TEST(GapShrinkage, IsZeroWhenThereWasNoExcess) { EXPECT_EQ(gap_shrinkage(0.0, 0.3), 0.0); }
-
-namespace {
-CandidateResult ranked(Effect effect, bool confirmed, double shrinkage, double objective, double held_out) {
-  CandidateResult c;
-  c.effect = effect;
-  c.confirmed = confirmed;
-  c.shrinkage = shrinkage;
-  c.objective = objective;
-  c.held_out_shrinkage = held_out;
-  return c;
-}
-}  // namespace
 
 TEST(RanksBefore, ConfirmedFirstThenShrinkageThenObjectiveAmongEqualShrinkages) {
   // A confirmed candidate outranks an unconfirmed one whatever their shrinkages.
