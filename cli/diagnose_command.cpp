@@ -40,6 +40,7 @@ struct DiagnoseOptions {
   int jobs = 1;
   double shape_floor = -1.0;  // < 0: the settings' calibrated value
   bool gap_only = false;
+  bool ablation = false;
   bool verbose = false;
 };
 
@@ -108,6 +109,7 @@ int run_diagnose(const DiagnoseOptions& o) {
   }
   settings.attribution.jobs = o.jobs;
   settings.attribute = !o.gap_only;
+  settings.attribution.ablation = o.ablation;
   if (o.shape_floor >= 0.0) settings.floors.shape_threshold = settings.held_out_shape_threshold = o.shape_floor;
   auto result = diagnosis::diagnose(*capture, settings,
                                     {.second = second ? &*second : nullptr, .held_out = held_out ? &*held_out : nullptr});
@@ -203,6 +205,10 @@ Runner add_diagnose_command(CLI::App& app) {
                              "--held-out-capture or --second-capture {:.2f}; 0: the largest floor sample)",
                              diagnosis::FloorSettings{}.shape_threshold, diagnosis::DiagnosisSettings::kFineShapeFloor,
                              diagnosis::DiagnosisSettings::kFineHeldOutShapeFloor));
+  app.add_flag("--ablation", o->ablation,
+               "Also validate each simulated candidate with its effect switched off at its refitted bending scale, and "
+               "credit it only for what the effect adds beyond that (report.json: candidates' \"ablated\"; off by "
+               "default; docs/DIAGNOSIS.md, \"Session 19\")");
   app.add_flag("--gap-only", o->gap_only,
                "Stop after the gap, floors and localisation (verdict \"not attributed\" above the floors)");
   app.add_flag("-v,--verbose", o->verbose, "Log progress on stderr");

@@ -63,6 +63,43 @@ sim::Expected<Evaluation> on_next_placement(ForwardModel& next, const ModelSetup
   return next.rescore(meshes, setup);
 }
 
+std::optional<double> largest_set(const ModelSetup& setup);
+
+/// `setup` from the validation states on the capture (or, given `rescored`, that evaluation's drapes re-scored: the
+/// sensor candidate re-renders the baseline's), then on the other placements in turn (the second, then the held-out
+/// one), each from the last: fills c.validated, c.second, c.held_out and c.setup.
+sim::Status validate(ForwardModel& model, ForwardModel* second, ForwardModel* held_out, const ModelSetup& setup,
+                     const Evaluation* rescored, const AttributionSettings& settings, CandidateResult& c) {
+  std::vector<sim::ClothMesh> fresh;
+  if (rescored)
+    for (const auto& s : rescored->states) fresh.push_back(s.mesh);
+  const std::vector<sim::InitialStateSpec> states = validation_states(settings);
+  auto validated = rescored ? model.rescore(fresh, setup) : model.evaluate(setup, states);
+  if (!validated) return validated.error();
+  ModelSetup laid = setup;
+  const Evaluation* last = &*validated;
+  std::optional<Evaluation> on_second;
+  for (ForwardModel* next : {second, held_out}) {
+    if (!next) continue;
+    ModelSetup again;
+    std::optional<double> direction;
+    auto e = on_next_placement(*next, laid, *last, states, again, &direction);
+    if (!e) return sim::Error{std::string(next == second ? "second" : "held-out") + " capture: " + e.error().message};
+    OtherPlacement placement{e->best, largest_set(again), direction};
+    if (next == second) {
+      c.second = std::move(placement);
+      on_second = std::move(*e);
+      last = &*on_second;
+    } else {
+      c.held_out = std::move(placement);
+    }
+    laid = std::move(again);
+  }
+  c.validated = validated->best;
+  c.setup = setup;
+  return {};
+}
+
 /// The largest rest angle of a setup's plastic set (unset for a setup that does not yield).
 std::optional<double> largest_set(const ModelSetup& setup) {
   if (!setup.effects.bending_yield_curvature) return std::nullopt;
@@ -212,34 +249,26 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
   if (scanned > 0) r.evaluations += scanned - 1;
   // The refitted setup from the validation states (the sensor candidate re-renders the baseline's drapes from them).
   const ModelSetup refitted = setup_of(r.x);
-  std::vector<sim::ClothMesh> fresh;
-  if (!sim)
-    for (const auto& s : baseline_validated.states) fresh.push_back(s.mesh);
-  const std::vector<sim::InitialStateSpec> states = validation_states(settings);
-  auto validated = sim ? model.evaluate(refitted, states) : model.rescore(fresh, refitted);
-  if (!validated) return validated.error();
-  // On the other placements in turn (the second, then the held-out one), each from the last.
-  ModelSetup laid = refitted;
-  const Evaluation* last = &*validated;
-  std::optional<Evaluation> on_second;
-  for (ForwardModel* next : {second, held_out}) {
-    if (!next) continue;
-    ModelSetup again;
-    std::optional<double> direction;
-    auto e = on_next_placement(*next, laid, *last, states, again, &direction);
-    if (!e) return sim::Error{std::string(next == second ? "second" : "held-out") + " capture: " + e.error().message};
-    OtherPlacement placement{e->best, largest_set(again), direction};
-    if (next == second) {
-      c.second = std::move(placement);
-      on_second = std::move(*e);
-      last = &*on_second;
-    } else {
-      c.held_out = std::move(placement);
-    }
-    laid = std::move(again);
+  if (sim::Status s = validate(model, second, held_out, refitted, sim ? nullptr : &baseline_validated, settings, c);
+      !s) {
+    return s.error();
   }
-  c.validated = validated->best;
-  c.setup = refitted;
+  if (settings.ablation && sim && !bar) {
+    // The same bending scale without the effect (the bar's shape at the candidate's scale).
+    CandidateResult off;
+    off.effect = c.effect;
+    std::vector<double> x = r.x;
+    x.resize(1);
+    ModelSetup ablated = baseline;
+    const double scale = std::exp(x[0]);
+    auto& a = ablated.bending.alpha;
+    auto& b = ablated.bending.beta;
+    a = {a.warp * scale, a.bias * scale, a.weft * scale};
+    b = {b.warp * scale, b.bias * scale, b.weft * scale};
+    if (sim::Status s = validate(model, second, held_out, ablated, nullptr, settings, off); !s) return s.error();
+    off.alpha_scale = scale;
+    c.ablated = std::make_shared<const CandidateResult>(std::move(off));
+  }
   c.alpha_scale = sim ? std::exp(r.x[0]) : 1.0;
   c.parameters.assign(r.x.begin() + static_cast<std::ptrdiff_t>(first), r.x.end());
   c.evaluations = r.evaluations;
@@ -380,9 +409,14 @@ sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& base
   for (std::size_t k = 0; k + 1 < tasks; ++k) {
     CandidateResult c = std::move(results[k]->value());
     const double h = confirmation_score(c.validated, c.held_out_drape());
-    c.shrinkage = gap_shrinkage(excess0, excess_above_floors(gap_terms(c.validated, c.paired_drape()), floors));
-    c.held_out_shrinkage = h0 > 0.0 ? 1.0 - h / h0 : 0.0;
-    c.confirmed = h <= h0;
+    double from = excess0, against = h0;  // with an ablation, the smaller of the reference's and its own
+    if (c.ablated) {
+      from = std::min(from, excess_above_floors(gap_terms(c.ablated->validated, c.ablated->paired_drape()), floors));
+      against = std::min(against, confirmation_score(c.ablated->validated, c.ablated->held_out_drape()));
+    }
+    c.shrinkage = gap_shrinkage(from, excess_above_floors(gap_terms(c.validated, c.paired_drape()), floors));
+    c.held_out_shrinkage = against > 0.0 ? 1.0 - h / against : 0.0;
+    c.confirmed = h <= against;
     a.candidates.push_back(std::move(c));
   }
   std::stable_sort(a.candidates.begin(), a.candidates.end(), ranks_before);

@@ -473,6 +473,7 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                           {"shape", c.drape.shape_all},
                           {"excess_above_floors", excess_above_floors(c.drape, r.floors)},
                           {"validated", validated_json(c, r.floors)},
+                          {"ablated", c.ablated ? validated_json(*c.ablated, r.floors) : nlohmann::json(nullptr)},
                           {"shrinkage", c.shrinkage},
                           {"held_out_shrinkage", c.held_out_shrinkage},
                           {"confirmed", c.confirmed},
