@@ -63,7 +63,12 @@ sim::Expected<Evaluation> on_next_placement(ForwardModel& next, const ModelSetup
   return next.rescore(meshes, setup);
 }
 
-std::optional<double> largest_set(const ModelSetup& setup);
+/// The largest rest angle of a setup's plastic set (unset for a setup that does not yield).
+std::optional<double> largest_set(const ModelSetup& setup) {
+  if (!setup.effects.bending_yield_curvature) return std::nullopt;
+  const Eigen::VectorXd& set = setup.plastic_set.rest_angles;
+  return set.size() > 0 ? set.cwiseAbs().maxCoeff() : 0.0;
+}
 
 /// `setup` from the validation states on the capture (or, given `rescored`, that evaluation's drapes re-scored: the
 /// sensor candidate re-renders the baseline's), then on the other placements in turn (the second, then the held-out
@@ -98,13 +103,6 @@ sim::Status validate(ForwardModel& model, ForwardModel* second, ForwardModel* he
   c.validated = validated->best;
   c.setup = setup;
   return {};
-}
-
-/// The largest rest angle of a setup's plastic set (unset for a setup that does not yield).
-std::optional<double> largest_set(const ModelSetup& setup) {
-  if (!setup.effects.bending_yield_curvature) return std::nullopt;
-  const Eigen::VectorXd& set = setup.plastic_set.rest_angles;
-  return set.size() > 0 ? set.cwiseAbs().maxCoeff() : 0.0;
 }
 
 /// The bending scale's range in a refit: ln of the factor on alpha and beta (0.22 .. 4.5 times the baseline fit's).
@@ -154,15 +152,17 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
     for (const auto& s : fit.states) meshes.push_back(s.mesh);
   std::optional<sim::Error> error;
   double best = std::numeric_limits<double>::infinity();
-  auto setup_of = [&](const std::vector<double>& x) {
+  auto scaled = [&](double ln_scale) {  // the baseline with alpha and beta times exp(ln_scale)
     ModelSetup setup = baseline;
-    if (sim) {
-      const double scale = std::exp(x[0]);
-      auto& a = setup.bending.alpha;
-      auto& b = setup.bending.beta;
-      a = {a.warp * scale, a.bias * scale, a.weft * scale};
-      b = {b.warp * scale, b.bias * scale, b.weft * scale};
-    }
+    const double scale = std::exp(ln_scale);
+    auto& a = setup.bending.alpha;
+    auto& b = setup.bending.beta;
+    a = {a.warp * scale, a.bias * scale, a.weft * scale};
+    b = {b.warp * scale, b.bias * scale, b.weft * scale};
+    return setup;
+  };
+  auto setup_of = [&](const std::vector<double>& x) {
+    ModelSetup setup = sim ? scaled(x[0]) : baseline;
     if (!bar) apply_effect(*effect, std::vector<double>(x.begin() + static_cast<std::ptrdiff_t>(first), x.end()), setup);
     return setup;
   };
@@ -257,16 +257,8 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
     // The same bending scale without the effect (the bar's shape at the candidate's scale).
     CandidateResult off;
     off.effect = c.effect;
-    std::vector<double> x = r.x;
-    x.resize(1);
-    ModelSetup ablated = baseline;
-    const double scale = std::exp(x[0]);
-    auto& a = ablated.bending.alpha;
-    auto& b = ablated.bending.beta;
-    a = {a.warp * scale, a.bias * scale, a.weft * scale};
-    b = {b.warp * scale, b.bias * scale, b.weft * scale};
-    if (sim::Status s = validate(model, second, held_out, ablated, nullptr, settings, off); !s) return s.error();
-    off.alpha_scale = scale;
+    off.alpha_scale = std::exp(r.x[0]);
+    if (sim::Status s = validate(model, second, held_out, scaled(r.x[0]), nullptr, settings, off); !s) return s.error();
     c.ablated = std::make_shared<const CandidateResult>(std::move(off));
   }
   c.alpha_scale = sim ? std::exp(r.x[0]) : 1.0;
