@@ -390,7 +390,7 @@ sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& base
   Attribution a;
   a.bar = std::move(results.back()->value());
   const double baseline_excess = excess_above_floors(gap_terms(validated.best, baseline_paired), floors);
-  const double bar_excess = excess_above_floors(gap_terms(a.bar.validated, a.bar.paired_drape()), floors);
+  const double bar_excess = a.bar.validated_excess(floors);
   a.bar.shrinkage = gap_shrinkage(baseline_excess, bar_excess);
   a.bar_within_floors = bar_excess == 0.0;
   const bool bar_is_reference = a.bar.shrinkage > 0.0;
@@ -403,10 +403,10 @@ sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& base
     const double h = confirmation_score(c.validated, c.held_out_drape());
     double from = excess0, against = h0;  // with an ablation, the smaller of the reference's and its own
     if (c.ablated) {
-      from = std::min(from, excess_above_floors(gap_terms(c.ablated->validated, c.ablated->paired_drape()), floors));
+      from = std::min(from, c.ablated->validated_excess(floors));
       against = std::min(against, confirmation_score(c.ablated->validated, c.ablated->held_out_drape()));
     }
-    c.shrinkage = gap_shrinkage(from, excess_above_floors(gap_terms(c.validated, c.paired_drape()), floors));
+    c.shrinkage = gap_shrinkage(from, c.validated_excess(floors));
     c.held_out_shrinkage = against > 0.0 ? 1.0 - h / against : 0.0;
     c.confirmed = h <= against;
     a.candidates.push_back(std::move(c));

@@ -131,7 +131,7 @@ nlohmann::json validated_json(const CandidateResult& c, const Floors& floors) {
           {"held_out_capture", placement_json(c.held_out_drape())},
           {"held_out_plastic_set_rad", set_json(c.held_out)},
           {"held_out_drift_direction_deg", direction_json(c.held_out)},
-          {"excess_above_floors", excess_above_floors(gap_terms(c.validated, c.paired_drape()), floors)}};
+          {"excess_above_floors", c.validated_excess(floors)}};
 }
 
 }  // namespace

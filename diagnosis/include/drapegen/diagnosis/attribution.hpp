@@ -71,6 +71,10 @@ struct CandidateResult {
     return second ? &second->best : held_out ? &held_out->best : nullptr;
   }
   [[nodiscard]] const ScoredDrape* held_out_drape() const { return held_out ? &held_out->best : nullptr; }
+  /// The gate's excess of its validation drape (with the paired capture's, if any): what the shrinkage measures.
+  [[nodiscard]] double validated_excess(const Floors& floors) const {
+    return excess_above_floors(gap_terms(validated, paired_drape()), floors);
+  }
   ModelSetup setup;  // the refitted setup
   /// With AttributionSettings::ablation: the refitted setup with its effect switched off (the bending at the refitted
   /// scale), validated the same way (validated, second, held_out, setup); null otherwise, and for the bar and sensor.
@@ -124,14 +128,14 @@ struct AttributionSettings {
   /// must stiffen it as far while it yields: beyond the other candidates' x4.5. The simplex refines from the best point
   /// (scale up to exp(kYieldScaleRange)) within the same budget.
   int yield_trade_levels = 0;
+  static constexpr double kYieldScaleRange = 3.0;
+  static constexpr double kYieldTradeCurvature = 100.0;  // 1/m
   /// Each simulated candidate is also validated with its effect switched off at its refitted bending scale (its
   /// ablation), and credited only for what the effect adds beyond it: the shrinkage is measured from the smaller of
   /// the reference's excess and the ablation's, and the confirmation must not be worse than either. A candidate that
   /// wins by the bending scale it was refitted with (its effect ended where it vanishes, e.g. shear at the membrane's
   /// stiffness) then shrinks nothing. Off by default (docs/DIAGNOSIS.md, "Session 19").
   bool ablation = false;
-  static constexpr double kYieldScaleRange = 3.0;
-  static constexpr double kYieldTradeCurvature = 100.0;  // 1/m
   std::uint64_t validation_seed = 2000;
   int jobs = 1;                     // candidate refits in parallel (one forward model per thread)
   std::vector<Effect> candidates{std::begin(kAllEffects), std::end(kAllEffects)};
