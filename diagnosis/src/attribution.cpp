@@ -168,32 +168,37 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
   };
   // The scan's best point, which the simplex evaluates first: its value is known (evaluations are deterministic).
   std::optional<std::pair<std::vector<double>, double>> known;
+  // The refit's objective of a setup: its fit score, or the mean of it and the second capture's (where a yielding
+  // setup is laid again from its best drape); `drape` receives its best drape on the capture.
+  auto objective_of = [&](const ModelSetup& setup, ScoredDrape& drape) -> sim::Expected<double> {
+    auto e = sim ? model.evaluate(setup) : model.rescore(meshes, setup);
+    if (!e) return e.error();
+    double value = e->best.fit_score;
+    if (second) {
+      ModelSetup placed;
+      auto e2 = on_next_placement(*second, setup, *e, model.initial_states(), placed);
+      if (!e2) return sim::Error{"second capture: " + e2.error().message};
+      value = 0.5 * (value + e2->best.fit_score);
+    }
+    drape = std::move(e->best);
+    return value;
+  };
   auto f = [&](const std::vector<double>& x) -> double {
     if (error) return std::numeric_limits<double>::infinity();
     if (known && known->first == x) return known->second;
-    const ModelSetup setup = setup_of(x);
-    auto e = sim ? model.evaluate(setup) : model.rescore(meshes, setup);
-    if (!e) {
-      error = e.error();
+    ScoredDrape drape;
+    auto value = objective_of(setup_of(x), drape);
+    if (!value) {
+      error = value.error();
       return std::numeric_limits<double>::infinity();
     }
-    double value = e->best.fit_score;
-    if (second) {  // the mean over both captures: a yielding setup is laid again on the second from its best drape
-      ModelSetup placed;
-      auto e2 = on_next_placement(*second, setup, *e, model.initial_states(), placed);
-      if (!e2) {
-        error = sim::Error{"second capture: " + e2.error().message};
-        return std::numeric_limits<double>::infinity();
-      }
-      value = 0.5 * (value + e2->best.fit_score);
-    }
     sim::logger()->debug("refit {}: {} -> {:.3f} mm (state {}, shape {:.2f})", bar ? "bending" : effect_name(*effect),
-                         fmt::join(x, ", "), value * 1e3, e->best.state, e->best.shape_fit);
-    if (value < best) {
-      best = value;
-      c.drape = e->best;
+                         fmt::join(x, ", "), *value * 1e3, drape.state, drape.shape_fit);
+    if (*value < best) {
+      best = *value;
+      c.drape = std::move(drape);
     }
-    return value;
+    return *value;
   };
   NelderMeadOptions options = settings.optimiser;
   if (!sim) options.max_evaluations = settings.sensor_evaluations;
@@ -258,6 +263,9 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
     CandidateResult off;
     off.effect = c.effect;
     off.alpha_scale = std::exp(r.x[0]);
+    auto objective = objective_of(scaled(r.x[0]), off.drape);  // where the bar would rank it
+    if (!objective) return objective.error();
+    off.objective = *objective;
     if (sim::Status s = validate(model, second, held_out, scaled(r.x[0]), nullptr, settings, off); !s) return s.error();
     c.ablated = std::make_shared<const CandidateResult>(std::move(off));
   }

@@ -134,6 +134,15 @@ nlohmann::json validated_json(const CandidateResult& c, const Floors& floors) {
           {"excess_above_floors", c.validated_excess(floors)}};
 }
 
+/// A candidate's ablation (null without one): validated as the candidate is, with its refit objective (where the bar's
+/// search would rank that bending scale).
+nlohmann::json ablated_json(const CandidateResult& c, const Floors& floors) {
+  if (!c.ablated) return nullptr;
+  nlohmann::json j = validated_json(*c.ablated, floors);
+  j["objective_mm"] = c.ablated->objective * 1e3;
+  return j;
+}
+
 }  // namespace
 
 DiagnosisSettings DiagnosisSettings::quick() {
@@ -473,7 +482,7 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                           {"shape", c.drape.shape_all},
                           {"excess_above_floors", excess_above_floors(c.drape, r.floors)},
                           {"validated", validated_json(c, r.floors)},
-                          {"ablated", c.ablated ? validated_json(*c.ablated, r.floors) : nlohmann::json(nullptr)},
+                          {"ablated", ablated_json(c, r.floors)},
                           {"shrinkage", c.shrinkage},
                           {"held_out_shrinkage", c.held_out_shrinkage},
                           {"confirmed", c.confirmed},

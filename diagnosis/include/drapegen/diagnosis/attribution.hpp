@@ -77,7 +77,8 @@ struct CandidateResult {
   }
   ModelSetup setup;  // the refitted setup
   /// With AttributionSettings::ablation: the refitted setup with its effect switched off (the bending at the refitted
-  /// scale), validated the same way (validated, second, held_out, setup); null otherwise, and for the bar and sensor.
+  /// scale), validated the same way (validated, second, held_out, setup), with its refit objective (objective, drape:
+  /// where the bar's search would rank that scale); null otherwise, and for the bar and sensor.
   std::shared_ptr<const CandidateResult> ablated;
 };
 
