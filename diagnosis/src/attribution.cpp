@@ -43,19 +43,25 @@ sim::Expected<Evaluation> on_next_placement(ForwardModel& next, const ModelSetup
   if (setup.drift.squaredNorm() > 0.0) {
     const double distance = setup.drift.norm();
     double best = std::numeric_limits<double>::infinity(), best_direction = 0.0;
+    // The best direction's drape from the best state: evaluate scores it again rather than simulating it again.
+    ForwardModel::Simulated simulated{.state = static_cast<std::size_t>(on.best.state)};
     placed = setup;
     for (int k = 0; k < kDriftDirections; ++k) {
       const double direction = M_PI * k / kDriftDirections;
       placed.drift = distance * Eigen::Vector2d(std::cos(direction), std::sin(direction));
-      auto mesh = next.simulate(placed, best_state);
+      bool converged = true;
+      auto mesh = next.simulate(placed, best_state, &converged);
       if (!mesh) return mesh.error();
       auto scored = next.score(*mesh, placed);
       if (!scored) return scored.error();
-      if (scored->fit_score < best) best = scored->fit_score, best_direction = direction;
+      if (scored->fit_score < best) {
+        best = scored->fit_score, best_direction = direction;
+        simulated.mesh = std::move(*mesh), simulated.converged = converged;
+      }
     }
     placed.drift = distance * Eigen::Vector2d(std::cos(best_direction), std::sin(best_direction));
     if (drift_direction) *drift_direction = best_direction;
-    return next.evaluate(placed, states);
+    return next.evaluate(placed, states, &simulated);
   }
   std::vector<sim::ClothMesh> meshes;
   for (const auto& d : on.states) meshes.push_back(d.mesh);

@@ -224,14 +224,22 @@ sim::Expected<ScoredDrape> ForwardModel::score(const sim::ClothMesh& mesh, const
 sim::Expected<Evaluation> ForwardModel::evaluate(const ModelSetup& setup) { return evaluate(setup, states_); }
 
 sim::Expected<Evaluation> ForwardModel::evaluate(const ModelSetup& setup,
-                                                 const std::vector<sim::InitialStateSpec>& states) {
+                                                 const std::vector<sim::InitialStateSpec>& states,
+                                                 const Simulated* simulated) {
   Evaluation e;
   double best = std::numeric_limits<double>::infinity();
+  const bool yields = setup.effects.bending_yield_curvature.has_value();
+  if (yields && simulated) return sim::Error{"evaluate: a yielding setup's drapes are always simulated"};
   for (std::size_t k = 0; k < states.size(); ++k) {
     bool converged = true;
-    const bool yields = setup.effects.bending_yield_curvature.has_value();
     Eigen::VectorXd rest_angles;
-    auto mesh = simulate(setup, states[k], &converged, yields ? &rest_angles : nullptr);
+    sim::Expected<sim::ClothMesh> mesh = sim::ClothMesh{};
+    if (simulated && simulated->state == k) {
+      *mesh = simulated->mesh;
+      converged = simulated->converged;
+    } else {
+      mesh = simulate(setup, states[k], &converged, yields ? &rest_angles : nullptr);
+    }
     if (!mesh) return mesh.error();
     auto scored = score(*mesh, setup);
     if (!scored) return scored.error();

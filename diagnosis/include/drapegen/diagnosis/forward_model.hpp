@@ -96,9 +96,17 @@ class ForwardModel {
   static constexpr std::uint64_t kModelNoiseSeed = 0x5FEA;
   /// Every initial state simulated and scored; the best by fit score.
   [[nodiscard]] sim::Expected<Evaluation> evaluate(const ModelSetup& setup);
+  /// A drape of the setup already simulated from one of the states, which evaluate scores instead of simulating again
+  /// (not for a yielding setup, whose drape must also leave its plastic set).
+  struct Simulated {
+    std::size_t state = 0;
+    sim::ClothMesh mesh;
+    bool converged = true;
+  };
   /// The same from other initial states (e.g. fresh ones that no fit has selected on).
   [[nodiscard]] sim::Expected<Evaluation> evaluate(const ModelSetup& setup,
-                                                   const std::vector<sim::InitialStateSpec>& states);
+                                                   const std::vector<sim::InitialStateSpec>& states,
+                                                   const Simulated* simulated = nullptr);
   /// Re-scores given meshes (no simulation): the sensor candidate's refit.
   [[nodiscard]] sim::Expected<Evaluation> rescore(const std::vector<sim::ClothMesh>& meshes, const ModelSetup& setup);
 
