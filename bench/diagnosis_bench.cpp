@@ -4,7 +4,8 @@
 // the floors, median shrinkage, region match, runtime. The diagnosis never sees the truth: it runs on a copy of
 // each capture directory without truth.json.
 // With --visible-only N, each effect capture is first screened (visibility_screen.hpp) and drawn again until its
-// effect is visible at all to the diagnosis's gap test.
+// effect is visible at all to the diagnosis's gap test and its specimen settled on every placement (a drape that did
+// not converge, e.g. a specimen sliding off the cylinder on a slippery top, is not a drape to diagnose).
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <atomic>
@@ -110,7 +111,8 @@ int main(int argc, char** argv) {
   app.add_option("--visible-only", screen_draws,
                  "Screen every effect capture (visibility_screen.hpp: gated as `drapegen diagnose --fine` gates its "
                  "gap, with placement 1 as the held-out capture if generated, the true fabric without the effect must "
-                 "leave an excess above the floors) and draw another fabric, strength and seed until it passes, at "
+                 "leave an excess above the floors, and the drape of every placement must have converged: a specimen "
+                 "that slides off the top has no drape) and draw another fabric, strength and seed until it passes, at "
                  "most N draws (the last is kept either way); the draws are logged in OUT/screen/NAME.json; controls "
                  "are screened once and kept (0: no screen)")
       ->capture_default_str()
@@ -222,6 +224,17 @@ int main(int argc, char** argv) {
     d.strength = draw_strength(c.effect, r);
     return d;
   };
+  // Whether the drape of every placement of a case generated under `root` converged (its truth files: placement 0
+  // and every later one there is).
+  const auto settled = [](const Case& c, const fs::path& root) {
+    for (int p = 0; p < diagnosis::kMaxPlacement; ++p) {
+      const fs::path path = root / "truth" / (p == 0 ? c.name + ".json" : fmt::format("{}.p{}.json", c.name, p));
+      if (p > 0 && !fs::exists(path)) break;
+      const auto truth = nlohmann::json::parse(std::ifstream(path), nullptr, false);
+      if (truth.is_discarded() || !truth.value("converged", false)) return false;
+    }
+    return true;
+  };
   // The screen of one draw generated under `root`: its record, or nothing on an error.
   const auto screen = [&](const Case& d, const fs::path& root, int k) -> std::optional<nlohmann::json> {
     const fs::path first = root / "captures" / d.name;
@@ -231,20 +244,22 @@ int main(int argc, char** argv) {
       std::cerr << "diagnosis_bench: screen " << d.name << ": " << v.error().message << "\n";
       return std::nullopt;
     }
+    const bool settles = settled(d, root);
     std::cout << fmt::format("screen {} draw {}: {} {:.3g}, {:.0f} g/m^2: true fabric's shape {:.2f} / {:.2f}, stable "
-                             "{:.1f} / {:.1f} mm: {}\n",
+                             "{:.1f} / {:.1f} mm: {}{}\n",
                              d.name, k, d.effect.empty() ? "none" : d.effect, d.strength, d.fabric.density, v->shape,
                              v->shape_floor, v->stable_mm, v->stable_floor_mm,
-                             v->visible() ? "visible" : "within the floors")
+                             v->visible() ? "visible" : "within the floors", settles ? "" : "; did not settle")
               << std::flush;
     return nlohmann::json{
         {"draw", k}, {"seed", d.seed}, {"density", d.fabric.density}, {"strength", d.strength},
         {"alpha", {d.fabric.bending.alpha.warp, d.fabric.bending.alpha.bias, d.fabric.bending.alpha.weft}},
         {"excess", v->excess}, {"stable_mm", v->stable_mm}, {"stable_floor_mm", v->stable_floor_mm},
-        {"shape", v->shape}, {"shape_floor", v->shape_floor}, {"visible", v->visible()}};
+        {"shape", v->shape}, {"shape_floor", v->shape_floor}, {"visible", v->visible()}, {"settled", settles}};
   };
-  // The screen: draws until the true fabric without the effect leaves an excess above the floors. A control is
-  // screened once and kept (the share of controls it passes is the screen's false-positive rate).
+  // The screen: draws until the true fabric without the effect leaves an excess above the floors and the specimen
+  // settled on every placement. A control is screened once and kept (the share of controls it passes is the screen's
+  // false-positive rate).
   const auto generate_visible = [&](const Case& c) -> bool {
     nlohmann::json draws = nlohmann::json::array();
     if (c.effect.empty()) {
@@ -260,7 +275,7 @@ int main(int argc, char** argv) {
       auto record = screen(d, root, k);
       if (!record) return false;
       draws.push_back(*record);
-      if ((*record)["visible"].get<bool>() || k + 1 == screen_draws) {
+      if (((*record)["visible"].get<bool>() && (*record)["settled"].get<bool>()) || k + 1 == screen_draws) {
         // The log first, then the kept draw's files, placement 0's capture last: its presence marks the case as
         // generated. A run stopped in between screens the case again on resume (the same draws) and completes the
         // move: a file already moved stays.
@@ -366,7 +381,7 @@ int main(int argc, char** argv) {
     }
     const std::string verdict = d.value("verdict", "?");
     const std::string family = t.value("family", "none");
-    nlohmann::json screened = nullptr;  // the kept draw's visibility, if the case was screened
+    nlohmann::json screened = nullptr;  // the kept draw passed the screen (visible, settled), if it was screened
     if (const fs::path log = fs::path(out) / "screen" / (c.name + ".json"); fs::exists(log)) {
       try {
         const auto draws = nlohmann::json::parse(std::ifstream(log));
@@ -374,7 +389,8 @@ int main(int argc, char** argv) {
           screen_draws_by_family[family].first++;
           screen_draws_by_family[family].second += draw.value("visible", false);
         }
-        if (!draws.empty()) screened = draws.back().value("visible", false);
+        // The kept draw's truth files tell whether it settled (logs written before the check have no "settled").
+        if (!draws.empty()) screened = draws.back().value("visible", false) && settled(c, out);
       } catch (const std::exception&) {
       }
     }
