@@ -37,6 +37,7 @@ struct DiagnoseOptions {
   int yield_trade = -1;  // < 0: the settings' value
   std::vector<std::string> candidates;  // empty: every effect
   std::optional<int> starts;  // unset: the settings' value
+  std::string start_alpha, start_beta;  // empty: the drape-coefficient guess
   int jobs = 1;
   double shape_floor = -1.0;  // < 0: the settings' calibrated value
   bool gap_only = false;
@@ -63,6 +64,17 @@ int run_diagnose(const DiagnoseOptions& o) {
   }
   if (o.yield_trade < -1 || o.yield_trade == 1 || o.yield_trade > 100) {
     return fail("--yield-trade must be 0 (off) or 2 .. 100");
+  }
+  std::optional<diagnosis::BendingParameters> start;
+  if (o.start_alpha.empty() != o.start_beta.empty()) return fail("--start-alpha and --start-beta go together");
+  if (!o.start_alpha.empty()) {
+    const auto alpha = parse_directional(o.start_alpha, "--start-alpha");
+    if (!alpha) return fail(alpha.error().message);
+    const auto beta = parse_directional(o.start_beta, "--start-beta");
+    if (!beta) return fail(beta.error().message);
+    if (!(alpha->warp > 0 && alpha->bias > 0 && alpha->weft > 0)) return fail("--start-alpha must be positive");
+    if (beta->warp > 0 || beta->bias > 0 || beta->weft > 0) return fail("--start-beta must not be positive");
+    start = diagnosis::BendingParameters{.alpha = *alpha, .beta = *beta};
   }
   std::vector<diagnosis::Effect> candidates;
   for (const auto& name : o.candidates) {
@@ -99,6 +111,7 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (o.yield_trade >= 0) settings.attribution.yield_trade_levels = o.yield_trade;
   if (!candidates.empty()) settings.attribution.candidates = candidates;
   if (o.starts) settings.start_levels = *o.starts;
+  settings.start = start;
   constexpr int kKeep = diagnosis::AttributionSettings::kSimplexAfterScan;
   for (auto [levels, option] : {std::pair{settings.attribution.scan_levels, "--refit-scan"},
                                  std::pair{settings.attribution.yield_trade_levels, "--yield-trade"}}) {
@@ -178,6 +191,12 @@ Runner add_diagnose_command(CLI::App& app) {
                              "docs/DIAGNOSIS.md, \"A second start\")",
                              diagnosis::DiagnosisSettings{}.start_ratios_mm.size(),
                              diagnosis::DiagnosisSettings{}.start_levels));
+  app.add_option("--start-alpha", o->start_alpha,
+                 "Start the baseline fit here instead of at the drape-coefficient guess: linear bending moduli W,B,F, "
+                 "g*mm^2/s^2 (e.g. a cantilever test's estimate; with --start-beta; the fit searches alpha's mean, two "
+                 "ratios and one -beta/alpha shared by the directions, within its box)");
+  app.add_option("--start-beta", o->start_beta,
+                 "The start's quadratic bending moduli W,B,F, g*mm^3/s^2, not positive (use --start-beta=-...)");
   app.add_option("--refit-evaluations", o->refit_evaluations,
                  "Evaluations per candidate refit and of the bar, the bending scale refitted alone (default 14, also "
                  "with --quick and --fine)");

@@ -266,6 +266,34 @@ endforeach()
 expect_failure(1 "--yield-trade must be 0" diagnose --capture ${WORK}/capture --yield-trade 1)
 expect_failure(1 "unknown effect 'bogus'" diagnose --capture ${WORK}/capture --candidates yield,bogus)
 expect_failure(1 "'curl' given twice" diagnose --capture ${WORK}/capture --candidates curl,shear,curl)
+# --start-alpha/--start-beta: the fit starts at the given bending instead of the drape-coefficient guess (report:
+# baseline.initial_guess, exactly the start when its beta is alpha times one length, as here: 2.5 mm).
+run_ok(out diagnose --capture ${WORK}/capture --quick --resolution 10 --states 2 --evaluations 4 --gap-only --json
+       --start-alpha 5000,4000,3000 --start-beta=-12500,-10000,-7500)
+string(JSON from GET "${out}" baseline initial_guess_from)
+if(NOT from STREQUAL "--start-alpha/--start-beta")
+  message(FATAL_ERROR "--start-alpha: the fit started from '${from}'")
+endif()
+set(start_bounds "4999.99 5000.01 -12500.01 -12499.99" "3999.99 4000.01 -10000.01 -9999.99"
+                 "2999.99 3000.01 -7500.01 -7499.99")
+foreach(k 0 1 2)
+  string(JSON a GET "${out}" baseline initial_guess alpha ${k})
+  string(JSON b GET "${out}" baseline initial_guess beta ${k})
+  list(GET start_bounds ${k} bounds)
+  separate_arguments(bounds)
+  list(GET bounds 0 a_lo)
+  list(GET bounds 1 a_hi)
+  list(GET bounds 2 b_lo)
+  list(GET bounds 3 b_hi)
+  if(a LESS a_lo OR a GREATER a_hi OR b LESS b_lo OR b GREATER b_hi)
+    message(FATAL_ERROR "--start-alpha: initial guess ${k} is ${a}, ${b} (expected within ${bounds})")
+  endif()
+endforeach()
+expect_failure(1 "--start-alpha and --start-beta go together" diagnose --capture ${WORK}/capture --start-alpha 1,2,3)
+expect_failure(1 "--start-alpha must be positive" diagnose --capture ${WORK}/capture --start-alpha 5000,0,3000
+               --start-beta=-1,-1,-1)
+expect_failure(1 "--start-beta must not be positive" diagnose --capture ${WORK}/capture --start-alpha 5000,4000,3000
+               --start-beta 1,-1,-1)
 
 # Three placements: the second in the candidate refits and the gate, the third held out of every fit (the confirmation).
 run_ok(out reality ${FABRIC} --effect bias=12 --resolution 14 --seed 4 --placement 2 --out ${WORK}/capture.p2)

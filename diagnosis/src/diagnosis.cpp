@@ -212,10 +212,18 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
   }
   DiagnosisResult r;
 
-  // 1. Baseline fit in the reduced space, from the drape-coefficient guess.
-  auto guess = initial_guess(model, std::max(1, settings.guess_levels));
-  if (!guess) return guess.error();
+  // 1. Baseline fit in the reduced space, from the drape-coefficient guess (or the given start).
+  const ReducedBending lo = reduced_lower(capture.specimen.density), hi = reduced_upper(capture.specimen.density);
+  sim::Expected<ReducedBending> guess = ReducedBending{};
+  if (settings.start) {
+    *guess = to_reduced(*settings.start);
+    for (std::size_t k = 0; k < guess->size(); ++k) (*guess)[k] = std::clamp((*guess)[k], lo[k], hi[k]);
+  } else {
+    guess = initial_guess(model, std::max(1, settings.guess_levels));
+    if (!guess) return guess.error();
+  }
   r.initial_guess = from_reduced(*guess);
+  r.start_given = settings.start.has_value();
   std::optional<sim::Error> error;
   double best = std::numeric_limits<double>::infinity();
   std::optional<std::pair<std::vector<double>, double>> known_start;  // a point scored already, and its score
@@ -236,7 +244,6 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
     }
     return value;
   };
-  const ReducedBending lo = reduced_lower(capture.specimen.density), hi = reduced_upper(capture.specimen.density);
   const auto simplex = [&](const ReducedBending& from) {
     return nelder_mead(objective, {from.begin(), from.end()}, {0.35, 0.4, 0.4, 1.0}, {lo.begin(), lo.end()},
                        {hi.begin(), hi.end()}, settings.baseline_optimiser);
@@ -412,6 +419,7 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
   for (double x : r.floors.multistability.held_out) floors["multistability_held_out_mm"].push_back(x * 1e3);
   j["floors"] = floors;
   j["baseline"] = {{"initial_guess", bending_json(r.initial_guess)},
+                   {"initial_guess_from", r.start_given ? "--start-alpha/--start-beta" : "drape coefficient"},
                    {"fitted", bending_json(r.fitted)},
                    {"fitted_reduced", r.fitted_reduced},
                    {"evaluations", r.baseline_evaluations},

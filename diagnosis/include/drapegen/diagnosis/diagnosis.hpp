@@ -28,6 +28,9 @@ struct DiagnosisSettings {
   /// signatures: top-1 11/30 with 4 levels against 15/30 without, controls 5/5 against 4/5 (docs/DIAGNOSIS.md,
   /// "Session 12").
   int start_levels = 0;
+  /// The baseline fit's start instead of the drape-coefficient guess (e.g. an estimate from a cantilever test or the
+  /// network), clamped to the search box; its reduced coordinates (to_reduced) are all the fit can use of it.
+  std::optional<BendingParameters> start;
   std::vector<double> start_ratios_mm{1.8, 3.6};  // about the 20% and 86% quantiles of fabrics618's -beta/alpha
   FloorSettings floors;
   AttributionSettings attribution;
@@ -54,7 +57,8 @@ struct DiagnosisSettings {
 };
 
 struct DiagnosisResult {
-  BendingParameters initial_guess;
+  BendingParameters initial_guess;  // the drape-coefficient guess, or the given start (clamped to the box)
+  bool start_given = false;         // DiagnosisSettings::start
   BendingParameters fitted;
   ReducedBending fitted_reduced{};
   int baseline_evaluations = 0;  // both simplexes'
