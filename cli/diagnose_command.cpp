@@ -38,6 +38,7 @@ struct DiagnoseOptions {
   std::vector<std::string> candidates;  // empty: every effect
   std::optional<int> starts;  // unset: the settings' value
   std::string start_alpha, start_beta;  // empty: the drape-coefficient guess
+  double start_box = 0.0;               // 0: the whole box
   int jobs = 1;
   double shape_floor = -1.0;  // < 0: the settings' calibrated value
   bool gap_only = false;
@@ -76,6 +77,9 @@ int run_diagnose(const DiagnoseOptions& o) {
     if (beta->warp > 0 || beta->bias > 0 || beta->weft > 0) return fail("--start-beta must not be positive");
     start = diagnosis::BendingParameters{.alpha = *alpha, .beta = *beta};
   }
+  if (o.start_box != 0.0 && (!start || !(o.start_box > 1.0 && o.start_box <= 100.0))) {
+    return fail("--start-box must be 1 .. 100 (exclusive of 1) and needs --start-alpha/--start-beta");
+  }
   std::vector<diagnosis::Effect> candidates;
   for (const auto& name : o.candidates) {
     const auto effect = diagnosis::parse_effect(name);
@@ -112,6 +116,10 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (!candidates.empty()) settings.attribution.candidates = candidates;
   if (o.starts) settings.start_levels = *o.starts;
   settings.start = start;
+  if (o.start_box > 1.0) {
+    settings.start_box = o.start_box;
+    settings.attribution.bending_scale_range = std::log(o.start_box);
+  }
   constexpr int kKeep = diagnosis::AttributionSettings::kSimplexAfterScan;
   for (auto [levels, option] : {std::pair{settings.attribution.scan_levels, "--refit-scan"},
                                  std::pair{settings.attribution.yield_trade_levels, "--yield-trade"}}) {
@@ -197,6 +205,10 @@ Runner add_diagnose_command(CLI::App& app) {
                  "ratios and one -beta/alpha shared by the directions, within its box)");
   app.add_option("--start-beta", o->start_beta,
                  "The start's quadratic bending moduli W,B,F, g*mm^3/s^2, not positive (use --start-beta=-...)");
+  app.add_option("--start-box", o->start_box,
+                 "With --start-alpha/--start-beta: a bending known to within this factor (e.g. 1.3 for a cantilever "
+                 "test's 30%): the fit searches only there, and the candidate refits scale the bending by at most this "
+                 "factor (default: the whole box, and x4.5)");
   app.add_option("--refit-evaluations", o->refit_evaluations,
                  "Evaluations per candidate refit and of the bar, the bending scale refitted alone (default 14, also "
                  "with --quick and --fine)");

@@ -289,6 +289,16 @@ foreach(k 0 1 2)
     message(FATAL_ERROR "--start-alpha: initial guess ${k} is ${a}, ${b} (expected within ${bounds})")
   endif()
 endforeach()
+# --start-box: the fit stays within the factor of the start (mean alpha 3915 x 1/1.1 .. 1.1 = 3559 .. 4307; 4 evaluations)
+run_ok(out diagnose --capture ${WORK}/capture --quick --resolution 10 --states 2 --evaluations 4 --gap-only --json
+       --start-alpha 5000,4000,3000 --start-beta=-12500,-10000,-7500 --start-box 1.1)
+string(JSON fitted_ln_alpha GET "${out}" baseline fitted_reduced 0)
+if(fitted_ln_alpha LESS 8.177 OR fitted_ln_alpha GREATER 8.368)
+  message(FATAL_ERROR "--start-box 1.1: the fit left the box (ln mean alpha ${fitted_ln_alpha}, box 8.177 .. 8.368)")
+endif()
+expect_failure(1 "--start-box must be" diagnose --capture ${WORK}/capture --start-box 1.3)
+expect_failure(1 "--start-box must be" diagnose --capture ${WORK}/capture --start-alpha 5000,4000,3000
+               --start-beta=-1,-1,-1 --start-box 0.5)
 expect_failure(1 "--start-alpha and --start-beta go together" diagnose --capture ${WORK}/capture --start-alpha 1,2,3)
 expect_failure(1 "--start-alpha must be positive" diagnose --capture ${WORK}/capture --start-alpha 5000,0,3000
                --start-beta=-1,-1,-1)

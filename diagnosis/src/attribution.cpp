@@ -111,9 +111,6 @@ sim::Status validate(ForwardModel& model, ForwardModel* second, ForwardModel* he
   return {};
 }
 
-/// The bending scale's range in a refit: ln of the factor on alpha and beta (0.22 .. 4.5 times the baseline fit's).
-constexpr double kBendingScaleRange = 1.5;
-
 /// Refits `effect` with the bending scale free, or with no effect (the bar) the bending scale alone, on the fit
 /// states (and the second capture, if given); then evaluates the refitted setup from the validation states on the
 /// capture and on the other placements.
@@ -129,7 +126,8 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
   std::vector<double> x0, step, lo, hi;
   const bool sim = bar || needs_simulation(*effect);
   if (sim) {  // the bending scale stays free: an effect may trade off against stiffness (and the bar refits it alone)
-    x0.push_back(0.0), step.push_back(0.25), lo.push_back(-kBendingScaleRange), hi.push_back(kBendingScaleRange);
+    const double range = settings.bending_scale_range;
+    x0.push_back(0.0), step.push_back(std::min(0.25, 0.5 * range)), lo.push_back(-range), hi.push_back(range);
   }
   const std::size_t first = x0.size();
   x0.insert(x0.end(), space.start.begin(), space.start.end());

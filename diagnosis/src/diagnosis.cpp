@@ -213,11 +213,18 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
   DiagnosisResult r;
 
   // 1. Baseline fit in the reduced space, from the drape-coefficient guess (or the given start).
-  const ReducedBending lo = reduced_lower(capture.specimen.density), hi = reduced_upper(capture.specimen.density);
+  ReducedBending lo = reduced_lower(capture.specimen.density), hi = reduced_upper(capture.specimen.density);
   sim::Expected<ReducedBending> guess = ReducedBending{};
   if (settings.start) {
     *guess = to_reduced(*settings.start);
     for (std::size_t k = 0; k < guess->size(); ++k) (*guess)[k] = std::clamp((*guess)[k], lo[k], hi[k]);
+    if (settings.start_box > 1.0) {  // the box narrowed to the start's neighbourhood
+      const double f = std::log(settings.start_box);
+      for (std::size_t k = 0; k < 3; ++k) {
+        lo[k] = std::max(lo[k], (*guess)[k] - f), hi[k] = std::min(hi[k], (*guess)[k] + f);
+      }
+      lo[3] = std::max(lo[3], (*guess)[3] / settings.start_box), hi[3] = std::min(hi[3], (*guess)[3] * settings.start_box);
+    }
   } else {
     guess = initial_guess(model, std::max(1, settings.guess_levels));
     if (!guess) return guess.error();
@@ -244,9 +251,11 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
     }
     return value;
   };
+  std::vector<double> steps{0.35, 0.4, 0.4, 1.0};
+  for (std::size_t k = 0; k < steps.size(); ++k) steps[k] = std::min(steps[k], 0.5 * (hi[k] - lo[k]));  // a narrow box
   const auto simplex = [&](const ReducedBending& from) {
-    return nelder_mead(objective, {from.begin(), from.end()}, {0.35, 0.4, 0.4, 1.0}, {lo.begin(), lo.end()},
-                       {hi.begin(), hi.end()}, settings.baseline_optimiser);
+    return nelder_mead(objective, {from.begin(), from.end()}, steps, {lo.begin(), lo.end()}, {hi.begin(), hi.end()},
+                       settings.baseline_optimiser);
   };
   // The simplex from the drape-coefficient guess; then, if a start of the grid scores better than where that simplex
   // ended, a second simplex from the best start, and the better of the two fits counts (so the fit is never worse
