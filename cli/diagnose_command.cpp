@@ -74,7 +74,6 @@ int run_diagnose(const DiagnoseOptions& o) {
     const auto beta = parse_directional(o.start_beta, "--start-beta");
     if (!beta) return fail(beta.error().message);
     if (!(alpha->warp > 0 && alpha->bias > 0 && alpha->weft > 0)) return fail("--start-alpha must be positive");
-    if (beta->warp > 0 || beta->bias > 0 || beta->weft > 0) return fail("--start-beta must not be positive");
     start = diagnosis::BendingParameters{.alpha = *alpha, .beta = *beta};
   }
   if (o.start_box != 0.0 && (!start || !(o.start_box > 1.0 && o.start_box <= 100.0))) {
@@ -204,7 +203,7 @@ Runner add_diagnose_command(CLI::App& app) {
                  "g*mm^2/s^2 (e.g. a cantilever test's estimate; with --start-beta; the fit searches alpha's mean, two "
                  "ratios and one -beta/alpha shared by the directions, within its box)");
   app.add_option("--start-beta", o->start_beta,
-                 "The start's quadratic bending moduli W,B,F, g*mm^3/s^2, not positive (use --start-beta=-...)");
+                 "The start's quadratic bending moduli W,B,F, g*mm^3/s^2 (use --start-beta=-... for a softening fabric)");
   app.add_option("--start-box", o->start_box,
                  "With --start-alpha/--start-beta: a bending known to within this factor (e.g. 1.3 for a cantilever "
                  "test's 30%): the fit searches only there, and the candidate refits scale the bending by at most this "

@@ -302,8 +302,6 @@ expect_failure(1 "--start-box must be" diagnose --capture ${WORK}/capture --star
 expect_failure(1 "--start-alpha and --start-beta go together" diagnose --capture ${WORK}/capture --start-alpha 1,2,3)
 expect_failure(1 "--start-alpha must be positive" diagnose --capture ${WORK}/capture --start-alpha 5000,0,3000
                --start-beta=-1,-1,-1)
-expect_failure(1 "--start-beta must not be positive" diagnose --capture ${WORK}/capture --start-alpha 5000,4000,3000
-               --start-beta 1,-1,-1)
 
 # Three placements: the second in the candidate refits and the gate, the third held out of every fit (the confirmation).
 run_ok(out reality ${FABRIC} --effect bias=12 --resolution 14 --seed 4 --placement 2 --out ${WORK}/capture.p2)
