@@ -18,6 +18,15 @@ score. Hypotheses for the next evaluation, not the diagnosis's rule (docs/DIAGNO
 - min_objective: the candidate whose refit objective (in-sample: the capture and the second capture) is the smallest;
   it ignores the held-out data, which the issue's attribution must use: a diagnostic of the refits, not a rule.
 
+Three more read reports made with `drapegen diagnose --ablation` (session 20; on reports without ablations they give
+the main rule):
+- without_ablation: the main rule (the bar or the baseline the reference, the objective breaking ties) recomputed
+  from the validated drapes, as a run without --ablation names (checked against such runs on 12 captures);
+- reach: the reference the smallest validated excess among the bar and every candidate's ablation (a bar that
+  reaches the candidates' bending scales, chosen on the validation drapes);
+- reach_objective: the reference the bending-only setup of the smallest refit objective among the bar and the
+  ablations (chosen as the bar's own search would choose).
+
     scripts/diagnosis_rules.py out/s18all [more runs ...]
 """
 import glob
@@ -26,7 +35,8 @@ import os
 import sys
 
 THRESHOLD = 0.25  # AttributionSettings::significant_shrinkage
-RULES = ["current", "tie_objective", "no_bar", "no_bar_unconfirmed", "mean3", "held_out_excess", "held_out_rank", "min_objective"]
+RULES = ["current", "tie_objective", "no_bar", "no_bar_unconfirmed", "mean3", "held_out_excess", "held_out_rank",
+         "min_objective", "without_ablation", "reach", "reach_objective"]
 FAMILY = {"pose": "sensor", "bias": "sensor", "multipath": "sensor", "misalign": "misalignment"}
 
 
@@ -58,6 +68,43 @@ def named(best, within):
     if within:
         return "none"
     return best[1] if best and best[0] >= THRESHOLD else "unexplained"
+
+
+def confirmation(v):
+    """A validated drape's confirmation score: the held-out capture's over all views, else the held-out view's."""
+    return v["held_out_capture"]["all_views_score_mm"] if v.get("held_out_capture") else v["held_out_score_mm"]
+
+
+def reference_rule(j, rule):
+    """The verdict with the reference chosen by `rule` (without_ablation, reach, reach_objective); the ranking as
+    attribute()'s: confirmed first, then the shrinkage, then the smaller objective."""
+    g, a = j["gap_tests"], j["attribution"]
+    bar = a["bending_refit_bar"]
+    base_excess, bar_excess = g["excess_above_floors"], bar["validated"]["excess_above_floors"]
+    if bar_excess == 0:
+        return "none"
+    ref = (bar_excess, confirmation(bar["validated"])) if bar_excess < base_excess else (
+        base_excess, confirmation(g))
+    ablations = [c["ablated"] for c in a["candidates"] if c.get("ablated")]
+    if rule == "reach":
+        for ab in ablations:
+            if ab["excess_above_floors"] < ref[0]:
+                ref = (ab["excess_above_floors"], confirmation(ab))
+    elif rule == "reach_objective":
+        best = min([(bar["objective_mm"], bar["validated"])] +
+                   [(ab["objective_mm"], ab) for ab in ablations if "objective_mm" in ab], key=lambda t: t[0])[1]
+        if best["excess_above_floors"] == 0:
+            return "none"
+        if best["excess_above_floors"] < base_excess:
+            ref = (best["excess_above_floors"], confirmation(best))
+    if ref[0] == 0:
+        return "none"
+    ranked = sorted(a["candidates"], key=lambda c: (
+        confirmation(c["validated"]) > ref[1], -shrink(ref[0], c["validated"]["excess_above_floors"]),
+        c["objective_mm"]))
+    top = ranked[0]
+    ok = confirmation(top["validated"]) <= ref[1] and shrink(ref[0], top["validated"]["excess_above_floors"]) >= THRESHOLD
+    return top["effect"] if ok else "unexplained"
 
 
 def verdicts(j):
@@ -104,6 +151,8 @@ def verdicts(j):
     v["held_out_rank"] = "none" if within else (
         max(ok, key=lambda c: c["held_out_shrinkage"])["effect"] if ok else "unexplained")
     v["min_objective"] = min(cands, key=lambda c: c["objective_mm"])["effect"]
+    for rule in ("without_ablation", "reach", "reach_objective"):
+        v[rule] = reference_rule(j, rule)
     return v
 
 
