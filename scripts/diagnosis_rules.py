@@ -28,6 +28,7 @@ the main rule):
   ablations (chosen as the bar's own search would choose).
 
     scripts/diagnosis_rules.py out/s18all [more runs ...]
+    scripts/diagnosis_rules.py --matrix without_ablation out/s21all     # one rule's confusion matrix
 """
 import glob
 import json
@@ -156,7 +157,15 @@ def verdicts(j):
     return v
 
 
+COLUMNS = ["none", "unexplained", "not attributed", "yield", "shear", "curl", "friction", "misalignment", "sensor"]
+
+
 def main(roots):
+    matrix_rule = None
+    if roots[:1] == ["--matrix"]:
+        if len(roots) < 3 or roots[1] not in RULES:
+            sys.exit(f"--matrix RULE DIR...: RULE one of {', '.join(RULES)}")
+        matrix_rule, roots = roots[1], roots[2:]
     if not roots:
         sys.exit(__doc__)
     for root in roots:
@@ -169,6 +178,15 @@ def main(roots):
                 truth = json.load(fh)
             family = FAMILY.get(truth["family"], truth["family"]) or "none"
             rows.append((name, family, verdicts(j)))
+        if matrix_rule:
+            families = ["none"] + sorted({fam for _, fam, _ in rows if fam != "none"})
+            print(f"{root}, rule {matrix_rule}:\n")
+            print("| truth \\ verdict | " + " | ".join(COLUMNS) + " |")
+            print("|---" * (len(COLUMNS) + 1) + "|")
+            for fam in families:
+                got = [v[matrix_rule] for _, f, v in rows if f == fam]
+                print(f"| {fam} | " + " | ".join(str(got.count(c)) for c in COLUMNS) + " |")
+            continue
         print(f"{root}: {len(rows)} diagnoses")
         print(f"{'case':16s} " + " ".join(f"{r:>18s}" for r in RULES))
         for name, family, v in rows:
