@@ -203,7 +203,8 @@ Runner add_diagnose_command(CLI::App& app) {
                  "g*mm^2/s^2 (e.g. a cantilever test's estimate; with --start-beta; the fit searches alpha's mean, two "
                  "ratios and one -beta/alpha shared by the directions, within its box)");
   app.add_option("--start-beta", o->start_beta,
-                 "The start's quadratic bending moduli W,B,F, g*mm^3/s^2 (use --start-beta=-... for a softening fabric)");
+                 "The start's quadratic bending moduli W,B,F, g*mm^3/s^2 (--start-beta=-... for a softening "
+                 "fabric)");
   app.add_option("--start-box", o->start_box,
                  "With --start-alpha/--start-beta: a bending known to within this factor (e.g. 1.3 for a cantilever "
                  "test's 30%): the fit searches only there, and the candidate refits scale the bending by at most this "

@@ -223,7 +223,8 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
       for (std::size_t k = 0; k < 3; ++k) {
         lo[k] = std::max(lo[k], (*guess)[k] - f), hi[k] = std::min(hi[k], (*guess)[k] + f);
       }
-      lo[3] = std::max(lo[3], (*guess)[3] / settings.start_box), hi[3] = std::min(hi[3], (*guess)[3] * settings.start_box);
+      lo[3] = std::max(lo[3], (*guess)[3] / settings.start_box);
+      hi[3] = std::min(hi[3], (*guess)[3] * settings.start_box);
     }
   } else {
     guess = initial_guess(model, std::max(1, settings.guess_levels));
