@@ -115,10 +115,7 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (!candidates.empty()) settings.attribution.candidates = candidates;
   if (o.starts) settings.start_levels = *o.starts;
   settings.start = start;
-  if (o.start_box > 1.0) {
-    settings.start_box = o.start_box;
-    settings.attribution.bending_scale_range = std::log(o.start_box);
-  }
+  settings.start_box = o.start_box;
   constexpr int kKeep = diagnosis::AttributionSettings::kSimplexAfterScan;
   for (auto [levels, option] : {std::pair{settings.attribution.scan_levels, "--refit-scan"},
                                  std::pair{settings.attribution.yield_trade_levels, "--yield-trade"}}) {

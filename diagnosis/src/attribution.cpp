@@ -267,10 +267,11 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
     CandidateResult off;
     off.effect = c.effect;
     off.alpha_scale = std::exp(r.x[0]);
-    auto objective = objective_of(scaled(r.x[0]), off.drape);  // where the bar would rank it
+    const ModelSetup switched_off = scaled(r.x[0]);
+    auto objective = objective_of(switched_off, off.drape);  // where the bar would rank it
     if (!objective) return objective.error();
     off.objective = *objective;
-    if (sim::Status s = validate(model, second, held_out, scaled(r.x[0]), nullptr, settings, off); !s) return s.error();
+    if (sim::Status s = validate(model, second, held_out, switched_off, nullptr, settings, off); !s) return s.error();
     c.ablated = std::make_shared<const CandidateResult>(std::move(off));
   }
   c.alpha_scale = sim ? std::exp(r.x[0]) : 1.0;

@@ -353,7 +353,11 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
     OtherCaptures other_captures;
     if (second_model) other_captures.second = {second_model.get(), &r.validated_second->best};
     if (held_out_model) other_captures.held_out = {held_out_model.get(), &r.validated_held_out->best};
-    auto attribution = attribute(model, fitted, r.fit, r.validated, r.floors, settings.attribution, make_model,
+    AttributionSettings attribution_settings = settings.attribution;
+    if (settings.start && settings.start_box > 1.0) {  // the known bending's precision bounds the refits' scale too
+      attribution_settings.bending_scale_range = std::log(settings.start_box);
+    }
+    auto attribution = attribute(model, fitted, r.fit, r.validated, r.floors, attribution_settings, make_model,
                                  other_captures);
     if (!attribution) return attribution.error();
     r.attribution = std::move(*attribution);

@@ -32,8 +32,9 @@ struct DiagnosisSettings {
   /// network), clamped to the search box; its reduced coordinates (to_reduced) are all the fit can use of it.
   std::optional<BendingParameters> start;
   /// With a start: the fit searches only within this factor of it (the mean alpha and the two alpha ratios within
-  /// x 1/start_box .. start_box, -beta/alpha as well), for a bending known from another test to that precision; set
-  /// AttributionSettings::bending_scale_range to ln(start_box) with it. 0: the whole box.
+  /// x 1/start_box .. start_box, -beta/alpha as well), for a bending known from another test to that precision; the
+  /// candidates' refits then scale the bending by at most this factor (instead of AttributionSettings::
+  /// bending_scale_range). 0: the whole box.
   double start_box = 0.0;
   std::vector<double> start_ratios_mm{1.8, 3.6};  // about the 20% and 86% quantiles of fabrics618's -beta/alpha
   FloorSettings floors;
