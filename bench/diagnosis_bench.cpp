@@ -117,6 +117,14 @@ int main(int argc, char** argv) {
                  "are screened once and kept (0: no screen)")
       ->capture_default_str()
       ->check(CLI::Range(0, 100));
+  double measured_bending_error = 0.0;
+  app.add_option("--measured-bending-error", measured_bending_error,
+                 "SIGMA > 0: every capture carries a measured bending, as drapegen reality --measured-bending-error "
+                 "SIGMA writes it (the true fabric times e^(SIGMA g) per parameter, stated within e^(2 SIGMA)); "
+                 "captures generated without one get it from their truth file (the same draw); diagnose with "
+                 "--diagnose-args --ignore-measured-bending for the protocol without it (default 0: none)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
   app.add_flag("--quick", quick, "Diagnose with --quick");
   app.add_flag("--generate-only", generate_only, "Only generate the captures");
   app.add_flag("--score-only", score_only, "Only score existing diagnoses");
@@ -202,6 +210,7 @@ int main(int argc, char** argv) {
       spec.resolution = resolution;
       spec.seed = c.seed;
       spec.placement = p;
+      spec.measured_bending_error = measured_bending_error;
       if (!c.effect.empty()) spec.effects.push_back({c.effect, c.strength});
       auto r = diagnosis::generate_reality(spec, dir.string());
       if (!r) {
@@ -305,6 +314,38 @@ int main(int argc, char** argv) {
                                          : fs::exists(fs::path(out) / "captures" / c.name / "capture.json");
       const bool ok = screen_draws > 0 && !done ? generate_visible(c) : generate(c, out);
       if (!ok) return 1;
+    }
+  }
+  if (!score_only && measured_bending_error > 0.0) {
+    // Captures generated without a measured bending get the one drapegen reality would have written: the kept draw's
+    // fabric and seed are in its truth file.
+    for (const auto& c : cases) {
+      for (int p = 0; p < placements; ++p) {
+        const std::string name = p == 0 ? c.name : fmt::format("{}.p{}", c.name, p);
+        const fs::path dir = fs::path(out) / "captures" / name;
+        auto capture = diagnosis::read_capture(dir.string());
+        if (!capture) {
+          std::cerr << "diagnosis_bench: " << capture.error().message << "\n";
+          return 1;
+        }
+        if (capture->specimen.measured_bending) continue;
+        const auto truth =
+            nlohmann::json::parse(std::ifstream(fs::path(out) / "truth" / (name + ".json")), nullptr, false);
+        if (truth.is_discarded() || !truth.contains("alpha") || !truth.contains("beta") || !truth.contains("seed")) {
+          std::cerr << "diagnosis_bench: " << name << ": no truth file with alpha, beta and seed\n";
+          return 1;
+        }
+        const auto a = truth["alpha"].get<std::vector<double>>(), b = truth["beta"].get<std::vector<double>>();
+        const diagnosis::BendingParameters bending{.alpha = {a.at(0), a.at(1), a.at(2)},
+                                                   .beta = {b.at(0), b.at(1), b.at(2)}};
+        capture->specimen.measured_bending =
+            diagnosis::measure_bending(bending, measured_bending_error, truth["seed"].get<std::uint64_t>());
+        if (sim::Status st = diagnosis::write_capture(dir.string(), *capture); !st) {
+          std::cerr << "diagnosis_bench: " << st.error().message << "\n";
+          return 1;
+        }
+        std::cout << fmt::format("{}: measured bending added (sigma {})\n", name, measured_bending_error);
+      }
     }
   }
   if (generate_only) return 0;

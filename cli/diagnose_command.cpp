@@ -39,6 +39,7 @@ struct DiagnoseOptions {
   std::optional<int> starts;  // unset: the settings' value
   std::string start_alpha, start_beta;  // empty: the drape-coefficient guess
   double start_box = 0.0;               // 0: the whole box
+  bool ignore_measured_bending = false;
   int jobs = 1;
   double shape_floor = -1.0;  // < 0: the settings' calibrated value
   bool gap_only = false;
@@ -116,6 +117,7 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (o.starts) settings.start_levels = *o.starts;
   settings.start = start;
   settings.start_box = o.start_box;
+  settings.use_measured_bending = !o.ignore_measured_bending;
   constexpr int kKeep = diagnosis::AttributionSettings::kSimplexAfterScan;
   for (auto [levels, option] : {std::pair{settings.attribution.scan_levels, "--refit-scan"},
                                  std::pair{settings.attribution.yield_trade_levels, "--yield-trade"}}) {
@@ -206,6 +208,11 @@ Runner add_diagnose_command(CLI::App& app) {
                  "With --start-alpha/--start-beta: a bending known to within this factor (e.g. 1.3 for a cantilever "
                  "test's 30%): the fit searches only there, and the candidate refits scale the bending by at most this "
                  "factor (default: the whole box, and x4.5)");
+  app.add_flag("--ignore-measured-bending", o->ignore_measured_bending,
+               "Do not use the capture's measured bending (capture.json specimen.measured_bending, docs/CAPTURE.md): "
+               "the fit starts at the drape-coefficient guess and searches the whole box. Without this flag, a "
+               "measured bending is the start and its within_factor the box, unless --start-alpha/--start-beta is "
+               "given");
   app.add_option("--refit-evaluations", o->refit_evaluations,
                  "Evaluations per candidate refit and of the bar, the bending scale refitted alone (default 14, also "
                  "with --quick and --fine)");

@@ -24,6 +24,7 @@ struct RealityOptions {
   std::string out;
   bool noise = true;
   bool json = false;
+  double measured_bending_error = 0.0;
 };
 
 int fail(const std::string& message, int code = kExitUsage) {
@@ -50,6 +51,10 @@ int run_reality(const RealityOptions& o) {
   }
   spec.placement = o.placement;
   spec.noise = o.noise;
+  if (!(o.measured_bending_error >= 0.0 && o.measured_bending_error <= 1.0)) {
+    return fail("--measured-bending-error must be 0 (none) .. 1");
+  }
+  spec.measured_bending_error = o.measured_bending_error;
   for (const auto& text : o.effects) {
     auto e = diagnosis::parse_reality_effect(text);
     if (!e) return fail(e.error().message);
@@ -99,6 +104,11 @@ Runner add_reality_command(CLI::App& app) {
   app.add_option("--out", o->out, "Capture directory (capture.json, view0..3.exr, truth.json, preview.png)")
       ->required();
   app.add_flag("!--no-noise", o->noise, "Clean depth (no sensor noise)");
+  app.add_option("--measured-bending-error", o->measured_bending_error,
+                 "SIGMA > 0: the capture carries a measured bending, as a bending test (e.g. a cantilever) of this "
+                 "precision would report it: each of --alpha/--beta times its own e^(SIGMA g), g standard normal, the "
+                 "same on every placement, stated within a factor e^(2 SIGMA) (docs/CAPTURE.md, \"Measured bending\"; "
+                 "default 0: none)");
   app.add_flag("--json", o->json, "Print the summary as JSON");
   return [o] { return run_reality(*o); };
 }

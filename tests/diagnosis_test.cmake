@@ -271,7 +271,7 @@ expect_failure(1 "'curl' given twice" diagnose --capture ${WORK}/capture --candi
 run_ok(out diagnose --capture ${WORK}/capture --quick --resolution 10 --states 2 --evaluations 4 --gap-only --json
        --start-alpha 5000,4000,3000 --start-beta=-12500,-10000,-7500)
 string(JSON from GET "${out}" baseline initial_guess_from)
-if(NOT from STREQUAL "--start-alpha/--start-beta")
+if(NOT from STREQUAL "given start")
   message(FATAL_ERROR "--start-alpha: the fit started from '${from}'")
 endif()
 set(start_bounds "4999.99 5000.01 -12500.01 -12499.99" "3999.99 4000.01 -10000.01 -9999.99"
@@ -302,6 +302,47 @@ expect_failure(1 "--start-box must be" diagnose --capture ${WORK}/capture --star
 expect_failure(1 "--start-alpha and --start-beta go together" diagnose --capture ${WORK}/capture --start-alpha 1,2,3)
 expect_failure(1 "--start-alpha must be positive" diagnose --capture ${WORK}/capture --start-alpha 5000,0,3000
                --start-beta=-1,-1,-1)
+# A capture with a measured bending (docs/CAPTURE.md): the fit starts there and stays within its stated factor, unless
+# --ignore-measured-bending (the drape-coefficient guess) or --start-alpha/--start-beta (that start) says otherwise.
+run_ok(out reality ${FABRIC} --effect bias=12 --resolution 14 --seed 4 --measured-bending-error 0.1
+       --out ${WORK}/measured)
+file(REMOVE ${WORK}/measured/truth.json)
+file(READ ${WORK}/measured/capture.json measured_json)
+string(JSON measured_alpha GET "${measured_json}" specimen measured_bending alpha 0)
+string(JSON measured_factor GET "${measured_json}" specimen measured_bending within_factor)
+if(measured_alpha EQUAL 13923 OR measured_alpha LESS 9000 OR measured_alpha GREATER 21000
+   OR NOT measured_factor GREATER 1.2214 OR NOT measured_factor LESS 1.2215)
+  message(FATAL_ERROR "--measured-bending-error 0.1: measured alpha_warp ${measured_alpha} (truth 13923), factor "
+                      "${measured_factor} (expected e^0.2)")
+endif()
+run_ok(out diagnose --capture ${WORK}/measured --quick --resolution 10 --states 2 --evaluations 4 --gap-only --json)
+string(JSON from GET "${out}" baseline initial_guess_from)
+string(JSON factor GET "${out}" baseline search_within_factor)
+string(JSON guess_alpha GET "${out}" baseline initial_guess alpha 0)
+if(NOT from STREQUAL "measured bending" OR NOT factor EQUAL measured_factor)
+  message(FATAL_ERROR "a measured bending: the fit started from '${from}' within '${factor}'")
+endif()
+# The initial guess is the measurement (its alphas exactly; CMake compares integers: within 1 of its whole part).
+string(REGEX REPLACE "\\..*" "" measured_int "${measured_alpha}")
+math(EXPR guess_lo "${measured_int} - 1")
+math(EXPR guess_hi "${measured_int} + 2")
+if(guess_alpha LESS guess_lo OR guess_alpha GREATER guess_hi)
+  message(FATAL_ERROR "a measured bending: initial guess alpha_warp ${guess_alpha}, measured ${measured_alpha}")
+endif()
+run_ok(out diagnose --capture ${WORK}/measured --quick --resolution 10 --states 2 --evaluations 4 --gap-only --json
+       --ignore-measured-bending)
+string(JSON from GET "${out}" baseline initial_guess_from)
+string(JSON factor_type TYPE "${out}" baseline search_within_factor)
+if(NOT from STREQUAL "drape coefficient" OR NOT factor_type STREQUAL "NULL")
+  message(FATAL_ERROR "--ignore-measured-bending: the fit started from '${from}' (box ${factor_type})")
+endif()
+run_ok(out diagnose --capture ${WORK}/measured --quick --resolution 10 --states 2 --evaluations 4 --gap-only --json
+       --start-alpha 5000,4000,3000 --start-beta=-12500,-10000,-7500)
+string(JSON from GET "${out}" baseline initial_guess_from)
+if(NOT from STREQUAL "given start")
+  message(FATAL_ERROR "--start-alpha on a capture with a measured bending: the fit started from '${from}'")
+endif()
+expect_failure(1 "--measured-bending-error must be" reality ${FABRIC} --measured-bending-error 1.5 --out ${WORK}/bad)
 
 # Three placements: the second in the candidate refits and the gate, the third held out of every fit (the confirmation).
 run_ok(out reality ${FABRIC} --effect bias=12 --resolution 14 --seed 4 --placement 2 --out ${WORK}/capture.p2)

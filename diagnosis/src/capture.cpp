@@ -42,6 +42,40 @@ sim::Expected<Eigen::MatrixXd> matrix_from(const nlohmann::json& j, int rows, in
   return m;
 }
 
+/// A directional triple [warp, bias, weft] of numbers.
+sim::Expected<sim::DirectionalValues> directional_from(const nlohmann::json& j, const std::string& what) {
+  if (!j.is_array() || j.size() != 3 || !j[0].is_number() || !j[1].is_number() || !j[2].is_number()) {
+    return sim::Error{fmt::format("{} must be [warp, bias, weft] numbers", what)};
+  }
+  return sim::DirectionalValues{j[0].get<double>(), j[1].get<double>(), j[2].get<double>()};
+}
+
+sim::Expected<MeasuredBending> measured_bending_from(const nlohmann::json& j, const std::string& where) {
+  if (!j.is_object()) return sim::Error{where + " must be an object"};
+  if (!j.contains("alpha") || !j.contains("beta") || !j.contains("within_factor")) {
+    return sim::Error{where + " needs \"alpha\", \"beta\" and \"within_factor\""};
+  }
+  MeasuredBending m;
+  auto alpha = directional_from(j["alpha"], where + ".alpha");
+  if (!alpha) return alpha.error();
+  auto beta = directional_from(j["beta"], where + ".beta");
+  if (!beta) return beta.error();
+  if (!(alpha->warp > 0.0 && alpha->bias > 0.0 && alpha->weft > 0.0)) {
+    return sim::Error{where + ".alpha must be positive"};
+  }
+  m.bending = BendingParameters{.alpha = *alpha, .beta = *beta};
+  const auto& factor = j["within_factor"];
+  if (!factor.is_number() || !(factor.get<double>() > 1.0 && factor.get<double>() <= 100.0)) {
+    return sim::Error{where + ".within_factor must be a number in (1, 100]"};
+  }
+  m.within_factor = factor.get<double>();
+  if (j.contains("method")) {
+    if (!j["method"].is_string()) return sim::Error{where + ".method must be a string"};
+    m.method = j["method"].get<std::string>();
+  }
+  return m;
+}
+
 }  // namespace
 
 sim::Status check_view(const CaptureView& view) {
@@ -109,6 +143,11 @@ sim::Expected<Capture> read_capture(const std::string& directory) {
     }
     if (!(c.specimen.cylinder_diameter >= 0.01 && c.specimen.cylinder_diameter < std::min(c.specimen.size_x, c.specimen.size_y))) {
       return sim::Error{fmt::format("{}: cylinder diameter must be 10 mm .. the specimen size", where)};
+    }
+    if (s.contains("measured_bending") && !s["measured_bending"].is_null()) {
+      auto measured = measured_bending_from(s["measured_bending"], where + ": specimen.measured_bending");
+      if (!measured) return measured.error();
+      c.specimen.measured_bending = std::move(*measured);
     }
     if (!j.contains("views") || !j["views"].is_array()) return sim::Error{fmt::format("{}: missing \"views\"", where)};
     const auto& views = j["views"];
@@ -179,6 +218,13 @@ sim::Status write_capture(const std::string& directory, const Capture& capture) 
                         {"density_g_per_m2", capture.specimen.density},
                         {"cylinder_diameter_mm", capture.specimen.cylinder_diameter * 1e3}}},
                       {"views", views}};
+  if (const auto& m = capture.specimen.measured_bending) {
+    const BendingParameters& b = m->bending;
+    j["specimen"]["measured_bending"] = {{"alpha", {b.alpha.warp, b.alpha.bias, b.alpha.weft}},
+                                         {"beta", {b.beta.warp, b.beta.bias, b.beta.weft}},
+                                         {"within_factor", m->within_factor},
+                                         {"method", m->method}};
+  }
   if (capture.scan_mesh) j["scan"] = *capture.scan_mesh;
   const fs::path path = dir / "capture.json";
   std::ofstream out(path);

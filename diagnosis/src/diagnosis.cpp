@@ -212,26 +212,36 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
   }
   DiagnosisResult r;
 
-  // 1. Baseline fit in the reduced space, from the drape-coefficient guess (or the given start).
+  // 1. Baseline fit in the reduced space, from the drape-coefficient guess (or the given start, or the capture's
+  // measured bending).
   ReducedBending lo = reduced_lower(capture.specimen.density), hi = reduced_upper(capture.specimen.density);
   sim::Expected<ReducedBending> guess = ReducedBending{};
-  if (settings.start) {
-    *guess = to_reduced(*settings.start);
+  std::optional<BendingParameters> fit_start = settings.start;
+  double start_box = settings.start_box;
+  r.initial_guess_from = "given start";
+  if (!fit_start && settings.use_measured_bending && capture.specimen.measured_bending) {
+    fit_start = capture.specimen.measured_bending->bending;
+    start_box = capture.specimen.measured_bending->within_factor;
+    r.initial_guess_from = "measured bending";
+  }
+  if (fit_start) {
+    *guess = to_reduced(*fit_start);
     for (std::size_t k = 0; k < guess->size(); ++k) (*guess)[k] = std::clamp((*guess)[k], lo[k], hi[k]);
-    if (settings.start_box > 1.0) {  // the box narrowed to the start's neighbourhood
-      const double f = std::log(settings.start_box);
+    if (start_box > 1.0) {  // the box narrowed to the start's neighbourhood
+      const double f = std::log(start_box);
       for (std::size_t k = 0; k < 3; ++k) {
         lo[k] = std::max(lo[k], (*guess)[k] - f), hi[k] = std::min(hi[k], (*guess)[k] + f);
       }
-      lo[3] = std::max(lo[3], (*guess)[3] / settings.start_box);
-      hi[3] = std::min(hi[3], (*guess)[3] * settings.start_box);
+      lo[3] = std::max(lo[3], (*guess)[3] / start_box);
+      hi[3] = std::min(hi[3], (*guess)[3] * start_box);
+      r.search_within_factor = start_box;
     }
   } else {
     guess = initial_guess(model, std::max(1, settings.guess_levels));
     if (!guess) return guess.error();
+    r.initial_guess_from = "drape coefficient";
   }
   r.initial_guess = from_reduced(*guess);
-  r.start_given = settings.start.has_value();
   std::optional<sim::Error> error;
   double best = std::numeric_limits<double>::infinity();
   std::optional<std::pair<std::vector<double>, double>> known_start;  // a point scored already, and its score
@@ -354,8 +364,8 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
     if (second_model) other_captures.second = {second_model.get(), &r.validated_second->best};
     if (held_out_model) other_captures.held_out = {held_out_model.get(), &r.validated_held_out->best};
     AttributionSettings attribution_settings = settings.attribution;
-    if (settings.start && settings.start_box > 1.0) {  // the known bending's precision bounds the refits' scale too
-      attribution_settings.bending_scale_range = std::log(settings.start_box);
+    if (r.search_within_factor > 1.0) {  // the known bending's precision bounds the refits' scale too
+      attribution_settings.bending_scale_range = std::log(r.search_within_factor);
     }
     auto attribution = attribute(model, fitted, r.fit, r.validated, r.floors, attribution_settings, make_model,
                                  other_captures);
@@ -433,7 +443,9 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
   for (double x : r.floors.multistability.held_out) floors["multistability_held_out_mm"].push_back(x * 1e3);
   j["floors"] = floors;
   j["baseline"] = {{"initial_guess", bending_json(r.initial_guess)},
-                   {"initial_guess_from", r.start_given ? "--start-alpha/--start-beta" : "drape coefficient"},
+                   {"initial_guess_from", r.initial_guess_from},
+                   {"search_within_factor", r.search_within_factor > 1.0 ? nlohmann::json(r.search_within_factor)
+                                                                        : nlohmann::json(nullptr)},
                    {"fitted", bending_json(r.fitted)},
                    {"fitted_reduced", r.fitted_reduced},
                    {"evaluations", r.baseline_evaluations},

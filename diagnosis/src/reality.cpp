@@ -91,6 +91,18 @@ sim::Expected<RealityEffect> parse_reality_effect(const std::string& text) {
   return e;
 }
 
+MeasuredBending measure_bending(const BendingParameters& truth, double sigma, std::uint64_t seed) {
+  renderer::Rng rng(renderer::mix_seed(seed, 0xBE4D));
+  auto scaled = [&](double x) { return x * std::exp(sigma * rng.gaussian()); };
+  MeasuredBending m;
+  for (auto [from, to] : {std::pair{&truth.alpha, &m.bending.alpha}, std::pair{&truth.beta, &m.bending.beta}}) {
+    to->warp = scaled(from->warp), to->bias = scaled(from->bias), to->weft = scaled(from->weft);
+  }
+  m.within_factor = std::exp(2.0 * sigma);
+  m.method = fmt::format("drapegen reality: the truth times e^({} g) per parameter", sigma);
+  return m;
+}
+
 namespace {
 
 /// What one placement of the specimen is: the drape's configuration (without a plastic set), the sensor's error and
@@ -232,6 +244,9 @@ sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std
   capture.specimen.size_y = config.specimen.size_y;
   capture.specimen.density = spec.density;
   capture.specimen.cylinder_diameter = 2.0 * rig.cylinder.radius;
+  if (spec.measured_bending_error > 0.0) {
+    capture.specimen.measured_bending = measure_bending(spec.bending, spec.measured_bending_error, spec.seed);
+  }
   std::vector<std::vector<renderer::DepthImage>> preview(1);
   const auto& setup = setups.front();
   for (int v = 0; v < static_cast<int>(setup.views.size()); ++v) {

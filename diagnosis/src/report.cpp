@@ -129,9 +129,12 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
                     gap.stable * 1e3,
                     r.floors.stable * 1e3, gap.shape, r.floors.shape);
   md += fmt::format("Fitted baseline: alpha = {:.0f}, {:.0f}, {:.0f} g mm^2/s^2; beta = {:.0f}, {:.0f}, {:.0f} g mm^3/s^2 "
-                    "({} simplex evaluations{}).\n\n",
+                    "({} simplex evaluations from the {}{}{}).\n\n",
                     r.fitted.alpha.warp, r.fitted.alpha.bias, r.fitted.alpha.weft, r.fitted.beta.warp,
-                    r.fitted.beta.bias, r.fitted.beta.weft, r.baseline_evaluations,
+                    r.fitted.beta.bias, r.fitted.beta.weft, r.baseline_evaluations, r.initial_guess_from,
+                    r.search_within_factor > 1.0
+                        ? fmt::format(", searched within x{:.3g} of it", r.search_within_factor)
+                        : std::string(),
                     r.start_evaluations == 0 ? std::string()
                     : fmt::format(", {} starts{}", r.start_evaluations,
                                   r.restarted ? "; the second simplex, from the best start, is the fit" : ""));

@@ -63,6 +63,51 @@ TEST(Capture, RoundTrip) {
   }
 }
 
+TEST(Capture, MeasuredBendingRoundTripsAndIsOptional) {
+  const std::string dir = fresh_dir("measured");
+  Capture c = plane_capture();
+  ASSERT_TRUE(write_capture(dir, c).ok());
+  auto r = read_capture(dir);
+  ASSERT_TRUE(r.has_value()) << r.error().message;
+  EXPECT_FALSE(r->specimen.measured_bending.has_value());
+  c.specimen.measured_bending = MeasuredBending{
+      .bending = {.alpha = {5000.0, 4000.0, 3000.0}, .beta = {-12500.0, 800.0, -7500.0}}, .within_factor = 1.3,
+      .method = "cantilever"};
+  ASSERT_TRUE(write_capture(dir, c).ok());
+  r = read_capture(dir);
+  ASSERT_TRUE(r.has_value()) << r.error().message;
+  ASSERT_TRUE(r->specimen.measured_bending.has_value());
+  const MeasuredBending& m = *r->specimen.measured_bending;
+  EXPECT_EQ(m.bending.alpha.bias, 4000.0);
+  EXPECT_EQ(m.bending.beta.bias, 800.0);  // a stiffening direction keeps its sign
+  EXPECT_EQ(m.bending.beta.weft, -7500.0);
+  EXPECT_EQ(m.within_factor, 1.3);
+  EXPECT_EQ(m.method, "cantilever");
+}
+
+TEST(Capture, BadMeasuredBendingIsAClearError) {
+  const std::string dir = fresh_dir("measured_bad");
+  ASSERT_TRUE(write_capture(dir, plane_capture()).ok());
+  const nlohmann::json good = nlohmann::json::parse(std::ifstream(fs::path(dir) / "capture.json"));
+  const std::vector<std::pair<nlohmann::json, std::string>> cases{
+      {{{"alpha", {1, 2}}, {"beta", {0, 0, 0}}, {"within_factor", 1.2}}, "alpha must be [warp, bias, weft]"},
+      {{{"alpha", {1, 0, 2}}, {"beta", {0, 0, 0}}, {"within_factor", 1.2}}, "alpha must be positive"},
+      {{{"alpha", {1, 1, 2}}, {"beta", {0, "x", 0}}, {"within_factor", 1.2}}, "beta must be [warp, bias, weft]"},
+      {{{"alpha", {1, 1, 2}}, {"beta", {0, 0, 0}}, {"within_factor", 1.0}},
+       "within_factor must be a number in (1, 100]"},
+      {{{"alpha", {1, 1, 2}}, {"beta", {0, 0, 0}}}, "needs \"alpha\", \"beta\" and \"within_factor\""},
+      {{{"alpha", {1, 1, 2}}, {"beta", {0, 0, 0}}, {"within_factor", 2}, {"method", 3}}, "method must be a string"},
+  };
+  for (const auto& [measured, expected] : cases) {
+    nlohmann::json j = good;
+    j["specimen"]["measured_bending"] = measured;
+    std::ofstream(fs::path(dir) / "capture.json") << j.dump();
+    const std::string e = read_error(dir);
+    EXPECT_NE(e.find("specimen.measured_bending"), std::string::npos) << e;
+    EXPECT_NE(e.find(expected), std::string::npos) << e;
+  }
+}
+
 TEST(Capture, MissingViewFile) {
   const std::string dir = fresh_dir("missing");
   ASSERT_TRUE(write_capture(dir, plane_capture()).ok());

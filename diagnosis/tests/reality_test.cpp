@@ -33,6 +33,7 @@ Placed place(int placement, const fs::path& dir,
   spec.seed = 21;
   spec.placement = placement;
   spec.noise = false;  // so that a difference between two placements is the drape's, not the noise's
+  spec.measured_bending_error = 0.1;
   for (const auto& e : effects) spec.effects.push_back(*parse_reality_effect(e));
   auto r = generate_reality(spec, dir.string());
   EXPECT_TRUE(r.has_value()) << (r ? "" : r.error().message);
@@ -72,6 +73,14 @@ TEST(Reality, ASecondPlacementKeepsTheSpecimenAndTheRigAndMovesTheDrape) {
   EXPECT_EQ(first.truth["sensor"], second.truth["sensor"]);
   EXPECT_EQ(first.truth["family"], second.truth["family"]);
   EXPECT_EQ(first.truth["effects"], second.truth["effects"]);
+  // So is the bending test's report of the specimen (not the truth).
+  ASSERT_TRUE(first.capture.specimen.measured_bending && second.capture.specimen.measured_bending);
+  const BendingParameters& m1 = first.capture.specimen.measured_bending->bending;
+  const BendingParameters& m2 = second.capture.specimen.measured_bending->bending;
+  EXPECT_EQ(m1.alpha.warp, m2.alpha.warp);
+  EXPECT_EQ(m1.beta.weft, m2.beta.weft);
+  EXPECT_NE(m1.alpha.warp, first.truth["alpha"][0].get<double>());
+  EXPECT_NEAR(first.capture.specimen.measured_bending->within_factor, std::exp(0.2), 1e-12);
   // The placement is new: initial state, orientation and drift; the misalignment keeps its distance (15 mm plus
   // the augmentation's up to 2 mm) but not its direction.
   EXPECT_NE(first.truth["initial_state"]["seed"], second.truth["initial_state"]["seed"]);
@@ -90,6 +99,34 @@ TEST(Reality, ASecondPlacementKeepsTheSpecimenAndTheRigAndMovesTheDrape) {
   for (std::size_t i = 0; i < a.size(); ++i) differing += std::abs(a[i] - b[i]) > 1e-3f;
   EXPECT_GT(differing, static_cast<int>(a.size() / 100));
   fs::remove_all(root);
+}
+
+TEST(Reality, AMeasuredBendingHasTheStatedLognormalError) {
+  // 6 parameters x 400 specimens: ln(measured / truth) has mean 0 and deviation sigma; about 95% lie within the
+  // stated factor e^(2 sigma); the sign of beta is kept; the same seed gives the same report.
+  const BendingParameters truth{.alpha = {13923, 11455, 8821}, .beta = {-35390, 2000, -22042}};
+  const double sigma = 0.12;
+  double sum = 0.0, sum2 = 0.0;
+  int n = 0, within = 0;
+  for (std::uint64_t seed = 0; seed < 400; ++seed) {
+    const MeasuredBending m = measure_bending(truth, sigma, seed);
+    EXPECT_NEAR(m.within_factor, std::exp(2.0 * sigma), 1e-12);
+    const BendingParameters& b = m.bending;
+    for (auto [t, x] : {std::pair{truth.alpha.warp, b.alpha.warp}, std::pair{truth.alpha.bias, b.alpha.bias},
+                        std::pair{truth.alpha.weft, b.alpha.weft}, std::pair{truth.beta.warp, b.beta.warp},
+                        std::pair{truth.beta.bias, b.beta.bias}, std::pair{truth.beta.weft, b.beta.weft}}) {
+      ASSERT_GT(x / t, 0.0);
+      const double e = std::log(x / t);
+      sum += e, sum2 += e * e, ++n;
+      within += std::abs(e) <= std::log(m.within_factor);
+    }
+  }
+  const double mean = sum / n, sd = std::sqrt(sum2 / n - mean * mean);
+  EXPECT_LT(std::abs(mean), 3.0 * sigma / std::sqrt(n));
+  EXPECT_NEAR(sd, sigma, 0.1 * sigma);
+  EXPECT_NEAR(static_cast<double>(within) / n, 0.954, 0.02);
+  EXPECT_EQ(measure_bending(truth, sigma, 7).bending.beta.bias, measure_bending(truth, sigma, 7).bending.beta.bias);
+  EXPECT_NE(measure_bending(truth, sigma, 7).bending.beta.bias, measure_bending(truth, sigma, 8).bending.beta.bias);
 }
 
 TEST(Reality, AYieldingSpecimenCarriesItsPlasticSetToTheNextPlacement) {

@@ -6,11 +6,21 @@
 #include <string>
 #include <vector>
 
+#include "drapegen/diagnosis/fabric_space.hpp"
 #include "drapegen/renderer/camera.hpp"
 #include "drapegen/renderer/depth_image.hpp"
 #include "drapegen/sim/expected.hpp"
 
 namespace drapegen::diagnosis {
+
+/// The specimen's bending as another test measured it (e.g. a cantilever test), and how precise that test is.
+struct MeasuredBending {
+  BendingParameters bending;
+  /// The test's precision: the true bending lies within this factor of `bending` (> 1; e.g. 1.25 for a test good
+  /// to about 10%). The diagnosis's fits stay within it.
+  double within_factor = 1.25;
+  std::string method;  // free text, e.g. "cantilever (ASTM D1388)"
+};
 
 /// Facts about the specimen and the tester that the operator knows.
 struct SpecimenFacts {
@@ -18,6 +28,7 @@ struct SpecimenFacts {
   double size_y = 0.3;             // m
   double density = 300.0;          // g/m^2
   double cylinder_diameter = 0.1;  // m
+  std::optional<MeasuredBending> measured_bending;  // optional: docs/CAPTURE.md, "Measured bending"
 };
 
 struct CaptureView {

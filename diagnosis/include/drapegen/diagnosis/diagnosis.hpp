@@ -36,6 +36,10 @@ struct DiagnosisSettings {
   /// candidates' refits then scale the bending by at most this factor (instead of AttributionSettings::
   /// bending_scale_range). 0: the whole box.
   double start_box = 0.0;
+  /// Without a start: a capture's measured bending (SpecimenFacts::measured_bending) is the start and its
+  /// within_factor the start_box. false: the capture's measured bending is not used (the fit starts at the
+  /// drape-coefficient guess and searches the whole box).
+  bool use_measured_bending = true;
   std::vector<double> start_ratios_mm{1.8, 3.6};  // about the 20% and 86% quantiles of fabrics618's -beta/alpha
   FloorSettings floors;
   AttributionSettings attribution;
@@ -63,7 +67,10 @@ struct DiagnosisSettings {
 
 struct DiagnosisResult {
   BendingParameters initial_guess;  // the drape-coefficient guess, or the given start (clamped to the box)
-  bool start_given = false;         // DiagnosisSettings::start
+  /// Where the initial guess came from: "drape coefficient", "given start" (DiagnosisSettings::start) or
+  /// "measured bending" (the capture's).
+  std::string initial_guess_from;
+  double search_within_factor = 0.0;  // the fit's box around the start (start_box or within_factor); 0: the whole box
   BendingParameters fitted;
   ReducedBending fitted_reduced{};
   int baseline_evaluations = 0;  // both simplexes'

@@ -47,7 +47,15 @@ struct RealitySpec {
   int placement = 0;
   std::vector<RealityEffect> effects;
   bool noise = true;
+  /// > 0: the capture carries a measured bending (SpecimenFacts::measured_bending), measure_bending(bending, this,
+  /// seed): what a bending test of this precision would have reported of the specimen, the same on every placement.
+  double measured_bending_error = 0.0;
 };
+
+/// A bending test's report of a specimen whose true bending is `truth`: each of the six parameters times its own
+/// e^(sigma g), g standard normal (seeded by `seed`), and the precision it states, within_factor = e^(2 sigma) (each
+/// parameter's 95% range). Never the truth itself for sigma > 0. sigma must be 0 .. 1.
+[[nodiscard]] MeasuredBending measure_bending(const BendingParameters& truth, double sigma, std::uint64_t seed);
 
 struct RealityResult {
   std::string truth_path;
