@@ -29,6 +29,18 @@ function(run_ok out_var)
   set(${out_var} "${out}" PARENT_SCOPE)
 endfunction()
 
+# A small gap-only diagnosis of `capture` (more options after it): sets `out` to its report.json and `from` to where
+# its baseline fit started (baseline.initial_guess_from), and stops the test unless that is `expected_from`.
+function(small_fit_from capture expected_from)
+  run_ok(report diagnose --capture ${capture} --quick --resolution 10 --states 2 --evaluations 4 --gap-only --json
+         ${ARGN})
+  string(JSON started GET "${report}" baseline initial_guess_from)
+  if(NOT started STREQUAL expected_from)
+    message(FATAL_ERROR "'${ARGN}' on ${capture}: the fit started from '${started}', not the ${expected_from}")
+  endif()
+  set(out "${report}" PARENT_SCOPE)
+endfunction()
+
 # Stops the test unless the diagnosis `json` paired its gate with `paired`, refitted on `refitted_on` and confirmed on
 # `confirmed_on` (report.json's roles of the other placements); `label` names the run.
 function(expect_roles label json paired refitted_on confirmed_on)
@@ -268,12 +280,7 @@ expect_failure(1 "unknown effect 'bogus'" diagnose --capture ${WORK}/capture --c
 expect_failure(1 "'curl' given twice" diagnose --capture ${WORK}/capture --candidates curl,shear,curl)
 # --start-alpha/--start-beta: the fit starts at the given bending instead of the drape-coefficient guess (report:
 # baseline.initial_guess, exactly the start when its beta is alpha times one length, as here: 2.5 mm).
-run_ok(out diagnose --capture ${WORK}/capture --quick --resolution 10 --states 2 --evaluations 4 --gap-only --json
-       --start-alpha 5000,4000,3000 --start-beta=-12500,-10000,-7500)
-string(JSON from GET "${out}" baseline initial_guess_from)
-if(NOT from STREQUAL "given start")
-  message(FATAL_ERROR "--start-alpha: the fit started from '${from}'")
-endif()
+small_fit_from(${WORK}/capture "given start" --start-alpha 5000,4000,3000 --start-beta=-12500,-10000,-7500)
 set(start_bounds "4999.99 5000.01 -12500.01 -12499.99" "3999.99 4000.01 -10000.01 -9999.99"
                  "2999.99 3000.01 -7500.01 -7499.99")
 foreach(k 0 1 2)
@@ -290,8 +297,8 @@ foreach(k 0 1 2)
   endif()
 endforeach()
 # --start-box: the fit stays within the factor of the start (mean alpha 3915 x 1/1.1 .. 1.1 = 3559 .. 4307; 4 evaluations)
-run_ok(out diagnose --capture ${WORK}/capture --quick --resolution 10 --states 2 --evaluations 4 --gap-only --json
-       --start-alpha 5000,4000,3000 --start-beta=-12500,-10000,-7500 --start-box 1.1)
+small_fit_from(${WORK}/capture "given start" --start-alpha 5000,4000,3000 --start-beta=-12500,-10000,-7500
+               --start-box 1.1)
 string(JSON fitted_ln_alpha GET "${out}" baseline fitted_reduced 0)
 if(fitted_ln_alpha LESS 8.177 OR fitted_ln_alpha GREATER 8.368)
   message(FATAL_ERROR "--start-box 1.1: the fit left the box (ln mean alpha ${fitted_ln_alpha}, box 8.177 .. 8.368)")
@@ -315,12 +322,11 @@ if(measured_alpha EQUAL 13923 OR measured_alpha LESS 9000 OR measured_alpha GREA
   message(FATAL_ERROR "--measured-bending-error 0.1: measured alpha_warp ${measured_alpha} (truth 13923), factor "
                       "${measured_factor} (expected e^0.2)")
 endif()
-run_ok(out diagnose --capture ${WORK}/measured --quick --resolution 10 --states 2 --evaluations 4 --gap-only --json)
-string(JSON from GET "${out}" baseline initial_guess_from)
+small_fit_from(${WORK}/measured "measured bending")
 string(JSON factor GET "${out}" baseline search_within_factor)
 string(JSON guess_alpha GET "${out}" baseline initial_guess alpha 0)
-if(NOT from STREQUAL "measured bending" OR NOT factor EQUAL measured_factor)
-  message(FATAL_ERROR "a measured bending: the fit started from '${from}' within '${factor}'")
+if(NOT factor EQUAL measured_factor)
+  message(FATAL_ERROR "a measured bending: the fit searched within '${factor}', measured ${measured_factor}")
 endif()
 # The initial guess is the measurement (its alphas exactly; CMake compares integers: within 1 of its whole part).
 string(REGEX REPLACE "\\..*" "" measured_int "${measured_alpha}")
@@ -329,19 +335,12 @@ math(EXPR guess_hi "${measured_int} + 2")
 if(guess_alpha LESS guess_lo OR guess_alpha GREATER guess_hi)
   message(FATAL_ERROR "a measured bending: initial guess alpha_warp ${guess_alpha}, measured ${measured_alpha}")
 endif()
-run_ok(out diagnose --capture ${WORK}/measured --quick --resolution 10 --states 2 --evaluations 4 --gap-only --json
-       --ignore-measured-bending)
-string(JSON from GET "${out}" baseline initial_guess_from)
+small_fit_from(${WORK}/measured "drape coefficient" --ignore-measured-bending)
 string(JSON factor_type TYPE "${out}" baseline search_within_factor)
-if(NOT from STREQUAL "drape coefficient" OR NOT factor_type STREQUAL "NULL")
-  message(FATAL_ERROR "--ignore-measured-bending: the fit started from '${from}' (box ${factor_type})")
+if(NOT factor_type STREQUAL "NULL")
+  message(FATAL_ERROR "--ignore-measured-bending: the fit searched a box (${factor_type})")
 endif()
-run_ok(out diagnose --capture ${WORK}/measured --quick --resolution 10 --states 2 --evaluations 4 --gap-only --json
-       --start-alpha 5000,4000,3000 --start-beta=-12500,-10000,-7500)
-string(JSON from GET "${out}" baseline initial_guess_from)
-if(NOT from STREQUAL "given start")
-  message(FATAL_ERROR "--start-alpha on a capture with a measured bending: the fit started from '${from}'")
-endif()
+small_fit_from(${WORK}/measured "given start" --start-alpha 5000,4000,3000 --start-beta=-12500,-10000,-7500)
 expect_failure(1 "--measured-bending-error must be" reality ${FABRIC} --measured-bending-error 1.5 --out ${WORK}/bad)
 
 # Three placements: the second in the candidate refits and the gate, the third held out of every fit (the confirmation).
