@@ -328,19 +328,28 @@ int main(int argc, char** argv) {
           std::cerr << "diagnosis_bench: " << capture.error().message << "\n";
           return 1;
         }
-        if (capture->specimen.measured_bending) continue;
-        const auto truth =
-            nlohmann::json::parse(std::ifstream(fs::path(out) / "truth" / (name + ".json")), nullptr, false);
-        if (truth.is_discarded() || !truth.contains("alpha") || !truth.contains("beta") || !truth.contains("seed")) {
-          std::cerr << "diagnosis_bench: " << name << ": no truth file with alpha, beta and seed\n";
+        if (const auto& m = capture->specimen.measured_bending) {
+          if (std::abs(m->within_factor - std::exp(2.0 * measured_bending_error)) > 1e-12) {
+            std::cerr << fmt::format("diagnosis_bench: {}: carries a measured bending within {:.4g}, not the e^(2 x "
+                                     "{}) of --measured-bending-error\n",
+                                     name, m->within_factor, measured_bending_error);
+            return 1;
+          }
+          continue;
+        }
+        diagnosis::BendingParameters bending;
+        std::uint64_t specimen_seed = 0;
+        try {
+          const auto truth = nlohmann::json::parse(std::ifstream(fs::path(out) / "truth" / (name + ".json")));
+          const auto a = truth.at("alpha").get<std::vector<double>>(), b = truth.at("beta").get<std::vector<double>>();
+          bending = {.alpha = {a.at(0), a.at(1), a.at(2)}, .beta = {b.at(0), b.at(1), b.at(2)}};
+          specimen_seed = truth.at("seed").get<std::uint64_t>();
+        } catch (const std::exception& e) {
+          std::cerr << "diagnosis_bench: " << name << ": no truth file with alpha, beta and seed: " << e.what() << "\n";
           return 1;
         }
-        const auto a = truth["alpha"].get<std::vector<double>>(), b = truth["beta"].get<std::vector<double>>();
-        const diagnosis::BendingParameters bending{.alpha = {a.at(0), a.at(1), a.at(2)},
-                                                   .beta = {b.at(0), b.at(1), b.at(2)}};
-        capture->specimen.measured_bending =
-            diagnosis::measure_bending(bending, measured_bending_error, truth["seed"].get<std::uint64_t>());
-        if (sim::Status st = diagnosis::write_capture(dir.string(), *capture); !st) {
+        capture->specimen.measured_bending = diagnosis::measure_bending(bending, measured_bending_error, specimen_seed);
+        if (sim::Status st = diagnosis::write_capture_json(dir.string(), *capture); !st) {
           std::cerr << "diagnosis_bench: " << st.error().message << "\n";
           return 1;
         }
@@ -408,6 +417,7 @@ int main(int argc, char** argv) {
   std::map<std::string, std::pair<int, int>> screen_draws_by_family;
   int visible_total = 0, visible_correct = 0;
   std::vector<double> shrinkages, named_shrinkages, seconds;
+  std::map<std::string, int> starts;
   nlohmann::json per_case = nlohmann::json::array();
   for (const auto& c : cases) {
     const fs::path result = fs::path(out) / "diagnoses" / (c.name + ".json");
@@ -440,6 +450,10 @@ int main(int argc, char** argv) {
       visible_correct += verdict == family;
     }
     const std::string region = d["localisation"].value("region", "?");
+    // Where the fit started (a measured bending or not): the protocol a diagnosis ran under, counted per start.
+    const std::string started =
+        d.contains("baseline") ? d["baseline"].value("initial_guess_from", "drape coefficient") : "?";
+    starts[started]++;
     confusion[family][verdict]++;
     seconds.push_back(d["runtime"].value("seconds", 0.0));
     double shrink = std::numeric_limits<double>::quiet_NaN();
@@ -472,7 +486,7 @@ int main(int argc, char** argv) {
                         {"gap_mm", d["gap_mm"]["all_views"]}, {"floor_mm", d["floors"]["all_views_mm"]},
                         {"tests", d.value("gap_tests", nlohmann::json::object())},
                         {"shrinkage", family == "none" ? nlohmann::json(nullptr) : nlohmann::json(shrink)},
-                        {"visible", screened},
+                        {"visible", screened}, {"fit_started_from", started},
                         {"seconds", d["runtime"]["seconds"]}});
   }
   auto median = [](std::vector<double> v) {
@@ -487,6 +501,10 @@ int main(int argc, char** argv) {
                                second_placement     ? ", placement 1 as the second capture, 2 held out"
                                : held_out_placement ? ", placement 1 as the held-out capture"
                                                     : "");
+  md += "Baseline fits started from:";
+  for (const auto& [from, n] : starts) md += fmt::format(" {} {},", from, n);
+  md.back() = '.';
+  md += starts.size() > 1 ? " (a mix of protocols)\n\n" : "\n\n";
   md += "| truth \\ verdict |";
   for (const auto& c : columns) md += " " + c + " |";
   md += "\n|---|";

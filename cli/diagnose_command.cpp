@@ -205,14 +205,13 @@ Runner add_diagnose_command(CLI::App& app) {
                  "The start's quadratic bending moduli W,B,F, g*mm^3/s^2 (--start-beta=-... for a softening "
                  "fabric)");
   app.add_option("--start-box", o->start_box,
-                 "With --start-alpha/--start-beta: a bending known to within this factor (e.g. 1.3 for a cantilever "
-                 "test's 30%): the fit searches only there, and the candidate refits scale the bending by at most this "
-                 "factor (default: the whole box, and x4.5)");
+                 "With --start-alpha/--start-beta: each of the six parameters known to within this factor (e.g. 1.3 "
+                 "for a test good to 30%): the fit searches only the bendings that allows, and the candidate refits "
+                 "scale the bending by at most this factor (default: the whole box, and x4.5)");
   app.add_flag("--ignore-measured-bending", o->ignore_measured_bending,
-               "Do not use the capture's measured bending (capture.json specimen.measured_bending, docs/CAPTURE.md): "
-               "the fit starts at the drape-coefficient guess and searches the whole box. Without this flag, a "
-               "measured bending is the start and its within_factor the box, unless --start-alpha/--start-beta is "
-               "given");
+               "Diagnose as if the capture had no measured bending (capture.json specimen.measured_bending, "
+               "docs/CAPTURE.md). Without this flag, a measured bending is the fit's start and its within_factor the "
+               "fit's box (as --start-alpha/--start-beta/--start-box), unless --start-alpha/--start-beta is given");
   app.add_option("--refit-evaluations", o->refit_evaluations,
                  "Evaluations per candidate refit and of the bar, the bending scale refitted alone (default 14, also "
                  "with --quick and --fine)");

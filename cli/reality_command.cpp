@@ -94,7 +94,9 @@ Runner add_reality_command(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--density", o->density, "Areal density, g/m^2")->capture_default_str();
   app.add_option("--resolution", o->resolution, "Vertices per side of the simulated specimen")->capture_default_str();
-  app.add_option("--seed", o->seed, "Seed of initial state, orientation, drift, camera and noise")->capture_default_str();
+  app.add_option("--seed", o->seed,
+                 "Seed of initial state, orientation, drift, camera, noise and the measured bending's error")
+      ->capture_default_str();
   app.add_option("--placement", o->placement,
                  "Placement K of the specimen: K > 0 re-drapes the same specimen (same fabric, effects and camera "
                  "calibration error) from another initial state, orientation, drift and noise: a second capture of it. A "

@@ -335,12 +335,22 @@ math(EXPR guess_hi "${measured_int} + 2")
 if(guess_alpha LESS guess_lo OR guess_alpha GREATER guess_hi)
   message(FATAL_ERROR "a measured bending: initial guess alpha_warp ${guess_alpha}, measured ${measured_alpha}")
 endif()
+# ... and the fit stays in its box: ln mean alpha 9.393 +- ln e^0.2 (the measurement of seed 4 above: alpha 14426,
+# 12245, 9787).
+string(JSON fitted_ln_alpha GET "${out}" baseline fitted_reduced 0)
+if(fitted_ln_alpha LESS 9.1928 OR fitted_ln_alpha GREATER 9.5929)
+  message(FATAL_ERROR "a measured bending: the fit left its box (ln mean alpha ${fitted_ln_alpha}, box 9.193 .. 9.593)")
+endif()
 small_fit_from(${WORK}/measured "drape coefficient" --ignore-measured-bending)
 string(JSON factor_type TYPE "${out}" baseline search_within_factor)
 if(NOT factor_type STREQUAL "NULL")
   message(FATAL_ERROR "--ignore-measured-bending: the fit searched a box (${factor_type})")
 endif()
 small_fit_from(${WORK}/measured "given start" --start-alpha 5000,4000,3000 --start-beta=-12500,-10000,-7500)
+string(JSON factor_type TYPE "${out}" baseline search_within_factor)
+if(NOT factor_type STREQUAL "NULL")
+  message(FATAL_ERROR "--start-alpha without --start-box on a capture with a measured bending: a box (${factor_type})")
+endif()
 expect_failure(1 "--measured-bending-error must be" reality ${FABRIC} --measured-bending-error 1.5 --out ${WORK}/bad)
 
 # Three placements: the second in the candidate refits and the gate, the third held out of every fit (the confirmation).

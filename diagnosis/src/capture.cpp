@@ -76,6 +76,11 @@ sim::Expected<MeasuredBending> measured_bending_from(const nlohmann::json& j, co
   return m;
 }
 
+/// A view's depth file name in the capture directory: its own file's name, or view<v>.exr.
+std::string view_file_name(const CaptureView& view, std::size_t v) {
+  return view.file.empty() ? fmt::format("view{}.exr", v) : fs::path(view.file).filename().string();
+}
+
 }  // namespace
 
 sim::Status check_view(const CaptureView& view) {
@@ -199,12 +204,20 @@ sim::Status write_capture(const std::string& directory, const Capture& capture) 
   std::error_code ec;
   fs::create_directories(dir, ec);
   if (ec) return sim::Error{fmt::format("{}: cannot create directory: {}", directory, ec.message())};
+  for (std::size_t v = 0; v < capture.views.size(); ++v) {
+    const std::string file = view_file_name(capture.views[v], v);
+    if (sim::Status s = write_depth_exr((dir / file).string(), capture.views[v].depth); !s) return s;
+  }
+  return write_capture_json(directory, capture);
+}
+
+sim::Status write_capture_json(const std::string& directory, const Capture& capture) {
+  const fs::path dir(directory);
+  std::error_code ec;
   nlohmann::json views = nlohmann::json::array();
   for (std::size_t v = 0; v < capture.views.size(); ++v) {
     const auto& view = capture.views[v];
-    const std::string file = view.file.empty() ? fmt::format("view{}.exr", v) : fs::path(view.file).filename().string();
-    if (sim::Status s = write_depth_exr((dir / file).string(), view.depth); !s) return s;
-    views.push_back({{"depth", file},
+    views.push_back({{"depth", view_file_name(view, v)},
                      {"width", view.camera.intrinsics.width},
                      {"height", view.camera.intrinsics.height},
                      {"K", matrix_json(view.camera.intrinsics.K)},
@@ -226,10 +239,16 @@ sim::Status write_capture(const std::string& directory, const Capture& capture) 
                                          {"method", m->method}};
   }
   if (capture.scan_mesh) j["scan"] = *capture.scan_mesh;
-  const fs::path path = dir / "capture.json";
-  std::ofstream out(path);
-  out << j.dump(2) << "\n";
-  if (!out) return sim::Error{fmt::format("{}: cannot write", path.string())};
+  // Through a temporary file: a reader (or a crash) never leaves half a capture.json.
+  const fs::path path = dir / "capture.json", tmp = dir / "capture.json.tmp";
+  {
+    std::ofstream out(tmp);
+    out << j.dump(2) << "\n";
+    out.close();
+    if (!out) return sim::Error{fmt::format("{}: cannot write", tmp.string())};
+  }
+  fs::rename(tmp, path, ec);
+  if (ec) return sim::Error{fmt::format("{}: cannot write: {}", path.string(), ec.message())};
   return {};
 }
 

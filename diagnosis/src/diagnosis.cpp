@@ -227,13 +227,11 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
   if (fit_start) {
     *guess = to_reduced(*fit_start);
     for (std::size_t k = 0; k < guess->size(); ++k) (*guess)[k] = std::clamp((*guess)[k], lo[k], hi[k]);
-    if (start_box > 1.0) {  // the box narrowed to the start's neighbourhood
-      const double f = std::log(start_box);
-      for (std::size_t k = 0; k < 3; ++k) {
-        lo[k] = std::max(lo[k], (*guess)[k] - f), hi[k] = std::min(hi[k], (*guess)[k] + f);
+    if (start_box > 1.0) {  // the box narrowed to the start's neighbourhood: reduced_box
+      const auto [near_lo, near_hi] = reduced_box(*guess, start_box);
+      for (std::size_t k = 0; k < guess->size(); ++k) {
+        lo[k] = std::max(lo[k], near_lo[k]), hi[k] = std::min(hi[k], near_hi[k]);
       }
-      lo[3] = std::max(lo[3], (*guess)[3] / start_box);
-      hi[3] = std::min(hi[3], (*guess)[3] * start_box);
       r.search_within_factor = start_box;
     }
   } else {

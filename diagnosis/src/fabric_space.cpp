@@ -1,5 +1,6 @@
 #include "drapegen/diagnosis/fabric_space.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace drapegen::diagnosis {
@@ -25,6 +26,15 @@ ReducedBending to_reduced(const BendingParameters& p) {
   x[2] = std::log(a.bias / g);
   x[3] = -(p.beta.warp + p.beta.bias + p.beta.weft) / (a.warp + a.bias + a.weft);
   return x;
+}
+
+std::pair<ReducedBending, ReducedBending> reduced_box(const ReducedBending& x, double factor) {
+  const double l = std::log(factor);
+  ReducedBending lo{x[0] - l, x[1] - 2.0 * l, x[2] - 2.0 * l, 0.0}, hi{x[0] + l, x[1] + 2.0 * l, x[2] + 2.0 * l, 0.0};
+  const double f2 = factor * factor;
+  lo[3] = std::min({x[3] / f2, x[3] * f2, x[3] - kMinRatioWidth});
+  hi[3] = std::max({x[3] / f2, x[3] * f2, x[3] + kMinRatioWidth});
+  return {lo, hi};
 }
 
 double stiffness_scale(double density_g_per_m2) { return density_g_per_m2 / 300.0; }

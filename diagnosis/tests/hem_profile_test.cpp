@@ -2,7 +2,6 @@
 
 #include <cmath>
 
-#include "drapegen/diagnosis/fabric_space.hpp"
 #include "drapegen/diagnosis/hem_profile.hpp"
 
 using namespace drapegen::diagnosis;
@@ -82,33 +81,4 @@ TEST(HemProfile, OrientationFollowsTheOffCentreNotTheFolds) {
   const auto h = harmonics(low_pass(target, kOrientationOrders), 8);
   EXPECT_NEAR(h[1].amplitude, 0.010, 1e-4);
   EXPECT_LT(h[8].amplitude, 1e-4);
-}
-
-TEST(FabricSpace, RoundTrip) {
-  BendingParameters p;
-  p.alpha = {13923, 11455, 8821};
-  p.beta = {-2.5 * 13923, -2.5 * 11455, -2.5 * 8821};
-  const auto x = to_reduced(p);
-  const auto q = from_reduced(x);
-  EXPECT_NEAR(q.alpha.warp, p.alpha.warp, 1e-6);
-  EXPECT_NEAR(q.alpha.bias, p.alpha.bias, 1e-6);
-  EXPECT_NEAR(q.alpha.weft, p.alpha.weft, 1e-6);
-  EXPECT_NEAR(q.beta.bias, p.beta.bias, 1e-6);
-  EXPECT_NEAR(x[3], 2.5, 1e-12);
-  EXPECT_NEAR(std::exp(x[0]), std::cbrt(13923.0 * 11455 * 8821), 1e-6);
-}
-
-TEST(FabricSpace, TheStiffnessRangeScalesWithDensity) {
-  // The drape depends on alpha / density: every fabric of fabrics618 lies inside the box at its own density, the
-  // lightest and softest (29 g/m^2, alpha 350) as well as the heaviest and stiffest (870 g/m^2, alpha 115000).
-  for (const auto& [density, alpha] : {std::pair{28.9, 347.0}, std::pair{870.3, 115487.0}, std::pair{300.0, 1778.0}}) {
-    EXPECT_LT(reduced_lower(density)[0], std::log(alpha)) << density;
-    EXPECT_GT(reduced_upper(density)[0], std::log(alpha)) << density;
-  }
-  EXPECT_NEAR(reduced_lower(30.0)[0], reduced_lower(300.0)[0] + std::log(0.1), 1e-12);
-  EXPECT_NEAR(reduced_upper(600.0)[0], reduced_upper(300.0)[0] + std::log(2.0), 1e-12);
-  for (int k = 1; k < 4; ++k) {  // the shape coordinates do not depend on density
-    EXPECT_EQ(reduced_lower(30.0)[k], reduced_lower(300.0)[k]);
-    EXPECT_EQ(reduced_upper(30.0)[k], reduced_upper(300.0)[k]);
-  }
 }

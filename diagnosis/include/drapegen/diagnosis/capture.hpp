@@ -16,8 +16,8 @@ namespace drapegen::diagnosis {
 /// The specimen's bending as another test measured it (e.g. a cantilever test), and how precise that test is.
 struct MeasuredBending {
   BendingParameters bending;
-  /// The test's precision: the true bending lies within this factor of `bending` (> 1; e.g. 1.25 for a test good
-  /// to about 10%). The diagnosis's fits stay within it.
+  /// The test's precision: each of the six true parameters lies within this factor of the measured one (> 1; e.g.
+  /// e^(2 x 0.1) = 1.22, the 95% range of a test with a 10% lognormal error). The diagnosis's fits stay within it.
   double within_factor = 1.25;
   std::string method;  // free text, e.g. "cantilever (ASTM D1388)"
 };
@@ -55,8 +55,12 @@ constexpr int kCaptureViews = 4;
 /// a view without any return, implausible specimen facts.
 [[nodiscard]] sim::Expected<Capture> read_capture(const std::string& directory);
 
-/// Writes capture.json and the depth EXRs (float) into `directory` (created if needed). capture.directory is ignored.
+/// Writes the depth EXRs (float), then capture.json (through a temporary file, so that it is whole or absent), into
+/// `directory` (created if needed). capture.directory is ignored.
 [[nodiscard]] sim::Status write_capture(const std::string& directory, const Capture& capture);
+/// Writes capture.json alone (through a temporary file), naming the depth files write_capture would: for a capture
+/// read from `directory` whose description changes (e.g. a measured bending added), the depth files stay as they are.
+[[nodiscard]] sim::Status write_capture_json(const std::string& directory, const Capture& capture);
 
 /// Checks one view's depth: size, finite, non-negative, some return.
 [[nodiscard]] sim::Status check_view(const CaptureView& view);

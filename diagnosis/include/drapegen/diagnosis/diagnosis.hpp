@@ -31,8 +31,8 @@ struct DiagnosisSettings {
   /// The baseline fit's start instead of the drape-coefficient guess (e.g. an estimate from a cantilever test or the
   /// network), clamped to the search box; its reduced coordinates (to_reduced) are all the fit can use of it.
   std::optional<BendingParameters> start;
-  /// With a start: the fit searches only within this factor of it (the mean alpha and the two alpha ratios within
-  /// x 1/start_box .. start_box, -beta/alpha as well), for a bending known from another test to that precision; the
+  /// With a start: the fit searches only the bendings whose six parameters each lie within this factor of the
+  /// start's (reduced_box), for a bending known from another test to that precision; the
   /// candidates' refits then scale the bending by at most this factor (instead of AttributionSettings::
   /// bending_scale_range). 0: the whole box.
   double start_box = 0.0;

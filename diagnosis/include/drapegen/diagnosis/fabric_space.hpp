@@ -2,6 +2,7 @@
 // The baseline model's six bending parameters and the reduced coordinates the fit searches in.
 
 #include <array>
+#include <utility>
 
 #include "drapegen/sim/anisotropy.hpp"
 
@@ -21,6 +22,13 @@ using ReducedBending = std::array<double, 4>;
 [[nodiscard]] BendingParameters from_reduced(const ReducedBending& x);
 /// The reduced coordinates of `p` (x3 is the alpha-weighted mean ratio).
 [[nodiscard]] ReducedBending to_reduced(const BendingParameters& p);
+
+/// The reduced coordinates of every bending whose six parameters each lie within a factor F of those of `x`'s:
+/// x0 +- ln F (a mean of the three ln alpha), x1 and x2 +- 2 ln F (differences of them), x3 within x 1/F^2 .. F^2
+/// (a ratio of beta to alpha) and at least +- kMinRatioWidth mm (a start with no softening, x3 = 0, keeps some room).
+/// Returns {lower, upper}.
+[[nodiscard]] std::pair<ReducedBending, ReducedBending> reduced_box(const ReducedBending& x, double factor);
+inline constexpr double kMinRatioWidth = 0.1;  // mm
 
 /// The drape depends on alpha / density only (paper Section 5.1.2), so the stiffness range scales with the specimen's
 /// density: alpha from 200 to 300000 at the standard 300 g/m^2 (fabrics618: 1778 .. 148108 there), times

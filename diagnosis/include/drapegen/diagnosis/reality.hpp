@@ -54,7 +54,7 @@ struct RealitySpec {
 
 /// A bending test's report of a specimen whose true bending is `truth`: each of the six parameters times its own
 /// e^(sigma g), g standard normal (seeded by `seed`), and the precision it states, within_factor = e^(2 sigma) (each
-/// parameter's 95% range). Never the truth itself for sigma > 0. sigma must be 0 .. 1.
+/// parameter's 95% range). For sigma > 0 it is not the truth (but for a zero beta, which stays 0). sigma: 0 .. 1.
 [[nodiscard]] MeasuredBending measure_bending(const BendingParameters& truth, double sigma, std::uint64_t seed);
 
 struct RealityResult {
