@@ -25,6 +25,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 
+#include "drapegen/diagnosis/bending_json.hpp"
 #include "drapegen/diagnosis/candidate_effect.hpp"
 #include "drapegen/diagnosis/diagnosis.hpp"
 #include "drapegen/diagnosis/forward_model.hpp"
@@ -42,13 +43,6 @@ sim::Expected<json> read_json(const fs::path& path) {
   json j = json::parse(in, nullptr, false);
   if (j.is_discarded()) return sim::Error{"not JSON: " + path.string()};
   return j;
-}
-
-diagnosis::BendingParameters bending_of(const json& j) {
-  diagnosis::BendingParameters b;
-  b.alpha = {j.at("alpha")[0].get<double>(), j.at("alpha")[1].get<double>(), j.at("alpha")[2].get<double>()};
-  b.beta = {j.at("beta")[0].get<double>(), j.at("beta")[1].get<double>(), j.at("beta")[2].get<double>()};
-  return b;
 }
 
 /// The truth file's (first) effect: its name and strength; none for a control.
@@ -215,12 +209,16 @@ sim::Status probe_case(const fs::path& run, const std::string& name, const diagn
   std::string fitted = "-", reported = "-";
   if (report) {
     diagnosis::ModelSetup setup;
-    setup.bending = bending_of(report->at("baseline").at("fitted"));
+    auto fitted_bending = diagnosis::bending_from_json(report->at("baseline").at("fitted"), "report baseline.fitted");
+    if (!fitted_bending) return fitted_bending.error();
+    setup.bending = *fitted_bending;
     fitted = cell(score(**model, setup, states, p1));
     reported = fmt::format("{:.2f}", report->at("gap_tests").at("capture").at("shape").get<double>());
   }
   diagnosis::ModelSetup truth_setup;
-  truth_setup.bending = bending_of(*truth);
+  auto true_bending = diagnosis::bending_from_json(*truth, "truth");
+  if (!true_bending) return true_bending.error();
+  truth_setup.bending = *true_bending;
   const auto without = score(**model, truth_setup, states, p1);
   if (!without) return without.error();
   std::string oracle = "-";

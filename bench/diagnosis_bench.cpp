@@ -22,6 +22,7 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
+#include "drapegen/diagnosis/bending_json.hpp"
 #include "drapegen/diagnosis/reality.hpp"
 #include "drapegen/renderer/random.hpp"
 #include "drapegen/sampler/fabric_data.hpp"
@@ -337,18 +338,16 @@ int main(int argc, char** argv) {
           }
           continue;
         }
-        diagnosis::BendingParameters bending;
-        std::uint64_t specimen_seed = 0;
-        try {
-          const auto truth = nlohmann::json::parse(std::ifstream(fs::path(out) / "truth" / (name + ".json")));
-          const auto a = truth.at("alpha").get<std::vector<double>>(), b = truth.at("beta").get<std::vector<double>>();
-          bending = {.alpha = {a.at(0), a.at(1), a.at(2)}, .beta = {b.at(0), b.at(1), b.at(2)}};
-          specimen_seed = truth.at("seed").get<std::uint64_t>();
-        } catch (const std::exception& e) {
-          std::cerr << "diagnosis_bench: " << name << ": no truth file with alpha, beta and seed: " << e.what() << "\n";
+        const fs::path truth_path = fs::path(out) / "truth" / (name + ".json");
+        const auto truth = nlohmann::json::parse(std::ifstream(truth_path), nullptr, false);
+        auto bending = diagnosis::bending_from_json(truth, truth_path.string());
+        if (!bending || !truth.contains("seed") || !truth["seed"].is_number_unsigned()) {
+          std::cerr << "diagnosis_bench: " << truth_path.string() << ": no truth file with alpha, beta and seed"
+                    << (bending ? "" : " (" + bending.error().message + ")") << "\n";
           return 1;
         }
-        capture->specimen.measured_bending = diagnosis::measure_bending(bending, measured_bending_error, specimen_seed);
+        capture->specimen.measured_bending =
+            diagnosis::measure_bending(*bending, measured_bending_error, truth["seed"].get<std::uint64_t>());
         if (sim::Status st = diagnosis::write_capture_json(dir.string(), *capture); !st) {
           std::cerr << "diagnosis_bench: " << st.error().message << "\n";
           return 1;

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "drapegen/diagnosis/bending_json.hpp"
 #include "drapegen/diagnosis/depth_exr.hpp"
 
 namespace drapegen::diagnosis {
@@ -42,28 +43,15 @@ sim::Expected<Eigen::MatrixXd> matrix_from(const nlohmann::json& j, int rows, in
   return m;
 }
 
-/// A directional triple [warp, bias, weft] of numbers.
-sim::Expected<sim::DirectionalValues> directional_from(const nlohmann::json& j, const std::string& what) {
-  if (!j.is_array() || j.size() != 3 || !j[0].is_number() || !j[1].is_number() || !j[2].is_number()) {
-    return sim::Error{fmt::format("{} must be [warp, bias, weft] numbers", what)};
-  }
-  return sim::DirectionalValues{j[0].get<double>(), j[1].get<double>(), j[2].get<double>()};
-}
-
 sim::Expected<MeasuredBending> measured_bending_from(const nlohmann::json& j, const std::string& where) {
   if (!j.is_object()) return sim::Error{where + " must be an object"};
   if (!j.contains("alpha") || !j.contains("beta") || !j.contains("within_factor")) {
     return sim::Error{where + " needs \"alpha\", \"beta\" and \"within_factor\""};
   }
   MeasuredBending m;
-  auto alpha = directional_from(j["alpha"], where + ".alpha");
-  if (!alpha) return alpha.error();
-  auto beta = directional_from(j["beta"], where + ".beta");
-  if (!beta) return beta.error();
-  if (!(alpha->warp > 0.0 && alpha->bias > 0.0 && alpha->weft > 0.0)) {
-    return sim::Error{where + ".alpha must be positive"};
-  }
-  m.bending = BendingParameters{.alpha = *alpha, .beta = *beta};
+  auto bending = bending_from_json(j, where);
+  if (!bending) return bending.error();
+  m.bending = *bending;
   const auto& factor = j["within_factor"];
   if (!factor.is_number() || !(factor.get<double>() > 1.0 && factor.get<double>() <= 100.0)) {
     return sim::Error{where + ".within_factor must be a number in (1, 100]"};
@@ -232,11 +220,10 @@ sim::Status write_capture_json(const std::string& directory, const Capture& capt
                         {"cylinder_diameter_mm", capture.specimen.cylinder_diameter * 1e3}}},
                       {"views", views}};
   if (const auto& m = capture.specimen.measured_bending) {
-    const BendingParameters& b = m->bending;
-    j["specimen"]["measured_bending"] = {{"alpha", {b.alpha.warp, b.alpha.bias, b.alpha.weft}},
-                                         {"beta", {b.beta.warp, b.beta.bias, b.beta.weft}},
-                                         {"within_factor", m->within_factor},
-                                         {"method", m->method}};
+    nlohmann::json measured = bending_json(m->bending);
+    measured["within_factor"] = m->within_factor;
+    measured["method"] = m->method;
+    j["specimen"]["measured_bending"] = measured;
   }
   if (capture.scan_mesh) j["scan"] = *capture.scan_mesh;
   // Through a temporary file: a reader (or a crash) never leaves half a capture.json.

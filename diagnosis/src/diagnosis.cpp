@@ -9,6 +9,7 @@
 
 #include <fmt/format.h>
 
+#include "drapegen/diagnosis/bending_json.hpp"
 #include "drapegen/sim/logging.hpp"
 
 namespace drapegen::diagnosis {
@@ -62,10 +63,6 @@ sim::Expected<ReducedBending> initial_guess(ForwardModel& model, int levels) {
   }
   sim::logger()->debug("initial guess: the capture's drape coefficient {:.3f} -> alpha {:.0f}", target, std::exp(la));
   return ReducedBending{std::clamp(la, lo[0], hi[0]), 0.0, 0.0, 2.5};
-}
-
-nlohmann::json bending_json(const BendingParameters& p) {
-  return {{"alpha", {p.alpha.warp, p.alpha.bias, p.alpha.weft}}, {"beta", {p.beta.warp, p.beta.bias, p.beta.weft}}};
 }
 
 nlohmann::json view_json(const ScoredDrape& d) {

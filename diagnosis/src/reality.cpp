@@ -8,6 +8,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 
+#include "drapegen/diagnosis/bending_json.hpp"
 #include "drapegen/diagnosis/candidate_effect.hpp"
 #include "drapegen/renderer/depth_renderer.hpp"
 #include "drapegen/renderer/noise.hpp"
@@ -274,8 +275,6 @@ sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std
       {"family", p.family},
       {"effects", p.effects},
       {"regions", p.regions},
-      {"alpha", {spec.bending.alpha.warp, spec.bending.alpha.bias, spec.bending.alpha.weft}},
-      {"beta", {spec.bending.beta.warp, spec.bending.beta.bias, spec.bending.beta.weft}},
       {"density_g_per_m2", spec.density},
       {"resolution", spec.resolution},
       {"seed", spec.seed},
@@ -295,6 +294,7 @@ sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std
       {"converged", converged},
       {"drape_coefficient", drape->measures.drape_coefficient},
       {"folds", drape->measures.folds}};
+  truth.update(bending_json(spec.bending));  // "alpha", "beta"
   RealityResult result;
   result.truth_path = (fs::path(directory) / "truth.json").string();
   std::ofstream out(result.truth_path);
