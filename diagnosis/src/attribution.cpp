@@ -126,8 +126,9 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
   std::vector<double> x0, step, lo, hi;
   const bool sim = bar || needs_simulation(*effect);
   if (sim) {  // the bending scale stays free: an effect may trade off against stiffness (and the bar refits it alone)
-    const double range = settings.bending_scale_range;
-    x0.push_back(0.0), step.push_back(std::min(0.25, 0.5 * range)), lo.push_back(-range), hi.push_back(range);
+    const double lower = std::min(0.0, settings.bending_scale_lower), upper = std::max(0.0, settings.bending_scale_upper);
+    // The first step goes up (the NelderMead reflects it down at the upper bound); a quarter of the range at most.
+    x0.push_back(0.0), step.push_back(std::min(0.25, 0.25 * (upper - lower))), lo.push_back(lower), hi.push_back(upper);
   }
   const std::size_t first = x0.size();
   x0.insert(x0.end(), space.start.begin(), space.start.end());

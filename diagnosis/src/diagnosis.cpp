@@ -359,9 +359,15 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
     if (second_model) other_captures.second = {second_model.get(), &r.validated_second->best};
     if (held_out_model) other_captures.held_out = {held_out_model.get(), &r.validated_held_out->best};
     AttributionSettings attribution_settings = settings.attribution;
-    if (r.search_within_factor > 1.0) {  // the known bending's precision bounds the refits' scale too
-      attribution_settings.bending_scale_range = std::log(r.search_within_factor);
+    if (r.search_within_factor > 1.0) {
+      // The known bending's box bounds the refits too: the bending scale moves only ln mean alpha (the ratios and
+      // -beta/alpha stay), so the refits reach from the fit to either end of the box's ln mean alpha, however far
+      // the fit sits from the box's middle.
+      attribution_settings.bending_scale_lower = lo[0] - r.fitted_reduced[0];
+      attribution_settings.bending_scale_upper = hi[0] - r.fitted_reduced[0];
     }
+    r.refit_scale_lower = attribution_settings.bending_scale_lower;
+    r.refit_scale_upper = attribution_settings.bending_scale_upper;
     auto attribution = attribute(model, fitted, r.fit, r.validated, r.floors, attribution_settings, make_model,
                                  other_captures);
     if (!attribution) return attribution.error();
@@ -522,6 +528,9 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
   j["attribution"] = {{"ran", ran},
                       {"confirmed_on", r.validated_held_out ? "held_out_capture" : "held_out_view"},
                       {"refitted_on", r.validated_second ? "capture_and_second_capture" : "capture"},
+                      {"alpha_scale_bounds", ran ? nlohmann::json::array({std::exp(r.refit_scale_lower),
+                                                                           std::exp(r.refit_scale_upper)})
+                                                 : nlohmann::json(nullptr)},
                       {"bending_refit_bar",
                        {{"alpha_scale", r.attribution.bar.alpha_scale},
                         {"bending", bending_json(r.attribution.bar.setup.bending)},

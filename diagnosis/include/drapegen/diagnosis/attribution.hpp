@@ -137,8 +137,10 @@ struct AttributionSettings {
   /// wins by the bending scale it was refitted with (its effect ended where it vanishes, e.g. shear at the membrane's
   /// stiffness) then shrinks nothing. Off by default (docs/DIAGNOSIS.md, "Session 19").
   bool ablation = false;
-  /// The refits' bending scale: ln of its largest factor on the baseline fit's alpha and beta (0.22 .. 4.5 times).
-  double bending_scale_range = 1.5;
+  /// The refits' bending scale s (alpha and beta of the baseline fit times e^s): its bounds, lower <= 0 <= upper
+  /// (x0.22 .. x4.5 by default; a measured bending's box, diagnose() sets them to where that box ends around the fit).
+  double bending_scale_lower = -1.5;
+  double bending_scale_upper = 1.5;
   std::uint64_t validation_seed = 2000;
   int jobs = 1;                     // candidate refits in parallel (one forward model per thread)
   std::vector<Effect> candidates{std::begin(kAllEffects), std::end(kAllEffects)};

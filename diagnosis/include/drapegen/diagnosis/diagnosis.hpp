@@ -102,6 +102,9 @@ struct DiagnosisResult {
   Localisation localisation;
   ShapeSet fit_target;  // the capture's shape features
   Attribution attribution;
+  /// The refits' bending scale bounds (AttributionSettings::bending_scale_lower/upper, ln of the factor on the fit's
+  /// alpha and beta) where the attribution ran.
+  double refit_scale_lower = 0.0, refit_scale_upper = 0.0;
   /// The verdict: the named effect ("none" within the floors, "unexplained" if no candidate shrinks it enough,
   /// "not attributed" above the floors when DiagnosisSettings::attribute is false).
   std::string verdict;
