@@ -207,7 +207,8 @@ Runner add_diagnose_command(CLI::App& app) {
   app.add_option("--start-box", o->start_box,
                  "With --start-alpha/--start-beta: each of the six parameters known to within this factor (e.g. 1.3 "
                  "for a test good to 30%): the fit searches only the bendings that allows, and the candidate refits "
-                 "scale the bending by at most this factor (default: the whole box, and x4.5)");
+                 "scale the bending only within that box, from the fit to either end of its mean alpha (default: the "
+                 "whole box, and x0.22 .. x4.5)");
   app.add_flag("--ignore-measured-bending", o->ignore_measured_bending,
                "Diagnose as if the capture had no measured bending (capture.json specimen.measured_bending, "
                "docs/CAPTURE.md). Without this flag, a measured bending is the fit's start and its within_factor the "

@@ -352,26 +352,26 @@ if(NOT factor_type STREQUAL "NULL")
   message(FATAL_ERROR "--start-alpha without --start-box on a capture with a measured bending: a box (${factor_type})")
 endif()
 expect_failure(1 "--measured-bending-error must be" reality ${FABRIC} --measured-bending-error 1.5 --out ${WORK}/bad)
-# The refits of a measured capture reach from the fit to either end of the measured box's ln mean alpha (9.193 ..
-# 9.593): alpha scale e^(9.193 - fit) .. e^(9.593 - fit), so beyond e^0.2 on the side away from the fit, within e^0.4.
-run_ok(out diagnose --capture ${WORK}/measured --quick --resolution 10 --states 2 --evaluations 4 --refit-evaluations 3
-       --candidates curl --json)
-string(JSON fitted_ln_alpha GET "${out}" baseline fitted_reduced 0)
+# A known bending's box bounds the refits: they reach from the fit to either end of the box's geometric mean alpha,
+# wherever the fit ends. A start at alpha 280000 within e^0.2: the box's mean alpha is 280000 / 1.2214 = 229245 ..
+# 300000 (the whole box's cap at 300 g/m^2), so the refits' range must be exactly that (x 1/F .. F around the fit
+# would pass 300000 or stop short of it).
+run_ok(out diagnose --capture ${WORK}/capture --quick --resolution 10 --states 2 --evaluations 4 --refit-evaluations 3
+       --candidates curl --start-alpha 280000,280000,280000 --start-beta=-700000,-700000,-700000 --start-box 1.2214
+       --json)
+string(JSON alpha_lo GET "${out}" attribution mean_alpha_bounds 0)
+string(JSON alpha_hi GET "${out}" attribution mean_alpha_bounds 1)
 string(JSON scale_lo GET "${out}" attribution alpha_scale_bounds 0)
 string(JSON scale_hi GET "${out}" attribution alpha_scale_bounds 1)
-if(fitted_ln_alpha LESS 9.3928)  # the soft half: the refits reach further up than e^0.2
-  set(reach_ok "${scale_hi}" GREATER_EQUAL 1.2214 AND "${scale_lo}" GREATER_EQUAL 0.8187)
-else()
-  set(reach_ok "${scale_lo}" LESS_EQUAL 0.8188 AND "${scale_hi}" LESS_EQUAL 1.2215)
-endif()
-if(NOT (${reach_ok}) OR scale_lo LESS 0.6703 OR scale_lo GREATER 1 OR scale_hi LESS 1 OR scale_hi GREATER 1.4919)
-  message(FATAL_ERROR "a measured bending: refits' alpha scale ${scale_lo} .. ${scale_hi} for a fit at ln mean alpha "
-                      "${fitted_ln_alpha} (box 9.193 .. 9.593)")
+if(alpha_lo LESS 229240 OR alpha_lo GREATER 229250 OR alpha_hi LESS 299990 OR alpha_hi GREATER 300010
+   OR scale_lo GREATER 1 OR scale_hi LESS 1)
+  message(FATAL_ERROR "a known bending's box: the refits' mean alpha ${alpha_lo} .. ${alpha_hi} (alpha scale "
+                      "${scale_lo} .. ${scale_hi}), expected 229245 .. 300000")
 endif()
 foreach(path "bending_refit_bar" "candidates;0")
   string(JSON scale GET "${out}" attribution ${path} alpha_scale)
   if(scale LESS scale_lo OR scale GREATER scale_hi)
-    message(FATAL_ERROR "a measured bending: ${path}'s alpha scale ${scale} outside ${scale_lo} .. ${scale_hi}")
+    message(FATAL_ERROR "a known bending's box: ${path}'s alpha scale ${scale} outside ${scale_lo} .. ${scale_hi}")
   endif()
 endforeach()
 

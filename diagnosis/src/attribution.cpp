@@ -214,11 +214,13 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
   double spacing = 0.0;
   const int room = options.max_evaluations - AttributionSettings::kSimplexAfterScan;
   const bool one_parameter = sim && !bar && space.start.size() == 1;
+  // The yield trade's reach: kYieldScaleRange, or a known bending's box (no room to trade when the fit is at its edge).
+  const double trade_reach = settings.bending_scale_known ? hi[0] : AttributionSettings::kYieldScaleRange;
   if (one_parameter && effect == Effect::kYield && settings.yield_trade_levels >= 2 &&
-      settings.yield_trade_levels <= room) {
+      settings.yield_trade_levels <= room && trade_reach > 0.01) {
     // Stiffer bending against a lower yield curvature (AttributionSettings::yield_trade_levels).
     const int n = settings.yield_trade_levels;
-    hi[0] = AttributionSettings::kYieldScaleRange;
+    hi[0] = trade_reach;
     spacing = hi[0] / (n - 1);
     for (int k = 0; k < n; ++k) {
       std::vector<double> x = x0;

@@ -280,7 +280,7 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
     ReducedBending best_x{};
     for (double la : levels) {
       for (double ratio : settings.start_ratios_mm) {
-        const ReducedBending x{la, 0.0, 0.0, std::clamp(ratio, lo[3], hi[3])};
+        const ReducedBending x{la, std::clamp(0.0, lo[1], hi[1]), std::clamp(0.0, lo[2], hi[2]), std::clamp(ratio, lo[3], hi[3])};
         const double value = objective({x.begin(), x.end()});
         if (error) return *error;
         ++r.start_evaluations;
@@ -360,11 +360,12 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
     if (held_out_model) other_captures.held_out = {held_out_model.get(), &r.validated_held_out->best};
     AttributionSettings attribution_settings = settings.attribution;
     if (r.search_within_factor > 1.0) {
-      // The known bending's box bounds the refits too: the bending scale moves only ln mean alpha (the ratios and
-      // -beta/alpha stay), so the refits reach from the fit to either end of the box's ln mean alpha, however far
-      // the fit sits from the box's middle.
+      // A known bending's box (a measured bending or --start-box) bounds the refits too: the bending scale moves only
+      // ln mean alpha (the ratios and -beta/alpha stay), so the refits reach from the fit to either end of the box's
+      // ln mean alpha, however far the fit sits from the box's middle.
       attribution_settings.bending_scale_lower = lo[0] - r.fitted_reduced[0];
       attribution_settings.bending_scale_upper = hi[0] - r.fitted_reduced[0];
+      attribution_settings.bending_scale_known = true;
     }
     r.refit_scale_lower = attribution_settings.bending_scale_lower;
     r.refit_scale_upper = attribution_settings.bending_scale_upper;
@@ -531,6 +532,10 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                       {"alpha_scale_bounds", ran ? nlohmann::json::array({std::exp(r.refit_scale_lower),
                                                                            std::exp(r.refit_scale_upper)})
                                                  : nlohmann::json(nullptr)},
+                      {"mean_alpha_bounds",  // the same as the refits' range of the geometric mean alpha
+                       ran ? nlohmann::json::array({std::exp(r.fitted_reduced[0] + r.refit_scale_lower),
+                                                    std::exp(r.fitted_reduced[0] + r.refit_scale_upper)})
+                           : nlohmann::json(nullptr)},
                       {"bending_refit_bar",
                        {{"alpha_scale", r.attribution.bar.alpha_scale},
                         {"bending", bending_json(r.attribution.bar.setup.bending)},

@@ -138,9 +138,12 @@ struct AttributionSettings {
   /// stiffness) then shrinks nothing. Off by default (docs/DIAGNOSIS.md, "Session 19").
   bool ablation = false;
   /// The refits' bending scale s (alpha and beta of the baseline fit times e^s): its bounds, lower <= 0 <= upper
-  /// (x0.22 .. x4.5 by default; a measured bending's box, diagnose() sets them to where that box ends around the fit).
+  /// (x0.22 .. x4.5 by default; for a known bending's box, a measured bending or DiagnosisSettings::start_box,
+  /// diagnose() sets them to where that box's mean alpha ends on either side of the fit).
   double bending_scale_lower = -1.5;
   double bending_scale_upper = 1.5;
+  /// The bounds are a known bending's: no refit leaves them, the yield trade (yield_trade_levels) included.
+  bool bending_scale_known = false;
   std::uint64_t validation_seed = 2000;
   int jobs = 1;                     // candidate refits in parallel (one forward model per thread)
   std::vector<Effect> candidates{std::begin(kAllEffects), std::end(kAllEffects)};

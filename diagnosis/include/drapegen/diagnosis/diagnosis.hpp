@@ -32,9 +32,9 @@ struct DiagnosisSettings {
   /// network), clamped to the search box; its reduced coordinates (to_reduced) are all the fit can use of it.
   std::optional<BendingParameters> start;
   /// With a start: the fit searches only the bendings whose six parameters each lie within this factor of the
-  /// start's (reduced_box), for a bending known from another test to that precision; the
-  /// candidates' refits then scale the bending by at most this factor (instead of AttributionSettings::
-  /// bending_scale_range). 0: the whole box.
+  /// start's (reduced_box), for a bending known from another test to that precision; the candidates' refits then
+  /// scale the bending only within that box (from the fit to either end of its mean alpha, instead of
+  /// AttributionSettings' x0.22 .. x4.5). 0: the whole box.
   double start_box = 0.0;
   /// Without a start: a capture's measured bending (SpecimenFacts::measured_bending) is the start and its
   /// within_factor the start_box. false: the capture's measured bending is not used (the fit starts at the
