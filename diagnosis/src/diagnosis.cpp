@@ -345,6 +345,7 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
   r.localisation = localise(model, gap);
   r.fit_target = model.target().shape;
   localise_features(r.localisation, gap, model.target(), r.floors.group_floor(), r.floors.stable_floor());
+  localise_against_floors(r.localisation, r.floors.region_floor());
 
   // 4. Which effect explains it (not when the gap is within the floors).
   const auto attribution_start = std::chrono::steady_clock::now();
@@ -473,7 +474,9 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
     regions.push_back({{"region", region_name(s.region)},
                        {"energy_share", s.energy_share},
                        {"pixel_share", s.pixel_share},
-                       {"enrichment", s.enrichment}});
+                       {"enrichment", s.enrichment},
+                       {"rms_mm", s.rms * 1e3},
+                       {"floor_ratio", s.floor_ratio}});
   }
   nlohmann::json harmonics = nlohmann::json::array();
   for (const auto& h : L.hem_difference) {
@@ -491,6 +494,7 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                        {"feature_groups", groups},
                        {"stable_ratio", L.stable_ratio},
                        {"pixel_region", region_name(L.pixel_region)},
+                       {"floor_region", region_name(L.floor_region)},
                        {"regions", regions},
                        {"view_share", L.view_share},
                        {"hem_difference_harmonics", harmonics},

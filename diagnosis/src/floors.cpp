@@ -31,6 +31,9 @@ sim::Status score_pseudo(ForwardModel& model, const ModelSetup& fitted, const Ev
   samples.stable.push_back(chosen->stable_all);
   samples.shape.push_back(chosen->shape_all);
   samples.groups.push_back(group_differences(target.shape.all, chosen->shape.all));
+  const RegionEnergy regions = region_energy(model, *chosen);
+  auto& mean_square = samples.region_mean_square.emplace_back();
+  for (int k = 0; k < RegionEnergy::kCount; ++k) mean_square[k] = regions.mean_square(static_cast<Region>(k));
   return {};
 }
 
@@ -64,6 +67,14 @@ std::vector<double> Floors::group_floor() const {
   for (const auto* samples : {&noise, &multistability})
     for (const auto& g : samples->groups)
       for (std::size_t k = 0; k < g.size() && k < top.size(); ++k) top[k] = std::max(top[k], g[k]);
+  return top;
+}
+
+std::array<double, RegionEnergy::kCount> Floors::region_floor() const {
+  std::array<double, RegionEnergy::kCount> top{};
+  for (const auto* samples : {&noise, &multistability})
+    for (const auto& m : samples->region_mean_square)
+      for (int k = 0; k < RegionEnergy::kCount; ++k) top[k] = std::max(top[k], m[k]);
   return top;
 }
 

@@ -61,14 +61,17 @@ void localise_features(Localisation& L, const ScoredDrape& drape, const Target& 
   if (L.stable_ratio > best) L.dominant = Region::kGlobal;
 }
 
-Localisation localise(const ForwardModel& model, const ScoredDrape& drape) {
-  Localisation L;
+double RegionEnergy::mean_square(Region region) const {
+  const int k = static_cast<int>(region);
+  return k < kCount && pixels[k] > 0.0 ? energy[k] / pixels[k] : 0.0;
+}
+
+RegionEnergy region_energy(const ForwardModel& model, const ScoredDrape& drape) {
+  RegionEnergy E;
   const Capture& capture = model.capture();
   const double R = 0.5 * capture.specimen.cylinder_diameter;
   const HemProfile model_outline = rotate(hem_profile_from_mesh(drape.mesh), drape.angle);
-  double energy[5] = {0, 0, 0, 0, 0}, pixels[5] = {0, 0, 0, 0, 0};
-  double total_energy = 0.0, total_pixels = 0.0;
-  std::vector<double> view_energy(drape.views.size(), 0.0);
+  E.view_energy.assign(drape.views.size(), 0.0);
   for (std::size_t v = 0; v < drape.views.size(); ++v) {
     const auto& cmp = drape.views[v];
     const auto& view = capture.views[v];
@@ -81,21 +84,30 @@ Localisation localise(const ForwardModel& model, const ScoredDrape& drape) {
       const Eigen::Vector3d p = to_specimen * (static_cast<double>(cmp.depth[i]) * view.camera.ray(u, row));
       const int k = static_cast<int>(classify_point(p, model_outline, R));
       const double e = static_cast<double>(res) * res;
-      energy[k] += e;
-      pixels[k] += 1.0;
-      total_energy += e;
-      total_pixels += 1.0;
-      view_energy[v] += e;
+      E.energy[k] += e;
+      E.pixels[k] += 1.0;
+      E.view_energy[v] += e;
     }
   }
+  return E;
+}
+
+Localisation localise(const ForwardModel& model, const ScoredDrape& drape) {
+  Localisation L;
+  const Capture& capture = model.capture();
+  const RegionEnergy E = region_energy(model, drape);
+  double total_energy = 0.0, total_pixels = 0.0;
+  for (int k = 0; k < RegionEnergy::kCount; ++k) total_energy += E.energy[k], total_pixels += E.pixels[k];
+  const HemProfile model_outline = rotate(hem_profile_from_mesh(drape.mesh), drape.angle);
   double best = 0.0;
   for (Region r : kRegions) {
     const int k = static_cast<int>(r);
     RegionShare s;
     s.region = r;
-    s.energy_share = total_energy > 0.0 ? energy[k] / total_energy : 0.0;
-    s.pixel_share = total_pixels > 0.0 ? pixels[k] / total_pixels : 0.0;
+    s.energy_share = total_energy > 0.0 ? E.energy[k] / total_energy : 0.0;
+    s.pixel_share = total_pixels > 0.0 ? E.pixels[k] / total_pixels : 0.0;
     s.enrichment = s.pixel_share > 0.0 ? s.energy_share / s.pixel_share : 0.0;
+    s.rms = std::sqrt(E.mean_square(r));
     L.regions.push_back(s);
     if (s.pixel_share >= kMinPixelShare && s.enrichment > best) {
       best = s.enrichment;
@@ -103,7 +115,7 @@ Localisation localise(const ForwardModel& model, const ScoredDrape& drape) {
     }
   }
   if (best < kMinEnrichment) L.pixel_region = Region::kGlobal;
-  for (double e : view_energy) L.view_share.push_back(total_energy > 0.0 ? e / total_energy : 0.0);
+  for (double e : E.view_energy) L.view_share.push_back(total_energy > 0.0 ? e / total_energy : 0.0);
 
   const HemProfile capture_outline = hem_profile_from_capture(capture);
   HemProfile diff;
@@ -118,6 +130,19 @@ Localisation localise(const ForwardModel& model, const ScoredDrape& drape) {
   L.capture_drape_coefficient = drape_coefficient(capture_outline, capture.specimen);
   L.model_drape_coefficient = drape_coefficient(model_outline, capture.specimen);
   return L;
+}
+
+void localise_against_floors(Localisation& L, const std::array<double, RegionEnergy::kCount>& floor_mean_square) {
+  double best = 1.0;
+  L.floor_region = Region::kGlobal;
+  for (auto& s : L.regions) {
+    const double floor = floor_mean_square[static_cast<int>(s.region)];
+    s.floor_ratio = floor > 0.0 ? s.rms / std::sqrt(floor) : 0.0;
+    if (s.pixel_share >= kMinPixelShare && s.floor_ratio > best) {
+      best = s.floor_ratio;
+      L.floor_region = s.region;
+    }
+  }
 }
 
 }  // namespace drapegen::diagnosis

@@ -145,11 +145,12 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
                       region_name(feature_region(kFeatureGroups[k])), r.localisation.group_ratio[k]);
   }
   md += fmt::format("| stable term (platform top, bare cylinder) | global | {:.2f} |\n\n", r.localisation.stable_ratio);
-  md += fmt::format("Pixel residuals by region (most enriched: {}):\n\n", region_name(r.localisation.pixel_region));
-  md += "| region | energy share | pixel share | enrichment |\n|---|---|---|---|\n";
+  md += fmt::format("Pixel residuals by region (most enriched: {}; most above its own floor: {}):\n\n",
+                    region_name(r.localisation.pixel_region), region_name(r.localisation.floor_region));
+  md += "| region | energy share | pixel share | enrichment | RMS (mm) | RMS / floor's |\n|---|---|---|---|---|---|\n";
   for (const auto& s : r.localisation.regions) {
-    md += fmt::format("| {} | {:.2f} | {:.2f} | {:.2f} |\n", region_name(s.region), s.energy_share, s.pixel_share,
-                      s.enrichment);
+    md += fmt::format("| {} | {:.2f} | {:.2f} | {:.2f} | {:.1f} | {:.2f} |\n", region_name(s.region), s.energy_share,
+                      s.pixel_share, s.enrichment, s.rms * 1e3, s.floor_ratio);
   }
   md += fmt::format("\nDominant region: **{}**. Per-view share of the residual energy:", region_name(r.localisation.dominant));
   for (double s : r.localisation.view_share) md += fmt::format(" {:.2f}", s);

@@ -4,9 +4,11 @@
 // simulated from other initial states, rendered with noise, taken as the capture). Each sample is scored exactly as
 // the capture is (best over the fit's initial-state drapes).
 
+#include <array>
 #include <vector>
 
 #include "drapegen/diagnosis/forward_model.hpp"
+#include "drapegen/diagnosis/localisation.hpp"
 
 namespace drapegen::diagnosis {
 
@@ -16,6 +18,8 @@ struct FloorSamples {
   std::vector<double> stable;    // the stable-region term over all views (m)
   std::vector<double> shape;     // the shape-feature distance over all views (dimensionless)
   std::vector<std::vector<double>> groups;  // per sample: group_differences over all views (m)
+  /// Per sample: the pixel residuals' mean square per region (m^2, RegionEnergy::mean_square).
+  std::vector<std::array<double, RegionEnergy::kCount>> region_mean_square;
 };
 
 struct Floors {
@@ -38,6 +42,8 @@ struct Floors {
   /// The largest sample of either kind, per feature group / of the stable term (no margin).
   [[nodiscard]] std::vector<double> group_floor() const;
   [[nodiscard]] double stable_floor() const;
+  /// The largest sample of either kind of each region's mean squared pixel residual (m^2; localise_against_floors).
+  [[nodiscard]] std::array<double, RegionEnergy::kCount> region_floor() const;
 };
 
 struct FloorSettings {

@@ -2,6 +2,7 @@
 // Where the gap sits: residual energy back-projected onto the specimen (platform top, rim, skirt, hem, exposed
 // cylinder), per view, and in the hem's angular harmonics, fold count and phase.
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -16,6 +17,20 @@ struct RegionShare {
   double energy_share = 0.0;  // fraction of the residual energy (sum of squared residuals)
   double pixel_share = 0.0;   // fraction of the pixels
   double enrichment = 0.0;    // energy_share / pixel_share
+  double rms = 0.0;           // m: RMS of the region's pixel residuals
+  /// The region's RMS over the largest floor sample's in the same region (localise_against_floors; 0 if the floors
+  /// have no pixels there): how far this part of the specimen is from what noise and other stable drapes leave.
+  double floor_ratio = 0.0;
+};
+
+/// A drape's residual maps back-projected onto the specimen: squared residuals and pixels per region (indexed by
+/// Region, kGlobal unused) and the squared residuals per view.
+struct RegionEnergy {
+  static constexpr int kCount = static_cast<int>(Region::kGlobal);
+  std::array<double, kCount> energy{}, pixels{};
+  std::vector<double> view_energy;
+  /// m^2: the region's mean squared residual (0 without pixels).
+  [[nodiscard]] double mean_square(Region region) const;
 };
 
 struct Localisation {
@@ -28,6 +43,9 @@ struct Localisation {
   double stable_ratio = 0.0;
   /// The residual maps' most enriched region, kGlobal if none stands out (pixel residuals: fold placement shows).
   Region pixel_region = Region::kGlobal;
+  /// The region whose pixel residuals exceed their own floor the most (RegionShare::floor_ratio, among regions with
+  /// enough pixels), kGlobal if none exceeds it (localise_against_floors).
+  Region floor_region = Region::kGlobal;
   std::vector<RegionShare> regions;
   std::vector<double> view_share;     // fraction of the residual energy per view
   std::vector<Harmonic> hem_difference;  // harmonics of (capture - model) hem radius
@@ -39,8 +57,15 @@ struct Localisation {
 /// Region of a specimen-frame point given the fitted drape's outline (the hem: within 25 mm of the outline).
 [[nodiscard]] Region classify_point(const Eigen::Vector3d& p, const HemProfile& model_outline, double cylinder_radius);
 
+/// `drape` scored against the capture (or a floor sample, with the capture's cameras): its residuals per region.
+[[nodiscard]] RegionEnergy region_energy(const ForwardModel& model, const ScoredDrape& drape);
+
 /// `drape` is the fitted drape scored against the capture (its residual maps).
 [[nodiscard]] Localisation localise(const ForwardModel& model, const ScoredDrape& drape);
+
+/// Sets each region's floor_ratio and floor_region: the region's residual RMS over the largest floor sample's there
+/// (`floor_mean_square`, m^2 per region, Floors::region_floor).
+void localise_against_floors(Localisation& localisation, const std::array<double, RegionEnergy::kCount>& floor_mean_square);
 
 /// The region a feature group describes: the outline groups the hem, the skirt groups the skirt.
 [[nodiscard]] Region feature_region(FeatureGroup group);

@@ -1,0 +1,94 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "drapegen/diagnosis/floors.hpp"
+#include "drapegen/diagnosis/localisation.hpp"
+
+using namespace drapegen::diagnosis;
+
+namespace {
+
+constexpr double kR = 0.05;  // the tester's cylinder radius (m)
+
+/// A round outline of radius r (m).
+HemProfile round_outline(double r) {
+  HemProfile h;
+  h.radius.assign(kHemBins, r);
+  return h;
+}
+
+RegionShare share(Region region, double rms, double pixel_share) {
+  RegionShare s;
+  s.region = region;
+  s.rms = rms;
+  s.pixel_share = pixel_share;
+  return s;
+}
+
+std::array<double, RegionEnergy::kCount> floors_of(double top, double rim, double skirt, double hem, double cylinder) {
+  std::array<double, RegionEnergy::kCount> f{};
+  f[static_cast<int>(Region::kTop)] = top * top;
+  f[static_cast<int>(Region::kRim)] = rim * rim;
+  f[static_cast<int>(Region::kSkirt)] = skirt * skirt;
+  f[static_cast<int>(Region::kHem)] = hem * hem;
+  f[static_cast<int>(Region::kCylinder)] = cylinder * cylinder;
+  return f;
+}
+
+}  // namespace
+
+TEST(ClassifyPoint, SplitsTheSpecimenIntoTopRimCylinderSkirtAndHem) {
+  const HemProfile outline = round_outline(0.12);
+  EXPECT_EQ(classify_point({0.02, 0.01, 0.0}, outline, kR), Region::kTop);
+  EXPECT_EQ(classify_point({0.055, 0.0, -0.01}, outline, kR), Region::kRim);      // over the edge
+  EXPECT_EQ(classify_point({0.051, 0.0, -0.08}, outline, kR), Region::kCylinder);  // bare side, far below the top
+  EXPECT_EQ(classify_point({0.0, 0.08, -0.06}, outline, kR), Region::kSkirt);
+  EXPECT_EQ(classify_point({0.0, -0.11, -0.12}, outline, kR), Region::kHem);       // within 25 mm of the outline
+  EXPECT_EQ(classify_point({-0.09, 0.0, -0.10}, outline, kR), Region::kSkirt);     // 30 mm inside it
+}
+
+TEST(RegionEnergy, MeanSquareIsEnergyPerPixelAndZeroWithoutPixels) {
+  RegionEnergy e;
+  e.energy[static_cast<int>(Region::kHem)] = 8e-6;
+  e.pixels[static_cast<int>(Region::kHem)] = 2.0;
+  EXPECT_DOUBLE_EQ(e.mean_square(Region::kHem), 4e-6);
+  EXPECT_EQ(e.mean_square(Region::kTop), 0.0);
+  EXPECT_EQ(e.mean_square(Region::kGlobal), 0.0);
+}
+
+TEST(LocaliseAgainstFloors, NamesTheRegionFurthestAboveItsOwnFloor) {
+  Localisation L;
+  // The hem has the largest residual (6 mm) but its floor (stable drapes place folds differently) is 5 mm; the rim's
+  // 3 mm is three times its 1 mm floor.
+  L.regions = {share(Region::kTop, 0.001, 0.1), share(Region::kRim, 0.003, 0.1), share(Region::kSkirt, 0.004, 0.2),
+               share(Region::kHem, 0.006, 0.5), share(Region::kCylinder, 0.001, 0.1)};
+  localise_against_floors(L, floors_of(0.001, 0.001, 0.004, 0.005, 0.002));
+  EXPECT_EQ(L.floor_region, Region::kRim);
+  EXPECT_NEAR(L.regions[0].floor_ratio, 1.0, 1e-12);
+  EXPECT_NEAR(L.regions[1].floor_ratio, 3.0, 1e-12);
+  EXPECT_NEAR(L.regions[3].floor_ratio, 1.2, 1e-12);
+  EXPECT_NEAR(L.regions[4].floor_ratio, 0.5, 1e-12);
+}
+
+TEST(LocaliseAgainstFloors, GlobalWhenNothingExceedsItsFloorAndIgnoresTinyOrFloorlessRegions) {
+  Localisation L;
+  L.regions = {share(Region::kTop, 0.001, 0.1), share(Region::kSkirt, 0.002, 0.5)};
+  localise_against_floors(L, floors_of(0.002, 0.0, 0.003, 0.0, 0.0));
+  EXPECT_EQ(L.floor_region, Region::kGlobal);
+  // A region far above its floor on 1% of the pixels does not count; one without floor pixels has no ratio.
+  L.regions = {share(Region::kTop, 0.01, 0.01), share(Region::kSkirt, 0.004, 0.5), share(Region::kHem, 0.01, 0.3)};
+  localise_against_floors(L, floors_of(0.001, 0.0, 0.002, 0.0, 0.0));
+  EXPECT_EQ(L.floor_region, Region::kSkirt);
+  EXPECT_NEAR(L.regions[0].floor_ratio, 10.0, 1e-12);
+  EXPECT_EQ(L.regions[2].floor_ratio, 0.0);
+}
+
+TEST(Floors, RegionFloorIsTheLargestSampleOfEitherKindPerRegion) {
+  Floors f;
+  f.noise.region_mean_square = {floors_of(0.001, 0.002, 0.003, 0.004, 0.001), floors_of(0.002, 0.001, 0.001, 0.001, 0)};
+  f.multistability.region_mean_square = {floors_of(0.0005, 0.001, 0.006, 0.008, 0.0005)};
+  const auto top = f.region_floor();
+  const auto expected = floors_of(0.002, 0.002, 0.006, 0.008, 0.001);
+  for (int k = 0; k < RegionEnergy::kCount; ++k) EXPECT_DOUBLE_EQ(top[k], expected[k]) << k;
+}
