@@ -412,6 +412,8 @@ int main(int argc, char** argv) {
   for (const auto& f : families) rows.push_back(f);
   std::map<std::string, std::map<std::string, int>> confusion;
   int effect_total = 0, effect_correct = 0, control_total = 0, control_within = 0, region_total = 0, region_match = 0;
+  // The region furthest above its own floor (localisation.floor_region, since session 22; absent in older reports).
+  int floor_region_total = 0, floor_region_match = 0;
   // The screen (--visible-only): per family, draws made and draws visible; the verdicts on visible captures.
   std::map<std::string, std::pair<int, int>> screen_draws_by_family;
   int visible_total = 0, visible_correct = 0;
@@ -470,6 +472,11 @@ int main(int argc, char** argv) {
       ++region_total;
       for (const auto& r : t["regions"]) region_ok = region_ok || r.get<std::string>() == region;
       region_match += region_ok;
+      if (d["localisation"].contains("floor_region")) {
+        const std::string floor_region = d["localisation"]["floor_region"].get<std::string>();
+        ++floor_region_total;
+        for (const auto& r : t["regions"]) floor_region_match += r.get<std::string>() == floor_region;
+      }
     }
     // The effect and its strength as generated (the truth file), not as this run would draw them: a run may score
     // captures an earlier run generated with other --controls or --seed, whose draws differ.
@@ -529,6 +536,10 @@ int main(int argc, char** argv) {
                     "none is named): {:.0f}%; over the correctly named captures alone: {:.0f}%\n",
                     100.0 * median(shrinkages), named_shrinkages.empty() ? 0.0 : 100.0 * median(named_shrinkages));
   md += fmt::format("- localised region matches the effect's region: {}/{}\n", region_match, region_total);
+  if (floor_region_total > 0) {
+    md += fmt::format("- the region furthest above its own floor (floor_region) matches it: {}/{}\n",
+                      floor_region_match, floor_region_total);
+  }
   md += fmt::format("- runtime per capture: median {:.0f} s, max {:.0f} s\n", median(seconds),
                     seconds.empty() ? 0.0 : *std::max_element(seconds.begin(), seconds.end()));
   md += "\n| case | effect | strength | verdict | stable / floor (mm) | shape / floor | region | region ok | "

@@ -280,7 +280,8 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
     ReducedBending best_x{};
     for (double la : levels) {
       for (double ratio : settings.start_ratios_mm) {
-        const ReducedBending x{la, std::clamp(0.0, lo[1], hi[1]), std::clamp(0.0, lo[2], hi[2]), std::clamp(ratio, lo[3], hi[3])};
+        const ReducedBending x{la, std::clamp(0.0, lo[1], hi[1]), std::clamp(0.0, lo[2], hi[2]),
+                               std::clamp(ratio, lo[3], hi[3])};
         const double value = objective({x.begin(), x.end()});
         if (error) return *error;
         ++r.start_evaluations;
