@@ -66,11 +66,13 @@ double RegionEnergy::mean_square(Region region) const {
   return k < kCount && pixels[k] > 0.0 ? energy[k] / pixels[k] : 0.0;
 }
 
-RegionEnergy region_energy(const ForwardModel& model, const ScoredDrape& drape) {
+namespace {
+
+/// region_energy with the drape's outline (turned as rendered) given.
+RegionEnergy region_energy(const ForwardModel& model, const ScoredDrape& drape, const HemProfile& model_outline) {
   RegionEnergy E;
   const Capture& capture = model.capture();
   const double R = 0.5 * capture.specimen.cylinder_diameter;
-  const HemProfile model_outline = rotate(hem_profile_from_mesh(drape.mesh), drape.angle);
   E.view_energy.assign(drape.views.size(), 0.0);
   for (std::size_t v = 0; v < drape.views.size(); ++v) {
     const auto& cmp = drape.views[v];
@@ -92,13 +94,19 @@ RegionEnergy region_energy(const ForwardModel& model, const ScoredDrape& drape) 
   return E;
 }
 
+}  // namespace
+
+RegionEnergy region_energy(const ForwardModel& model, const ScoredDrape& drape) {
+  return region_energy(model, drape, rotate(hem_profile_from_mesh(drape.mesh), drape.angle));
+}
+
 Localisation localise(const ForwardModel& model, const ScoredDrape& drape) {
   Localisation L;
   const Capture& capture = model.capture();
-  const RegionEnergy E = region_energy(model, drape);
+  const HemProfile model_outline = rotate(hem_profile_from_mesh(drape.mesh), drape.angle);
+  const RegionEnergy E = region_energy(model, drape, model_outline);
   double total_energy = 0.0, total_pixels = 0.0;
   for (int k = 0; k < RegionEnergy::kCount; ++k) total_energy += E.energy[k], total_pixels += E.pixels[k];
-  const HemProfile model_outline = rotate(hem_profile_from_mesh(drape.mesh), drape.angle);
   double best = 0.0;
   for (Region r : kRegions) {
     const int k = static_cast<int>(r);
