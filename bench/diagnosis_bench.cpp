@@ -469,13 +469,17 @@ int main(int argc, char** argv) {
       shrink = verdict != "none" && verdict != "unexplained" ? d.value("shrinkage", 0.0) : 0.0;
       shrinkages.push_back(shrink);
       if (verdict == family) named_shrinkages.push_back(shrink);
+      auto is_true_region = [&t](const std::string& name) {
+        for (const auto& r : t["regions"])
+          if (r.get<std::string>() == name) return true;
+        return false;
+      };
       ++region_total;
-      for (const auto& r : t["regions"]) region_ok = region_ok || r.get<std::string>() == region;
+      region_ok = is_true_region(region);
       region_match += region_ok;
       if (d["localisation"].contains("floor_region")) {
-        const std::string floor_region = d["localisation"]["floor_region"].get<std::string>();
         ++floor_region_total;
-        for (const auto& r : t["regions"]) floor_region_match += r.get<std::string>() == floor_region;
+        floor_region_match += is_true_region(d["localisation"]["floor_region"].get<std::string>());
       }
     }
     // The effect and its strength as generated (the truth file), not as this run would draw them: a run may score
