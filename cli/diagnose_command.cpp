@@ -44,6 +44,7 @@ struct DiagnoseOptions {
   double shape_floor = -1.0;  // < 0: the settings' calibrated value
   bool gap_only = false;
   bool ablation = false;
+  double held_out_tolerance = diagnosis::AttributionSettings{}.held_out_tolerance;
   bool verbose = false;
 };
 
@@ -60,6 +61,7 @@ int run_diagnose(const DiagnoseOptions& o) {
     return fail("--evaluations and --refit-evaluations must be 1 .. 10000");
   }
   if (o.shape_floor > 100.0) return fail("--shape-floor must be 0 (from the floor samples) .. 100");
+  if (!(o.held_out_tolerance >= 0.0 && o.held_out_tolerance <= 1.0)) return fail("--held-out-tolerance must be 0 .. 1");
   if (o.starts && (*o.starts < 0 || *o.starts > 100)) return fail("--starts must be 0 (the guess alone) .. 100");
   if (o.refit_scan < -1 || o.refit_scan == 1 || o.refit_scan > 100) {
     return fail("--refit-scan must be 0 (off) or 2 .. 100");
@@ -129,6 +131,7 @@ int run_diagnose(const DiagnoseOptions& o) {
   settings.attribution.jobs = o.jobs;
   settings.attribute = !o.gap_only;
   settings.attribution.ablation = o.ablation;
+  settings.attribution.held_out_tolerance = o.held_out_tolerance;
   if (o.shape_floor >= 0.0) settings.floors.shape_threshold = settings.held_out_shape_threshold = o.shape_floor;
   auto result = diagnosis::diagnose(*capture, settings,
                                     {.second = second ? &*second : nullptr, .held_out = held_out ? &*held_out : nullptr});
@@ -244,6 +247,10 @@ Runner add_diagnose_command(CLI::App& app) {
                "Also validate each simulated candidate with its effect switched off at its refitted bending scale, and "
                "credit it only for what the effect adds beyond that (report.json: candidates' \"ablated\"; off by "
                "default; docs/DIAGNOSIS.md, \"Session 19\")");
+  app.add_option("--held-out-tolerance", o->held_out_tolerance,
+                 "A candidate is confirmed when its score on the held-out view or capture is at most 1 + this times "
+                 "the reference's (0: not worse at all; docs/DIAGNOSIS.md, \"Session 23\")")
+      ->capture_default_str();
   app.add_flag("--gap-only", o->gap_only,
                "Stop after the gap, floors and localisation (verdict \"not attributed\" above the floors)");
   app.add_flag("-v,--verbose", o->verbose, "Log progress on stderr");

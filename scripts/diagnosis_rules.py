@@ -18,6 +18,13 @@ score. Hypotheses for the next evaluation, not the diagnosis's rule (docs/DIAGNO
 - min_objective: the candidate whose refit objective (in-sample: the capture and the second capture) is the smallest;
   it ignores the held-out data, which the issue's attribution must use: a diagnostic of the refits, not a rule.
 
+Two more recompute the held-out confirmation from each candidate's held-out shrinkage (session 23):
+- strict: confirmed only if not worse than the reference on the held-out capture (held-out shrinkage >= 0; the rule
+  before session 23);
+- tolerance: confirmed if at most 10% worse (held-out shrinkage >= -0.1; AttributionSettings::held_out_tolerance, the
+  rule since session 23);
+both rank as attribute() does: confirmed first, then the shrinkage, then the smaller objective.
+
 Three more read reports made with `drapegen diagnose --ablation` (session 20; on reports without ablations they give
 the main rule):
 - without_ablation: the main rule (the bar or the baseline the reference, the objective breaking ties) recomputed
@@ -36,7 +43,8 @@ import os
 import sys
 
 THRESHOLD = 0.25  # AttributionSettings::significant_shrinkage
-RULES = ["current", "tie_objective", "no_bar", "no_bar_unconfirmed", "mean3", "held_out_excess", "held_out_rank",
+TOLERANCE = 0.1  # AttributionSettings::held_out_tolerance (since session 23)
+RULES = ["current", "strict", "tolerance", "tie_objective", "no_bar", "no_bar_unconfirmed", "mean3", "held_out_excess", "held_out_rank",
          "min_objective", "without_ablation", "reach", "reach_objective"]
 FAMILY = {"pose": "sensor", "bias": "sensor", "multipath": "sensor", "misalign": "misalignment"}
 
@@ -108,6 +116,18 @@ def reference_rule(j, rule):
     return top["effect"] if ok else "unexplained"
 
 
+def confirmation_rule(j, tolerance):
+    """The verdict with a candidate confirmed when its held-out shrinkage is at least -tolerance."""
+    a = j["attribution"]
+    if j.get("within_floors_after_bending_refit", False):
+        return "none"
+    ranked = sorted(a["candidates"], key=lambda c: (
+        c["held_out_shrinkage"] < -tolerance, -c["shrinkage"], c["objective_mm"], -c["held_out_shrinkage"]))
+    top = ranked[0]
+    ok = top["held_out_shrinkage"] >= -tolerance and top["shrinkage"] >= THRESHOLD
+    return top["effect"] if ok else "unexplained"
+
+
 def verdicts(j):
     g = j["gap_tests"]
     a = j["attribution"]
@@ -116,7 +136,7 @@ def verdicts(j):
         return {r: j["verdict"] for r in RULES}
     sf, shf = g["stable_floor_mm"], g["shape_floor"]
     within = j.get("within_floors_after_bending_refit", False)
-    v = {"current": j["verdict"]}
+    v = {"current": j["verdict"], "strict": confirmation_rule(j, 0.0), "tolerance": confirmation_rule(j, TOLERANCE)}
     top = cands[0]
     tied = [c for c in cands if c["confirmed"] and c["shrinkage"] == top["shrinkage"]]
     v["tie_objective"] = min(tied, key=lambda c: c["objective_mm"])["effect"] if (

@@ -184,6 +184,28 @@ endif()
 if((shape LESS shape_a AND shape LESS shape_b) OR (shape GREATER shape_a AND shape GREATER shape_b))
   message(FATAL_ERROR "the gate's shape distance ${shape} is not between the captures' (${shape_a}, ${shape_b})")
 endif()
+# The confirmation: a candidate is confirmed exactly when the held-out capture's score is at most 10% (the default
+# tolerance) above the reference's, i.e. its held-out shrinkage is at least -0.1.
+string(JSON tolerance GET "${out}" attribution held_out_tolerance)
+if(NOT tolerance EQUAL 0.1)
+  message(FATAL_ERROR "held-out tolerance ${tolerance}, not the default 0.1")
+endif()
+math(EXPR last "${ncand} - 1")
+foreach(i RANGE ${last})
+  string(JSON effect GET "${out}" attribution candidates ${i} effect)
+  string(JSON held_out_shrinkage GET "${out}" attribution candidates ${i} held_out_shrinkage)
+  string(JSON confirmed GET "${out}" attribution candidates ${i} confirmed)
+  if(held_out_shrinkage LESS -0.1)  # (LESS compares as numbers, decimals and exponents included)
+    set(within FALSE)
+  else()
+    set(within TRUE)
+  endif()
+  if((within AND NOT confirmed) OR (NOT within AND confirmed))
+    message(FATAL_ERROR "${effect}: held-out shrinkage ${held_out_shrinkage}, confirmed ${confirmed} (tolerance 0.1)")
+  endif()
+endforeach()
+expect_failure(1 "--held-out-tolerance must be" diagnose --capture ${WORK}/capture --held-out-tolerance 1.5)
+
 # The scan: the yield refit spends 3 of its 6 simulations on ln K = ln 3, (ln 3 + ln 400) / 2, ln 400 (report.json
 # lists them), the simplex the other 3 (its start, the best level, is not simulated again).
 math(EXPR last "${ncand} - 1")

@@ -96,7 +96,7 @@ sim::Status validate(ForwardModel& model, ForwardModel* second, ForwardModel* he
     std::optional<double> direction;
     auto e = on_next_placement(*next, laid, *last, states, again, &direction);
     if (!e) return sim::Error{std::string(next == second ? "second" : "held-out") + " capture: " + e.error().message};
-    OtherPlacement placement{e->best, largest_set(again), direction};
+    OtherPlacement placement{e->best, largest_set(again), direction, e->all_scores()};
     if (next == second) {
       c.second = std::move(placement);
       on_second = std::move(*e);
@@ -305,6 +305,10 @@ bool ranks_before(const CandidateResult& x, const CandidateResult& y) {
   return x.held_out_shrinkage > y.held_out_shrinkage;
 }
 
+bool confirms(double held_out_after, double held_out_before, double tolerance) {
+  return held_out_after <= (1.0 + tolerance) * held_out_before;
+}
+
 double gap_shrinkage(double excess_before, double excess_after) {
   return excess_before > 0.0 ? 1.0 - excess_after / excess_before : 0.0;
 }
@@ -402,8 +406,10 @@ sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& base
   // Shrinkage: of the excess above the floors that made the gate fire (the same two tests), once the candidate is
   // added, measured from the validation states against the reference: the better (smaller excess) of the baseline
   // and the bar. So an effect counts only for what it adds beyond refitting the bending alone. The held-out view (not
-  // in any refit), or the held-out capture, must confirm it, i.e. not get worse than the reference's.
+  // in any refit), or the held-out capture, must confirm it, i.e. not get worse than the reference's (beyond the
+  // tolerance for the noise of choosing the best validation drape there: confirms).
   Attribution a;
+  a.held_out_tolerance = settings.held_out_tolerance;
   a.bar = std::move(results.back()->value());
   const double baseline_excess = excess_above_floors(gap_terms(validated.best, baseline_paired), floors);
   const double bar_excess = a.bar.validated_excess(floors);
@@ -424,7 +430,7 @@ sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& base
     }
     c.shrinkage = gap_shrinkage(from, c.validated_excess(floors));
     c.held_out_shrinkage = against > 0.0 ? 1.0 - h / against : 0.0;
-    c.confirmed = h <= against;
+    c.confirmed = confirms(h, against, settings.held_out_tolerance);
     a.candidates.push_back(std::move(c));
   }
   std::stable_sort(a.candidates.begin(), a.candidates.end(), ranks_before);

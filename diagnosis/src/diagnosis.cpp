@@ -103,11 +103,23 @@ nlohmann::json spread_json(const ValidationSpread& s) {
           {"pairwise_groups_mm", pair_groups}};
 }
 
-/// A validation drape against another placement (null without one).
-nlohmann::json placement_json(const ScoredDrape* d) {
-  if (!d) return nullptr;
-  return {{"stable_mm", d->stable_all * 1e3}, {"shape", d->shape_all}, {"all_views_score_mm", d->all_score * 1e3},
-          {"best_validation_state", d->state}};
+/// A setup's validation drapes against another placement (null without one): the best (chosen by that capture's fit
+/// views) and every drape's all-views score (`all_scores`, m; validation states' order).
+nlohmann::json placement_json(const ScoredDrape* best, const std::vector<double>& all_scores) {
+  if (!best) return nullptr;
+  nlohmann::json scores = nlohmann::json::array();
+  for (double s : all_scores) scores.push_back(s * 1e3);
+  return {{"stable_mm", best->stable_all * 1e3},
+          {"shape", best->shape_all},
+          {"all_views_score_mm", best->all_score * 1e3},
+          {"best_validation_state", best->state},
+          {"validation_all_views_scores_mm", std::move(scores)}};
+}
+nlohmann::json placement_json(const std::optional<Evaluation>& e) {
+  return e ? placement_json(&e->best, e->all_scores()) : nullptr;
+}
+nlohmann::json placement_json(const std::optional<OtherPlacement>& p) {
+  return p ? placement_json(&p->best, p->all_scores) : nullptr;
 }
 
 /// A refitted candidate (or the bar) from the validation states: its drape against the capture, against the other
@@ -122,10 +134,10 @@ nlohmann::json validated_json(const CandidateResult& c, const Floors& floors) {
   return {{"stable_mm", c.validated.stable_all * 1e3},
           {"shape", c.validated.shape_all},
           {"held_out_score_mm", c.validated.held_out_score * 1e3},
-          {"second_capture", placement_json(c.second ? &c.second->best : nullptr)},
+          {"second_capture", placement_json(c.second)},
           {"second_plastic_set_rad", set_json(c.second)},
           {"second_drift_direction_deg", direction_json(c.second)},
-          {"held_out_capture", placement_json(c.held_out_drape())},
+          {"held_out_capture", placement_json(c.held_out)},
           {"held_out_plastic_set_rad", set_json(c.held_out)},
           {"held_out_drift_direction_deg", direction_json(c.held_out)},
           {"excess_above_floors", c.validated_excess(floors)}};
@@ -418,8 +430,8 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                                     : r.validated_held_out ? nlohmann::json("held_out_capture")
                                                            : nlohmann::json(nullptr)},
                     {"capture", {{"stable_mm", r.gap_drape().stable_all * 1e3}, {"shape", r.gap_drape().shape_all}}},
-                    {"second_capture", placement_json(r.validated_second ? &r.validated_second->best : nullptr)},
-                    {"held_out_capture", placement_json(r.validated_held_out ? &r.validated_held_out->best : nullptr)},
+                    {"second_capture", placement_json(r.validated_second)},
+                    {"held_out_capture", placement_json(r.validated_held_out)},
                     {"validation_states", r.validated.states.size()},
                     {"best_validation_state", r.gap_drape().state},
                     {"validation_spread", spread_json(r.validation_spread)},
@@ -533,6 +545,7 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
   }
   j["attribution"] = {{"ran", ran},
                       {"confirmed_on", r.validated_held_out ? "held_out_capture" : "held_out_view"},
+                      {"held_out_tolerance", r.attribution.held_out_tolerance},
                       {"refitted_on", r.validated_second ? "capture_and_second_capture" : "capture"},
                       {"alpha_scale_bounds", ran ? nlohmann::json::array({std::exp(r.refit_scale_lower),
                                                                            std::exp(r.refit_scale_upper)})

@@ -66,6 +66,12 @@ struct ScoredDrape {
 struct Evaluation {
   ScoredDrape best;                  // the best state by fit_score
   std::vector<ScoredDrape> states;   // every state (same order as the initial states)
+  /// Every state's all_score (same order).
+  [[nodiscard]] std::vector<double> all_scores() const {
+    std::vector<double> scores;
+    for (const auto& d : states) scores.push_back(d.all_score);
+    return scores;
+  }
 };
 
 class ForwardModel {
