@@ -248,8 +248,8 @@ Runner add_diagnose_command(CLI::App& app) {
                "credit it only for what the effect adds beyond that (report.json: candidates' \"ablated\"; off by "
                "default; docs/DIAGNOSIS.md, \"Session 19\")");
   app.add_option("--held-out-tolerance", o->held_out_tolerance,
-                 "A candidate is confirmed when its score on the held-out view or capture is at most 1 + this times "
-                 "the reference's (0: not worse at all; docs/DIAGNOSIS.md, \"Session 23\")")
+                 "A candidate is confirmed when its score on the held-out view or capture is at most (1 + this) "
+                 "times the reference's (0: not worse at all; docs/DIAGNOSIS.md, \"Session 23\")")
       ->capture_default_str();
   app.add_flag("--gap-only", o->gap_only,
                "Stop after the gap, floors and localisation (verdict \"not attributed\" above the floors)");

@@ -7,7 +7,8 @@ The run must have attributed every capture (`--diagnose-args "--shape-floor 0.00
 candidate's validated stable term, shape distance and held-out score; the verdicts for any F and T then follow from
 them exactly as drapegen diagnose decides (docs/DIAGNOSIS.md, "Attribution"): the stable floor is the run's, the
 reference is the better of the baseline's and the bending-only bar's validated drapes, a candidate counts only if its
-held-out view does not get worse than the reference's.
+held-out view is at most the run's held-out tolerance worse than the reference's (report.json
+`attribution.held_out_tolerance`; 0, not worse at all, in reports made before session 23).
 
     scripts/diagnosis_calibration.py out/calib60_s2 --floors 1.0 1.15 1.3 --thresholds 0.15 0.25 0.35
 
@@ -71,7 +72,8 @@ def verdict(d, shape_floor, threshold, confirm=True):
         e = excess(stable, shape, sf, shape_floor)
         shrink = 1.0 - e / ref_excess if ref_excess > 0 else 0.0
         held = 1.0 - held_score / ref_held if ref_held > 0 else 0.0
-        ranked.append((held_score <= ref_held or not confirm, shrink, held, c["effect"]))
+        tolerance = a.get("held_out_tolerance", 0.0)
+        ranked.append((held_score <= (1.0 + tolerance) * ref_held or not confirm, shrink, held, c["effect"]))
     ranked.sort(key=lambda r: (not r[0], -r[1], -r[2]))
     confirmed, shrink, _, effect = ranked[0]
     if confirmed and shrink >= threshold:

@@ -22,8 +22,9 @@ Two more recompute the held-out confirmation from each candidate's held-out shri
 - strict: confirmed only if not worse than the reference on the held-out capture (held-out shrinkage >= 0; the rule
   before session 23);
 - tolerance: confirmed if at most 10% worse (held-out shrinkage >= -0.1; AttributionSettings::held_out_tolerance, the
-  rule since session 23);
-both rank as attribute() does: confirmed first, then the shrinkage, then the smaller objective.
+  rule since session 23; `--tolerance T` sets another);
+both rank as attribute() does: confirmed first, then the shrinkage, then the smaller objective. The other rules
+confirm as the run did (its report's `attribution.held_out_tolerance`, 0 in reports made before session 23).
 
 Three more read reports made with `drapegen diagnose --ablation` (session 20; on reports without ablations they give
 the main rule):
@@ -36,6 +37,7 @@ the main rule):
 
     scripts/diagnosis_rules.py out/s18all [more runs ...]
     scripts/diagnosis_rules.py --matrix without_ablation out/s21all     # one rule's confusion matrix
+    scripts/diagnosis_rules.py --tolerance 0.05 out/s23all               # the tolerance rule at 5%
 """
 import glob
 import json
@@ -43,9 +45,9 @@ import os
 import sys
 
 THRESHOLD = 0.25  # AttributionSettings::significant_shrinkage
-TOLERANCE = 0.1  # AttributionSettings::held_out_tolerance (since session 23)
-RULES = ["current", "strict", "tolerance", "tie_objective", "no_bar", "no_bar_unconfirmed", "mean3", "held_out_excess", "held_out_rank",
-         "min_objective", "without_ablation", "reach", "reach_objective"]
+TOLERANCE = 0.1  # AttributionSettings::held_out_tolerance (since session 23); --tolerance sets the rule's
+RULES = ["current", "strict", "tolerance", "tie_objective", "no_bar", "no_bar_unconfirmed", "mean3", "held_out_excess",
+         "held_out_rank", "min_objective", "without_ablation", "reach", "reach_objective"]
 FAMILY = {"pose": "sensor", "bias": "sensor", "multipath": "sensor", "misalign": "misalignment"}
 
 
@@ -79,6 +81,11 @@ def named(best, within):
     return best[1] if best and best[0] >= THRESHOLD else "unexplained"
 
 
+def run_tolerance(j):
+    """The held-out tolerance the run confirmed with (0 before session 23, whose reports do not state it)."""
+    return j["attribution"].get("held_out_tolerance", 0.0)
+
+
 def confirmation(v):
     """A validated drape's confirmation score: the held-out capture's over all views, else the held-out view's."""
     return v["held_out_capture"]["all_views_score_mm"] if v.get("held_out_capture") else v["held_out_score_mm"]
@@ -88,6 +95,7 @@ def reference_rule(j, rule):
     """The verdict with the reference chosen by `rule` (without_ablation, reach, reach_objective); the ranking as
     attribute()'s: confirmed first, then the shrinkage, then the smaller objective."""
     g, a = j["gap_tests"], j["attribution"]
+    tol = 1.0 + run_tolerance(j)
     bar = a["bending_refit_bar"]
     base_excess, bar_excess = g["excess_above_floors"], bar["validated"]["excess_above_floors"]
     if bar_excess == 0:
@@ -109,10 +117,11 @@ def reference_rule(j, rule):
     if ref[0] == 0:
         return "none"
     ranked = sorted(a["candidates"], key=lambda c: (
-        confirmation(c["validated"]) > ref[1], -shrink(ref[0], c["validated"]["excess_above_floors"]),
+        confirmation(c["validated"]) > tol * ref[1], -shrink(ref[0], c["validated"]["excess_above_floors"]),
         c["objective_mm"]))
     top = ranked[0]
-    ok = confirmation(top["validated"]) <= ref[1] and shrink(ref[0], top["validated"]["excess_above_floors"]) >= THRESHOLD
+    ok = (confirmation(top["validated"]) <= tol * ref[1] and
+          shrink(ref[0], top["validated"]["excess_above_floors"]) >= THRESHOLD)
     return top["effect"] if ok else "unexplained"
 
 
@@ -151,7 +160,8 @@ def verdicts(j):
         return shrink(e0, c["validated"]["excess_above_floors"])
 
     ordered = sorted(cands, key=lambda c: (-gate_shrink(c), held(c)))  # attribute()'s order against the baseline
-    v["no_bar"] = named(first_largest((gate_shrink(c), c["effect"]) for c in ordered if held(c) <= h0), False)
+    tol = 1.0 + run_tolerance(j)
+    v["no_bar"] = named(first_largest((gate_shrink(c), c["effect"]) for c in ordered if held(c) <= tol * h0), False)
     v["no_bar_unconfirmed"] = named(first_largest((gate_shrink(c), c["effect"]) for c in ordered), False)
     baseline = {"capture": (g["capture"]["stable_mm"], g["capture"]["shape"]),
                 "second": (g["second_capture"]["stable_mm"], g["second_capture"]["shape"]),
@@ -181,6 +191,11 @@ COLUMNS = ["none", "unexplained", "not attributed", "yield", "shear", "curl", "f
 
 
 def main(roots):
+    global TOLERANCE
+    if roots[:1] == ["--tolerance"]:
+        if len(roots) < 3:
+            sys.exit("--tolerance T DIR...")
+        TOLERANCE, roots = float(roots[1]), roots[2:]
     matrix_rule = None
     if roots[:1] == ["--matrix"]:
         if len(roots) < 3 or roots[1] not in RULES:

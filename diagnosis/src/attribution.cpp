@@ -406,8 +406,8 @@ sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& base
   // Shrinkage: of the excess above the floors that made the gate fire (the same two tests), once the candidate is
   // added, measured from the validation states against the reference: the better (smaller excess) of the baseline
   // and the bar. So an effect counts only for what it adds beyond refitting the bending alone. The held-out view (not
-  // in any refit), or the held-out capture, must confirm it, i.e. not get worse than the reference's (beyond the
-  // tolerance for the noise of choosing the best validation drape there: confirms).
+  // in any refit), or the held-out capture, must confirm it: its score there at most (1 + held_out_tolerance) times
+  // the reference's, a tolerance for the noise of choosing the best validation drape there (confirms).
   Attribution a;
   a.held_out_tolerance = settings.held_out_tolerance;
   a.bar = std::move(results.back()->value());

@@ -187,10 +187,8 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
                         c.validated.all_score * 1e3, 100 * c.shrinkage, held * 1e3, 100 * c.held_out_shrinkage,
                         c.confirmed ? "yes" : "no", params, c.alpha_scale);
     }
-    md += fmt::format("\nConfirmed: the held-out {}'s score at most {:.0f}% above the reference's (its shrinkage at "
-                      "least -{:.0f}%).\n",
-                      held_out ? "capture" : "view", 100 * r.attribution.held_out_tolerance,
-                      100 * r.attribution.held_out_tolerance);
+    md += fmt::format("\nConfirmed: the held-out {}'s score at most {:g}% above the reference's.\n",
+                      held_out ? "capture" : "view", 100 * r.attribution.held_out_tolerance);
     if (after) md += "\n![after](residual_after.png)\n\nResidual after adding the named effect.\n";
   }
   md += fmt::format("\nRuntime {:.0f} s (fit {:.0f} s, floors {:.0f} s, attribution {:.0f} s).\n", r.seconds,

@@ -2,7 +2,7 @@
 // Which effect explains the gap: each candidate is added to the model with its own parameters, refitted on the fit
 // views (with the bending scale free as well), and judged by how much it shrinks the excess above the floors that
 // made the gate fire (excess_above_floors: the stable term and the shape distance over their floors), confirmed on
-// the held-out view (which must not get worse). Both the baseline and each refitted candidate are judged on fresh
+// the held-out view (which must not get worse than AttributionSettings::held_out_tolerance allows). Both the baseline and each refitted candidate are judged on fresh
 // initial states that no fit selected on (validation states): the fit's best score is the minimum of a multistable,
 // noisy objective over its evaluations, so a refit compared with it must beat the baseline's luckiest draw.
 // Confidence: a block bootstrap over the held-out view's residual tiles of the named effect against the runner-up.
@@ -56,7 +56,7 @@ struct CandidateResult {
   /// gap_shrinkage of excess_above_floors: the baseline's against this candidate's refitted drape.
   double shrinkage = 0.0;
   double held_out_shrinkage = 0.0;  // 1 - held_out_after / held_out_before (the view not in the refit)
-  bool confirmed = false;           // the held-out view does not get worse (beyond the tolerance: confirms)
+  bool confirmed = false;           // its held-out score is at most (1 + held_out_tolerance) x the reference's
   int evaluations = 0;
   /// A scan's level: the effect's parameter (as in effect_space), the bending scale and the refit objective there.
   struct ScanLevel {
