@@ -2,9 +2,10 @@
 // Which effect explains the gap: each candidate is added to the model with its own parameters, refitted on the fit
 // views (with the bending scale free as well), and judged by how much it shrinks the excess above the floors that
 // made the gate fire (excess_above_floors: the stable term and the shape distance over their floors), confirmed on
-// the held-out view (which must not get worse than AttributionSettings::held_out_tolerance allows). Both the baseline and each refitted candidate are judged on fresh
-// initial states that no fit selected on (validation states): the fit's best score is the minimum of a multistable,
-// noisy objective over its evaluations, so a refit compared with it must beat the baseline's luckiest draw.
+// the held-out view (which must not get worse than AttributionSettings::held_out_tolerance allows). Both the baseline
+// and each refitted candidate are judged on fresh initial states that no fit selected on (validation states): the
+// fit's best score is the minimum of a multistable, noisy objective over its evaluations, so a refit compared with it
+// must beat the baseline's luckiest draw.
 // Confidence: a block bootstrap over the held-out view's residual tiles of the named effect against the runner-up.
 //
 // Other placements of the specimen (OtherCaptures) take part where the capture's own data cannot tell:
