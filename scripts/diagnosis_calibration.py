@@ -66,14 +66,14 @@ def verdict(d, shape_floor, threshold, confirm=True):
         ref_excess, ref_held = base, t["held_out_capture"]["all_views_score_mm"]
     else:
         ref_excess, ref_held = base, d["gap_mm"]["held_out_view"]
+    allowed = 1.0 + a.get("held_out_tolerance", 0.0)  # the run's confirmation: at most this x the reference's
     ranked = []
     for c in a["candidates"]:
         stable, shape, held_score = terms(c["validated"])
         e = excess(stable, shape, sf, shape_floor)
         shrink = 1.0 - e / ref_excess if ref_excess > 0 else 0.0
         held = 1.0 - held_score / ref_held if ref_held > 0 else 0.0
-        tolerance = a.get("held_out_tolerance", 0.0)
-        ranked.append((held_score <= (1.0 + tolerance) * ref_held or not confirm, shrink, held, c["effect"]))
+        ranked.append((held_score <= allowed * ref_held or not confirm, shrink, held, c["effect"]))
     ranked.sort(key=lambda r: (not r[0], -r[1], -r[2]))
     confirmed, shrink, _, effect = ranked[0]
     if confirmed and shrink >= threshold:

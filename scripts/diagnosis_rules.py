@@ -95,7 +95,7 @@ def reference_rule(j, rule):
     """The verdict with the reference chosen by `rule` (without_ablation, reach, reach_objective); the ranking as
     attribute()'s: confirmed first, then the shrinkage, then the smaller objective."""
     g, a = j["gap_tests"], j["attribution"]
-    tol = 1.0 + run_tolerance(j)
+    allowed = 1.0 + run_tolerance(j)  # a confirmed candidate's held-out score: at most this x the reference's
     bar = a["bending_refit_bar"]
     base_excess, bar_excess = g["excess_above_floors"], bar["validated"]["excess_above_floors"]
     if bar_excess == 0:
@@ -117,10 +117,10 @@ def reference_rule(j, rule):
     if ref[0] == 0:
         return "none"
     ranked = sorted(a["candidates"], key=lambda c: (
-        confirmation(c["validated"]) > tol * ref[1], -shrink(ref[0], c["validated"]["excess_above_floors"]),
+        confirmation(c["validated"]) > allowed * ref[1], -shrink(ref[0], c["validated"]["excess_above_floors"]),
         c["objective_mm"]))
     top = ranked[0]
-    ok = (confirmation(top["validated"]) <= tol * ref[1] and
+    ok = (confirmation(top["validated"]) <= allowed * ref[1] and
           shrink(ref[0], top["validated"]["excess_above_floors"]) >= THRESHOLD)
     return top["effect"] if ok else "unexplained"
 
@@ -160,8 +160,9 @@ def verdicts(j):
         return shrink(e0, c["validated"]["excess_above_floors"])
 
     ordered = sorted(cands, key=lambda c: (-gate_shrink(c), held(c)))  # attribute()'s order against the baseline
-    tol = 1.0 + run_tolerance(j)
-    v["no_bar"] = named(first_largest((gate_shrink(c), c["effect"]) for c in ordered if held(c) <= tol * h0), False)
+    allowed = 1.0 + run_tolerance(j)
+    v["no_bar"] = named(first_largest((gate_shrink(c), c["effect"]) for c in ordered if held(c) <= allowed * h0),
+                        False)
     v["no_bar_unconfirmed"] = named(first_largest((gate_shrink(c), c["effect"]) for c in ordered), False)
     baseline = {"capture": (g["capture"]["stable_mm"], g["capture"]["shape"]),
                 "second": (g["second_capture"]["stable_mm"], g["second_capture"]["shape"]),

@@ -55,11 +55,11 @@ def main(args):
         e0 = bar["validated"]["excess_above_floors"] if bar_is_reference else g["excess_above_floors"]
         h0 = (bar["validated"]["held_out_capture"] if bar_is_reference else g["held_out_capture"])["all_views_score_mm"]
         # The new run's held-out tolerance (0 before session 23) confirms the old run's candidates too.
-        tolerance = 1.0 + a.get("held_out_tolerance", 0.0)
+        allowed = 1.0 + a.get("held_out_tolerance", 0.0)
         ranked, before = [], None
         for c in old["attribution"]["candidates"]:
             entry = dict(effect=c["effect"], shrinkage=shrink(e0, c["validated"]["excess_above_floors"]),
-                         confirmed=held_out(c) <= tolerance * h0, objective=c["objective_mm"],
+                         confirmed=held_out(c) <= allowed * h0, objective=c["objective_mm"],
                          held_out=1 - held_out(c) / h0, c=c)
             if c["effect"] == swapped["effect"]:
                 before = entry
