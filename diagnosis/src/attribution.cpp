@@ -44,7 +44,8 @@ sim::Expected<Evaluation> on_next_placement(ForwardModel& next, const ModelSetup
     const double distance = setup.drift.norm();
     double best = std::numeric_limits<double>::infinity(), best_direction = 0.0;
     // The best direction's drape from the best state: evaluate scores it again rather than simulating it again.
-    ForwardModel::Simulated simulated{.state = static_cast<std::size_t>(on.best.state)};
+    ForwardModel::Simulated simulated;
+    simulated.state = static_cast<std::size_t>(on.best.state);
     placed = setup;
     for (int k = 0; k < kDriftDirections; ++k) {
       const double direction = M_PI * k / kDriftDirections;

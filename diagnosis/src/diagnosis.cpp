@@ -504,6 +504,8 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
         {"difference_mm", diff[k] * 1e3}, {"floor_mm", floor[k] * 1e3}, {"ratio", L.group_ratio[k]}};
   }
   j["localisation"] = {{"region", region_name(L.dominant)},
+                       {"dominant_feature", L.dominant_feature.empty() ? nlohmann::json(nullptr)
+                                                                       : nlohmann::json(L.dominant_feature)},
                        {"feature_groups", groups},
                        {"stable_ratio", L.stable_ratio},
                        {"pixel_region", region_name(L.pixel_region)},

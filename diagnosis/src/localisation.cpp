@@ -9,6 +9,9 @@ namespace {
 constexpr Region kRegions[] = {Region::kTop, Region::kRim, Region::kSkirt, Region::kHem, Region::kCylinder};
 constexpr double kMinPixelShare = 0.02;
 constexpr double kMinEnrichment = 1.3;
+/// The stable term's excess over its floor from which it is a sensor error (everywhere) rather than the specimen's
+/// contact with the platform (place_gap; calibrated on seeds 4-10, docs/DIAGNOSIS.md session 24).
+constexpr double kSensorScaleStableRatio = 1.5;
 
 }  // namespace
 
@@ -45,20 +48,46 @@ void localise_features(Localisation& L, const ScoredDrape& drape, const Target& 
   const auto diff = group_differences(capture.shape.all, drape.shape.all);
   const auto scale = default_feature_scales();
   L.group_ratio.assign(diff.size(), 0.0);
-  double best = 1.0;
-  L.dominant = Region::kGlobal;
   for (std::size_t k = 0; k < diff.size(); ++k) {
     if (diff[k] < 0.0) continue;
     const double floor = std::max(k < group_floor.size() ? group_floor[k] : 0.0, 0.5 * scale[k]);
     L.group_ratio[k] = diff[k] / floor;
-    if (L.group_ratio[k] > best) {
-      best = L.group_ratio[k];
-      L.dominant = feature_region(kFeatureGroups[k]);
-    }
   }
-  // The stable term (platform top, bare cylinder) is where sensor errors show: everywhere at once.
   L.stable_ratio = drape.stable_all / std::max(stable_floor, 1e-4);
-  if (L.stable_ratio > best) L.dominant = Region::kGlobal;
+  place_gap(L);
+}
+
+void place_gap(Localisation& L) {
+  double best = 1.0;
+  std::size_t group = L.group_ratio.size();
+  for (std::size_t k = 0; k < L.group_ratio.size() && k < std::size(kFeatureGroups); ++k) {
+    if (L.group_ratio[k] > best) best = L.group_ratio[k], group = k;
+  }
+  if (L.stable_ratio > best) {
+    // The stable term (platform top, bare cylinder) leads: a sensor-scale excess is everywhere at once; a smaller
+    // one, with the specimen's shape within its floors, is the specimen's contact with the platform.
+    L.dominant_feature = "stable";
+    L.dominant = L.stable_ratio >= kSensorScaleStableRatio ? Region::kGlobal : Region::kTop;
+    return;
+  }
+  if (group == L.group_ratio.size()) {
+    L.dominant_feature.clear();
+    L.dominant = Region::kGlobal;
+    return;
+  }
+  const FeatureGroup g = kFeatureGroups[group];
+  L.dominant_feature = feature_group_name(g);
+  L.dominant = feature_region(g);
+  // The outline's shape (its harmonics, sorted radii, height) follows the skirt above it: the hem carries the skirt's
+  // change where the skirt's residual is the denser one. A shift of the centre is the hem's own (a placement).
+  if (L.dominant == Region::kHem && g != FeatureGroup::kOffCentre) {
+    double skirt = 0.0, hem = 0.0;
+    for (const auto& s : L.regions) {
+      if (s.region == Region::kSkirt) skirt = s.enrichment;
+      if (s.region == Region::kHem) hem = s.enrichment;
+    }
+    if (skirt > hem) L.dominant = Region::kSkirt;
+  }
 }
 
 double RegionEnergy::mean_square(Region region) const {

@@ -152,7 +152,12 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
     md += fmt::format("| {} | {:.2f} | {:.2f} | {:.2f} | {:.1f} | {:.2f} |\n", region_name(s.region), s.energy_share,
                       s.pixel_share, s.enrichment, s.rms * 1e3, s.floor_ratio);
   }
-  md += fmt::format("\nDominant region: **{}**. Per-view share of the residual energy:", region_name(r.localisation.dominant));
+  const std::string& led = r.localisation.dominant_feature;
+  md += fmt::format("\nDominant region: **{}** ({}). Per-view share of the residual energy:",
+                    region_name(r.localisation.dominant),
+                    led.empty()      ? "nothing exceeds its floor"
+                    : led == "stable" ? "led by the stable term"
+                                      : fmt::format("led by {}", led));
   for (double s : r.localisation.view_share) md += fmt::format(" {:.2f}", s);
   md += fmt::format(".\nFolds: capture {}, model {}; drape coefficient: capture {:.3f}, model {:.3f}.\n",
                     r.localisation.capture_folds, r.localisation.model_folds,

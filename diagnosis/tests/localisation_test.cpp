@@ -36,6 +36,21 @@ std::array<double, RegionEnergy::kCount> floors_of(double top, double rim, doubl
   return f;
 }
 
+/// A localisation whose feature groups all sit at `ratio` but `group` at `lead`, with the stable term at `stable`
+/// and the skirt's and the hem's pixel residuals enriched `skirt` and `hem` times.
+Localisation excess(FeatureGroup group, double lead, double stable, double skirt, double hem, double ratio = 0.8) {
+  Localisation L;
+  L.group_ratio.assign(std::size(kFeatureGroups), ratio);
+  for (std::size_t k = 0; k < std::size(kFeatureGroups); ++k)
+    if (kFeatureGroups[k] == group) L.group_ratio[k] = lead;
+  L.stable_ratio = stable;
+  RegionShare s = share(Region::kSkirt, 0.01, 0.2), h = share(Region::kHem, 0.01, 0.5);
+  s.enrichment = skirt;
+  h.enrichment = hem;
+  L.regions = {share(Region::kTop, 0.002, 0.1), s, h};
+  return L;
+}
+
 }  // namespace
 
 TEST(ClassifyPoint, SplitsTheSpecimenIntoTopRimCylinderSkirtAndHem) {
@@ -91,4 +106,51 @@ TEST(Floors, RegionFloorIsTheLargestSampleOfEitherKindPerRegion) {
   const auto top = f.region_floor();
   const auto expected = floors_of(0.002, 0.002, 0.006, 0.008, 0.001);
   for (int k = 0; k < RegionEnergy::kCount; ++k) EXPECT_DOUBLE_EQ(top[k], expected[k]) << k;
+}
+
+TEST(PlaceGap, TheStableTermIsEverywhereAtASensorScaleAndThePlatformContactBelowIt) {
+  Localisation L = excess(FeatureGroup::kHemHeight, 1.4, 2.0, 1.0, 1.0);
+  place_gap(L);
+  EXPECT_EQ(L.dominant, Region::kGlobal);
+  EXPECT_EQ(L.dominant_feature, "stable");
+  L = excess(FeatureGroup::kHemHeight, 1.2, 1.3, 1.0, 1.0);
+  place_gap(L);
+  EXPECT_EQ(L.dominant, Region::kTop);
+  EXPECT_EQ(L.dominant_feature, "stable");
+  // Below a larger group ratio the stable term does not lead.
+  L = excess(FeatureGroup::kSkirtHeight, 2.5, 2.0, 1.0, 1.0);
+  place_gap(L);
+  EXPECT_EQ(L.dominant, Region::kSkirt);
+  EXPECT_EQ(L.dominant_feature, "skirt_height");
+}
+
+TEST(PlaceGap, TheHemsOutlineCarriesTheSkirtWhereTheSkirtsResidualIsDenser) {
+  for (FeatureGroup g : {FeatureGroup::kHarmonics, FeatureGroup::kSortedRadii, FeatureGroup::kHemHeight}) {
+    Localisation L = excess(g, 2.0, 0.9, 1.6, 1.2);
+    place_gap(L);
+    EXPECT_EQ(L.dominant, Region::kSkirt) << feature_group_name(g);
+    EXPECT_EQ(L.dominant_feature, feature_group_name(g));
+    L = excess(g, 2.0, 0.9, 1.1, 1.2);
+    place_gap(L);
+    EXPECT_EQ(L.dominant, Region::kHem) << feature_group_name(g);
+  }
+  // A shifted centre is the hem's own (a placement), however dense the skirt's residual.
+  Localisation L = excess(FeatureGroup::kOffCentre, 2.0, 0.9, 1.6, 1.2);
+  place_gap(L);
+  EXPECT_EQ(L.dominant, Region::kHem);
+  EXPECT_EQ(L.dominant_feature, "off_centre");
+  // The skirt's groups are the skirt's whatever the pixels say.
+  for (FeatureGroup g : {FeatureGroup::kSkirtHeight, FeatureGroup::kSkirtSpread, FeatureGroup::kFolds}) {
+    L = excess(g, 2.0, 0.9, 0.8, 1.3);
+    place_gap(L);
+    EXPECT_EQ(L.dominant, Region::kSkirt) << feature_group_name(g);
+  }
+}
+
+TEST(PlaceGap, GlobalWithNoFeatureNamedWhenNothingExceedsItsFloor) {
+  Localisation L = excess(FeatureGroup::kHemHeight, 0.95, 0.97, 1.6, 1.2);
+  L.dominant_feature = "left over";
+  place_gap(L);
+  EXPECT_EQ(L.dominant, Region::kGlobal);
+  EXPECT_TRUE(L.dominant_feature.empty());
 }

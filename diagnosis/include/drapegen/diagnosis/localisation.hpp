@@ -34,9 +34,11 @@ struct RegionEnergy {
 };
 
 struct Localisation {
-  /// Where the gap sits: the region of the shape-feature group (or the stable term) that exceeds its floor the most
-  /// (localise_features), kGlobal for the stable term or if nothing exceeds its floor.
+  /// Where the gap sits (place_gap): from the shape-feature group or the stable term that exceeds its floor the most
+  /// (dominant_feature), kGlobal if nothing exceeds its floor.
   Region dominant = Region::kGlobal;
+  /// That feature: a feature group's name, "stable" for the stable term, empty if nothing exceeds its floor.
+  std::string dominant_feature;
   /// Per feature group (kFeatureGroups order) and for the stable term: the capture's difference from the fitted
   /// drape over the largest floor sample's (at least half the group's scale).
   std::vector<double> group_ratio;
@@ -69,9 +71,16 @@ void localise_against_floors(Localisation& localisation, const std::array<double
 
 /// The region a feature group describes: the outline groups the hem, the skirt groups the skirt.
 [[nodiscard]] Region feature_region(FeatureGroup group);
-/// Sets group_ratio, stable_ratio and dominant from the fitted drape's shape features against the capture's and the
-/// floors (floors.hpp) of each group.
+/// Sets group_ratio, stable_ratio (and, by place_gap, dominant) from the fitted drape's shape features against the
+/// capture's and the floors (floors.hpp) of each group.
 void localise_features(Localisation& localisation, const ScoredDrape& drape, const Target& capture,
                        const std::vector<double>& group_floor, double stable_floor);
+
+/// Sets dominant and dominant_feature from group_ratio, stable_ratio and the regions' enrichment. The largest ratio
+/// above 1 leads. The stable term: kGlobal (a sensor error acts everywhere) from 1.5 times its floor, below that kTop
+/// (the specimen's contact with the platform). A skirt group: kSkirt. The hem's centre offset: kHem. The other hem
+/// groups (harmonics, sorted radii, hem height): kSkirt if the skirt's pixel residual is denser than the hem's (the
+/// outline carries a change of the skirt above it), else kHem. Nothing above 1: kGlobal.
+void place_gap(Localisation& localisation);
 
 }  // namespace drapegen::diagnosis

@@ -1,0 +1,95 @@
+#!/usr/bin/env python3
+"""Where the gap sits, under the localisation's rules, read off the report.json files of diagnosis benchmark runs
+(`drapegen_diagnosis_bench`; the truth files are read only to score). docs/DIAGNOSIS.md, "Session 24".
+
+- as_run: the report's `localisation.region`;
+- largest: the region of the feature group (or the stable term) furthest above its floor, outline groups "hem", skirt
+  groups "skirt", the stable term "global" (the rule before session 24);
+- place_gap: the rule since session 24 (diagnosis/src/localisation.cpp, place_gap): the stable term "global" from
+  1.5 times its floor, else "top"; the hem's centre offset "hem"; the other outline groups "skirt" where the skirt's
+  pixel residual is denser than the hem's, else "hem"; skirt groups "skirt";
+- pixel_region, floor_region: the report's other two localisers (the most enriched region; the region furthest
+  above its own floor, in reports since session 22).
+
+Per rule: the effect captures whose region is one of the effect's regions (the truth file's `regions`), per family.
+
+    scripts/region_rules.py out/s24s11main_all [more runs ...]
+    scripts/region_rules.py --sensor-scale 1.3 --skirt-denser 1.1 out/s23all     # place_gap with other constants
+"""
+import argparse
+import collections
+import glob
+import json
+import os
+
+OUTLINE = {"harmonics", "off_centre", "sorted_radii", "hem_height"}
+RULES = ["as_run", "largest", "place_gap", "pixel_region", "floor_region"]
+
+
+def leading(loc):
+    """The feature group furthest above its floor, or "stable", or None (nothing above 1)."""
+    best, lead = 1.0, None
+    for name, g in loc["feature_groups"].items():
+        if g["ratio"] > best:
+            best, lead = g["ratio"], name
+    return "stable" if loc["stable_ratio"] > best else lead
+
+
+def largest(loc):
+    lead = leading(loc)
+    if lead is None or lead == "stable":
+        return "global"
+    return "hem" if lead in OUTLINE else "skirt"
+
+
+def place_gap(loc, sensor_scale, skirt_denser):
+    lead = leading(loc)
+    if lead is None:
+        return "global"
+    if lead == "stable":
+        return "global" if loc["stable_ratio"] >= sensor_scale else "top"
+    if lead not in OUTLINE:
+        return "skirt"
+    if lead == "off_centre":
+        return "hem"
+    enrichment = {r["region"]: r["enrichment"] for r in loc["regions"]}
+    return "skirt" if enrichment.get("skirt", 0.0) > skirt_denser * enrichment.get("hem", 0.0) else "hem"
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("runs", nargs="+", help="benchmark output directories (diagnoses/, truth/)")
+    ap.add_argument("--sensor-scale", type=float, default=1.5, help="place_gap's stable ratio for 'global'")
+    ap.add_argument("--skirt-denser", type=float, default=1.0, help="place_gap's skirt/hem enrichment factor")
+    args = ap.parse_args()
+    hits = {r: collections.Counter() for r in RULES}
+    totals = collections.Counter()
+    for run in args.runs:
+        for path in sorted(glob.glob(os.path.join(run, "diagnoses", "*.json"))):
+            name = os.path.basename(path)[:-len(".json")]
+            truth_path = os.path.join(run, "truth", name + ".json")
+            if ".p" in name or not os.path.exists(truth_path):
+                continue
+            family = name.rsplit("_", 1)[0]
+            if family == "none":
+                continue
+            with open(path) as f:
+                loc = json.load(f)["localisation"]
+            with open(truth_path) as f:
+                regions = set(json.load(f)["regions"])
+            region = {"as_run": loc["region"], "largest": largest(loc),
+                      "place_gap": place_gap(loc, args.sensor_scale, args.skirt_denser),
+                      "pixel_region": loc["pixel_region"], "floor_region": loc.get("floor_region")}
+            totals[family] += 1
+            for rule in RULES:
+                hits[rule][family] += region[rule] in regions
+    families = sorted(totals)
+    print("%-13s %7s  " % ("rule", "all") + " ".join("%12s" % f for f in families))
+    for rule in RULES:
+        n = sum(hits[rule].values())
+        print("%-13s %3d/%-3d  " % (rule, n, sum(totals.values())) +
+              " ".join("%12s" % ("%d/%d" % (hits[rule][f], totals[f])) for f in families))
+
+
+if __name__ == "__main__":
+    main()
