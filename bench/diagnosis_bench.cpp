@@ -414,6 +414,7 @@ int main(int argc, char** argv) {
   int effect_total = 0, effect_correct = 0, control_total = 0, control_within = 0, region_total = 0, region_match = 0;
   // The region furthest above its own floor (localisation.floor_region, since session 22; absent in older reports).
   int floor_region_total = 0, floor_region_match = 0;
+  std::map<std::string, std::pair<int, int>> region_by_family;  // localised region: matched, scored
   // The screen (--visible-only): per family, draws made and draws visible; the verdicts on visible captures.
   std::map<std::string, std::pair<int, int>> screen_draws_by_family;
   int visible_total = 0, visible_correct = 0;
@@ -477,6 +478,8 @@ int main(int argc, char** argv) {
       ++region_total;
       region_ok = is_true_region(region);
       region_match += region_ok;
+      region_by_family[family].first += region_ok;
+      region_by_family[family].second++;
       if (d["localisation"].contains("floor_region")) {
         ++floor_region_total;
         floor_region_match += is_true_region(d["localisation"]["floor_region"].get<std::string>());
@@ -539,7 +542,14 @@ int main(int argc, char** argv) {
   md += fmt::format("- median shrinkage of the excess above the floors once the named effect is added (0 when "
                     "none is named): {:.0f}%; over the correctly named captures alone: {:.0f}%\n",
                     100.0 * median(shrinkages), named_shrinkages.empty() ? 0.0 : 100.0 * median(named_shrinkages));
-  md += fmt::format("- localised region matches the effect's region: {}/{}\n", region_match, region_total);
+  md += fmt::format("- localised region matches the effect's region: {}/{}", region_match, region_total);
+  if (!region_by_family.empty()) {
+    md += " (";
+    for (const auto& [family, n] : region_by_family) md += fmt::format("{} {}/{}, ", family, n.first, n.second);
+    md.resize(md.size() - 2);
+    md += ")";
+  }
+  md += "\n";
   if (floor_region_total > 0) {
     md += fmt::format("- the region furthest above its own floor (floor_region) matches it: {}/{}\n",
                       floor_region_match, floor_region_total);
