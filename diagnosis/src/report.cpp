@@ -61,6 +61,25 @@ sim::Status write_residual_png(const std::string& path, const std::vector<std::v
   return {};
 }
 
+namespace {
+
+/// What placed the gap (place_gap), for the report's "Dominant region" line.
+std::string leading_feature_text(const Localisation& L) {
+  const std::string& led = L.dominant_feature;
+  if (led.empty()) return "nothing exceeds its floor";
+  if (led == "stable") return "led by the stable term";
+  for (FeatureGroup g : kFeatureGroups) {
+    if (feature_group_name(g) == led && feature_region(g) != L.dominant) {
+      return fmt::format("led by {}, an outline group; the skirt's residual is denser than the hem's, so the outline "
+                         "carries a change of the skirt",
+                         led);
+    }
+  }
+  return fmt::format("led by {}", led);
+}
+
+}  // namespace
+
 sim::Status write_report(const std::string& directory, const DiagnosisResult& r, const Capture& capture,
                          ForwardModel& model) {
   const fs::path dir(directory);
@@ -152,12 +171,8 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
     md += fmt::format("| {} | {:.2f} | {:.2f} | {:.2f} | {:.1f} | {:.2f} |\n", region_name(s.region), s.energy_share,
                       s.pixel_share, s.enrichment, s.rms * 1e3, s.floor_ratio);
   }
-  const std::string& led = r.localisation.dominant_feature;
   md += fmt::format("\nDominant region: **{}** ({}). Per-view share of the residual energy:",
-                    region_name(r.localisation.dominant),
-                    led.empty()      ? "nothing exceeds its floor"
-                    : led == "stable" ? "led by the stable term"
-                                      : fmt::format("led by {}", led));
+                    region_name(r.localisation.dominant), leading_feature_text(r.localisation));
   for (double s : r.localisation.view_share) md += fmt::format(" {:.2f}", s);
   md += fmt::format(".\nFolds: capture {}, model {}; drape coefficient: capture {:.3f}, model {:.3f}.\n",
                     r.localisation.capture_folds, r.localisation.model_folds,
