@@ -13,8 +13,14 @@
 
 Per rule: the effect captures whose region is one of the effect's regions (the truth file's `regions`), per family.
 
+With --ranking: verdicts of a region-aware attribution (an experiment, negative in session 24), top-1 and controls per
+run: `tolerance` (the rule since session 23, applied to every report with --tolerance, default 0.1: confirmed first, then the shrinkage, then the smaller objective),
+`region_tie` (at equal shrinkage, an effect that acts where place_gap put the gap first) and `region_significant`
+(among the confirmed candidates with a significant shrinkage, such an effect first).
+
     scripts/region_rules.py out/s24s11main_all [more runs ...]
     scripts/region_rules.py --sensor-scale 1.3 --skirt-denser 1.1 out/s23all     # place_gap with other constants
+    scripts/region_rules.py --ranking out/s24s11main_all                          # the region-aware ranking
 """
 import argparse
 import collections
@@ -24,6 +30,10 @@ import os
 
 OUTLINE = {"harmonics", "off_centre", "sorted_radii", "hem_height"}
 RULES = ["as_run", "largest", "place_gap", "pixel_region", "floor_region"]
+# Where each effect acts (candidate_effect.cpp, effect_regions).
+EFFECT_REGIONS = {"yield": {"skirt"}, "shear": {"skirt"}, "curl": {"hem"}, "misalignment": {"hem"},
+                  "friction": {"top", "rim"}, "sensor": {"global"}}
+SIGNIFICANT = 0.25  # AttributionSettings::significant_shrinkage
 
 
 def leading(loc):
@@ -56,12 +66,66 @@ def place_gap(loc, sensor_scale, skirt_denser):
     return "skirt" if enrichment.get("skirt", 0.0) > skirt_denser * enrichment.get("hem", 0.0) else "hem"
 
 
+def ranked_verdict(report, region, rule, tolerance):
+    """The verdict of `rule` (tolerance, region_tie, region_significant) from the report's candidates, a candidate
+    confirmed when its held-out shrinkage is at least -tolerance."""
+    a = report["attribution"]
+    if not a.get("candidates"):
+        return report["verdict"]
+    if report.get("within_floors_after_bending_refit", False):
+        return "none"
+    def key(c):
+        unconfirmed = c["held_out_shrinkage"] < -tolerance
+        elsewhere = region not in EFFECT_REGIONS[c["effect"]]
+        if rule == "region_tie":
+            return (unconfirmed, -c["shrinkage"], elsewhere, c["objective_mm"])
+        if rule == "region_significant":
+            return (unconfirmed, c["shrinkage"] < SIGNIFICANT, elsewhere, -c["shrinkage"], c["objective_mm"])
+        return (unconfirmed, -c["shrinkage"], c["objective_mm"])
+
+    top = min(a["candidates"], key=key)
+    confirmed = top["held_out_shrinkage"] >= -tolerance and top["shrinkage"] >= SIGNIFICANT
+    return top["effect"] if confirmed else "unexplained"
+
+
+def ranking(runs, sensor_scale, skirt_denser, tolerance):
+    rules = ["tolerance", "region_tie", "region_significant"]
+    for run in runs:
+        right = {r: 0 for r in rules}
+        controls = {r: 0 for r in rules}
+        effects = ncontrols = 0
+        for path in sorted(glob.glob(os.path.join(run, "diagnoses", "*.json"))):
+            name = os.path.basename(path)[:-len(".json")]
+            if ".p" in name:
+                continue
+            family = name.rsplit("_", 1)[0]
+            with open(path) as f:
+                report = json.load(f)
+            region = place_gap(report["localisation"], sensor_scale, skirt_denser)
+            effects += family != "none"
+            ncontrols += family == "none"
+            for rule in rules:
+                verdict = ranked_verdict(report, region, rule, tolerance)
+                if family == "none":
+                    controls[rule] += verdict == "none"
+                else:
+                    right[rule] += verdict == family
+        print(run + ": " + ", ".join("%s %d/%d (controls %d/%d)" % (r, right[r], effects, controls[r], ncontrols)
+                                     for r in rules))
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("runs", nargs="+", help="benchmark output directories (diagnoses/, truth/)")
     ap.add_argument("--sensor-scale", type=float, default=1.5, help="place_gap's stable ratio for 'global'")
     ap.add_argument("--skirt-denser", type=float, default=1.0, help="place_gap's skirt/hem enrichment factor")
+    ap.add_argument("--ranking", action="store_true", help="the region-aware attribution's verdicts instead")
+    ap.add_argument("--tolerance", type=float, default=0.1,
+                    help="--ranking: the held-out tolerance for every report (default 0.1, the default since session 23)")
     args = ap.parse_args()
+    if args.ranking:
+        ranking(args.runs, args.sensor_scale, args.skirt_denser, args.tolerance)
+        return
     hits = {r: collections.Counter() for r in RULES}
     totals = collections.Counter()
     for run in args.runs:
