@@ -163,7 +163,7 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
     md += fmt::format("| {} | {} | {:.2f} |\n", feature_group_name(kFeatureGroups[k]),
                       region_name(feature_region(kFeatureGroups[k])), r.localisation.group_ratio[k]);
   }
-  md += fmt::format("| stable term (platform top, bare cylinder) | global | {:.2f} |\n\n", r.localisation.stable_ratio);
+  md += fmt::format("| stable term (platform top, bare cylinder) | global (from 1.5), else top | {:.2f} |\n\n", r.localisation.stable_ratio);
   md += fmt::format("Pixel residuals by region (most enriched: {}; most above its own floor: {}):\n\n",
                     region_name(r.localisation.pixel_region), region_name(r.localisation.floor_region));
   md += "| region | energy share | pixel share | enrichment | RMS (mm) | RMS / floor's |\n|---|---|---|---|---|---|\n";
