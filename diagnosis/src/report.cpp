@@ -160,10 +160,13 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
   md += "## Where the gap sits\n\nShape features, capture against the fitted baseline, over the largest floor sample:\n\n"
         "| feature group | region | ratio to floor |\n|---|---|---|\n";
   for (std::size_t k = 0; k < r.localisation.group_ratio.size(); ++k) {
-    md += fmt::format("| {} | {} | {:.2f} |\n", feature_group_name(kFeatureGroups[k]),
-                      region_name(feature_region(kFeatureGroups[k])), r.localisation.group_ratio[k]);
+    const FeatureGroup g = kFeatureGroups[k];
+    const bool outline = feature_region(g) == Region::kHem && g != FeatureGroup::kOffCentre;
+    md += fmt::format("| {} | {}{} | {:.2f} |\n", feature_group_name(g), region_name(feature_region(g)),
+                      outline ? " (skirt where its residual is denser)" : "", r.localisation.group_ratio[k]);
   }
-  md += fmt::format("| stable term (platform top, bare cylinder) | global (from 1.5), else top | {:.2f} |\n\n", r.localisation.stable_ratio);
+  md += fmt::format("| stable term (platform top, bare cylinder) | global (from 1.5), else top | {:.2f} |\n\n",
+                    r.localisation.stable_ratio);
   md += fmt::format("Pixel residuals by region (most enriched: {}; most above its own floor: {}):\n\n",
                     region_name(r.localisation.pixel_region), region_name(r.localisation.floor_region));
   md += "| region | energy share | pixel share | enrichment | RMS (mm) | RMS / floor's |\n|---|---|---|---|---|---|\n";
