@@ -9,9 +9,6 @@ namespace {
 constexpr Region kRegions[] = {Region::kTop, Region::kRim, Region::kSkirt, Region::kHem, Region::kCylinder};
 constexpr double kMinPixelShare = 0.02;
 constexpr double kMinEnrichment = 1.3;
-/// The stable term's excess over its floor from which it is a sensor error (everywhere) rather than the specimen's
-/// contact with the platform (place_gap; calibrated on seeds 4-10, docs/DIAGNOSIS.md session 24).
-constexpr double kSensorScaleStableRatio = 1.5;
 
 }  // namespace
 
@@ -41,6 +38,10 @@ Region feature_region(FeatureGroup group) {
     case FeatureGroup::kFolds: return Region::kSkirt;
   }
   return Region::kGlobal;
+}
+
+bool follows_skirt(FeatureGroup group) {
+  return feature_region(group) == Region::kHem && group != FeatureGroup::kOffCentre;
 }
 
 void localise_features(Localisation& L, const ScoredDrape& drape, const Target& capture,
@@ -80,7 +81,7 @@ void place_gap(Localisation& L) {
   L.dominant = feature_region(g);
   // The outline's shape (its harmonics, sorted radii, height) follows the skirt above it: the hem carries the skirt's
   // change where the skirt's residual is the denser one. A shift of the centre is the hem's own (a placement).
-  if (L.dominant == Region::kHem && g != FeatureGroup::kOffCentre) {
+  if (follows_skirt(g)) {
     double skirt = 0.0, hem = 0.0;
     for (const auto& s : L.regions) {
       if (s.region == Region::kSkirt) skirt = s.enrichment;

@@ -69,7 +69,7 @@ std::string leading_feature_text(const Localisation& L) {
   if (led.empty()) return "nothing exceeds its floor";
   if (led == "stable") return "led by the stable term";
   for (FeatureGroup g : kFeatureGroups) {
-    if (feature_group_name(g) == led && feature_region(g) != L.dominant) {
+    if (feature_group_name(g) == led && follows_skirt(g) && L.dominant == Region::kSkirt) {
       return fmt::format("led by {}, an outline group; the skirt's residual is denser than the hem's, so the outline "
                          "carries a change of the skirt",
                          led);
@@ -161,12 +161,11 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
         "| feature group | region | ratio to floor |\n|---|---|---|\n";
   for (std::size_t k = 0; k < r.localisation.group_ratio.size(); ++k) {
     const FeatureGroup g = kFeatureGroups[k];
-    const bool outline = feature_region(g) == Region::kHem && g != FeatureGroup::kOffCentre;
     md += fmt::format("| {} | {}{} | {:.2f} |\n", feature_group_name(g), region_name(feature_region(g)),
-                      outline ? " (skirt where its residual is denser)" : "", r.localisation.group_ratio[k]);
+                      follows_skirt(g) ? " (skirt where its residual is denser)" : "", r.localisation.group_ratio[k]);
   }
-  md += fmt::format("| stable term (platform top, bare cylinder) | global (from 1.5), else top | {:.2f} |\n\n",
-                    r.localisation.stable_ratio);
+  md += fmt::format("| stable term (platform top, bare cylinder) | global (from {:g}), else top | {:.2f} |\n\n",
+                    kSensorScaleStableRatio, r.localisation.stable_ratio);
   md += fmt::format("Pixel residuals by region (most enriched: {}; most above its own floor: {}):\n\n",
                     region_name(r.localisation.pixel_region), region_name(r.localisation.floor_region));
   md += "| region | energy share | pixel share | enrichment | RMS (mm) | RMS / floor's |\n|---|---|---|---|---|---|\n";

@@ -71,6 +71,12 @@ void localise_against_floors(Localisation& localisation, const std::array<double
 
 /// The region a feature group describes: the outline groups the hem, the skirt groups the skirt.
 [[nodiscard]] Region feature_region(FeatureGroup group);
+/// An outline group that carries a change of the skirt above it (harmonics, sorted radii, hem height: every outline
+/// group but the centre offset); place_gap counts it for the skirt where the skirt's residual is the denser.
+[[nodiscard]] bool follows_skirt(FeatureGroup group);
+/// The stable term's ratio to its floor from which place_gap calls it a sensor error (everywhere) rather than the
+/// specimen's contact with the platform (calibrated on seeds 4-10, docs/DIAGNOSIS.md session 24).
+inline constexpr double kSensorScaleStableRatio = 1.5;
 /// Sets group_ratio, stable_ratio (and, by place_gap, dominant) from the fitted drape's shape features against the
 /// capture's and the floors (floors.hpp) of each group.
 void localise_features(Localisation& localisation, const ScoredDrape& drape, const Target& capture,
