@@ -27,13 +27,16 @@ import collections
 import glob
 import json
 import os
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from diagnosis_rules import THRESHOLD, confirmation_rule  # noqa: E402  (the tolerance rule and its threshold)
 
 OUTLINE = {"harmonics", "off_centre", "sorted_radii", "hem_height"}
 RULES = ["as_run", "largest", "place_gap", "pixel_region", "floor_region"]
 # Where each effect acts (candidate_effect.cpp, effect_regions).
 EFFECT_REGIONS = {"yield": {"skirt"}, "shear": {"skirt"}, "curl": {"hem"}, "misalignment": {"hem"},
                   "friction": {"top", "rim"}, "sensor": {"global"}}
-SIGNIFICANT = 0.25  # AttributionSettings::significant_shrinkage
 
 
 def leading(loc):
@@ -72,6 +75,8 @@ def ranked_verdict(report, region, rule, tolerance):
     a = report["attribution"]
     if not a.get("candidates"):
         return report["verdict"]
+    if rule == "tolerance":
+        return confirmation_rule(report, tolerance)
     if report.get("within_floors_after_bending_refit", False):
         return "none"
     def key(c):
@@ -79,12 +84,10 @@ def ranked_verdict(report, region, rule, tolerance):
         elsewhere = region not in EFFECT_REGIONS[c["effect"]]
         if rule == "region_tie":
             return (unconfirmed, -c["shrinkage"], elsewhere, c["objective_mm"])
-        if rule == "region_significant":
-            return (unconfirmed, c["shrinkage"] < SIGNIFICANT, elsewhere, -c["shrinkage"], c["objective_mm"])
-        return (unconfirmed, -c["shrinkage"], c["objective_mm"])
+        return (unconfirmed, c["shrinkage"] < THRESHOLD, elsewhere, -c["shrinkage"], c["objective_mm"])
 
     top = min(a["candidates"], key=key)
-    confirmed = top["held_out_shrinkage"] >= -tolerance and top["shrinkage"] >= SIGNIFICANT
+    confirmed = top["held_out_shrinkage"] >= -tolerance and top["shrinkage"] >= THRESHOLD
     return top["effect"] if confirmed else "unexplained"
 
 
