@@ -23,7 +23,11 @@ Two more recompute the held-out confirmation from each candidate's held-out shri
   before session 23);
 - tolerance: confirmed if at most 10% worse (held-out shrinkage >= -0.1; AttributionSettings::held_out_tolerance, the
   rule since session 23; `--tolerance T` sets another);
-both rank as attribute() does: confirmed first, then the shrinkage, then the smaller objective. The other rules
+both rank as attribute() does since session 25: confirmed first, then the shrinkage, then a physical effect before
+the sensor error, then the smaller objective. Two more break the ties of equal shrinkage otherwise (session 25):
+- objective_ties: the smaller objective alone (the tolerance rule as sessions 23-24 ran it);
+- parsimony: fewer parameters first (candidate_effect.cpp, effect_space: sensor 9, misalignment 2, the others 1),
+  then the smaller objective. The other rules
 confirm as the run did (its report's `attribution.held_out_tolerance`, 0 in reports made before session 23).
 
 Three more read reports made with `drapegen diagnose --ablation` (session 20; on reports without ablations they give
@@ -46,8 +50,13 @@ import sys
 
 THRESHOLD = 0.25  # AttributionSettings::significant_shrinkage
 TOLERANCE = 0.1  # AttributionSettings::held_out_tolerance (since session 23); --tolerance sets the rule's
-RULES = ["current", "strict", "tolerance", "tie_objective", "no_bar", "no_bar_unconfirmed", "mean3", "held_out_excess",
-         "held_out_rank", "min_objective", "without_ablation", "reach", "reach_objective"]
+RULES = ["current", "strict", "tolerance", "objective_ties", "parsimony", "tie_objective", "no_bar", "no_bar_unconfirmed",
+         "mean3", "held_out_excess", "held_out_rank", "min_objective", "without_ablation", "reach", "reach_objective"]
+PARAMETERS = {"sensor": 9, "misalignment": 2}  # effect_space's dimension; the others have 1
+# How each rule orders candidates of equal shrinkage before their objectives (confirmation_rule).
+TIES = {"physical_first": lambda effect: effect == "sensor",  # attribute() since session 25 (needs_simulation)
+        "objective": lambda effect: 0,
+        "parsimony": lambda effect: PARAMETERS.get(effect, 1)}
 FAMILY = {"pose": "sensor", "bias": "sensor", "multipath": "sensor", "misalign": "misalignment"}
 
 
@@ -125,13 +134,15 @@ def reference_rule(j, rule):
     return top["effect"] if ok else "unexplained"
 
 
-def confirmation_rule(j, tolerance):
-    """The verdict with a candidate confirmed when its held-out shrinkage is at least -tolerance."""
+def confirmation_rule(j, tolerance, ties="physical_first"):
+    """The verdict with a candidate confirmed when its held-out shrinkage is at least -tolerance; candidates of equal
+    shrinkage ordered by TIES[ties], then the smaller objective."""
     a = j["attribution"]
     if j.get("within_floors_after_bending_refit", False):
         return "none"
     ranked = sorted(a["candidates"], key=lambda c: (
-        c["held_out_shrinkage"] < -tolerance, -c["shrinkage"], c["objective_mm"], -c["held_out_shrinkage"]))
+        c["held_out_shrinkage"] < -tolerance, -c["shrinkage"], TIES[ties](c["effect"]),
+        c["objective_mm"], -c["held_out_shrinkage"]))
     top = ranked[0]
     ok = top["held_out_shrinkage"] >= -tolerance and top["shrinkage"] >= THRESHOLD
     return top["effect"] if ok else "unexplained"
@@ -145,7 +156,9 @@ def verdicts(j):
         return {r: j["verdict"] for r in RULES}
     sf, shf = g["stable_floor_mm"], g["shape_floor"]
     within = j.get("within_floors_after_bending_refit", False)
-    v = {"current": j["verdict"], "strict": confirmation_rule(j, 0.0), "tolerance": confirmation_rule(j, TOLERANCE)}
+    v = {"current": j["verdict"], "strict": confirmation_rule(j, 0.0), "tolerance": confirmation_rule(j, TOLERANCE),
+         "objective_ties": confirmation_rule(j, TOLERANCE, "objective"),
+         "parsimony": confirmation_rule(j, TOLERANCE, "parsimony")}
     top = cands[0]
     tied = [c for c in cands if c["confirmed"] and c["shrinkage"] == top["shrinkage"]]
     v["tie_objective"] = min(tied, key=lambda c: c["objective_mm"])["effect"] if (

@@ -14,7 +14,7 @@
 Per rule: the effect captures whose region is one of the effect's regions (the truth file's `regions`), per family.
 
 With --ranking: verdicts of a region-aware attribution (an experiment, negative in session 24), top-1 and controls per
-run: `tolerance` (the rule since session 23, applied to every report with --tolerance, default 0.1: confirmed first, then the shrinkage, then the smaller objective),
+run: `tolerance` (the rule since session 23, applied to every report with --tolerance, default 0.1: confirmed first, then the shrinkage, then the smaller objective, as sessions 23-24 ranked),
 `region_tie` (at equal shrinkage, an effect that acts where place_gap put the gap first) and `region_significant`
 (among the confirmed candidates with a significant shrinkage, such an effect first).
 
@@ -76,7 +76,7 @@ def ranked_verdict(report, region, rule, tolerance):
     if not a.get("candidates"):
         return report["verdict"]
     if rule == "tolerance":
-        return confirmation_rule(report, tolerance)
+        return confirmation_rule(report, tolerance, "objective")
     if report.get("within_floors_after_bending_refit", False):
         return "none"
     def key(c):

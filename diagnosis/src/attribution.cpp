@@ -302,6 +302,7 @@ double confirmation_score(const ScoredDrape& drape, const ScoredDrape* held_out_
 bool ranks_before(const CandidateResult& x, const CandidateResult& y) {
   if (x.confirmed != y.confirmed) return x.confirmed;
   if (x.shrinkage != y.shrinkage) return x.shrinkage > y.shrinkage;
+  if (needs_simulation(x.effect) != needs_simulation(y.effect)) return needs_simulation(x.effect);
   if (x.objective != y.objective) return x.objective < y.objective;
   return x.held_out_shrinkage > y.held_out_shrinkage;
 }

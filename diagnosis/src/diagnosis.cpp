@@ -103,17 +103,22 @@ nlohmann::json spread_json(const ValidationSpread& s) {
           {"pairwise_groups_mm", pair_groups}};
 }
 
+/// Lengths in metres as a JSON array of millimetres.
+nlohmann::json millimetres(const std::vector<double>& metres) {
+  nlohmann::json mm = nlohmann::json::array();
+  for (double x : metres) mm.push_back(x * 1e3);
+  return mm;
+}
+
 /// A setup's validation drapes against another placement (null without one): the best (chosen by that capture's fit
 /// views) and every drape's all-views score (`all_scores`, m; validation states' order).
 nlohmann::json placement_json(const ScoredDrape* best, const std::vector<double>& all_scores) {
   if (!best) return nullptr;
-  nlohmann::json scores = nlohmann::json::array();
-  for (double s : all_scores) scores.push_back(s * 1e3);
   return {{"stable_mm", best->stable_all * 1e3},
           {"shape", best->shape_all},
           {"all_views_score_mm", best->all_score * 1e3},
           {"best_validation_state", best->state},
-          {"validation_all_views_scores_mm", std::move(scores)}};
+          {"validation_all_views_scores_mm", millimetres(all_scores)}};
 }
 nlohmann::json placement_json(const std::optional<Evaluation>& e) {
   return e ? placement_json(&e->best, e->all_scores()) : nullptr;
@@ -449,14 +454,10 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                            {"typical_held_out_view_mm", r.floors.typical_held_out * 1e3},
                            {"noise_shape", r.floors.noise.shape},
                            {"multistability_shape", r.floors.multistability.shape},
-                           {"noise_all_mm", nlohmann::json::array()},
-                           {"noise_held_out_mm", nlohmann::json::array()},
-                           {"multistability_all_mm", nlohmann::json::array()},
-                           {"multistability_held_out_mm", nlohmann::json::array()}};
-  for (double x : r.floors.noise.all) floors["noise_all_mm"].push_back(x * 1e3);
-  for (double x : r.floors.noise.held_out) floors["noise_held_out_mm"].push_back(x * 1e3);
-  for (double x : r.floors.multistability.all) floors["multistability_all_mm"].push_back(x * 1e3);
-  for (double x : r.floors.multistability.held_out) floors["multistability_held_out_mm"].push_back(x * 1e3);
+                           {"noise_all_mm", millimetres(r.floors.noise.all)},
+                           {"noise_held_out_mm", millimetres(r.floors.noise.held_out)},
+                           {"multistability_all_mm", millimetres(r.floors.multistability.all)},
+                           {"multistability_held_out_mm", millimetres(r.floors.multistability.held_out)}};
   j["floors"] = floors;
   j["baseline"] = {{"initial_guess", bending_json(r.initial_guess)},
                    {"initial_guess_from", r.initial_guess_from},
@@ -489,6 +490,8 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                        {"pixel_share", s.pixel_share},
                        {"enrichment", s.enrichment},
                        {"rms_mm", s.rms * 1e3},
+                       {"mean_mm", s.mean * 1e3},
+                       {"view_mean_mm", millimetres(s.view_mean)},
                        {"floor_ratio", s.floor_ratio}});
   }
   nlohmann::json harmonics = nlohmann::json::array();

@@ -96,6 +96,17 @@ double RegionEnergy::mean_square(Region region) const {
   return k < kCount && pixels[k] > 0.0 ? energy[k] / pixels[k] : 0.0;
 }
 
+double RegionEnergy::mean(Region region) const {
+  const int k = static_cast<int>(region);
+  return k < kCount && pixels[k] > 0.0 ? sum[k] / pixels[k] : 0.0;
+}
+
+double RegionEnergy::view_mean(std::size_t view, Region region) const {
+  const int k = static_cast<int>(region);
+  if (view >= view_sum.size() || k >= kCount || view_pixels[view][k] <= 0.0) return 0.0;
+  return view_sum[view][k] / view_pixels[view][k];
+}
+
 namespace {
 
 /// region_energy with the drape's outline (turned as rendered) given.
@@ -104,6 +115,8 @@ RegionEnergy region_energy(const ForwardModel& model, const ScoredDrape& drape, 
   const Capture& capture = model.capture();
   const double R = 0.5 * capture.specimen.cylinder_diameter;
   E.view_energy.assign(drape.views.size(), 0.0);
+  E.view_sum.assign(drape.views.size(), {});
+  E.view_pixels.assign(drape.views.size(), {});
   for (std::size_t v = 0; v < drape.views.size(); ++v) {
     const auto& cmp = drape.views[v];
     const auto& view = capture.views[v];
@@ -117,8 +130,11 @@ RegionEnergy region_energy(const ForwardModel& model, const ScoredDrape& drape, 
       const int k = static_cast<int>(classify_point(p, model_outline, R));
       const double e = static_cast<double>(res) * res;
       E.energy[k] += e;
+      E.sum[k] += res;
       E.pixels[k] += 1.0;
       E.view_energy[v] += e;
+      E.view_sum[v][k] += res;
+      E.view_pixels[v][k] += 1.0;
     }
   }
   return E;
@@ -146,6 +162,8 @@ Localisation localise(const ForwardModel& model, const ScoredDrape& drape) {
     s.pixel_share = total_pixels > 0.0 ? E.pixels[k] / total_pixels : 0.0;
     s.enrichment = s.pixel_share > 0.0 ? s.energy_share / s.pixel_share : 0.0;
     s.rms = std::sqrt(E.mean_square(r));
+    s.mean = E.mean(r);
+    for (std::size_t v = 0; v < drape.views.size(); ++v) s.view_mean.push_back(E.view_mean(v, r));
     L.regions.push_back(s);
     if (s.pixel_share >= kMinPixelShare && s.enrichment > best) {
       best = s.enrichment;

@@ -90,7 +90,7 @@ TEST(GapShrinkage, CreditsRemovingTheReasonTheGateFired) {
 
 TEST(GapShrinkage, IsZeroWhenThereWasNoExcess) { EXPECT_EQ(gap_shrinkage(0.0, 0.3), 0.0); }
 
-TEST(RanksBefore, ConfirmedFirstThenShrinkageThenObjectiveAmongEqualShrinkages) {
+TEST(RanksBefore, ConfirmedFirstThenShrinkageThenPhysicalEffectsThenObjectiveAmongEqualShrinkages) {
   // A confirmed candidate outranks an unconfirmed one whatever their shrinkages.
   EXPECT_TRUE(ranks_before(ranked(Effect::kCurl, true, 0.3, 9e-3, 0.0), ranked(Effect::kShear, false, 1.0, 1e-3, 0.5)));
   // The larger shrinkage first, whatever the objective.
@@ -98,9 +98,16 @@ TEST(RanksBefore, ConfirmedFirstThenShrinkageThenObjectiveAmongEqualShrinkages) 
   // Both within the floors (shrinkage 1): the clipped excess cannot rank them, the smaller refit objective does,
   // ahead of the held-out shrinkage (seed 6's friction captures, docs/DIAGNOSIS.md "Session 19").
   const CandidateResult friction = ranked(Effect::kFriction, true, 1.0, 4.74e-3, 0.31);
-  const CandidateResult sensor = ranked(Effect::kSensor, true, 1.0, 5.50e-3, 0.32);
+  const CandidateResult shear = ranked(Effect::kShear, true, 1.0, 5.50e-3, 0.32);
+  EXPECT_TRUE(ranks_before(friction, shear));
+  EXPECT_FALSE(ranks_before(shear, friction));
+  // A physical effect before the sensor error at equal shrinkage, even at a larger objective (seed 13's friction_02,
+  // docs/DIAGNOSIS.md "Session 25")...
+  const CandidateResult sensor = ranked(Effect::kSensor, true, 1.0, 4.0e-3, 0.4);
   EXPECT_TRUE(ranks_before(friction, sensor));
   EXPECT_FALSE(ranks_before(sensor, friction));
+  // ... but not at a smaller shrinkage.
+  EXPECT_TRUE(ranks_before(ranked(Effect::kSensor, true, 0.9, 6e-3, 0.0), ranked(Effect::kCurl, true, 0.8, 4e-3, 0.5)));
   // Equal objectives as well: the larger held-out shrinkage.
   EXPECT_TRUE(ranks_before(ranked(Effect::kCurl, true, 1.0, 5e-3, 0.4), ranked(Effect::kShear, true, 1.0, 5e-3, 0.3)));
   // A strict weak order: nothing ranks before itself.

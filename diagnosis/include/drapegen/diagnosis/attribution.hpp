@@ -185,8 +185,9 @@ struct Attribution {
 
 /// The attribution's order of candidates (true: `x` ranks before `y`): confirmed ones first, then the larger shrinkage
 /// of the gate's excess; among equal shrinkages (in practice several candidates that each bring the excess to 0: the
-/// excess is clipped at the floors, so it cannot rank them) the smaller refit objective, then the larger held-out
-/// shrinkage.
+/// excess is clipped at the floors, so it cannot rank them) a physical effect before the sensor error (its nine camera
+/// parameters absorb a local change of the drape that a one-parameter effect explains as well; docs/DIAGNOSIS.md,
+/// "Session 25"), then the smaller refit objective, then the larger held-out shrinkage.
 [[nodiscard]] bool ranks_before(const CandidateResult& x, const CandidateResult& y);
 
 /// The held-out confirmation: `held_out_after` (the candidate's confirmation_score) is at most (1 + tolerance) times

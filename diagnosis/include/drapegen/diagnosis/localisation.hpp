@@ -18,19 +18,28 @@ struct RegionShare {
   double pixel_share = 0.0;   // fraction of the pixels
   double enrichment = 0.0;    // energy_share / pixel_share
   double rms = 0.0;           // m: RMS of the region's pixel residuals
+  /// m: the mean of the region's pixel residuals (capture minus model depth: > 0 where the capture lies further from
+  /// the camera), over all views and per view (0 in a view without pixels there). A depth bias shifts it by the
+  /// bias in every view; a change of the specimen's shape rarely shifts a whole region one way.
+  double mean = 0.0;
+  std::vector<double> view_mean;
   /// The region's RMS over the largest floor sample's in the same region (localise_against_floors; 0 if the floors
   /// have no pixels there): how far this part of the specimen is from what noise and other stable drapes leave.
   double floor_ratio = 0.0;
 };
 
-/// A drape's residual maps back-projected onto the specimen: squared residuals and pixels per region (indexed by
-/// Region, kGlobal unused) and the squared residuals per view.
+/// A drape's residual maps back-projected onto the specimen: squared residuals, residuals and pixels per region
+/// (indexed by Region, kGlobal unused), the squared residuals per view and the residuals and pixels per view and region.
 struct RegionEnergy {
   static constexpr int kCount = static_cast<int>(Region::kGlobal);
-  std::array<double, kCount> energy{}, pixels{};
+  std::array<double, kCount> energy{}, sum{}, pixels{};
   std::vector<double> view_energy;
+  std::vector<std::array<double, kCount>> view_sum, view_pixels;
   /// m^2: the region's mean squared residual (0 without pixels).
   [[nodiscard]] double mean_square(Region region) const;
+  /// m: the region's mean residual, over all views or in one view (0 without pixels).
+  [[nodiscard]] double mean(Region region) const;
+  [[nodiscard]] double view_mean(std::size_t view, Region region) const;
 };
 
 struct Localisation {
