@@ -33,7 +33,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from diagnosis_rules import THRESHOLD, confirmation_rule  # noqa: E402  (the tolerance rule and its threshold)
 
 OUTLINE = {"harmonics", "off_centre", "sorted_radii", "hem_height"}
-RULES = ["as_run", "largest", "place_gap", "pixel_region", "floor_region"]
+RULES = ["as_run", "largest", "place_gap", "signed", "pixel_region", "floor_region"]
 # Where each effect acts (candidate_effect.cpp, effect_regions).
 EFFECT_REGIONS = {"yield": {"skirt"}, "shear": {"skirt"}, "curl": {"hem"}, "misalignment": {"hem"},
                   "friction": {"top", "rim"}, "sensor": {"global"}}
@@ -55,11 +55,27 @@ def largest(loc):
     return "hem" if lead in OUTLINE else "skirt"
 
 
-def place_gap(loc, sensor_scale, skirt_denser):
+def stable_region(loc, lifted_scale):
+    """Where the stable term's excess sits, from the rigid regions' residuals (reports since session 25): the bare
+    cylinder if the platform top is within its own floor; everywhere if the top is seen further than the fitted
+    cloth (mean residual > 0: no cloth lies below the platform, a camera error does that); a lifted top (mean < 0):
+    the specimen's contact below lifted_scale times the stable floor, everywhere above."""
+    regions = {r["region"]: r for r in loc["regions"]}
+    top = regions["top"]
+    if top["floor_ratio"] <= 1.0:
+        return "cylinder"
+    if top["mean_mm"] > 0.0:
+        return "global"
+    return "top" if loc["stable_ratio"] < lifted_scale else "global"
+
+
+def place_gap(loc, sensor_scale, skirt_denser, lifted_scale=None):
     lead = leading(loc)
     if lead is None:
         return "global"
     if lead == "stable":
+        if lifted_scale is not None and "mean_mm" in loc["regions"][0]:
+            return stable_region(loc, lifted_scale)
         return "global" if loc["stable_ratio"] >= sensor_scale else "top"
     if lead not in OUTLINE:
         return "skirt"
@@ -121,6 +137,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("runs", nargs="+", help="benchmark output directories (diagnoses/, truth/)")
     ap.add_argument("--sensor-scale", type=float, default=1.5, help="place_gap's stable ratio for 'global'")
+    ap.add_argument("--lifted-scale", type=float, default=2.25, help="signed: the stable ratio from which a lifted top is 'global'")
     ap.add_argument("--skirt-denser", type=float, default=1.0, help="place_gap's skirt/hem enrichment factor")
     ap.add_argument("--ranking", action="store_true", help="the region-aware attribution's verdicts instead")
     ap.add_argument("--tolerance", type=float, default=0.1,
@@ -146,6 +163,7 @@ def main():
                 regions = set(json.load(f)["regions"])
             region = {"as_run": loc["region"], "largest": largest(loc),
                       "place_gap": place_gap(loc, args.sensor_scale, args.skirt_denser),
+                      "signed": place_gap(loc, args.sensor_scale, args.skirt_denser, args.lifted_scale),
                       "pixel_region": loc["pixel_region"], "floor_region": loc.get("floor_region")}
             totals[family] += 1
             for rule in RULES:

@@ -362,8 +362,8 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
   // 3. Where the gap sits.
   r.localisation = localise(model, gap);
   r.fit_target = model.target().shape;
-  localise_features(r.localisation, gap, model.target(), r.floors.group_floor(), r.floors.stable_floor());
   localise_against_floors(r.localisation, r.floors.region_floor());
+  localise_features(r.localisation, gap, model.target(), r.floors.group_floor(), r.floors.stable_floor());
 
   // 4. Which effect explains it (not when the gap is within the floors).
   const auto attribution_start = std::chrono::steady_clock::now();

@@ -58,6 +58,18 @@ void localise_features(Localisation& L, const ScoredDrape& drape, const Target& 
   place_gap(L);
 }
 
+Region stable_region(const Localisation& L) {
+  const auto top = std::find_if(L.regions.begin(), L.regions.end(),
+                                [](const RegionShare& s) { return s.region == Region::kTop; });
+  // The top within what noise and other stable drapes leave there: the excess is on the bare cylinder below the
+  // skirt (a multipath return in the corner the skirt makes with it).
+  if (top == L.regions.end() || top->floor_ratio <= 1.0) return Region::kCylinder;
+  // Seen below the fitted cloth: no specimen lies inside the platform, a depth bias or a moved camera puts it there.
+  if (top->mean > 0.0) return Region::kGlobal;
+  // Lifted: the specimen's contact (cloth that slid rises in wrinkles over the top) unless lifted at a camera's scale.
+  return L.stable_ratio < kLiftedTopSensorRatio ? Region::kTop : Region::kGlobal;
+}
+
 void place_gap(Localisation& L) {
   double best = 1.0;
   std::size_t group = L.group_ratio.size();
@@ -65,10 +77,8 @@ void place_gap(Localisation& L) {
     if (L.group_ratio[k] > best) best = L.group_ratio[k], group = k;
   }
   if (L.stable_ratio > best) {
-    // The stable term (platform top, bare cylinder) leads: a sensor-scale excess is everywhere at once; a smaller
-    // one, with the specimen's shape within its floors, is the specimen's contact with the platform.
     L.dominant_feature = "stable";
-    L.dominant = L.stable_ratio >= kSensorScaleStableRatio ? Region::kGlobal : Region::kTop;
+    L.dominant = stable_region(L);
     return;
   }
   if (group == L.group_ratio.size()) {

@@ -67,7 +67,13 @@ namespace {
 std::string leading_feature_text(const Localisation& L) {
   const std::string& led = L.dominant_feature;
   if (led.empty()) return "nothing exceeds its floor";
-  if (led == "stable") return "led by the stable term";
+  if (led == "stable") {
+    switch (L.dominant) {
+      case Region::kCylinder: return "led by the stable term, with the platform top within its floor: the bare cylinder";
+      case Region::kTop: return "led by the stable term, the platform top lifted below a camera error's scale";
+      default: return "led by the stable term, the platform top seen below the cloth or lifted at a camera error's scale";
+    }
+  }
   for (FeatureGroup g : kFeatureGroups) {
     if (feature_group_name(g) == led && follows_skirt(g) && L.dominant == Region::kSkirt) {
       return fmt::format("led by {}, an outline group; the skirt's residual is denser than the hem's, so the outline "
@@ -164,14 +170,16 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
     md += fmt::format("| {} | {}{} | {:.2f} |\n", feature_group_name(g), region_name(feature_region(g)),
                       follows_skirt(g) ? " (skirt where its residual is denser)" : "", r.localisation.group_ratio[k]);
   }
-  md += fmt::format("| stable term (platform top, bare cylinder) | global (from {:g}), else top | {:.2f} |\n\n",
-                    kSensorScaleStableRatio, r.localisation.stable_ratio);
+  md += fmt::format("| stable term (platform top, bare cylinder) | cylinder if the top is within its floor; global if "
+                    "the top is seen below the cloth or lifted from {:g}; else top | {:.2f} |\n\n",
+                    kLiftedTopSensorRatio, r.localisation.stable_ratio);
   md += fmt::format("Pixel residuals by region (most enriched: {}; most above its own floor: {}):\n\n",
                     region_name(r.localisation.pixel_region), region_name(r.localisation.floor_region));
-  md += "| region | energy share | pixel share | enrichment | RMS (mm) | RMS / floor's |\n|---|---|---|---|---|---|\n";
+  md += "| region | energy share | pixel share | enrichment | RMS (mm) | mean (mm; > 0: the capture farther) | RMS / "
+        "floor's |\n|---|---|---|---|---|---|---|\n";
   for (const auto& s : r.localisation.regions) {
-    md += fmt::format("| {} | {:.2f} | {:.2f} | {:.2f} | {:.1f} | {:.2f} |\n", region_name(s.region), s.energy_share,
-                      s.pixel_share, s.enrichment, s.rms * 1e3, s.floor_ratio);
+    md += fmt::format("| {} | {:.2f} | {:.2f} | {:.2f} | {:.1f} | {:+.1f} | {:.2f} |\n", region_name(s.region),
+                      s.energy_share, s.pixel_share, s.enrichment, s.rms * 1e3, s.mean * 1e3, s.floor_ratio);
   }
   md += fmt::format("\nDominant region: **{}** ({}). Per-view share of the residual energy:",
                     region_name(r.localisation.dominant), leading_feature_text(r.localisation));

@@ -108,20 +108,56 @@ TEST(Floors, RegionFloorIsTheLargestSampleOfEitherKindPerRegion) {
   for (int k = 0; k < RegionEnergy::kCount; ++k) EXPECT_DOUBLE_EQ(top[k], expected[k]) << k;
 }
 
-TEST(PlaceGap, TheStableTermIsEverywhereAtASensorScaleAndThePlatformContactBelowIt) {
-  Localisation L = excess(FeatureGroup::kHemHeight, 1.4, 2.0, 1.0, 1.0);
+/// `L` with its platform top's residual at `mean` (m) and `floor_ratio` times its floor.
+Localisation with_top(Localisation L, double mean, double floor_ratio) {
+  for (auto& s : L.regions) {
+    if (s.region != Region::kTop) continue;
+    s.mean = mean;
+    s.floor_ratio = floor_ratio;
+  }
+  return L;
+}
+
+TEST(PlaceGap, TheStableTermSitsWhereTheRigidSurfacesSayAndLeadsOnlyAboveTheGroups) {
+  // The top within its own floor: the stable term's excess is on the bare cylinder (multipath).
+  Localisation L = with_top(excess(FeatureGroup::kHemHeight, 1.2, 1.6, 1.0, 1.0), -0.2e-3, 0.95);
+  place_gap(L);
+  EXPECT_EQ(L.dominant, Region::kCylinder);
+  EXPECT_EQ(L.dominant_feature, "stable");
+  // The top seen below the fitted cloth (a depth bias): everywhere, whatever the stable ratio.
+  L = with_top(excess(FeatureGroup::kHemHeight, 1.2, 1.6, 1.0, 1.0), 4.8e-3, 1.6);
   place_gap(L);
   EXPECT_EQ(L.dominant, Region::kGlobal);
-  EXPECT_EQ(L.dominant_feature, "stable");
-  L = excess(FeatureGroup::kHemHeight, 1.2, 1.3, 1.0, 1.0);
+  // A lifted top (friction's wrinkles): the specimen's contact below a camera error's scale, everywhere from it.
+  L = with_top(excess(FeatureGroup::kHemHeight, 1.2, 1.64, 1.0, 1.0), -5.1e-3, 1.7);
   place_gap(L);
   EXPECT_EQ(L.dominant, Region::kTop);
-  EXPECT_EQ(L.dominant_feature, "stable");
+  L = with_top(excess(FeatureGroup::kHemHeight, 1.2, kLiftedTopSensorRatio, 1.0, 1.0), -7.8e-3, 2.8);
+  place_gap(L);
+  EXPECT_EQ(L.dominant, Region::kGlobal);
+  EXPECT_EQ(stable_region(L), Region::kGlobal);
   // Below a larger group ratio the stable term does not lead.
-  L = excess(FeatureGroup::kSkirtHeight, 2.5, 2.0, 1.0, 1.0);
+  L = with_top(excess(FeatureGroup::kSkirtHeight, 2.5, 2.0, 1.0, 1.0), 4.8e-3, 1.6);
   place_gap(L);
   EXPECT_EQ(L.dominant, Region::kSkirt);
   EXPECT_EQ(L.dominant_feature, "skirt_height");
+}
+
+TEST(RegionEnergy, MeanIsTheSignedResidualPerPixelOverallAndPerView) {
+  RegionEnergy e;
+  const int top = static_cast<int>(Region::kTop);
+  e.sum[top] = 6e-3;  // view 0: one pixel at +4 mm; view 1: two pixels summing to +2 mm
+  e.pixels[top] = 3.0;
+  e.view_sum = {{}, {}};
+  e.view_pixels = {{}, {}};
+  e.view_sum[0][top] = 4e-3, e.view_pixels[0][top] = 1.0;
+  e.view_sum[1][top] = 2e-3, e.view_pixels[1][top] = 2.0;
+  EXPECT_DOUBLE_EQ(e.mean(Region::kTop), 2e-3);
+  EXPECT_DOUBLE_EQ(e.view_mean(0, Region::kTop), 4e-3);
+  EXPECT_DOUBLE_EQ(e.view_mean(1, Region::kTop), 1e-3);
+  EXPECT_EQ(e.view_mean(2, Region::kTop), 0.0);  // no such view
+  EXPECT_EQ(e.mean(Region::kRim), 0.0);          // no pixels
+  EXPECT_EQ(e.mean(Region::kGlobal), 0.0);
 }
 
 TEST(PlaceGap, TheHemsOutlineCarriesTheSkirtWhereTheSkirtsResidualIsDenser) {

@@ -83,17 +83,24 @@ void localise_against_floors(Localisation& localisation, const std::array<double
 /// An outline group that carries a change of the skirt above it (harmonics, sorted radii, hem height: every outline
 /// group but the centre offset); place_gap counts it for the skirt where the skirt's residual is the denser.
 [[nodiscard]] bool follows_skirt(FeatureGroup group);
-/// The stable term's ratio to its floor from which place_gap calls it a sensor error (everywhere) rather than the
-/// specimen's contact with the platform (calibrated on seeds 4-10, docs/DIAGNOSIS.md session 24).
-inline constexpr double kSensorScaleStableRatio = 1.5;
+/// The stable term's ratio to its floor from which stable_region calls a lifted platform top a sensor error
+/// (everywhere) rather than the specimen's contact with the platform (calibrated on seeds 4-13, docs/DIAGNOSIS.md
+/// "Session 25": a specimen lifted by friction reached 1.64, a camera pose error that lifts the top 3.15).
+inline constexpr double kLiftedTopSensorRatio = 2.25;
+/// Where the stable term's excess (platform top, bare cylinder) sits, from the rigid regions' residuals (their
+/// floor_ratio set): the bare cylinder (kCylinder) if the platform top is within its own floor; everywhere (kGlobal)
+/// if the top is seen further from the camera than the fitted cloth (mean residual > 0: cloth cannot lie below the
+/// platform, a camera error can put it there); a lifted top (mean <= 0): the specimen's contact (kTop) below
+/// kLiftedTopSensorRatio times the stable floor, a camera error (kGlobal) from it.
+[[nodiscard]] Region stable_region(const Localisation& localisation);
 /// Sets group_ratio, stable_ratio (and, by place_gap, dominant) from the fitted drape's shape features against the
-/// capture's and the floors (floors.hpp) of each group.
+/// capture's and the floors (floors.hpp) of each group. Call after localise_against_floors (stable_region reads the
+/// regions' floor ratios).
 void localise_features(Localisation& localisation, const ScoredDrape& drape, const Target& capture,
                        const std::vector<double>& group_floor, double stable_floor);
 
-/// Sets dominant and dominant_feature from group_ratio, stable_ratio and the regions' enrichment. The largest ratio
-/// above 1 leads. The stable term: kGlobal (a sensor error acts everywhere) from 1.5 times its floor, below that kTop
-/// (the specimen's contact with the platform). A skirt group: kSkirt. The hem's centre offset: kHem. The other hem
+/// Sets dominant and dominant_feature from group_ratio, stable_ratio and the regions' enrichment, mean and floor
+/// ratio. The largest ratio above 1 leads. The stable term: stable_region. A skirt group: kSkirt. The hem's centre offset: kHem. The other hem
 /// groups (harmonics, sorted radii, hem height): kSkirt if the skirt's pixel residual is denser than the hem's (the
 /// outline carries a change of the skirt above it), else kHem. Nothing above 1: kGlobal.
 void place_gap(Localisation& localisation);
