@@ -5,9 +5,13 @@
 - as_run: the report's `localisation.region`;
 - largest: the region of the feature group (or the stable term) furthest above its floor, outline groups "hem", skirt
   groups "skirt", the stable term "global" (the rule before session 24);
-- place_gap: the rule since session 24 (diagnosis/src/localisation.cpp, place_gap): the stable term "global" from
-  1.5 times its floor, else "top"; the hem's centre offset "hem"; the other outline groups "skirt" where the skirt's
-  pixel residual is denser than the hem's, else "hem"; skirt groups "skirt";
+- place_gap_24: the rule of session 24: the stable term "global" from 1.5 times its floor, else "top"; the hem's
+  centre offset "hem"; the other outline groups "skirt" where the skirt's pixel residual is denser than the hem's,
+  else "hem"; skirt groups "skirt";
+- place_gap: the rule since session 25 (diagnosis/src/localisation.cpp, place_gap and stable_region): as
+  place_gap_24 but the stable term placed by the rigid surfaces (stable_region below), and a lifted platform top
+  (the stable term above its floor, stable_region "top") leading whatever else exceeds its floor; on reports before
+  session 25 (no signed region means) it falls back to place_gap_24;
 - pixel_region, floor_region: the report's other two localisers (the most enriched region; the region furthest
   above its own floor, in reports since session 22).
 
@@ -19,7 +23,7 @@ run: `tolerance` (the rule since session 23, applied to every report with --tole
 (among the confirmed candidates with a significant shrinkage, such an effect first).
 
     scripts/region_rules.py out/s24s11main_all [more runs ...]
-    scripts/region_rules.py --sensor-scale 1.3 --skirt-denser 1.1 out/s23all     # place_gap with other constants
+    scripts/region_rules.py --lifted-scale 2 --skirt-denser 1.1 out/s23all       # place_gap with other constants
     scripts/region_rules.py --ranking out/s24s11main_all                          # the region-aware ranking
 """
 import argparse
@@ -33,7 +37,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from diagnosis_rules import THRESHOLD, confirmation_rule  # noqa: E402  (the tolerance rule and its threshold)
 
 OUTLINE = {"harmonics", "off_centre", "sorted_radii", "hem_height"}
-RULES = ["as_run", "largest", "place_gap", "signed", "pixel_region", "floor_region"]
+RULES = ["as_run", "largest", "place_gap_24", "place_gap", "pixel_region", "floor_region"]
 # Where each effect acts (candidate_effect.cpp, effect_regions).
 EFFECT_REGIONS = {"yield": {"skirt"}, "shear": {"skirt"}, "curl": {"hem"}, "misalignment": {"hem"},
                   "friction": {"top", "rim"}, "sensor": {"global"}}
@@ -71,10 +75,13 @@ def stable_region(loc, lifted_scale):
 
 def place_gap(loc, sensor_scale, skirt_denser, lifted_scale=None):
     lead = leading(loc)
+    signed = lifted_scale is not None and "mean_mm" in loc["regions"][0]
+    if signed and loc["stable_ratio"] > 1.0 and stable_region(loc, lifted_scale) == "top":
+        return "top"  # a lifted platform top leads whatever else exceeds its floor (session 25)
     if lead is None:
         return "global"
     if lead == "stable":
-        if lifted_scale is not None and "mean_mm" in loc["regions"][0]:
+        if signed:
             return stable_region(loc, lifted_scale)
         return "global" if loc["stable_ratio"] >= sensor_scale else "top"
     if lead not in OUTLINE:
@@ -120,7 +127,7 @@ def ranking(runs, sensor_scale, skirt_denser, tolerance):
             family = name.rsplit("_", 1)[0]
             with open(path) as f:
                 report = json.load(f)
-            region = place_gap(report["localisation"], sensor_scale, skirt_denser)
+            region = place_gap(report["localisation"], sensor_scale, skirt_denser)  # session 24's, as it was tested
             effects += family != "none"
             ncontrols += family == "none"
             for rule in rules:
@@ -136,8 +143,9 @@ def ranking(runs, sensor_scale, skirt_denser, tolerance):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("runs", nargs="+", help="benchmark output directories (diagnoses/, truth/)")
-    ap.add_argument("--sensor-scale", type=float, default=1.5, help="place_gap's stable ratio for 'global'")
-    ap.add_argument("--lifted-scale", type=float, default=2.25, help="signed: the stable ratio from which a lifted top is 'global'")
+    ap.add_argument("--sensor-scale", type=float, default=1.5, help="place_gap_24's stable ratio for 'global'")
+    ap.add_argument("--lifted-scale", type=float, default=2.25,
+                    help="place_gap: the stable ratio from which a lifted top is 'global' (kLiftedTopSensorRatio)")
     ap.add_argument("--skirt-denser", type=float, default=1.0, help="place_gap's skirt/hem enrichment factor")
     ap.add_argument("--ranking", action="store_true", help="the region-aware attribution's verdicts instead")
     ap.add_argument("--tolerance", type=float, default=0.1,
@@ -162,8 +170,8 @@ def main():
             with open(truth_path) as f:
                 regions = set(json.load(f)["regions"])
             region = {"as_run": loc["region"], "largest": largest(loc),
-                      "place_gap": place_gap(loc, args.sensor_scale, args.skirt_denser),
-                      "signed": place_gap(loc, args.sensor_scale, args.skirt_denser, args.lifted_scale),
+                      "place_gap_24": place_gap(loc, args.sensor_scale, args.skirt_denser),
+                      "place_gap": place_gap(loc, args.sensor_scale, args.skirt_denser, args.lifted_scale),
                       "pixel_region": loc["pixel_region"], "floor_region": loc.get("floor_region")}
             totals[family] += 1
             for rule in RULES:

@@ -76,7 +76,9 @@ void place_gap(Localisation& L) {
   for (std::size_t k = 0; k < L.group_ratio.size() && k < std::size(kFeatureGroups); ++k) {
     if (L.group_ratio[k] > best) best = L.group_ratio[k], group = k;
   }
-  if (L.stable_ratio > best) {
+  // The stable term leads; or it exceeds its floor with the platform top lifted: under the adhesion the baseline
+  // assumes, the top cannot lift, only a specimen that slid over it does, and the outline's change follows from that.
+  if (L.stable_ratio > best || (L.stable_ratio > 1.0 && stable_region(L) == Region::kTop)) {
     L.dominant_feature = "stable";
     L.dominant = stable_region(L);
     return;

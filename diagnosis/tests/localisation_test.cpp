@@ -136,11 +136,24 @@ TEST(PlaceGap, TheStableTermSitsWhereTheRigidSurfacesSayAndLeadsOnlyAboveTheGrou
   place_gap(L);
   EXPECT_EQ(L.dominant, Region::kGlobal);
   EXPECT_EQ(stable_region(L), Region::kGlobal);
-  // Below a larger group ratio the stable term does not lead.
+  // Below a larger group ratio the stable term does not lead...
   L = with_top(excess(FeatureGroup::kSkirtHeight, 2.5, 2.0, 1.0, 1.0), 4.8e-3, 1.6);
   place_gap(L);
   EXPECT_EQ(L.dominant, Region::kSkirt);
   EXPECT_EQ(L.dominant_feature, "skirt_height");
+  L = with_top(excess(FeatureGroup::kHarmonics, 2.5, 1.3, 1.6, 1.2), -0.2e-3, 0.9);  // the top within its floor
+  place_gap(L);
+  EXPECT_EQ(L.dominant, Region::kSkirt);
+  EXPECT_EQ(L.dominant_feature, "harmonics");
+  // ... unless it exceeds its floor with the top lifted: the specimen slid over the platform (friction), whatever
+  // the outline's change.
+  L = with_top(excess(FeatureGroup::kHarmonics, 2.5, 1.3, 1.6, 1.2), -3.0e-3, 1.4);
+  place_gap(L);
+  EXPECT_EQ(L.dominant, Region::kTop);
+  EXPECT_EQ(L.dominant_feature, "stable");
+  L = with_top(excess(FeatureGroup::kHarmonics, 2.5, 0.95, 1.6, 1.2), -3.0e-3, 1.4);  // the stable term within
+  place_gap(L);
+  EXPECT_EQ(L.dominant, Region::kSkirt);
 }
 
 TEST(RegionEnergy, MeanIsTheSignedResidualPerPixelOverallAndPerView) {
