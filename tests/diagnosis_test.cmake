@@ -146,13 +146,13 @@ if(NOT region MATCHES "^(${expected})$")
   message(FATAL_ERROR "region ${region} with '${led}' leading (stable ratio ${stable_ratio}, top mean ${top_mean} mm, "
                       "top floor ratio ${top_floor_ratio}): expected ${expected}")
 endif()
-# A 12 mm depth bias moves the platform top 12 mm away from the camera in every view: the top's mean residual
-# (capture - model) is about +12 mm in each (noise, a few pixels at the truncation and the rim's edge aside).
+# A 12 mm depth bias moves the platform top away from the camera by the same amount in every view: the top's mean
+# residual (capture - model) is most of +12 mm in each (about 10 on this 14x14 mesh: pixels at the rim's edge).
 string(JSON nviews LENGTH "${top_view_means}")
 math(EXPR last "${nviews} - 1")
 foreach(i RANGE ${last})
   string(JSON m GET "${top_view_means}" ${i})
-  if(m LESS 9.0 OR m GREATER 15.0)
+  if(m LESS 8.0 OR m GREATER 13.0)
     message(FATAL_ERROR "a 12 mm depth bias moves the platform top by ${m} mm in view ${i} (mean ${top_mean} mm)")
   endif()
 endforeach()
