@@ -68,10 +68,20 @@ std::string leading_feature_text(const Localisation& L) {
   const std::string& led = L.dominant_feature;
   if (led.empty()) return "nothing exceeds its floor";
   if (led == "stable") {
+    double top_mean = 0.0;
+    for (const auto& s : L.regions)
+      if (s.region == Region::kTop) top_mean = s.mean;
     switch (L.dominant) {
       case Region::kCylinder: return "led by the stable term, with the platform top within its floor: the bare cylinder";
-      case Region::kTop: return "led by the stable term, the platform top lifted below a camera error's scale";
-      default: return "led by the stable term, the platform top seen below the cloth or lifted at a camera error's scale";
+      case Region::kTop:
+        return fmt::format("the stable term above its floor with the platform top lifted by {:.1f} mm, below a camera "
+                           "error's scale: the specimen's contact with the platform",
+                           -top_mean * 1e3);
+      default:
+        return top_mean > 0.0 ? fmt::format("led by the stable term, the platform top seen {:.1f} mm farther than the "
+                                            "fitted cloth: a camera error",
+                                            top_mean * 1e3)
+                              : "led by the stable term, the platform top lifted at a camera error's scale";
     }
   }
   for (FeatureGroup g : kFeatureGroups) {
