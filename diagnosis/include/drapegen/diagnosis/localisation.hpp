@@ -20,7 +20,7 @@ struct RegionShare {
   double rms = 0.0;           // m: RMS of the region's pixel residuals
   /// m: the mean of the region's pixel residuals (capture minus model depth: > 0 where the capture lies further from
   /// the camera), over all views and per view (0 in a view without pixels there). A depth bias shifts it by the
-  /// bias in every view; a change of the specimen's shape rarely shifts a whole region one way.
+  /// bias in every view; cloth lifted off the platform top shifts the top's below 0.
   double mean = 0.0;
   std::vector<double> view_mean;
   /// The region's RMS over the largest floor sample's in the same region (localise_against_floors; 0 if the floors
@@ -101,9 +101,10 @@ void localise_features(Localisation& localisation, const ScoredDrape& drape, con
 
 /// Sets dominant and dominant_feature from group_ratio, stable_ratio and the regions' enrichment, mean and floor
 /// ratio. The largest ratio above 1 leads, but a stable term above its floor whose stable_region is kTop (a lifted
-/// platform top) leads whatever else exceeds its floor. The stable term: stable_region. A skirt group: kSkirt. The hem's centre offset: kHem. The other hem
-/// groups (harmonics, sorted radii, hem height): kSkirt if the skirt's pixel residual is denser than the hem's (the
-/// outline carries a change of the skirt above it), else kHem. Nothing above 1: kGlobal.
+/// platform top) leads whatever else exceeds its floor. The stable term: stable_region. A skirt group: kSkirt. The
+/// hem's centre offset: kHem. The other hem groups (harmonics, sorted radii, hem height): kSkirt if the skirt's pixel
+/// residual is denser than the hem's (the outline carries a change of the skirt above it), else kHem. Nothing above
+/// 1: kGlobal.
 void place_gap(Localisation& localisation);
 
 }  // namespace drapegen::diagnosis
