@@ -62,7 +62,7 @@ def largest(loc):
 def stable_region(loc, lifted_scale):
     """Where the stable term's excess sits, from the rigid regions' residuals (reports since session 25): the bare
     cylinder if the platform top is within its own floor; everywhere if the top is seen further than the fitted
-    cloth (mean residual > 0: no cloth lies below the platform, a camera error does that); a lifted top (mean < 0):
+    cloth (mean residual > 0: no cloth lies below the platform, a camera error does that); a lifted top (mean <= 0):
     the specimen's contact below lifted_scale times the stable floor, everywhere above."""
     regions = {r["region"]: r for r in loc["regions"]}
     top = regions["top"]
