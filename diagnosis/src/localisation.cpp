@@ -58,12 +58,17 @@ void localise_features(Localisation& L, const ScoredDrape& drape, const Target& 
   place_gap(L);
 }
 
+const RegionShare* region_share(const Localisation& L, Region region) {
+  const auto s =
+      std::find_if(L.regions.begin(), L.regions.end(), [&](const RegionShare& x) { return x.region == region; });
+  return s == L.regions.end() ? nullptr : &*s;
+}
+
 Region stable_region(const Localisation& L) {
-  const auto top = std::find_if(L.regions.begin(), L.regions.end(),
-                                [](const RegionShare& s) { return s.region == Region::kTop; });
+  const RegionShare* top = region_share(L, Region::kTop);
   // The top within what noise and other stable drapes leave there: the excess is on the bare cylinder below the
   // skirt (a multipath return in the corner the skirt makes with it).
-  if (top == L.regions.end() || top->floor_ratio <= 1.0) return Region::kCylinder;
+  if (!top || top->floor_ratio <= 1.0) return Region::kCylinder;
   // Seen below the fitted cloth: no specimen lies inside the platform, a depth bias or a moved camera puts it there.
   if (top->mean > 0.0) return Region::kGlobal;
   // Lifted: the specimen's contact (cloth that slid rises in wrinkles over the top) unless lifted at a camera's scale.
@@ -78,9 +83,10 @@ void place_gap(Localisation& L) {
   }
   // The stable term leads; or it exceeds its floor with the platform top lifted: under the adhesion the baseline
   // assumes, the top cannot lift, only a specimen that slid over it does, and the outline's change follows from that.
-  if (L.stable_ratio > best || (L.stable_ratio > 1.0 && stable_region(L) == Region::kTop)) {
+  const Region stable_at = stable_region(L);
+  if (L.stable_ratio > best || (L.stable_ratio > 1.0 && stable_at == Region::kTop)) {
     L.dominant_feature = "stable";
-    L.dominant = stable_region(L);
+    L.dominant = stable_at;
     return;
   }
   if (group == L.group_ratio.size()) {
@@ -94,12 +100,8 @@ void place_gap(Localisation& L) {
   // The outline's shape (its harmonics, sorted radii, height) follows the skirt above it: the hem carries the skirt's
   // change where the skirt's residual is the denser one. A shift of the centre is the hem's own (a placement).
   if (follows_skirt(g)) {
-    double skirt = 0.0, hem = 0.0;
-    for (const auto& s : L.regions) {
-      if (s.region == Region::kSkirt) skirt = s.enrichment;
-      if (s.region == Region::kHem) hem = s.enrichment;
-    }
-    if (skirt > hem) L.dominant = Region::kSkirt;
+    const RegionShare *skirt = region_share(L, Region::kSkirt), *hem = region_share(L, Region::kHem);
+    if ((skirt ? skirt->enrichment : 0.0) > (hem ? hem->enrichment : 0.0)) L.dominant = Region::kSkirt;
   }
 }
 
@@ -110,7 +112,10 @@ double RegionEnergy::mean_square(Region region) const {
 
 double RegionEnergy::mean(Region region) const {
   const int k = static_cast<int>(region);
-  return k < kCount && pixels[k] > 0.0 ? sum[k] / pixels[k] : 0.0;
+  if (k >= kCount || pixels[k] <= 0.0) return 0.0;
+  double sum = 0.0;
+  for (const auto& view : view_sum) sum += view[k];
+  return sum / pixels[k];
 }
 
 double RegionEnergy::view_mean(std::size_t view, Region region) const {
@@ -142,7 +147,6 @@ RegionEnergy region_energy(const ForwardModel& model, const ScoredDrape& drape, 
       const int k = static_cast<int>(classify_point(p, model_outline, R));
       const double e = static_cast<double>(res) * res;
       E.energy[k] += e;
-      E.sum[k] += res;
       E.pixels[k] += 1.0;
       E.view_energy[v] += e;
       E.view_sum[v][k] += res;

@@ -68,11 +68,11 @@ std::string leading_feature_text(const Localisation& L) {
   const std::string& led = L.dominant_feature;
   if (led.empty()) return "nothing exceeds its floor";
   if (led == "stable") {
-    double top_mean = 0.0;
-    for (const auto& s : L.regions)
-      if (s.region == Region::kTop) top_mean = s.mean;
+    const RegionShare* top = region_share(L, Region::kTop);
+    const double top_mean = top ? top->mean : 0.0;
     switch (L.dominant) {
-      case Region::kCylinder: return "led by the stable term, with the platform top within its floor: the bare cylinder";
+      case Region::kCylinder:
+        return "led by the stable term, with the platform top within its floor: the bare cylinder";
       case Region::kTop:
         return fmt::format("the stable term above its floor with the platform top lifted by {:.1f} mm, below a camera "
                            "error's scale: the specimen's contact with the platform",

@@ -159,8 +159,7 @@ TEST(PlaceGap, TheStableTermSitsWhereTheRigidSurfacesSayAndLeadsOnlyAboveTheGrou
 TEST(RegionEnergy, MeanIsTheSignedResidualPerPixelOverallAndPerView) {
   RegionEnergy e;
   const int top = static_cast<int>(Region::kTop);
-  e.sum[top] = 6e-3;  // view 0: one pixel at +4 mm; view 1: two pixels summing to +2 mm
-  e.pixels[top] = 3.0;
+  e.pixels[top] = 3.0;  // view 0: one pixel at +4 mm; view 1: two pixels summing to +2 mm
   e.view_sum = {{}, {}};
   e.view_pixels = {{}, {}};
   e.view_sum[0][top] = 4e-3, e.view_pixels[0][top] = 1.0;

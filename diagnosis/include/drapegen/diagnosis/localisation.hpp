@@ -28,11 +28,11 @@ struct RegionShare {
   double floor_ratio = 0.0;
 };
 
-/// A drape's residual maps back-projected onto the specimen: squared residuals, residuals and pixels per region
-/// (indexed by Region, kGlobal unused), the squared residuals per view and the residuals and pixels per view and region.
+/// A drape's residual maps back-projected onto the specimen: squared residuals and pixels per region (indexed by
+/// Region, kGlobal unused), the squared residuals per view and the residuals and pixels per view and region.
 struct RegionEnergy {
   static constexpr int kCount = static_cast<int>(Region::kGlobal);
-  std::array<double, kCount> energy{}, sum{}, pixels{};
+  std::array<double, kCount> energy{}, pixels{};
   std::vector<double> view_energy;
   std::vector<std::array<double, kCount>> view_sum, view_pixels;
   /// m^2: the region's mean squared residual (0 without pixels).
@@ -64,6 +64,9 @@ struct Localisation {
   double capture_fold_phase = 0.0, model_fold_phase = 0.0;  // radians, phase of the fold-count harmonic
   double capture_drape_coefficient = 0.0, model_drape_coefficient = 0.0;
 };
+
+/// The localisation's share of `region` (nullptr if it has none: not localised yet, or kGlobal).
+[[nodiscard]] const RegionShare* region_share(const Localisation& localisation, Region region);
 
 /// Region of a specimen-frame point given the fitted drape's outline (the hem: within 25 mm of the outline).
 [[nodiscard]] Region classify_point(const Eigen::Vector3d& p, const HemProfile& model_outline, double cylinder_radius);
