@@ -103,6 +103,14 @@ nlohmann::json spread_json(const ValidationSpread& s) {
           {"pairwise_groups_mm", pair_groups}};
 }
 
+nlohmann::json repeatability_json(const FoldRepeatability& f) {
+  auto least = [](const std::vector<double>& v) {
+    return v.empty() ? nlohmann::json(nullptr) : nlohmann::json(*std::min_element(v.begin(), v.end()));
+  };
+  return {{"capture_pairs", f.capture}, {"capture_min", least(f.capture)}, {"model_pairs", f.model},
+          {"model_min", least(f.model)}};
+}
+
 /// Lengths in metres as a JSON array of millimetres.
 nlohmann::json millimetres(const std::vector<double>& metres) {
   nlohmann::json mm = nlohmann::json::array();
@@ -349,6 +357,16 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
     *into = std::move(*e);
   }
   r.validation_spread = validation_spread(r.validated.states, model.target().shape.all);
+  {  // Does the specimen drape the same way on every placement, as often as the fitted model does?
+    std::vector<HemProfile> placements{hem_profile_from_capture(capture)};
+    for (const Capture* other : {others.second, others.held_out})
+      if (other) placements.push_back(hem_profile_from_capture(*other));
+    const std::vector<sim::InitialStateSpec> states = validation_states(settings.attribution);
+    std::vector<sim::ClothMesh> sine;
+    for (std::size_t k = 0; k < r.validated.states.size() && k < states.size(); ++k)
+      if (states[k].shape == sim::InitialShape::kSine) sine.push_back(r.validated.states[k].mesh);
+    r.fold_repeatability = fold_repeatability(placements, sine);
+  }
   const ScoredDrape& gap = r.gap_drape();
   r.gap_all = gap.all_score;
   r.gap_fit = gap.fit_score;
@@ -440,6 +458,7 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                     {"validation_states", r.validated.states.size()},
                     {"best_validation_state", r.gap_drape().state},
                     {"validation_spread", spread_json(r.validation_spread)},
+                    {"fold_repeatability", repeatability_json(r.fold_repeatability)},
                     {"validation_drapes", states},
                     {"fit_states", {{"stable_mm", r.fit.best.stable_all * 1e3},
                                     {"shape", r.fit.best.shape_all},

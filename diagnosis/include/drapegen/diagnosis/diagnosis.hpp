@@ -9,6 +9,7 @@
 
 #include "drapegen/diagnosis/attribution.hpp"
 #include "drapegen/diagnosis/floors.hpp"
+#include "drapegen/diagnosis/fold_repeatability.hpp"
 #include "drapegen/diagnosis/localisation.hpp"
 #include "drapegen/diagnosis/validation_spread.hpp"
 
@@ -96,6 +97,9 @@ struct DiagnosisResult {
   [[nodiscard]] GapTerms gap() const { return gap_terms(validated.best, paired_gap_drape()); }
   /// The validation drapes' distances to the capture and among themselves (the fitted fabric's multistability).
   ValidationSpread validation_spread;
+  /// Whether the capture's placements fold alike, against the fitted model's drapes from the validation states
+  /// (reported; not in the gate).
+  FoldRepeatability fold_repeatability;
   Floors floors;
   double gap_all = 0.0, gap_fit = 0.0, gap_held_out = 0.0;
   bool within_floors = false;

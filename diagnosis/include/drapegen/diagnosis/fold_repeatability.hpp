@@ -1,0 +1,41 @@
+#pragma once
+// Whether the specimen drapes the same way twice. Laid on the tester again, an elastic specimen folds where it folded
+// before, in its own frame, unless it has several stable drapes; the fitted model says which (its drapes from
+// several initial states). A specimen that keeps creases from its last drape (a yield moment, hysteresis) is laid
+// again from them and folds elsewhere. The fold content of two outlines (the hem radius against angle without its
+// low orders) is compared at the turn that matches them best, since the specimen's orientation on the table is
+// unknown. docs/DIAGNOSIS.md, "Session 26".
+
+#include <vector>
+
+#include "drapegen/diagnosis/hem_profile.hpp"
+#include "drapegen/sim/mesh.hpp"
+
+namespace drapegen::diagnosis {
+
+/// The outline's folds: the profile minus its orders 0..kOrientationOrders (centre offset, the anisotropy's ellipse,
+/// the square's corners), which every drape of a fabric shares.
+[[nodiscard]] HemProfile fold_content(const HemProfile& profile);
+
+/// The correlation of two outlines' fold content at the turn (whole bins) that matches them best: 1 for the same
+/// folds however turned, near 0 for unrelated ones. 0 if either has no fold content (below 1 um RMS).
+[[nodiscard]] double fold_correlation(const HemProfile& a, const HemProfile& b);
+
+/// Every pair's fold_correlation (i < j, in order 01, 02, .., 12, ..).
+[[nodiscard]] std::vector<double> pairwise_fold_correlations(const std::vector<HemProfile>& outlines);
+
+struct FoldRepeatability {
+  /// Between the capture's placements (the capture, the second, the held-out capture: pairs 01, 02, 12 of those given).
+  std::vector<double> capture;
+  /// Between the fitted model's drapes from the validation states' sine states (flat excluded: no placement starts
+  /// flat), every pair.
+  std::vector<double> model;
+  int model_drapes = 0;
+  [[nodiscard]] bool measured() const { return !capture.empty() && model.size() >= 2; }
+};
+
+/// `placements`: the captures' outlines (every view), the capture first; `drapes`: the model's drapes.
+[[nodiscard]] FoldRepeatability fold_repeatability(const std::vector<HemProfile>& placements,
+                                                   const std::vector<sim::ClothMesh>& drapes);
+
+}  // namespace drapegen::diagnosis

@@ -1,0 +1,55 @@
+#include "drapegen/diagnosis/fold_repeatability.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace drapegen::diagnosis {
+
+HemProfile fold_content(const HemProfile& profile) {
+  const HemProfile low = low_pass(profile, kOrientationOrders);
+  HemProfile folds = profile;
+  for (int k = 0; k < profile.bins(); ++k) folds.radius[k] = profile.radius[k] - low.radius[k];
+  return folds;
+}
+
+double fold_correlation(const HemProfile& a, const HemProfile& b) {
+  const int n = a.bins();
+  if (n == 0 || b.bins() != n) return 0.0;
+  const HemProfile fa = fold_content(a), fb = fold_content(b);
+  // Fold content below a micrometre RMS is rounding, not folds.
+  auto rms = [](const HemProfile& p) {
+    double sum = 0.0;
+    int count = 0;
+    for (double r : p.radius)
+      if (std::isfinite(r)) sum += r * r, ++count;
+    return count > 0 ? std::sqrt(sum / count) : 0.0;
+  };
+  if (rms(fa) < 1e-6 || rms(fb) < 1e-6) return 0.0;
+  double best = -1.0;  // stays -1 if no turn has fold content on both
+  for (int shift = 0; shift < n; ++shift) {  // b turned by `shift` bins
+    double ab = 0.0, aa = 0.0, bb = 0.0;
+    for (int k = 0; k < n; ++k) {
+      const double x = fa.radius[k], y = fb.radius[(k + shift) % n];
+      if (!std::isfinite(x) || !std::isfinite(y)) continue;
+      ab += x * y, aa += x * x, bb += y * y;
+    }
+    if (aa > 0.0 && bb > 0.0) best = std::max(best, ab / std::sqrt(aa * bb));
+  }
+  return best < -1.0 + 1e-12 ? 0.0 : best;
+}
+
+std::vector<double> pairwise_fold_correlations(const std::vector<HemProfile>& outlines) {
+  std::vector<double> c;
+  for (std::size_t i = 0; i < outlines.size(); ++i)
+    for (std::size_t j = i + 1; j < outlines.size(); ++j) c.push_back(fold_correlation(outlines[i], outlines[j]));
+  return c;
+}
+
+FoldRepeatability fold_repeatability(const std::vector<HemProfile>& placements,
+                                     const std::vector<sim::ClothMesh>& drapes) {
+  std::vector<HemProfile> model;
+  for (const auto& mesh : drapes) model.push_back(hem_profile_from_mesh(mesh));
+  return {pairwise_fold_correlations(placements), pairwise_fold_correlations(model), static_cast<int>(drapes.size())};
+}
+
+}  // namespace drapegen::diagnosis
