@@ -477,6 +477,18 @@ file(REMOVE ${WORK}/capture.p2/truth.json)
 run_ok(out diagnose --capture ${WORK}/capture --second-capture ${WORK}/capture.p1 --held-out-capture ${WORK}/capture.p2
        --quick --resolution 10 --states 2 --evaluations 8 --refit-evaluations 6 --json)
 expect_roles("--second-capture" "${out}" second_capture capture_and_second_capture held_out_capture)
+# Fold repeatability: a correlation for each pair of the three placements, and for each pair of the model's drapes.
+string(JSON npairs LENGTH "${out}" gap_tests fold_repeatability capture_pairs)
+string(JSON nmodel LENGTH "${out}" gap_tests fold_repeatability model_pairs)
+if(NOT npairs EQUAL 3 OR nmodel LESS 1)
+  message(FATAL_ERROR "fold repeatability: ${npairs} capture pairs (expected 3), ${nmodel} model pairs")
+endif()
+foreach(i RANGE 2)
+  string(JSON c GET "${out}" gap_tests fold_repeatability capture_pairs ${i})
+  if(c LESS -1 OR c GREATER 1)
+    message(FATAL_ERROR "fold repeatability: capture pair ${i}'s correlation ${c} outside -1 .. 1")
+  endif()
+endforeach()
 # The gate's shape distance is the mean over the capture and the second capture, not the held-out one.
 string(JSON shape GET "${out}" gap_tests shape)
 string(JSON shape_a GET "${out}" gap_tests capture shape)
