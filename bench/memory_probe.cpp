@@ -45,7 +45,8 @@ std::pair<double, double> model_repeatability(const dg::Capture& capture, const 
   if (!model) return {NAN, NAN};
   dg::ModelSetup setup;
   setup.bending = bending;
-  std::vector<drapegen::sim::InitialStateSpec> all = dg::fit_initial_states(states + 1, 2000), sine(all.begin() + 1, all.end());
+  const std::vector<drapegen::sim::InitialStateSpec> all = dg::fit_initial_states(states + 1, 2000);
+  const std::vector<drapegen::sim::InitialStateSpec> sine(all.begin() + 1, all.end());
   std::vector<drapegen::sim::ClothMesh> drapes;
   for (const auto& st : sine) {
     auto mesh = (*model)->simulate(setup, st);
@@ -66,9 +67,11 @@ int main(int argc, char** argv) {
       ->required();
   std::string setup = "none";
   int states = 6;
-  app.add_option("--model", setup, "Also the elastic model's repeatability: none, truth (the true fabric without "
-                 "its effect) or fitted (diagnoses/NAME.json's fit)")->check(CLI::IsMember({"none", "truth", "fitted"}));
-  app.add_option("--states", states, "Sine states of the model");
+  app.add_option("--model", setup,
+                 "Also the elastic model's repeatability: none, truth (the true fabric without its effect) or fitted "
+                 "(diagnoses/NAME.json's baseline fit)")
+      ->check(CLI::IsMember({"none", "truth", "fitted"}));
+  app.add_option("--states", states, "Sine states of the model (default 6)")->check(CLI::Range(2, 50));
   CLI11_PARSE(app, argc, argv);
   fmt::print("{:<28} {:>8} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7}\n", "case", "set_rad", "true01", "true02",
              "true12", "blind01", "blind02", "blind12", "mod_min", "mod_med");
@@ -92,7 +95,10 @@ int main(int argc, char** argv) {
         const double rotation = truth["initial_state"]["rotation_rad"].get<double>();
         if (!first) {
           first = *capture;
-          if (setup == "truth") bending = dg::bending_from_json(truth, "truth").value();
+          if (setup == "truth") {
+            auto b = dg::bending_from_json(truth, "truth");
+            if (b) bending = *b;
+          }
           std::ifstream report(run + "/diagnoses/" + name + ".json");
           if (setup == "fitted" && report) {
             auto fitted = dg::bending_from_json(nlohmann::json::parse(report)["baseline"]["fitted"], "fitted");
