@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 namespace drapegen::diagnosis {
 
@@ -25,7 +26,7 @@ double fold_correlation(const HemProfile& a, const HemProfile& b) {
     return count > 0 ? std::sqrt(sum / count) : 0.0;
   };
   if (rms(fa) < 1e-6 || rms(fb) < 1e-6) return 0.0;
-  double best = -1.0;  // stays -1 if no turn has fold content on both
+  std::optional<double> best;  // none if no turn has fold content on both
   for (int shift = 0; shift < n; ++shift) {  // b turned by `shift` bins
     double ab = 0.0, aa = 0.0, bb = 0.0;
     for (int k = 0; k < n; ++k) {
@@ -33,9 +34,9 @@ double fold_correlation(const HemProfile& a, const HemProfile& b) {
       if (!std::isfinite(x) || !std::isfinite(y)) continue;
       ab += x * y, aa += x * x, bb += y * y;
     }
-    if (aa > 0.0 && bb > 0.0) best = std::max(best, ab / std::sqrt(aa * bb));
+    if (aa > 0.0 && bb > 0.0) best = std::max(best.value_or(-1.0), ab / std::sqrt(aa * bb));
   }
-  return best < -1.0 + 1e-12 ? 0.0 : best;
+  return best.value_or(0.0);
 }
 
 std::vector<double> pairwise_fold_correlations(const std::vector<HemProfile>& outlines) {

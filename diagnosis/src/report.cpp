@@ -201,9 +201,8 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
     md += "Fold repeatability (the folds' correlation at the best turn; 1: folds alike): between the capture's "
           "placements";
     for (double c : f.capture) md += fmt::format(" {:.2f}", c);
-    md += fmt::format("; between the fitted model's drapes from {} initial states: lowest {:.2f}.\n",
-                      f.model_drapes,
-                      *std::min_element(f.model.begin(), f.model.end()));
+    md += fmt::format("; between the fitted model's drapes from {} sine initial states: lowest {:.2f}.\n",
+                      f.model_drapes, *std::min_element(f.model.begin(), f.model.end()));
   }
   md += "Hem radius difference (capture - model), largest harmonics:";
   auto h = r.localisation.hem_difference;
