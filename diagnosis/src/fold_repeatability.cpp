@@ -13,10 +13,12 @@ HemProfile fold_content(const HemProfile& profile) {
   return folds;
 }
 
-double fold_correlation(const HemProfile& a, const HemProfile& b) {
-  const int n = a.bins();
-  if (n == 0 || b.bins() != n) return 0.0;
-  const HemProfile fa = fold_content(a), fb = fold_content(b);
+namespace {
+
+/// fold_correlation of two fold contents (fold_content already taken).
+double best_turn_correlation(const HemProfile& fa, const HemProfile& fb) {
+  const int n = fa.bins();
+  if (n == 0 || fb.bins() != n) return 0.0;
   // Fold content below a micrometre RMS is rounding, not folds.
   auto rms = [](const HemProfile& p) {
     double sum = 0.0;
@@ -39,10 +41,18 @@ double fold_correlation(const HemProfile& a, const HemProfile& b) {
   return best.value_or(0.0);
 }
 
+}  // namespace
+
+double fold_correlation(const HemProfile& a, const HemProfile& b) {
+  return best_turn_correlation(fold_content(a), fold_content(b));
+}
+
 std::vector<double> pairwise_fold_correlations(const std::vector<HemProfile>& outlines) {
+  std::vector<HemProfile> folds;  // each outline's fold content once, not once per pair
+  for (const HemProfile& outline : outlines) folds.push_back(fold_content(outline));
   std::vector<double> c;
-  for (std::size_t i = 0; i < outlines.size(); ++i)
-    for (std::size_t j = i + 1; j < outlines.size(); ++j) c.push_back(fold_correlation(outlines[i], outlines[j]));
+  for (std::size_t i = 0; i < folds.size(); ++i)
+    for (std::size_t j = i + 1; j < folds.size(); ++j) c.push_back(best_turn_correlation(folds[i], folds[j]));
   return c;
 }
 
