@@ -12,6 +12,9 @@
   place_gap_24 but the stable term placed by the rigid surfaces (stable_region below), and a lifted platform top
   (the stable term above its floor, stable_region "top") leading whatever else exceeds its floor; on reports before
   session 25 (no signed region means) it falls back to place_gap_24;
+- place_gap_27: place_gap, but a platform top above its own floor and seen farther than the fitted cloth places the
+  gap everywhere, and a stable term from lifted_scale times its floor places it by stable_region, whatever leads
+  (pre-registered in session 27 before seed 19 was diagnosed);
 - pixel_region, floor_region: the report's other two localisers (the most enriched region; the region furthest
   above its own floor, in reports since session 22).
 
@@ -37,7 +40,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from diagnosis_rules import THRESHOLD, confirmation_rule  # noqa: E402  (the tolerance rule and its threshold)
 
 OUTLINE = {"harmonics", "off_centre", "sorted_radii", "hem_height"}
-RULES = ["as_run", "largest", "place_gap_24", "place_gap", "pixel_region", "floor_region"]
+RULES = ["as_run", "largest", "place_gap_24", "place_gap", "place_gap_27", "pixel_region", "floor_region"]
 # Where each effect acts (candidate_effect.cpp, effect_regions).
 EFFECT_REGIONS = {"yield": {"skirt"}, "shear": {"skirt"}, "curl": {"hem"}, "misalignment": {"hem"},
                   "friction": {"top", "rim"}, "sensor": {"global"}}
@@ -90,6 +93,20 @@ def place_gap(loc, sensor_scale, skirt_denser, lifted_scale=None):
         return "hem"
     enrichment = {r["region"]: r["enrichment"] for r in loc["regions"]}
     return "skirt" if enrichment.get("skirt", 0.0) > skirt_denser * enrichment.get("hem", 0.0) else "hem"
+
+
+def place_gap_27(loc, sensor_scale, skirt_denser, lifted_scale):
+    """place_gap with the rigid surfaces placing the gap whatever leads (pre-registered in session 27 for seed 19):
+    a platform top above its own floor and seen farther than the fitted cloth (no cloth lies inside the platform),
+    or a stable term at least lifted_scale times its floor (more than a specimen's contact lifts it), is the rigid
+    surfaces' gap, placed by stable_region; else place_gap."""
+    if "mean_mm" in loc["regions"][0]:
+        top = {r["region"]: r for r in loc["regions"]}["top"]
+        if top["floor_ratio"] > 1.0 and top["mean_mm"] > 0.0:
+            return "global"
+        if loc["stable_ratio"] >= lifted_scale:
+            return stable_region(loc, lifted_scale)
+    return place_gap(loc, sensor_scale, skirt_denser, lifted_scale)
 
 
 def ranked_verdict(report, region, rule, tolerance):
@@ -172,6 +189,7 @@ def main():
             region = {"as_run": loc["region"], "largest": largest(loc),
                       "place_gap_24": place_gap(loc, args.sensor_scale, args.skirt_denser),
                       "place_gap": place_gap(loc, args.sensor_scale, args.skirt_denser, args.lifted_scale),
+                      "place_gap_27": place_gap_27(loc, args.sensor_scale, args.skirt_denser, args.lifted_scale),
                       "pixel_region": loc["pixel_region"], "floor_region": loc.get("floor_region")}
             totals[family] += 1
             for rule in RULES:
