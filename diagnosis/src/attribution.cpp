@@ -11,6 +11,7 @@
 
 #include <fmt/ranges.h>
 
+#include "drapegen/diagnosis/fold_repeatability.hpp"
 #include "drapegen/renderer/random.hpp"
 #include "drapegen/sim/logging.hpp"
 
@@ -109,6 +110,11 @@ sim::Status validate(ForwardModel& model, ForwardModel* second, ForwardModel* he
   }
   c.validated = validated->best;
   c.setup = setup;
+  std::vector<sim::ClothMesh> chosen{c.validated.mesh};
+  for (const auto* other : {&c.second, &c.held_out})
+    if (*other) chosen.push_back((*other)->best.mesh);
+  c.placement_folds = drape_fold_correlations(chosen);
+  c.drape_folds = drape_fold_correlations(sine_drapes(*validated, states));
   return {};
 }
 

@@ -108,7 +108,7 @@ nlohmann::json repeatability_json(const FoldRepeatability& f) {
     return v.empty() ? nlohmann::json(nullptr) : nlohmann::json(*std::min_element(v.begin(), v.end()));
   };
   return {{"capture_pairs", f.capture}, {"capture_min", least(f.capture)}, {"model_pairs", f.model},
-          {"model_min", least(f.model)}};
+          {"model_min", least(f.model)}, {"model_placement_pairs", f.model_placements}};
 }
 
 /// Lengths in metres as a JSON array of millimetres.
@@ -361,11 +361,12 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
     std::vector<HemProfile> placements{hem_profile_from_capture(capture)};
     for (const Capture* other : {others.second, others.held_out})
       if (other) placements.push_back(hem_profile_from_capture(*other));
-    const std::vector<sim::InitialStateSpec> states = validation_states(settings.attribution);
-    std::vector<sim::ClothMesh> sine;
-    for (std::size_t k = 0; k < r.validated.states.size() && k < states.size(); ++k)
-      if (states[k].shape == sim::InitialShape::kSine) sine.push_back(r.validated.states[k].mesh);
-    r.fold_repeatability = fold_repeatability(placements, sine);
+    r.fold_repeatability =
+        fold_repeatability(placements, sine_drapes(r.validated, validation_states(settings.attribution)));
+    std::vector<sim::ClothMesh> chosen{r.validated.best.mesh};
+    for (const auto* other : {&r.validated_second, &r.validated_held_out})
+      if (*other) chosen.push_back((*other)->best.mesh);
+    r.fold_repeatability.model_placements = drape_fold_correlations(chosen);
   }
   const ScoredDrape& gap = r.gap_drape();
   r.gap_all = gap.all_score;
@@ -564,6 +565,8 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                           {"held_out_shrinkage", c.held_out_shrinkage},
                           {"confirmed", c.confirmed},
                           {"evaluations", c.evaluations},
+                          {"fold_repeatability",
+                           {{"placement_pairs", c.placement_folds}, {"drape_pairs", c.drape_folds}}},
                           {"scan", scan},
                           {"seconds", c.seconds}});
   }

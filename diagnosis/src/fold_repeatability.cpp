@@ -56,11 +56,22 @@ std::vector<double> pairwise_fold_correlations(const std::vector<HemProfile>& ou
   return c;
 }
 
+std::vector<double> drape_fold_correlations(const std::vector<sim::ClothMesh>& drapes) {
+  std::vector<HemProfile> outlines;
+  for (const auto& mesh : drapes) outlines.push_back(hem_profile_from_mesh(mesh));
+  return pairwise_fold_correlations(outlines);
+}
+
+std::vector<sim::ClothMesh> sine_drapes(const Evaluation& evaluation, const std::vector<sim::InitialStateSpec>& states) {
+  std::vector<sim::ClothMesh> sine;
+  for (std::size_t k = 0; k < evaluation.states.size() && k < states.size(); ++k)
+    if (states[k].shape == sim::InitialShape::kSine) sine.push_back(evaluation.states[k].mesh);
+  return sine;
+}
+
 FoldRepeatability fold_repeatability(const std::vector<HemProfile>& placements,
                                      const std::vector<sim::ClothMesh>& drapes) {
-  std::vector<HemProfile> model;
-  for (const auto& mesh : drapes) model.push_back(hem_profile_from_mesh(mesh));
-  return {pairwise_fold_correlations(placements), pairwise_fold_correlations(model), static_cast<int>(drapes.size())};
+  return {pairwise_fold_correlations(placements), drape_fold_correlations(drapes), static_cast<int>(drapes.size()), {}};
 }
 
 }  // namespace drapegen::diagnosis

@@ -64,3 +64,49 @@ TEST(FoldRepeatability, PairsInOrder) {
   EXPECT_EQ(r.model_drapes, 0);
   EXPECT_FALSE(r.measured());
 }
+
+namespace {
+/// A skirt's hem only: a ring of vertices 0.1 m below the top at the outline's radius (its edges sampled between).
+drapegen::sim::ClothMesh hem_ring(std::vector<int> fold_orders, double phase) {
+  const HemProfile p = outline(std::move(fold_orders), phase);
+  constexpr int n = 720;
+  drapegen::sim::ClothMesh m;
+  m.rest.setZero(2, n);
+  m.positions.resize(3, n);
+  m.triangles.resize(3, n);
+  for (int k = 0; k < n; ++k) {
+    const double t = 2 * M_PI * k / n;
+    const double r = p.radius[static_cast<int>(k * kHemBins / n)];
+    m.positions.col(k) << r * std::cos(t), r * std::sin(t), -0.1;
+    m.triangles.col(k) << k, (k + 1) % n, (k + 2) % n;
+  }
+  return m;
+}
+}  // namespace
+
+TEST(FoldRepeatability, DrapesCorrelateByTheirOutlines) {
+  const std::vector<drapegen::sim::ClothMesh> drapes{hem_ring({7}, 0.0), hem_ring({7}, 0.7), hem_ring({9}, 0.0)};
+  const std::vector<double> c = drape_fold_correlations(drapes);
+  ASSERT_EQ(c.size(), 3u);
+  EXPECT_GT(c[0], 0.95);            // the same seven folds, turned
+  EXPECT_LT(std::abs(c[1]), 0.1);   // seven against nine
+  EXPECT_LT(std::abs(c[2]), 0.1);
+  EXPECT_TRUE(drape_fold_correlations({drapes[0]}).empty());
+}
+
+TEST(FoldRepeatability, SineDrapesOnly) {
+  using drapegen::sim::InitialShape;
+  Evaluation e;
+  e.states.resize(4);
+  for (int k = 0; k < 4; ++k) e.states[k].mesh = hem_ring({7 + k}, 0.0);
+  std::vector<drapegen::sim::InitialStateSpec> states(4);
+  states[0].shape = InitialShape::kFlat;
+  states[1].shape = states[3].shape = InitialShape::kSine;
+  states[2].shape = InitialShape::kFold;
+  const auto sine = sine_drapes(e, states);
+  ASSERT_EQ(sine.size(), 2u);
+  EXPECT_EQ(sine[0].positions, e.states[1].mesh.positions);
+  EXPECT_EQ(sine[1].positions, e.states[3].mesh.positions);
+  states.resize(2);  // states beyond those given are not the evaluation's sine states
+  EXPECT_EQ(sine_drapes(e, states).size(), 1u);
+}

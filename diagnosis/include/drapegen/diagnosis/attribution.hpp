@@ -80,6 +80,10 @@ struct CandidateResult {
     return excess_above_floors(gap_terms(validated, paired_drape()), floors);
   }
   ModelSetup setup;  // the refitted setup
+  /// How alike the refitted setup's drapes fold (fold_repeatability.hpp; reported only): between its best drapes on
+  /// the capture, the second and the held-out placement, paired as the capture's placements are (a yielding setup is
+  /// laid again on each from the last one's set); between its drapes on the capture from the sine validation states.
+  std::vector<double> placement_folds, drape_folds;
   /// With AttributionSettings::ablation: the refitted setup with its effect switched off (the bending at the refitted
   /// scale), validated the same way (validated, second, held_out, setup), with its refit objective (objective, drape:
   /// where the bar's search would rank that scale); null otherwise, and for the bar and sensor.

@@ -8,7 +8,9 @@
 
 #include <vector>
 
+#include "drapegen/diagnosis/forward_model.hpp"
 #include "drapegen/diagnosis/hem_profile.hpp"
+#include "drapegen/sim/initial_state.hpp"
 #include "drapegen/sim/mesh.hpp"
 
 namespace drapegen::diagnosis {
@@ -24,6 +26,13 @@ namespace drapegen::diagnosis {
 /// Every pair's fold_correlation (i < j, in order 01, 02, .., 12, ..).
 [[nodiscard]] std::vector<double> pairwise_fold_correlations(const std::vector<HemProfile>& outlines);
 
+/// Every pair's fold_correlation of the drapes' outlines (hem_profile_from_mesh).
+[[nodiscard]] std::vector<double> drape_fold_correlations(const std::vector<sim::ClothMesh>& drapes);
+
+/// The drapes of `evaluation` from sine states (`states`: its initial states, in order): no placement starts flat.
+[[nodiscard]] std::vector<sim::ClothMesh> sine_drapes(const Evaluation& evaluation,
+                                                      const std::vector<sim::InitialStateSpec>& states);
+
 struct FoldRepeatability {
   /// Between the capture's placements (the capture, the second, the held-out capture: pairs 01, 02, 12 of those given).
   std::vector<double> capture;
@@ -31,6 +40,9 @@ struct FoldRepeatability {
   /// flat), every pair.
   std::vector<double> model;
   int model_drapes = 0;
+  /// Between the fitted model's best drapes on each placement (the one each placement's fit views choose among the
+  /// validation drapes), paired as `capture` is.
+  std::vector<double> model_placements;
   [[nodiscard]] bool measured() const { return !capture.empty() && model.size() >= 2; }
 };
 
