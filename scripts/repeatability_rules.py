@@ -13,6 +13,16 @@ among the captures the gate passed as within the floors and among the rest:
     scripts/repeatability_rules.py DIR [DIR ...]            # DIR: a benchmark run (diagnoses/, truth/) or a directory
                                                             # of NAME.json reports beside a run's truth/ (--truth)
     scripts/repeatability_rules.py --truth out/run/truth --scale 1.5 2 3 out/gaponly
+    scripts/repeatability_rules.py --candidates out/run          # the candidates' own repeatability (session 27)
+
+With --candidates (reports since session 27, attribution run): per capture the mean of its placements' pairs, the
+fitted model's best drapes' on the three placements (`model_placement_pairs`), and each candidate's (its best drapes
+on the three placements, `placement_pairs`; a yielding one laid again from its set) with the 10th percentile of its
+drapes' pairs (`drape_pairs`); `closest`: the confirmed candidate whose placements' mean is nearest the capture's;
+and the rule `repeat_closest` (pre-registered in session 27 before seed 20): where repeat_excess fires and two or more
+candidates are confirmed with a shrinkage of at least 0.25, the verdict is the one of them whose placements' mean is
+nearest the capture's; elsewhere the verdict as run; and `repeat_curl` (pre-registered likewise): where repeat_excess
+fires and the curl candidate is confirmed with a shrinkage of at least 0.25, curl; elsewhere the verdict as run.
 """
 import argparse
 import collections
@@ -35,12 +45,71 @@ def reports(directory, truth_dir):
             yield name, json.load(f), json.load(t)
 
 
+def mean(values):
+    return sum(values) / len(values) if values else float("nan")
+
+
+def repeat_excess(f):
+    """Every capture pair below the model pairs' 10th percentile minus 0.1 (session 26)."""
+    model = sorted(f["model_pairs"])
+    return bool(model) and max(f["capture_pairs"]) < model[int(0.1 * len(model))] - 0.1
+
+
+def candidates(runs, truth_dir):
+    short = {"yield": "yld", "shear": "shr", "curl": "crl", "friction": "frc", "misalignment": "mis", "sensor": "sen"}
+    right = collections.Counter()
+    total = collections.Counter()
+    as_run = collections.Counter()
+    closest_rule = collections.Counter()
+    curl_rule = collections.Counter()
+    for run in runs:
+        for name, r, truth in reports(run, truth_dir):
+            f = r["gap_tests"].get("fold_repeatability") or {}
+            cands = [c for c in r["attribution"].get("candidates", []) if "fold_repeatability" in c]
+            if not cands or not f.get("capture_pairs"):
+                continue
+            capture = mean(f["capture_pairs"])
+            cells = []
+            confirmed = []
+            for c in cands:
+                fr = c["fold_repeatability"]
+                placed = mean(fr["placement_pairs"])
+                drapes = sorted(fr["drape_pairs"])
+                q10 = drapes[int(0.1 * len(drapes))] if drapes else float("nan")
+                mark = "*" if c["confirmed"] and c["shrinkage"] >= 0.25 else " "
+                cells.append(f"{short[c['effect']]}{mark}{placed:5.2f}/{q10:4.2f}")
+                if mark == "*":
+                    confirmed.append((abs(placed - capture), c["effect"]))
+            closest = min(confirmed)[1] if confirmed else "-"
+            fires = repeat_excess(f)
+            rule = closest if fires and len(confirmed) >= 2 else r["verdict"]
+            curl_ok = any(c["effect"] == "curl" and c["confirmed"] and c["shrinkage"] >= 0.25 for c in cands)
+            curl = "curl" if fires and curl_ok else r["verdict"]
+            family = truth["family"] or "none"
+            total[family] += 1
+            right[family] += closest == family
+            as_run[family] += r["verdict"] == family
+            closest_rule[family] += rule == family
+            curl_rule[family] += curl == family
+            print(f"{name:<16} {r['verdict']:<12} cap {capture:5.2f} model {mean(f.get('model_placement_pairs', [])):5.2f} "
+                  + " ".join(cells) + f"  closest {closest}" + (f"  repeat_excess -> {rule} (repeat_curl {curl})" if fires else ""))
+    print("closest right: " + ", ".join(f"{fam} {right[fam]}/{total[fam]}" for fam in sorted(total)))
+    print("as run right: " + ", ".join(f"{fam} {as_run[fam]}/{total[fam]}" for fam in sorted(total)))
+    print("repeat_closest right: " + ", ".join(f"{fam} {closest_rule[fam]}/{total[fam]}" for fam in sorted(total)))
+    print("repeat_curl right: " + ", ".join(f"{fam} {curl_rule[fam]}/{total[fam]}" for fam in sorted(total)))
+    print("(captures whose attribution ran; a control is right when named none)")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("runs", nargs="+")
     parser.add_argument("--truth", help="truth directory (default: RUN/truth)")
     parser.add_argument("--scale", type=float, nargs="+", default=[1.5, 2.0, 3.0])
+    parser.add_argument("--candidates", action="store_true", help="the candidates' own repeatability")
     args = parser.parse_args()
+    if args.candidates:
+        candidates(args.runs, args.truth)
+        return
     rows = []
     for run in args.runs:
         for name, r, truth in reports(run, args.truth):
