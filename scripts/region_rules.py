@@ -15,6 +15,8 @@
 - place_gap_27: place_gap, but a platform top above its own floor and seen farther than the fitted cloth places the
   gap everywhere, and a stable term from lifted_scale times its floor places it by stable_region, whatever leads
   (pre-registered in session 27 before seed 19 was diagnosed);
+- place_gap_27b: place_gap_27, and a platform top at least lifted_scale times its own floor placing the gap
+  everywhere (pre-registered in session 27 before seed 20 was diagnosed);
 - pixel_region, floor_region: the report's other two localisers (the most enriched region; the region furthest
   above its own floor, in reports since session 22).
 
@@ -40,7 +42,8 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from diagnosis_rules import THRESHOLD, confirmation_rule  # noqa: E402  (the tolerance rule and its threshold)
 
 OUTLINE = {"harmonics", "off_centre", "sorted_radii", "hem_height"}
-RULES = ["as_run", "largest", "place_gap_24", "place_gap", "place_gap_27", "pixel_region", "floor_region"]
+RULES = ["as_run", "largest", "place_gap_24", "place_gap", "place_gap_27", "place_gap_27b", "pixel_region",
+         "floor_region"]
 # Where each effect acts (candidate_effect.cpp, effect_regions).
 EFFECT_REGIONS = {"yield": {"skirt"}, "shear": {"skirt"}, "curl": {"hem"}, "misalignment": {"hem"},
                   "friction": {"top", "rim"}, "sensor": {"global"}}
@@ -107,6 +110,16 @@ def place_gap_27(loc, sensor_scale, skirt_denser, lifted_scale):
         if loc["stable_ratio"] >= lifted_scale:
             return stable_region(loc, lifted_scale)
     return place_gap(loc, sensor_scale, skirt_denser, lifted_scale)
+
+
+def place_gap_27b(loc, sensor_scale, skirt_denser, lifted_scale):
+    """place_gap_27, and a platform top at least lifted_scale times its own floor (of either sign) is a camera's error,
+    "global" whatever leads (pre-registered in session 27 before seed 20 was diagnosed)."""
+    if "mean_mm" in loc["regions"][0]:
+        top = {r["region"]: r for r in loc["regions"]}["top"]
+        if top["floor_ratio"] >= lifted_scale:
+            return "global"
+    return place_gap_27(loc, sensor_scale, skirt_denser, lifted_scale)
 
 
 def ranked_verdict(report, region, rule, tolerance):
@@ -190,6 +203,7 @@ def main():
                       "place_gap_24": place_gap(loc, args.sensor_scale, args.skirt_denser),
                       "place_gap": place_gap(loc, args.sensor_scale, args.skirt_denser, args.lifted_scale),
                       "place_gap_27": place_gap_27(loc, args.sensor_scale, args.skirt_denser, args.lifted_scale),
+                      "place_gap_27b": place_gap_27b(loc, args.sensor_scale, args.skirt_denser, args.lifted_scale),
                       "pixel_region": loc["pixel_region"], "floor_region": loc.get("floor_region")}
             totals[family] += 1
             for rule in RULES:
