@@ -33,6 +33,7 @@ struct DiagnoseOptions {
   int states = 0;
   int evaluations = 0;
   int refit_evaluations = 0;
+  int sensor_evaluations = 0;
   int refit_scan = -1;  // < 0: the settings' value
   int yield_trade = -1;  // < 0: the settings' value
   std::vector<std::string> candidates;  // empty: every effect
@@ -57,8 +58,9 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (o.jobs < 1 || o.jobs > 64) return fail("--jobs must be 1 .. 64");
   if (o.resolution != 0 && (o.resolution < 6 || o.resolution > 60)) return fail("--resolution must be 6 .. 60");
   if (o.states < 0 || o.states > 16) return fail("--states must be 1 .. 16");
-  if (o.evaluations < 0 || o.evaluations > 10000 || o.refit_evaluations < 0 || o.refit_evaluations > 10000) {
-    return fail("--evaluations and --refit-evaluations must be 1 .. 10000");
+  if (o.evaluations < 0 || o.evaluations > 10000 || o.refit_evaluations < 0 || o.refit_evaluations > 10000 ||
+      o.sensor_evaluations < 0 || o.sensor_evaluations > 10000) {
+    return fail("--evaluations, --refit-evaluations and --sensor-evaluations must be 1 .. 10000");
   }
   if (o.shape_floor > 100.0) return fail("--shape-floor must be 0 (from the floor samples) .. 100");
   if (!(o.held_out_tolerance >= 0.0 && o.held_out_tolerance <= 1.0)) return fail("--held-out-tolerance must be 0 .. 1");
@@ -113,6 +115,7 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (o.states > 0) settings.fit.initial_states = o.states;
   if (o.evaluations > 0) settings.baseline_optimiser.max_evaluations = o.evaluations;
   if (o.refit_evaluations > 0) settings.attribution.optimiser.max_evaluations = o.refit_evaluations;
+  if (o.sensor_evaluations > 0) settings.attribution.sensor_evaluations = o.sensor_evaluations;
   if (o.refit_scan >= 0) settings.attribution.scan_levels = o.refit_scan;
   if (o.yield_trade >= 0) settings.attribution.yield_trade_levels = o.yield_trade;
   if (!candidates.empty()) settings.attribution.candidates = candidates;
@@ -218,6 +221,9 @@ Runner add_diagnose_command(CLI::App& app) {
                "fit's box (as --start-alpha/--start-beta/--start-box), unless --start-alpha/--start-beta is given");
   app.add_option("--refit-evaluations", o->refit_evaluations,
                  "Evaluations per candidate refit and of the bar, the bending scale refitted alone (default 14, also "
+                 "with --quick and --fine)");
+  app.add_option("--sensor-evaluations", o->sensor_evaluations,
+                 "Evaluations of the sensor candidate's refit, which re-renders the baseline's drapes (default 200, 100 "
                  "with --quick and --fine)");
   app.add_option("--refit-scan", o->refit_scan,
                  fmt::format("Refits of one-parameter effects (yield, shear, curl, friction) start with this many "

@@ -83,8 +83,15 @@ void place_gap(Localisation& L) {
   }
   // The stable term leads; or it exceeds its floor with the platform top lifted: under the adhesion the baseline
   // assumes, the top cannot lift, only a specimen that slid over it does, and the outline's change follows from that.
+  // The rigid surfaces also place the gap whatever leads when they are the camera's (session 27): a top above its
+  // own floor seen farther than the fitted cloth (no cloth lies inside the platform), or a stable term from
+  // kLiftedTopSensorRatio times its floor (beyond what a specimen's contact lifts); an error of the camera moves the
+  // outline as well, often further above its floor than the rigid surfaces.
   const Region stable_at = stable_region(L);
-  if (L.stable_ratio > best || (L.stable_ratio > 1.0 && stable_at == Region::kTop)) {
+  const RegionShare* top = region_share(L, Region::kTop);
+  const bool top_farther = top && top->floor_ratio > 1.0 && top->mean > 0.0;
+  if (L.stable_ratio > best || (L.stable_ratio > 1.0 && stable_at == Region::kTop) || top_farther ||
+      L.stable_ratio >= kLiftedTopSensorRatio) {
     L.dominant_feature = "stable";
     L.dominant = stable_at;
     return;

@@ -137,7 +137,7 @@ TEST(PlaceGap, TheStableTermSitsWhereTheRigidSurfacesSayAndLeadsOnlyAboveTheGrou
   EXPECT_EQ(L.dominant, Region::kGlobal);
   EXPECT_EQ(stable_region(L), Region::kGlobal);
   // Below a larger group ratio the stable term does not lead...
-  L = with_top(excess(FeatureGroup::kSkirtHeight, 2.5, 2.0, 1.0, 1.0), 4.8e-3, 1.6);
+  L = with_top(excess(FeatureGroup::kSkirtHeight, 2.5, 2.0, 1.0, 1.0), -1.5e-3, 0.9);  // the top within its floor
   place_gap(L);
   EXPECT_EQ(L.dominant, Region::kSkirt);
   EXPECT_EQ(L.dominant_feature, "skirt_height");
@@ -145,6 +145,21 @@ TEST(PlaceGap, TheStableTermSitsWhereTheRigidSurfacesSayAndLeadsOnlyAboveTheGrou
   place_gap(L);
   EXPECT_EQ(L.dominant, Region::kSkirt);
   EXPECT_EQ(L.dominant_feature, "harmonics");
+  // ... unless the rigid surfaces are the camera's: a top seen farther than the fitted cloth (a depth bias), even
+  // with the stable term itself within its floor, or a stable term from a camera error's scale (a pose error).
+  L = with_top(excess(FeatureGroup::kSkirtHeight, 2.5, 2.0, 1.0, 1.0), 4.8e-3, 1.6);
+  place_gap(L);
+  EXPECT_EQ(L.dominant, Region::kGlobal);
+  EXPECT_EQ(L.dominant_feature, "stable");
+  L = with_top(excess(FeatureGroup::kSortedRadii, 3.5, 0.9, 1.0, 1.0), 4.8e-3, 1.1);
+  place_gap(L);
+  EXPECT_EQ(L.dominant, Region::kGlobal);
+  L = with_top(excess(FeatureGroup::kSkirtHeight, 5.6, kLiftedTopSensorRatio, 1.0, 1.0), -11.0e-3, 3.0);
+  place_gap(L);
+  EXPECT_EQ(L.dominant, Region::kGlobal);
+  L = with_top(excess(FeatureGroup::kSkirtHeight, 5.6, kLiftedTopSensorRatio, 1.0, 1.0), -0.1e-3, 0.9);
+  place_gap(L);
+  EXPECT_EQ(L.dominant, Region::kCylinder);  // the top within its floor: the bare cylinder's (multipath)
   // ... unless it exceeds its floor with the top lifted: the specimen slid over the platform (friction), whatever
   // the outline's change.
   L = with_top(excess(FeatureGroup::kHarmonics, 2.5, 1.3, 1.6, 1.2), -3.0e-3, 1.4);
