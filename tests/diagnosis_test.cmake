@@ -519,6 +519,13 @@ endforeach()
 if(NOT sensor_seen)
   message(FATAL_ERROR "fold repeatability: no sensor candidate among ${ncand}")
 endif()
+# Whether the placements fold less alike than the model's drapes, and whether that put curl first (consistent: curl
+# first only where they do).
+string(JSON unlike GET "${out}" gap_tests fold_repeatability folds_less_alike)
+string(JSON curl_first GET "${out}" attribution curl_first)
+if(curl_first AND NOT unlike)
+  message(FATAL_ERROR "curl put first though the placements fold no less alike than the model's drapes")
+endif()
 # --sensor-evaluations: the sensor refit's budget.
 foreach(i RANGE ${last})
   string(JSON effect GET "${out}" attribution candidates ${i} effect)

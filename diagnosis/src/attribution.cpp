@@ -305,6 +305,15 @@ double confirmation_score(const ScoredDrape& drape, const ScoredDrape* held_out_
   return held_out_capture ? held_out_capture->all_score : drape.held_out_score;
 }
 
+bool curl_first(std::vector<CandidateResult>& ranked, double significant) {
+  const auto curl = std::find_if(ranked.begin(), ranked.end(), [&](const CandidateResult& c) {
+    return c.effect == Effect::kCurl && c.confirmed && c.shrinkage >= significant;
+  });
+  if (curl == ranked.end() || curl == ranked.begin()) return false;
+  std::rotate(ranked.begin(), curl, curl + 1);
+  return true;
+}
+
 bool ranks_before(const CandidateResult& x, const CandidateResult& y) {
   if (x.confirmed != y.confirmed) return x.confirmed;
   if (x.shrinkage != y.shrinkage) return x.shrinkage > y.shrinkage;
@@ -442,6 +451,9 @@ sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& base
     a.candidates.push_back(std::move(c));
   }
   std::stable_sort(a.candidates.begin(), a.candidates.end(), ranks_before);
+  a.curl_promoted = others.fold_unlike_model && curl_first(a.candidates, settings.significant_shrinkage);
+  if (a.curl_promoted)
+    sim::logger()->info("attribution: the placements fold less alike than the fitted model's drapes; curl first");
   if (!a.candidates.empty()) {
     a.named = !a.bar_within_floors && a.candidates[0].confirmed &&
               a.candidates[0].shrinkage >= settings.significant_shrinkage;

@@ -108,7 +108,8 @@ nlohmann::json repeatability_json(const FoldRepeatability& f) {
     return v.empty() ? nlohmann::json(nullptr) : nlohmann::json(*std::min_element(v.begin(), v.end()));
   };
   return {{"capture_pairs", f.capture}, {"capture_min", least(f.capture)}, {"model_pairs", f.model},
-          {"model_min", least(f.model)}, {"model_placement_pairs", f.model_placements}};
+          {"model_min", least(f.model)}, {"model_placement_pairs", f.model_placements},
+          {"folds_less_alike", folds_less_alike(f)}};
 }
 
 /// Lengths in metres as a JSON array of millimetres.
@@ -396,6 +397,7 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
     OtherCaptures other_captures;
     if (second_model) other_captures.second = {second_model.get(), &r.validated_second->best};
     if (held_out_model) other_captures.held_out = {held_out_model.get(), &r.validated_held_out->best};
+    other_captures.fold_unlike_model = folds_less_alike(r.fold_repeatability);
     AttributionSettings attribution_settings = settings.attribution;
     if (r.search_within_factor > 1.0) {
       // A known bending's box (a measured bending or --start-box) bounds the refits too: the bending scale moves only
@@ -571,6 +573,7 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                           {"seconds", c.seconds}});
   }
   j["attribution"] = {{"ran", ran},
+                      {"curl_first", r.attribution.curl_promoted},
                       {"confirmed_on", r.validated_held_out ? "held_out_capture" : "held_out_view"},
                       {"held_out_tolerance", ran ? nlohmann::json(r.attribution.held_out_tolerance) : nullptr},
                       {"refitted_on", r.validated_second ? "capture_and_second_capture" : "capture"},

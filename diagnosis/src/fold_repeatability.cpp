@@ -69,6 +69,14 @@ std::vector<sim::ClothMesh> sine_drapes(const Evaluation& evaluation, const std:
   return sine;
 }
 
+bool folds_less_alike(const FoldRepeatability& f) {
+  if (!f.measured()) return false;
+  std::vector<double> model = f.model;
+  std::sort(model.begin(), model.end());
+  const double q10 = model[static_cast<std::size_t>(0.1 * static_cast<double>(model.size()))];
+  return *std::max_element(f.capture.begin(), f.capture.end()) < q10 - kFoldsUnlikeMargin;
+}
+
 FoldRepeatability fold_repeatability(const std::vector<HemProfile>& placements,
                                      const std::vector<sim::ClothMesh>& drapes) {
   return {pairwise_fold_correlations(placements), drape_fold_correlations(drapes), static_cast<int>(drapes.size()), {}};

@@ -110,3 +110,14 @@ TEST(FoldRepeatability, SineDrapesOnly) {
   states.resize(2);  // states beyond those given are not the evaluation's sine states
   EXPECT_EQ(sine_drapes(e, states).size(), 1u);
 }
+
+TEST(FoldRepeatability, FoldsLessAlikeWhenEveryCapturePairIsBelowTheModelsTenthPercentileByTheMargin) {
+  FoldRepeatability f;
+  f.model = {0.95, 0.2, 0.96, 0.97, 0.94, 0.93, 0.98, 0.99, 0.95, 0.96};  // 10th percentile: sorted[1] = 0.93
+  f.capture = {0.5, 0.82, 0.6};
+  EXPECT_TRUE(folds_less_alike(f));
+  f.capture = {0.5, 0.84, 0.6};  // one pair within the margin
+  EXPECT_FALSE(folds_less_alike(f));
+  f.capture.clear();  // not measured
+  EXPECT_FALSE(folds_less_alike(f));
+}

@@ -103,6 +103,9 @@ struct OtherCapture {
 struct OtherCaptures {
   OtherCapture second;    // in every candidate refit and the gate
   OtherCapture held_out;  // in no fit: confirmation, bootstrap (and the gate without a second)
+  /// The placements fold less alike than the fitted model's drapes (fold_repeatability.hpp, folds_less_alike): the
+  /// attribution then names curl where curl is confirmed and significant (curl_first).
+  bool fold_unlike_model = false;
   [[nodiscard]] const OtherCapture& paired() const { return second ? second : held_out; }
 };
 
@@ -175,6 +178,8 @@ struct Attribution {
   /// The bar's validated drape is within the floors (gate of the baseline's): the baseline model explains the capture
   /// once its bending is refitted, so the gap was the baseline fit's, and no effect is named.
   bool bar_within_floors = false;
+  /// curl_first moved the curl candidate to the front (OtherCaptures::fold_unlike_model).
+  bool curl_promoted = false;
 };
 
 /// The validation states: fresh initial states (flat, then sine) that no fit selects on.
@@ -193,6 +198,13 @@ struct Attribution {
 /// parameters absorb a local change of the drape that a one-parameter effect explains as well; docs/DIAGNOSIS.md,
 /// "Session 25"), then the smaller refit objective, then the larger held-out shrinkage.
 [[nodiscard]] bool ranks_before(const CandidateResult& x, const CandidateResult& y);
+
+/// Where the capture's placements fold less alike than the fitted model's drapes, a curl candidate that is confirmed
+/// and shrinks the gap by at least `significant` moves to the front of `ranked` (the others keep their order): edges
+/// that roll settle differently on every placement, which neither a softer elastic fit nor a yielding one laid again
+/// reproduced on seeds 17-20 (rule "repeat_curl", pre-registered before seed 20; docs/DIAGNOSIS.md, "Session 27").
+/// Returns whether it moved one.
+bool curl_first(std::vector<CandidateResult>& ranked, double significant);
 
 /// The held-out confirmation: `held_out_after` (the candidate's confirmation_score) is at most (1 + tolerance) times
 /// `held_out_before` (the reference's).

@@ -46,6 +46,13 @@ struct FoldRepeatability {
   [[nodiscard]] bool measured() const { return !capture.empty() && model.size() >= 2; }
 };
 
+/// The capture's placements fold less alike than the fitted model's drapes: every capture pair below the model pairs'
+/// 10th percentile (sorted, element floor(0.1 n)) minus kFoldsUnlikeMargin ("repeat_excess", pre-registered in
+/// session 26; on seeds 17-20 it held for 9 of 20 curled specimens, 1 of 20 yielding ones and none of the other 95,
+/// controls included: docs/DIAGNOSIS.md, "Session 27"). False unless measured().
+[[nodiscard]] bool folds_less_alike(const FoldRepeatability& f);
+inline constexpr double kFoldsUnlikeMargin = 0.1;
+
 /// `placements`: the captures' outlines (every view), the capture first; `drapes`: the model's drapes.
 [[nodiscard]] FoldRepeatability fold_repeatability(const std::vector<HemProfile>& placements,
                                                    const std::vector<sim::ClothMesh>& drapes);
