@@ -48,7 +48,7 @@ struct FoldRepeatability {
 
 /// The capture's placements fold less alike than the fitted model's drapes: every capture pair below the model pairs'
 /// 10th percentile (sorted, element floor(0.1 n)) minus kFoldsUnlikeMargin ("repeat_excess", pre-registered in
-/// session 26; on seeds 17-20 it held for 9 of 20 curled specimens, 1 of 20 yielding ones and none of the other 95,
+/// session 26; on seeds 17-20 it held for 9 of 20 curled specimens, 1 of 20 yielding ones and none of the other 85,
 /// controls included: docs/DIAGNOSIS.md, "Session 27"). False unless measured().
 [[nodiscard]] bool folds_less_alike(const FoldRepeatability& f);
 inline constexpr double kFoldsUnlikeMargin = 0.1;
