@@ -149,6 +149,10 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
     md += fmt::format("**Verdict: {}** (confidence {:.2f} against the runner-up, {}); adding it shrinks the held-out gap "
                       "above the floor by {:.0f}%.\n\n",
                       r.verdict, r.attribution.confidence, r.runner_up, 100.0 * c.shrinkage);
+    if (r.attribution.curl_promoted)
+      md += "Curl is named ahead of the candidate its shrinkage ranks first: the capture's placements fold less "
+            "alike than the fitted model's drapes do (fold repeatability, below), as rolled edges settle differently "
+            "on every placement.\n\n";
   }
   md += "## Gap and floors (score in mm: stable-region RMS + 4 mm x shape-feature distance)\n\n";
   md += "| | all views | held-out view |\n|---|---|---|\n";
