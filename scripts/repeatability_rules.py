@@ -49,10 +49,15 @@ def mean(values):
     return sum(values) / len(values) if values else float("nan")
 
 
-def repeat_excess(f):
-    """Every capture pair below the model pairs' 10th percentile minus 0.1 (session 26)."""
+def model_q10(f):
+    """The model pairs' 10th percentile (sorted, element floor(0.1 n)), as folds_less_alike takes it."""
     model = sorted(f["model_pairs"])
-    return bool(model) and max(f["capture_pairs"]) < model[int(0.1 * len(model))] - 0.1
+    return model[int(0.1 * len(model))]
+
+
+def repeat_excess(f):
+    """Every capture pair below the model pairs' 10th percentile minus 0.1 (session 26; folds_less_alike)."""
+    return bool(f["model_pairs"]) and max(f["capture_pairs"]) < model_q10(f) - 0.1
 
 
 def candidates(runs, truth_dir):
@@ -116,9 +121,8 @@ def main():
             f = r["gap_tests"].get("fold_repeatability")
             if not f or f["capture_min"] is None or f["model_min"] is None:
                 continue
-            model = sorted(f["model_pairs"])
-            q10 = model[int(0.1 * len(model))]
-            excess = max(f["capture_pairs"]) < q10 - 0.1
+            q10 = model_q10(f)
+            excess = repeat_excess(f)
             rows.append((os.path.basename(os.path.normpath(run)) + "/" + name, truth["family"], r["within_floors"],
                          r["verdict"], f["capture_min"], f["model_min"], max(f["capture_pairs"]), q10, excess))
     print(f"{'case':<32} {'family':<13} {'within':>6} {'verdict':<13} {'cap_min':>7} {'mod_min':>7} {'ratio':>6} "

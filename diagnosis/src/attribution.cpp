@@ -110,10 +110,8 @@ sim::Status validate(ForwardModel& model, ForwardModel* second, ForwardModel* he
   }
   c.validated = validated->best;
   c.setup = setup;
-  std::vector<sim::ClothMesh> chosen{c.validated.mesh};
-  for (const auto* other : {&c.second, &c.held_out})
-    if (*other) chosen.push_back((*other)->best.mesh);
-  c.placement_folds = drape_fold_correlations(chosen);
+  c.placement_folds =
+      placement_fold_correlations(c.validated, c.second ? &c.second->best : nullptr, c.held_out_drape());
   c.drape_folds = drape_fold_correlations(sine_drapes(*validated, states));
   return {};
 }

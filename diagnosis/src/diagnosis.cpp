@@ -364,10 +364,9 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
       if (other) placements.push_back(hem_profile_from_capture(*other));
     r.fold_repeatability =
         fold_repeatability(placements, sine_drapes(r.validated, validation_states(settings.attribution)));
-    std::vector<sim::ClothMesh> chosen{r.validated.best.mesh};
-    for (const auto* other : {&r.validated_second, &r.validated_held_out})
-      if (*other) chosen.push_back((*other)->best.mesh);
-    r.fold_repeatability.model_placements = drape_fold_correlations(chosen);
+    r.fold_repeatability.model_placements = placement_fold_correlations(
+        r.validated.best, r.validated_second ? &r.validated_second->best : nullptr,
+        r.validated_held_out ? &r.validated_held_out->best : nullptr);
   }
   const ScoredDrape& gap = r.gap_drape();
   r.gap_all = gap.all_score;

@@ -62,6 +62,14 @@ std::vector<double> drape_fold_correlations(const std::vector<sim::ClothMesh>& d
   return pairwise_fold_correlations(outlines);
 }
 
+std::vector<double> placement_fold_correlations(const ScoredDrape& capture, const ScoredDrape* second,
+                                                const ScoredDrape* held_out) {
+  std::vector<sim::ClothMesh> chosen{capture.mesh};
+  for (const ScoredDrape* other : {second, held_out})
+    if (other) chosen.push_back(other->mesh);
+  return drape_fold_correlations(chosen);
+}
+
 std::vector<sim::ClothMesh> sine_drapes(const Evaluation& evaluation, const std::vector<sim::InitialStateSpec>& states) {
   std::vector<sim::ClothMesh> sine;
   for (std::size_t k = 0; k < evaluation.states.size() && k < states.size(); ++k)

@@ -87,10 +87,9 @@ void place_gap(Localisation& L) {
   // own floor seen farther than the fitted cloth (no cloth lies inside the platform), or a stable term from
   // kLiftedTopSensorRatio times its floor (beyond what a specimen's contact lifts); an error of the camera moves the
   // outline as well, often further above its floor than the rigid surfaces.
+  // (stable_region says kGlobal exactly for a top seen farther, or a lifted one from that ratio.)
   const Region stable_at = stable_region(L);
-  const RegionShare* top = region_share(L, Region::kTop);
-  const bool top_farther = top && top->floor_ratio > 1.0 && top->mean > 0.0;
-  if (L.stable_ratio > best || (L.stable_ratio > 1.0 && stable_at == Region::kTop) || top_farther ||
+  if (L.stable_ratio > best || (L.stable_ratio > 1.0 && stable_at == Region::kTop) || stable_at == Region::kGlobal ||
       L.stable_ratio >= kLiftedTopSensorRatio) {
     L.dominant_feature = "stable";
     L.dominant = stable_at;

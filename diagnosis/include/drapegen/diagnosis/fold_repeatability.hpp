@@ -29,6 +29,11 @@ namespace drapegen::diagnosis {
 /// Every pair's fold_correlation of the drapes' outlines (hem_profile_from_mesh).
 [[nodiscard]] std::vector<double> drape_fold_correlations(const std::vector<sim::ClothMesh>& drapes);
 
+/// drape_fold_correlations of the drapes a model chose on each placement (null: that placement not given), paired as
+/// the capture's placements are (FoldRepeatability::capture).
+[[nodiscard]] std::vector<double> placement_fold_correlations(const ScoredDrape& capture, const ScoredDrape* second,
+                                                              const ScoredDrape* held_out);
+
 /// The drapes of `evaluation` from sine states (`states`: its initial states, in order): no placement starts flat.
 [[nodiscard]] std::vector<sim::ClothMesh> sine_drapes(const Evaluation& evaluation,
                                                       const std::vector<sim::InitialStateSpec>& states);
