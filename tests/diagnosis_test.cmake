@@ -526,6 +526,16 @@ string(JSON curl_first GET "${out}" attribution curl_first)
 if(curl_first AND NOT unlike)
   message(FATAL_ERROR "curl put first though the placements fold no less alike than the model's drapes")
 endif()
+# The camera from the rigid surfaces: a depth bias of 12 mm reads long on the platform top and the bare side alike,
+# as a camera farther back along its axis; their pixels lie closer to the surfaces at the estimate.
+string(JSON t_z GET "${out}" rigid_surfaces translation_mm 2)
+string(JSON rms_recorded GET "${out}" rigid_surfaces rms_recorded_mm)
+string(JSON rms_estimated GET "${out}" rigid_surfaces rms_estimated_mm)
+if(t_z LESS 5 OR NOT rms_estimated LESS rms_recorded)
+  message(FATAL_ERROR "rigid surfaces of a 12 mm depth bias: camera moved ${t_z} mm along its axis (expected 5 or "
+                      "more), RMS ${rms_recorded} -> ${rms_estimated} mm")
+endif()
+message(STATUS "rigid surfaces of a 12 mm depth bias: ${t_z} mm along the axis, RMS ${rms_recorded} -> ${rms_estimated} mm")
 # --sensor-evaluations: the sensor refit's budget.
 foreach(i RANGE ${last})
   string(JSON effect GET "${out}" attribution candidates ${i} effect)

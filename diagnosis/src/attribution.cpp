@@ -156,6 +156,16 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
   }
   lo.insert(lo.end(), space.lower.begin(), space.lower.end());
   hi.insert(hi.end(), space.upper.begin(), space.upper.end());
+  if (effect == Effect::kSensor && settings.sensor_start) {
+    // The camera pose the rigid surfaces show (rotation in mrad, translation in mm: effect_space's first six).
+    const renderer::SensorError& start = *settings.sensor_start;
+    for (int k = 0; k < 3; ++k) {
+      const std::size_t r = first + static_cast<std::size_t>(k), t = r + 3;
+      x0[r] = std::clamp(start.rotation[k] * 1e3, lo[r], hi[r]);
+      x0[t] = std::clamp(start.translation[k] * 1e3, lo[t], hi[t]);
+    }
+    sim::logger()->debug("refit sensor: start from the rigid surfaces' pose {}", fmt::join(x0, ", "));
+  }
 
   std::vector<sim::ClothMesh> meshes;
   if (!sim)

@@ -234,6 +234,13 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
     *made = std::move(*m);
   }
   DiagnosisResult r;
+  // 0. The camera from the rigid surfaces (no simulation): the sensor candidate's start.
+  if (auto pose = estimate_rigid_pose(capture, RigidSurfaces::for_specimen(capture.specimen))) {
+    r.rigid_pose = *pose;
+  } else {
+    r.rigid_pose_error = pose.error().message;
+    sim::logger()->warn("{}: the sensor candidate starts from the recorded camera", r.rigid_pose_error);
+  }
 
   // 1. Baseline fit in the reduced space, from the drape-coefficient guess (or the given start, or the capture's
   // measured bending).
@@ -406,6 +413,7 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
       attribution_settings.bending_scale_upper = hi[0] - r.fitted_reduced[0];
       attribution_settings.bending_scale_known = true;
     }
+    if (r.rigid_pose) attribution_settings.sensor_start = r.rigid_pose->pose;
     r.refit_scale_lower = attribution_settings.bending_scale_lower;
     r.refit_scale_upper = attribution_settings.bending_scale_upper;
     auto attribution = attribute(model, fitted, r.fit, r.validated, r.floors, attribution_settings, make_model,
@@ -480,6 +488,19 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                            {"multistability_all_mm", millimetres(r.floors.multistability.all)},
                            {"multistability_held_out_mm", millimetres(r.floors.multistability.held_out)}};
   j["floors"] = floors;
+  if (r.rigid_pose) {
+    const RigidPose& p = *r.rigid_pose;
+    j["rigid_surfaces"] = {{"rotation_mrad", {p.pose.rotation.x() * 1e3, p.pose.rotation.y() * 1e3,
+                                              p.pose.rotation.z() * 1e3}},
+                           {"translation_mm", {p.pose.translation.x() * 1e3, p.pose.translation.y() * 1e3,
+                                               p.pose.translation.z() * 1e3}},
+                           {"rms_recorded_mm", p.rms_recorded * 1e3},
+                           {"rms_estimated_mm", p.rms_estimated * 1e3},
+                           {"top_pixels", p.top_pixels},
+                           {"side_pixels", p.side_pixels}};
+  } else {
+    j["rigid_surfaces"] = {{"error", r.rigid_pose_error}};
+  }
   j["baseline"] = {{"initial_guess", bending_json(r.initial_guess)},
                    {"initial_guess_from", r.initial_guess_from},
                    {"search_within_factor", r.search_within_factor > 1.0 ? nlohmann::json(r.search_within_factor)

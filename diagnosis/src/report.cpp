@@ -167,6 +167,19 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
                                            : "",
                     gap.stable * 1e3,
                     r.floors.stable * 1e3, gap.shape, r.floors.shape);
+  if (r.rigid_pose) {
+    const RigidPose& p = *r.rigid_pose;
+    md += fmt::format("Camera from the rigid surfaces (the cloth on the platform top, the bare side below the specimen's "
+                      "reach; {} and {} pixels): rotation ({:.1f}, {:.1f}, {:.1f}) mrad, translation ({:.1f}, {:.1f}, "
+                      "{:.1f}) mm in the camera frame; the pixels' RMS distance to the surfaces {:.2f} mm at the "
+                      "recorded camera, {:.2f} mm at this one. The sensor candidate starts from it.\n\n",
+                      p.top_pixels, p.side_pixels, p.pose.rotation.x() * 1e3, p.pose.rotation.y() * 1e3,
+                      p.pose.rotation.z() * 1e3, p.pose.translation.x() * 1e3, p.pose.translation.y() * 1e3,
+                      p.pose.translation.z() * 1e3, p.rms_recorded * 1e3, p.rms_estimated * 1e3);
+  } else {
+    md += fmt::format("Camera from the rigid surfaces: not estimated ({}); the sensor candidate starts from the recorded "
+                      "camera.\n\n", r.rigid_pose_error);
+  }
   md += fmt::format("Fitted baseline: alpha = {:.0f}, {:.0f}, {:.0f} g mm^2/s^2; beta = {:.0f}, {:.0f}, {:.0f} g mm^3/s^2 "
                     "({} simplex evaluations from the {}{}{}).\n\n",
                     r.fitted.alpha.warp, r.fitted.alpha.bias, r.fitted.alpha.weft, r.fitted.beta.warp,

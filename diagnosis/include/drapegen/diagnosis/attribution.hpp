@@ -29,6 +29,7 @@
 #include "drapegen/diagnosis/floors.hpp"
 #include "drapegen/diagnosis/forward_model.hpp"
 #include "drapegen/diagnosis/nelder_mead.hpp"
+#include "drapegen/renderer/sensor_error.hpp"
 
 namespace drapegen::diagnosis {
 
@@ -161,6 +162,10 @@ struct AttributionSettings {
   double bending_scale_upper = 1.5;
   /// The bounds are a known bending's: no refit leaves them, the yield trade (yield_trade_levels) included.
   bool bending_scale_known = false;
+  /// The sensor candidate's start: the camera pose read off the rigid surfaces (rigid_pose.hpp; diagnose() sets it),
+  /// else none. The candidate only re-renders the baseline's drapes, so a start far from a large pose error was
+  /// never reached (docs/DIAGNOSIS.md, "Session 28").
+  std::optional<renderer::SensorError> sensor_start;
   std::uint64_t validation_seed = 2000;
   int jobs = 1;                     // candidate refits in parallel (one forward model per thread)
   std::vector<Effect> candidates{std::begin(kAllEffects), std::end(kAllEffects)};

@@ -11,6 +11,7 @@
 #include "drapegen/diagnosis/floors.hpp"
 #include "drapegen/diagnosis/fold_repeatability.hpp"
 #include "drapegen/diagnosis/localisation.hpp"
+#include "drapegen/diagnosis/rigid_pose.hpp"
 #include "drapegen/diagnosis/validation_spread.hpp"
 
 namespace drapegen::diagnosis {
@@ -100,6 +101,10 @@ struct DiagnosisResult {
   /// Whether the capture's placements fold alike, against the fitted model's drapes from the validation states
   /// (reported; not in the gate).
   FoldRepeatability fold_repeatability;
+  /// The camera's pose error read off the platform top and bare side before the fit (the sensor candidate's start),
+  /// or why it could not be (rigid_pose_error).
+  std::optional<RigidPose> rigid_pose;
+  std::string rigid_pose_error;
   Floors floors;
   double gap_all = 0.0, gap_fit = 0.0, gap_held_out = 0.0;
   bool within_floors = false;

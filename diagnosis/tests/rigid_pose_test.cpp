@@ -1,0 +1,120 @@
+// The camera's pose error read off the tester's rigid surfaces (rigid_pose.hpp), on captures of the reality generator
+// whose truth says what the camera's error was.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <unistd.h>
+
+#include "drapegen/diagnosis/capture.hpp"
+#include "drapegen/diagnosis/reality.hpp"
+#include "drapegen/diagnosis/rigid_pose.hpp"
+
+namespace drapegen::diagnosis {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Generated {
+  Capture capture;
+  renderer::SensorError truth;
+};
+
+Generated generate(const std::string& name, const std::vector<std::string>& effects, std::uint64_t seed) {
+  const fs::path dir = fs::temp_directory_path() / ("drapegen_rigid_pose_test_" + std::to_string(::getpid())) / name;
+  fs::remove_all(dir);
+  RealitySpec spec;
+  spec.bending.alpha = {13923, 11455, 8821};
+  spec.bending.beta = {-35390, -29660, -22042};
+  spec.resolution = 14;
+  spec.seed = seed;
+  for (const auto& e : effects) spec.effects.push_back(*parse_reality_effect(e));
+  auto made = generate_reality(spec, dir.string());
+  EXPECT_TRUE(made.has_value()) << (made ? "" : made.error().message);
+  Generated g;
+  if (!made) return g;
+  auto capture = read_capture(dir.string());
+  EXPECT_TRUE(capture.has_value()) << (capture ? "" : capture.error().message);
+  if (capture) g.capture = std::move(capture).value();
+  std::ifstream in(made->truth_path);
+  const auto truth = nlohmann::json::parse(in)["sensor"];
+  for (int k = 0; k < 3; ++k) {
+    g.truth.rotation[k] = truth["rotation_rad"][k].get<double>();
+    g.truth.translation[k] = truth["translation_m"][k].get<double>();
+  }
+  return g;
+}
+
+/// Where a pixel at the capture's image centre row lands: the recorded camera's error as a displacement at the
+/// platform (what the fit would have to absorb), for a pose and another.
+double displacement_at_platform(const Capture& c, const renderer::SensorError& a, const renderer::SensorError& b) {
+  const Eigen::Vector3d centre(0.0, 0.0, 0.0);
+  double worst = 0.0;
+  for (const auto& view : c.views) {
+    const Eigen::Vector3d pa = a.true_camera(view.camera).world_to_camera * centre;
+    const Eigen::Vector3d pb = b.true_camera(view.camera).world_to_camera * centre;
+    worst = std::max(worst, (pa - pb).norm());
+  }
+  return worst;
+}
+
+TEST(RigidPose, RecoversTheCameraPoseErrorOfACapture) {
+  const Generated g = generate("pose", {"pose=1.5"}, 19015);
+  ASSERT_EQ(g.capture.views.size(), 4u);
+  ASSERT_GT(g.truth.rotation.norm(), 0.015);  // a pose error of 1.5 degrees: ~26 mrad
+  auto estimate = estimate_rigid_pose(g.capture, RigidSurfaces::for_specimen(g.capture.specimen));
+  ASSERT_TRUE(estimate.has_value()) << estimate.error().message;
+  // The platform's centre seen through the estimated camera error lands within 3 mm of where the true error puts it;
+  // the recorded camera puts it 15 mm or more away.
+  const renderer::SensorError none;
+  EXPECT_GT(displacement_at_platform(g.capture, g.truth, none), 0.015);
+  EXPECT_LT(displacement_at_platform(g.capture, g.truth, estimate->pose), 0.003);
+  // The rigid pixels lie on the surfaces, to the depth noise, once the camera is where the estimate says.
+  EXPECT_LT(estimate->rms_estimated, 0.0016);
+  EXPECT_GT(estimate->rms_recorded, estimate->rms_estimated + 3e-4);
+  EXPECT_GT(estimate->top_pixels, 500);
+  EXPECT_GT(estimate->side_pixels, 500);
+}
+
+TEST(RigidPose, FindsNoErrorInACalibratedCamera) {
+  // The skirt lies against the platform's side near the top (1 mm out): side pixels are read only below where the
+  // specimen can reach, else the estimate tilts the camera by ~15 mrad to put the skirt on the side.
+  const Generated g = generate("control", {}, 19020);
+  ASSERT_EQ(g.capture.views.size(), 4u);
+  EXPECT_EQ(g.truth.rotation.norm(), 0.0);
+  auto estimate = estimate_rigid_pose(g.capture, RigidSurfaces::for_specimen(g.capture.specimen));
+  ASSERT_TRUE(estimate.has_value()) << estimate.error().message;
+  EXPECT_LT(estimate->pose.rotation.norm(), 0.004);
+  EXPECT_LT(displacement_at_platform(g.capture, g.truth, estimate->pose), 0.002);
+  EXPECT_NEAR(estimate->rms_recorded, estimate->rms_estimated, 1e-4);
+  RigidSurfaces near_the_top = RigidSurfaces::for_specimen(g.capture.specimen);
+  near_the_top.side_below = 0.03;
+  auto tilted = estimate_rigid_pose(g.capture, near_the_top);
+  ASSERT_TRUE(tilted.has_value()) << tilted.error().message;
+  EXPECT_GT(tilted->pose.rotation.norm(), 0.008);
+}
+
+TEST(RigidPose, SaysWhyWithoutTheRigidSurfaces) {
+  const Generated g = generate("narrow", {}, 19020);
+  ASSERT_EQ(g.capture.views.size(), 4u);
+  RigidSurfaces surfaces = RigidSurfaces::for_specimen(g.capture.specimen);
+  surfaces.cylinder_radius = 0.2;  // a platform the views do not see
+  auto estimate = estimate_rigid_pose(g.capture, surfaces);
+  ASSERT_FALSE(estimate.has_value());
+  EXPECT_NE(estimate.error().message.find("pixels on the platform top"), std::string::npos) << estimate.error().message;
+}
+
+TEST(RigidPose, SidePixelsStartBelowWhereTheSpecimenReaches) {
+  SpecimenFacts facts;
+  facts.size_x = facts.size_y = 0.3;
+  facts.cylinder_diameter = 0.1;
+  const RigidSurfaces s = RigidSurfaces::for_specimen(facts);
+  EXPECT_DOUBLE_EQ(s.cylinder_radius, 0.05);
+  EXPECT_NEAR(s.side_below, 0.15 * std::sqrt(2.0) - 0.05 + 0.01, 1e-12);
+}
+
+}  // namespace
+}  // namespace drapegen::diagnosis
