@@ -104,7 +104,8 @@ string(JSON ncand LENGTH "${out}" attribution candidates)
 if(NOT ncand EQUAL 6)
   message(FATAL_ERROR "expected 6 candidates, got ${ncand}")
 endif()
-# The region follows the feature that leads (localisation.hpp, place_gap): none -> global; the stable term ->
+# The region follows the feature that leads (localisation.hpp, place_gap): a camera the rigid surfaces put 3 mm or more
+# from its calibration at the platform -> global; none -> global; the stable term ->
 # stable_region (the bare cylinder if the platform top is within its floor; global if the top is seen below the cloth
 # or lifted from 2.25 times the stable floor; else the top); the centre offset -> hem; other features -> skirt or hem.
 string(JSON led_type TYPE "${out}" localisation dominant_feature)
@@ -124,7 +125,13 @@ if(led_type STREQUAL "NULL")
   set(expected global)
 else()
   string(JSON led GET "${out}" localisation dominant_feature)
-  if(led MATCHES "^stable$")
+  string(JSON moved GET "${out}" localisation camera_moved_mm)
+  if(led MATCHES "^camera$")
+    if(moved LESS 3)
+      message(FATAL_ERROR "the camera led the region, moved only ${moved} mm at the platform")
+    endif()
+    set(expected global)
+  elseif(led MATCHES "^stable$")
     if(top_floor_ratio LESS_EQUAL 1.0)
       set(expected cylinder)
     elseif(top_mean GREATER 0.0 OR stable_ratio GREATER_EQUAL 2.25)
@@ -536,6 +543,13 @@ if(t_z LESS 5 OR NOT rms_estimated LESS rms_recorded)
                       "more), RMS ${rms_recorded} -> ${rms_estimated} mm")
 endif()
 message(STATUS "rigid surfaces of a 12 mm depth bias: ${t_z} mm along the axis, RMS ${rms_recorded} -> ${rms_estimated} mm")
+# A camera that far off places the gap everywhere, whatever the features say.
+string(JSON moved GET "${out}" localisation camera_moved_mm)
+string(JSON region GET "${out}" localisation region)
+string(JSON led GET "${out}" localisation dominant_feature)
+if(moved LESS 3 OR NOT region STREQUAL "global" OR NOT led STREQUAL "camera")
+  message(FATAL_ERROR "a 12 mm depth bias: the camera moved ${moved} mm at the platform, region ${region} led by ${led}")
+endif()
 # --sensor-evaluations: the sensor refit's budget.
 foreach(i RANGE ${last})
   string(JSON effect GET "${out}" attribution candidates ${i} effect)

@@ -387,6 +387,7 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
 
   // 3. Where the gap sits.
   r.localisation = localise(model, gap);
+  if (r.rigid_pose) r.localisation.camera_moved = platform_displacement(r.rigid_pose->pose, capture);
   r.fit_target = model.target().shape;
   localise_against_floors(r.localisation, r.floors.region_floor());
   localise_features(r.localisation, gap, model.target(), r.floors.group_floor(), r.floors.stable_floor());
@@ -553,6 +554,7 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                                                                        : nlohmann::json(L.dominant_feature)},
                        {"feature_groups", groups},
                        {"stable_ratio", L.stable_ratio},
+                       {"camera_moved_mm", L.camera_moved * 1e3},
                        {"pixel_region", region_name(L.pixel_region)},
                        {"floor_region", region_name(L.floor_region)},
                        {"regions", regions},

@@ -76,6 +76,11 @@ Region stable_region(const Localisation& L) {
 }
 
 void place_gap(Localisation& L) {
+  if (L.camera_moved >= kCameraMovedAtPlatform) {  // the rigid surfaces show the camera elsewhere than recorded
+    L.dominant_feature = "camera";
+    L.dominant = Region::kGlobal;
+    return;
+  }
   double best = 1.0;
   std::size_t group = L.group_ratio.size();
   for (std::size_t k = 0; k < L.group_ratio.size() && k < std::size(kFeatureGroups); ++k) {

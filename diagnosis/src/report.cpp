@@ -67,6 +67,10 @@ namespace {
 std::string leading_feature_text(const Localisation& L) {
   const std::string& led = L.dominant_feature;
   if (led.empty()) return "nothing exceeds its floor";
+  if (led == "camera") {
+    return fmt::format("the rigid surfaces put the camera {:.1f} mm from its calibration at the platform: a camera error",
+                       L.camera_moved * 1e3);
+  }
   if (led == "stable") {
     const RegionShare* top = region_share(L, Region::kTop);
     const double top_mean = top ? top->mean : 0.0;

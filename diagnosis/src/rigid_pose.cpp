@@ -1,5 +1,6 @@
 #include "drapegen/diagnosis/rigid_pose.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <Eigen/Cholesky>
@@ -57,6 +58,15 @@ RigidSurfaces RigidSurfaces::for_specimen(const SpecimenFacts& specimen) {
   s.cylinder_radius = 0.5 * specimen.cylinder_diameter;
   s.side_below = 0.5 * std::hypot(specimen.size_x, specimen.size_y) - s.cylinder_radius + 0.01;
   return s;
+}
+
+double platform_displacement(const renderer::SensorError& pose, const Capture& capture) {
+  double largest = 0.0;
+  for (const auto& view : capture.views) {
+    const Eigen::Vector3d recorded = view.camera.world_to_camera.translation();  // the centre, in the camera's frame
+    largest = std::max(largest, (pose.true_camera(view.camera).world_to_camera.translation() - recorded).norm());
+  }
+  return largest;
 }
 
 sim::Expected<RigidPose> estimate_rigid_pose(const Capture& capture, const RigidSurfaces& surfaces,

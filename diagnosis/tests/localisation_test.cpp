@@ -217,3 +217,17 @@ TEST(PlaceGap, GlobalWithNoFeatureNamedWhenNothingExceedsItsFloor) {
   EXPECT_EQ(L.dominant, Region::kGlobal);
   EXPECT_TRUE(L.dominant_feature.empty());
 }
+
+TEST(PlaceGap, ACameraTheRigidSurfacesMoveFromItsCalibrationPlacesTheGapEverywhere) {
+  // An outline group well above its floor would place it on the skirt; a camera 3 mm off at the platform overrides.
+  Localisation L = excess(FeatureGroup::kSkirtHeight, 4.0, 0.9, 1.6, 1.2);
+  L.camera_moved = kCameraMovedAtPlatform;
+  place_gap(L);
+  EXPECT_EQ(L.dominant, Region::kGlobal);
+  EXPECT_EQ(L.dominant_feature, "camera");
+  // Below it (a friction specimen's cloth lifts the top: up to 2.2 mm on seeds 17-20), the features place it.
+  L.camera_moved = 0.0022;
+  place_gap(L);
+  EXPECT_EQ(L.dominant, Region::kSkirt);
+  EXPECT_EQ(L.dominant_feature, "skirt_height");
+}

@@ -48,17 +48,28 @@ Generated generate(const std::string& name, const std::vector<std::string>& effe
   return g;
 }
 
-/// Where a pixel at the capture's image centre row lands: the recorded camera's error as a displacement at the
-/// platform (what the fit would have to absorb), for a pose and another.
-double displacement_at_platform(const Capture& c, const renderer::SensorError& a, const renderer::SensorError& b) {
-  const Eigen::Vector3d centre(0.0, 0.0, 0.0);
+/// m: how far apart two pose errors put the platform's centre (the largest over the views).
+double displacement_between(const renderer::SensorError& a, const renderer::SensorError& b, const Capture& c) {
   double worst = 0.0;
   for (const auto& view : c.views) {
-    const Eigen::Vector3d pa = a.true_camera(view.camera).world_to_camera * centre;
-    const Eigen::Vector3d pb = b.true_camera(view.camera).world_to_camera * centre;
-    worst = std::max(worst, (pa - pb).norm());
+    worst = std::max(worst, (a.true_camera(view.camera).world_to_camera.translation() -
+                             b.true_camera(view.camera).world_to_camera.translation()).norm());
   }
   return worst;
+}
+
+TEST(RigidPose, PlatformDisplacementIsHowFarTheErrorMovesThePlatformCentreInTheCamerasFrame) {
+  const Generated g = generate("displacement", {}, 19020);
+  ASSERT_EQ(g.capture.views.size(), 4u);
+  renderer::SensorError shift;
+  shift.translation = Eigen::Vector3d(0.003, 0.004, 0.0);
+  EXPECT_NEAR(platform_displacement(shift, g.capture), 0.005, 1e-12);
+  // A turn by theta about the camera's x axis moves the centre (at p in the camera's frame) by 2 sin(theta / 2) times
+  // its distance from that axis.
+  renderer::SensorError turn;
+  turn.rotation = Eigen::Vector3d(0.01, 0.0, 0.0);
+  const Eigen::Vector3d p = g.capture.views[0].camera.world_to_camera.translation();
+  EXPECT_NEAR(platform_displacement(turn, g.capture), 2.0 * std::sin(0.005) * std::hypot(p.y(), p.z()), 1e-9);
 }
 
 TEST(RigidPose, RecoversTheCameraPoseErrorOfACapture) {
@@ -69,9 +80,8 @@ TEST(RigidPose, RecoversTheCameraPoseErrorOfACapture) {
   ASSERT_TRUE(estimate.has_value()) << estimate.error().message;
   // The platform's centre seen through the estimated camera error lands within 3 mm of where the true error puts it;
   // the recorded camera puts it 15 mm or more away.
-  const renderer::SensorError none;
-  EXPECT_GT(displacement_at_platform(g.capture, g.truth, none), 0.015);
-  EXPECT_LT(displacement_at_platform(g.capture, g.truth, estimate->pose), 0.003);
+  EXPECT_GT(platform_displacement(g.truth, g.capture), 0.015);
+  EXPECT_LT(displacement_between(g.truth, estimate->pose, g.capture), 0.003);
   // The rigid pixels lie on the surfaces, to the depth noise, once the camera is where the estimate says.
   EXPECT_LT(estimate->rms_estimated, 0.0016);
   EXPECT_GT(estimate->rms_recorded, estimate->rms_estimated + 3e-4);
@@ -88,7 +98,7 @@ TEST(RigidPose, FindsNoErrorInACalibratedCamera) {
   auto estimate = estimate_rigid_pose(g.capture, RigidSurfaces::for_specimen(g.capture.specimen));
   ASSERT_TRUE(estimate.has_value()) << estimate.error().message;
   EXPECT_LT(estimate->pose.rotation.norm(), 0.004);
-  EXPECT_LT(displacement_at_platform(g.capture, g.truth, estimate->pose), 0.002);
+  EXPECT_LT(displacement_between(g.truth, estimate->pose, g.capture), 0.002);
   EXPECT_NEAR(estimate->rms_recorded, estimate->rms_estimated, 1e-4);
   RigidSurfaces near_the_top = RigidSurfaces::for_specimen(g.capture.specimen);
   near_the_top.side_below = 0.03;

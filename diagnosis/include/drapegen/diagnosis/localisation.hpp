@@ -46,8 +46,12 @@ struct Localisation {
   /// Where the gap sits (place_gap): from the shape-feature group or the stable term that exceeds its floor the most
   /// (dominant_feature), kGlobal if nothing exceeds its floor.
   Region dominant = Region::kGlobal;
-  /// That feature: a feature group's name, "stable" for the stable term, empty if nothing exceeds its floor.
+  /// That feature: a feature group's name, "stable" for the stable term, "camera" for the rigid surfaces' camera
+  /// (camera_moved), empty if nothing exceeds its floor.
   std::string dominant_feature;
+  /// m: how far the camera error read off the rigid surfaces moves the platform's centre (rigid_pose.hpp,
+  /// platform_displacement; diagnose sets it before localise_features), 0 if not estimated.
+  double camera_moved = 0.0;
   /// Per feature group (kFeatureGroups order) and for the stable term: the capture's difference from the fitted
   /// drape over the largest floor sample's (at least half the group's scale).
   std::vector<double> group_ratio;
@@ -90,6 +94,10 @@ void localise_against_floors(Localisation& localisation, const std::array<double
 /// (everywhere) rather than the specimen's contact with the platform (calibrated on seeds 4-13, docs/DIAGNOSIS.md
 /// "Session 25": a specimen lifted by friction reached 1.64, a camera pose error that lifts the top 3.15).
 inline constexpr double kLiftedTopSensorRatio = 2.25;
+/// m: the camera_moved from which place_gap calls the gap a camera error's (everywhere) whatever leads (session 28,
+/// seeds 17-20: pose and bias errors 4.6-24 mm; friction, whose cloth sits higher on the top, at most 2.2 mm;
+/// anything else at most 1.2 mm).
+inline constexpr double kCameraMovedAtPlatform = 0.003;
 /// Where the stable term's excess (platform top, bare cylinder) sits, from the rigid regions' residuals (their
 /// floor_ratio set): the bare cylinder (kCylinder) if the platform top is within its own floor; everywhere (kGlobal)
 /// if the top is seen further from the camera than the fitted cloth (mean residual > 0: cloth cannot lie below the
@@ -102,8 +110,9 @@ inline constexpr double kLiftedTopSensorRatio = 2.25;
 void localise_features(Localisation& localisation, const ScoredDrape& drape, const Target& capture,
                        const std::vector<double>& group_floor, double stable_floor);
 
-/// Sets dominant and dominant_feature from group_ratio, stable_ratio and the regions' enrichment, mean and floor
-/// ratio. The largest ratio above 1 leads, but the stable term leads whatever else exceeds its floor when it is above
+/// Sets dominant and dominant_feature from camera_moved, group_ratio, stable_ratio and the regions' enrichment, mean
+/// and floor ratio. A camera the rigid surfaces put kCameraMovedAtPlatform or farther from its calibration places
+/// it everywhere (kGlobal, "camera"). Else the largest ratio above 1 leads, but the stable term leads whatever else exceeds its floor when it is above
 /// its floor with stable_region kTop (a lifted platform top), when the top is above its own floor and seen farther than
 /// the fitted cloth, or when it is at least kLiftedTopSensorRatio times its floor (a camera's error; session 27). The
 /// stable term: stable_region. A skirt group: kSkirt. The

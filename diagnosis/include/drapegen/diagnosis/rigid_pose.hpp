@@ -53,6 +53,10 @@ struct RigidPose {
   int side_pixels = 0;
 };
 
+/// m: how far the pose error moves the platform's centre in the camera's frame (the largest over the views): what a
+/// fit would have to absorb, blind to a turn about the platform axis.
+[[nodiscard]] double platform_displacement(const renderer::SensorError& pose, const Capture& capture);
+
 /// The pose error of the capture's camera from its rigid pixels (every view: one camera, the table turning). Fails
 /// when too few pixels see either surface (e.g. a capture whose views miss the platform).
 [[nodiscard]] sim::Expected<RigidPose> estimate_rigid_pose(const Capture& capture, const RigidSurfaces& surfaces = {},
