@@ -153,7 +153,7 @@ sim::Expected<RigidPose> estimate_rigid_pose(const Capture& capture, const Rigid
     const double band = settings.first_band * std::pow(settings.last_band / settings.first_band, t);
     residuals(x, band, on);
     residuals_on(x, on, r0);
-    // Central differences: one parameter unit (1 mrad or 1 mm) is small against the surfaces' curvature.
+    // Central differences with steps of 0.01 mrad and 0.01 mm (the residuals are smooth in the pose).
     Eigen::Matrix<double, 6, 6> JtJ = Eigen::Matrix<double, 6, 6>::Zero();
     Pose Jtr = Pose::Zero();
     std::vector<Pose> J(points.size(), Pose::Zero());

@@ -5,8 +5,8 @@
 // a camera that sits elsewhere than its calibration says sees them moved. The estimate is the SensorError pose
 // (renderer/sensor_error.hpp: the camera really at delta * recorded) that brings the capture's rigid pixels back onto
 // the surfaces, by Levenberg-Marquardt over the pixels within a band of them that narrows as the pose improves.
-// Rotation about the platform axis leaves both surfaces unchanged: the damping keeps that component at zero (the
-// outline turn of every drape absorbs it). docs/DIAGNOSIS.md, "The camera from the rigid surfaces".
+// Rotation about the platform axis leaves both surfaces unchanged: the damping keeps the steps out of that
+// direction (the outline turn of every drape absorbs it). docs/DIAGNOSIS.md, "The camera from the rigid surfaces".
 
 #include <vector>
 
