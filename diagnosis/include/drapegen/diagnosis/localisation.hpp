@@ -112,13 +112,12 @@ void localise_features(Localisation& localisation, const ScoredDrape& drape, con
 
 /// Sets dominant and dominant_feature from camera_moved, group_ratio, stable_ratio and the regions' enrichment, mean
 /// and floor ratio. A camera the rigid surfaces put kCameraMovedAtPlatform or farther from its calibration places
-/// it everywhere (kGlobal, "camera"). Else the largest ratio above 1 leads, but the stable term leads whatever else exceeds its floor when it is above
-/// its floor with stable_region kTop (a lifted platform top), when the top is above its own floor and seen farther than
-/// the fitted cloth, or when it is at least kLiftedTopSensorRatio times its floor (a camera's error; session 27). The
-/// stable term: stable_region. A skirt group: kSkirt. The
-/// hem's centre offset: kHem. The other hem groups (harmonics, sorted radii, hem height): kSkirt if the skirt's pixel
-/// residual is denser than the hem's (the outline carries a change of the skirt above it), else kHem. Nothing above
-/// 1: kGlobal.
+/// it everywhere (kGlobal, "camera"). Else the largest ratio above 1 leads, but the stable term leads whatever else
+/// exceeds its floor when it is above its floor with stable_region kTop (a lifted platform top), when the top is above
+/// its own floor and seen farther than the fitted cloth, or when it is at least kLiftedTopSensorRatio times its floor
+/// (a camera's error; session 27). The stable term: stable_region. A skirt group: kSkirt. The hem's centre offset: kHem.
+/// The other hem groups (harmonics, sorted radii, hem height): kSkirt if the skirt's pixel residual is denser than the
+/// hem's (the outline carries a change of the skirt above it), else kHem. Nothing above 1: kGlobal.
 void place_gap(Localisation& localisation);
 
 }  // namespace drapegen::diagnosis
