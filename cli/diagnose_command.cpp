@@ -45,6 +45,7 @@ struct DiagnoseOptions {
   double shape_floor = -1.0;  // < 0: the settings' calibrated value
   bool gap_only = false;
   bool ablation = false;
+  bool sensor_bending = false;
   double held_out_tolerance = diagnosis::AttributionSettings{}.held_out_tolerance;
   bool verbose = false;
 };
@@ -116,6 +117,7 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (o.evaluations > 0) settings.baseline_optimiser.max_evaluations = o.evaluations;
   if (o.refit_evaluations > 0) settings.attribution.optimiser.max_evaluations = o.refit_evaluations;
   if (o.sensor_evaluations > 0) settings.attribution.sensor_evaluations = o.sensor_evaluations;
+  settings.attribution.sensor_bending = o.sensor_bending;
   if (o.refit_scan >= 0) settings.attribution.scan_levels = o.refit_scan;
   if (o.yield_trade >= 0) settings.attribution.yield_trade_levels = o.yield_trade;
   if (!candidates.empty()) settings.attribution.candidates = candidates;
@@ -225,6 +227,11 @@ Runner add_diagnose_command(CLI::App& app) {
   app.add_option("--sensor-evaluations", o->sensor_evaluations,
                  "Evaluations of the sensor candidate's refit, which re-renders the baseline's drapes (default 200, 100 "
                  "with --quick and --fine)");
+  app.add_flag("--sensor-bending", o->sensor_bending,
+               "The sensor candidate also refits the bending scale with a multipath gain under the camera it found, "
+               "by simulation (a grid of 3 scales x 2 gains, a simplex within --refit-evaluations, the best without "
+               "multipath), and keeps it if it beats both the re-rendering and that (off by default; "
+               "docs/DIAGNOSIS.md, \"Session 29\")");
   app.add_option("--refit-scan", o->refit_scan,
                  fmt::format("Refits of one-parameter effects (yield, shear, curl, friction) start with this many "
                              "strengths over the effect's range (bending as fitted), then refine from the best within "

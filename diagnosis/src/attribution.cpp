@@ -190,8 +190,8 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
   std::optional<std::pair<std::vector<double>, double>> known;
   // The refit's objective of a setup: its fit score, or the mean of it and the second capture's (where a yielding
   // setup is laid again from its best drape); `drape` receives its best drape on the capture.
-  auto objective_of = [&](const ModelSetup& setup, ScoredDrape& drape) -> sim::Expected<double> {
-    auto e = sim ? model.evaluate(setup) : model.rescore(meshes, setup);
+  auto objective_of = [&](const ModelSetup& setup, ScoredDrape& drape, bool simulate) -> sim::Expected<double> {
+    auto e = simulate ? model.evaluate(setup) : model.rescore(meshes, setup);
     if (!e) return e.error();
     double value = e->best.fit_score;
     if (second) {
@@ -207,7 +207,7 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
     if (error) return std::numeric_limits<double>::infinity();
     if (known && known->first == x) return known->second;
     ScoredDrape drape;
-    auto value = objective_of(setup_of(x), drape);
+    auto value = objective_of(setup_of(x), drape, sim);
     if (!value) {
       error = value.error();
       return std::numeric_limits<double>::infinity();
@@ -274,9 +274,79 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
   NelderMeadResult r = nelder_mead(f, x0, step, lo, hi, options);
   if (error) return *error;
   if (scanned > 0) r.evaluations += scanned - 1;
-  // The refitted setup from the validation states (the sensor candidate re-renders the baseline's drapes from them).
-  const ModelSetup refitted = setup_of(r.x);
-  if (sim::Status s = validate(model, second, held_out, refitted, sim ? nullptr : &baseline_validated, settings, c);
+  ModelSetup refitted = setup_of(r.x);
+  double ln_scale = sim ? r.x[0] : 0.0;
+  if (effect == Effect::kSensor && settings.sensor_bending) {
+    // The bending refitted under the camera the render-only refit found (AttributionSettings::sensor_bending).
+    const std::size_t gain = r.x.size() - 1;  // multipath_mm, effect_space's last
+    auto under_camera = [&](double s, double g) {
+      ModelSetup setup = scaled(s);
+      std::vector<double> camera = r.x;
+      camera[gain] = g;
+      apply_effect(Effect::kSensor, camera, setup);
+      return setup;
+    };
+    double stage_best = std::numeric_limits<double>::infinity();
+    ScoredDrape stage_drape;
+    auto g = [&](const std::vector<double>& y) -> double {
+      if (error) return std::numeric_limits<double>::infinity();
+      ScoredDrape drape;
+      auto value = objective_of(under_camera(y[0], y[1]), drape, true);
+      if (!value) {
+        error = value.error();
+        return std::numeric_limits<double>::infinity();
+      }
+      sim::logger()->debug("refit sensor, bending under its camera: scale x{:.2f}, multipath {:.1f} mm -> {:.3f} mm",
+                           std::exp(y[0]), y[1], *value * 1e3);
+      c.scan.push_back({y[1], std::exp(y[0]), *value});
+      if (*value < stage_best) stage_best = *value, stage_drape = std::move(drape);
+      return *value;
+    };
+    const double lower = std::min(0.0, settings.bending_scale_lower);
+    const double upper = std::max(0.0, settings.bending_scale_upper);
+    const double gain_hi = hi[first + gain];
+    std::vector<double> y_best;
+    for (double s : AttributionSettings::kSensorBendingScales) {
+      for (double m : AttributionSettings::kSensorBendingGains) {
+        std::vector<double> y{std::clamp(s, lower, upper), std::min(m, gain_hi)};
+        if (const double v = g(y); y_best.empty() || v <= stage_best) y_best = y;
+        if (error) return *error;
+      }
+    }
+    const int grid = static_cast<int>(c.scan.size());
+    NelderMeadOptions refine = settings.optimiser;
+    refine.max_evaluations = std::max(1, refine.max_evaluations - grid + 1);  // its first point is the grid's best
+    const std::vector<double> known_y = y_best;
+    const double known_value = stage_best;
+    auto g_known = [&](const std::vector<double>& y) { return y == known_y ? known_value : g(y); };
+    const std::vector<double> y_step{y_best[0] < 0.5 * (lower + upper) ? 0.25 : -0.25,
+                                     y_best[1] < 0.5 * gain_hi ? 5.0 : -5.0};
+    NelderMeadResult q = nelder_mead(g_known, y_best, y_step, {lower, 0.0}, {upper, gain_hi}, refine);
+    if (error) return *error;
+    const int simulated = static_cast<int>(c.scan.size());
+    // Its ablation: the same bending scale seen by the same camera without multipath.
+    ScoredDrape ablation_drape;
+    auto ablation = objective_of(under_camera(q.x[0], 0.0), ablation_drape, true);
+    if (!ablation) return ablation.error();
+    c.scan.push_back({0.0, std::exp(q.x[0]), *ablation});
+    r.evaluations += simulated + 1;
+    sim::logger()->debug("refit sensor, bending under its camera: x{:.2f}, {:.1f} mm -> {:.3f} mm (render-only "
+                         "{:.3f}, without multipath {:.3f})",
+                         std::exp(q.x[0]), q.x[1], stage_best * 1e3, best * 1e3, *ablation * 1e3);
+    if (stage_best < best && stage_best < *ablation) {
+      best = stage_best;
+      c.drape = std::move(stage_drape);
+      r.x[gain] = q.x[1];
+      ln_scale = q.x[0];
+      refitted = under_camera(q.x[0], q.x[1]);
+      c.bending_under_sensor = true;
+    }
+  }
+  // The refitted setup from the validation states (the sensor candidate re-renders the baseline's drapes from them,
+  // unless it refitted the bending under its camera).
+  const bool rerendered = !sim && !c.bending_under_sensor;
+  if (sim::Status s = validate(model, second, held_out, refitted, rerendered ? &baseline_validated : nullptr, settings,
+                               c);
       !s) {
     return s.error();
   }
@@ -286,13 +356,13 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
     off.effect = c.effect;
     off.alpha_scale = std::exp(r.x[0]);
     const ModelSetup switched_off = scaled(r.x[0]);
-    auto objective = objective_of(switched_off, off.drape);  // where the bar would rank it
+    auto objective = objective_of(switched_off, off.drape, true);  // where the bar would rank it
     if (!objective) return objective.error();
     off.objective = *objective;
     if (sim::Status s = validate(model, second, held_out, switched_off, nullptr, settings, off); !s) return s.error();
     c.ablated = std::make_shared<const CandidateResult>(std::move(off));
   }
-  c.alpha_scale = sim ? std::exp(r.x[0]) : 1.0;
+  c.alpha_scale = std::exp(ln_scale);
   c.parameters.assign(r.x.begin() + static_cast<std::ptrdiff_t>(first), r.x.end());
   c.evaluations = r.evaluations;
   c.objective = best;

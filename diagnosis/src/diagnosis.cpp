@@ -592,6 +592,7 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                           {"fold_repeatability",
                            {{"placement_pairs", c.placement_folds}, {"drape_pairs", c.drape_folds}}},
                           {"scan", scan},
+                          {"bending_under_sensor", c.bending_under_sensor},
                           {"seconds", c.seconds}});
   }
   j["attribution"] = {{"ran", ran},

@@ -64,8 +64,13 @@ struct CandidateResult {
   struct ScanLevel {
     double parameter = 0.0, alpha_scale = 1.0, objective = 0.0;
   };
-  /// The scan that preceded the simplex, if one ran (AttributionSettings::scan_levels, yield_trade_levels).
+  /// The scan that preceded the simplex, if one ran (AttributionSettings::scan_levels, yield_trade_levels); for the
+  /// sensor candidate with AttributionSettings::sensor_bending, every simulation of its bending refit (parameter: the
+  /// multipath gain, mm): the grid, the simplex, then the best's ablation (gain 0).
   std::vector<ScanLevel> scan;
+  /// The sensor candidate refitted the bending with its camera and kept it (AttributionSettings::sensor_bending): its
+  /// drapes are simulated, not the baseline's re-rendered.
+  bool bending_under_sensor = false;
   double seconds = 0.0;
   ScoredDrape drape;      // the refit's best drape (fit states)
   ScoredDrape validated;  // the refitted setup's best drape from the validation states: shrinkage, confirmation
@@ -166,6 +171,17 @@ struct AttributionSettings {
   /// else none. The candidate only re-renders the baseline's drapes, so a start far from a large pose error was
   /// never reached (docs/DIAGNOSIS.md, "Session 28").
   std::optional<renderer::SensorError> sensor_start;
+  /// The sensor candidate also refits the bending under the camera it found, with a multipath gain, by simulation:
+  /// a multipath error deepens the folds' valleys as seen, the baseline fit takes that for a softer fabric, and
+  /// re-rendering its drapes with the true gain scores worse than without (docs/DIAGNOSIS.md, "Session 28"). After the
+  /// render-only refit, the bending scale and the gain are scored on a grid (kSensorBendingScales x
+  /// kSensorBendingGains, the rest of the camera as refitted), refined by a simplex from the best within
+  /// optimiser.max_evaluations simulations, and the best is scored once more without multipath (its ablation). The
+  /// candidate keeps it, and is then validated by simulation, only if it beats both the render-only refit and its
+  /// ablation. Off by default.
+  bool sensor_bending = false;
+  static constexpr double kSensorBendingScales[] = {0.5, 1.0, 1.5};  // ln of the bending scale (clamped to the bounds)
+  static constexpr double kSensorBendingGains[] = {15.0, 30.0};      // multipath gain, mm
   std::uint64_t validation_seed = 2000;
   int jobs = 1;                     // candidate refits in parallel (one forward model per thread)
   std::vector<Effect> candidates{std::begin(kAllEffects), std::end(kAllEffects)};
