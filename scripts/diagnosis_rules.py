@@ -39,7 +39,12 @@ the main rule):
 - reach_objective: the reference the bending-only setup of the smallest refit objective among the bar and the
   ablations (chosen as the bar's own search would choose).
 
+One more lists where session 29's common bending would be validated (it needs a simulation, so no verdict here):
+- `--common DIR...`: per capture, the confirmed candidates that each bring the gate's excess to 0 (`common` when
+  three or more, AttributionSettings::common_bending_effects), the verdict as run and whether it is right.
+
     scripts/diagnosis_rules.py out/s18all [more runs ...]
+    scripts/diagnosis_rules.py --common out/s28s19all out/s28s20      # where the common bending fires
     scripts/diagnosis_rules.py --matrix without_ablation out/s21all     # one rule's confusion matrix
     scripts/diagnosis_rules.py --tolerance 0.05 out/s23all               # the tolerance rule at 5%
 """
@@ -204,8 +209,36 @@ def verdicts(j):
 COLUMNS = ["none", "unexplained", "not attributed", "yield", "shear", "curl", "friction", "misalignment", "sensor"]
 
 
+def common(roots):
+    """Where three or more confirmed candidates each bring the excess to 0 (session 29's common bending)."""
+    fired = right = 0
+    for root in roots:
+        for f in sorted(glob.glob(os.path.join(root, "diagnoses", "*.json"))):
+            name = os.path.basename(f)[:-5]
+            with open(f) as fh:
+                j = json.load(fh)
+            with open(os.path.join(root, "truth", name + ".json")) as fh:
+                truth = json.load(fh)
+            family = FAMILY.get(truth["family"], truth["family"]) or "none"
+            a = j.get("attribution") or {}
+            if not a.get("ran"):
+                continue
+            within = [c for c in a["candidates"]
+                      if c["confirmed"] and c["validated"]["excess_above_floors"] == 0.0]
+            verdict = j["verdict"]
+            fires = len(within) >= 3 and not j.get("within_floors_after_bending_refit", False)
+            fired += fires
+            right += fires and verdict == family
+            print(f"{root:14s} {name:16s} {family:12s} {verdict:13s} {'right' if verdict == family else 'wrong':5s} "
+                  f"{'common' if fires else '      '} " +
+                  " ".join(f"{c['effect']}@x{c['alpha_scale']:.2f}" for c in within))
+    print(f"common bending fires on {fired} captures, {right} of them named right as run")
+
+
 def main(roots):
     global TOLERANCE
+    if roots[:1] == ["--common"]:
+        return common(roots[1:])
     if roots[:1] == ["--tolerance"]:
         if len(roots) < 3:
             sys.exit("--tolerance T DIR...")

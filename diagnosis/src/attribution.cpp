@@ -71,6 +71,16 @@ sim::Expected<Evaluation> on_next_placement(ForwardModel& next, const ModelSetup
   return next.rescore(meshes, setup);
 }
 
+/// `setup` with its bending's alpha and beta times exp(ln_scale).
+ModelSetup scaled_bending(ModelSetup setup, double ln_scale) {
+  const double scale = std::exp(ln_scale);
+  auto& a = setup.bending.alpha;
+  auto& b = setup.bending.beta;
+  a = {a.warp * scale, a.bias * scale, a.weft * scale};
+  b = {b.warp * scale, b.bias * scale, b.weft * scale};
+  return setup;
+}
+
 /// The largest rest angle of a setup's plastic set (unset for a setup that does not yield).
 std::optional<double> largest_set(const ModelSetup& setup) {
   if (!setup.effects.bending_yield_curvature) return std::nullopt;
@@ -172,15 +182,7 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
     for (const auto& s : fit.states) meshes.push_back(s.mesh);
   std::optional<sim::Error> error;
   double best = std::numeric_limits<double>::infinity();
-  auto scaled = [&](double ln_scale) {  // the baseline with alpha and beta times exp(ln_scale)
-    ModelSetup setup = baseline;
-    const double scale = std::exp(ln_scale);
-    auto& a = setup.bending.alpha;
-    auto& b = setup.bending.beta;
-    a = {a.warp * scale, a.bias * scale, a.weft * scale};
-    b = {b.warp * scale, b.bias * scale, b.weft * scale};
-    return setup;
-  };
+  auto scaled = [&](double ln_scale) { return scaled_bending(baseline, ln_scale); };
   auto setup_of = [&](const std::vector<double>& x) {
     ModelSetup setup = sim ? scaled(x[0]) : baseline;
     if (!bar) apply_effect(*effect, std::vector<double>(x.begin() + static_cast<std::ptrdiff_t>(first), x.end()), setup);
@@ -383,6 +385,23 @@ double confirmation_score(const ScoredDrape& drape, const ScoredDrape* held_out_
   return held_out_capture ? held_out_capture->all_score : drape.held_out_score;
 }
 
+std::optional<CommonBending> common_bending(const std::vector<CandidateResult>& candidates, const Floors& floors,
+                                            int at_least) {
+  CommonBending shared;
+  std::vector<double> ln_scales;
+  for (const auto& c : candidates) {
+    if (c.confirmed && c.validated_excess(floors) == 0.0) {
+      shared.effects.push_back(c.effect);
+      ln_scales.push_back(std::log(c.alpha_scale));
+    }
+  }
+  if (at_least <= 0 || static_cast<int>(ln_scales.size()) < at_least) return std::nullopt;
+  std::sort(ln_scales.begin(), ln_scales.end());
+  const std::size_t n = ln_scales.size();
+  shared.ln_scale = 0.5 * (ln_scales[(n - 1) / 2] + ln_scales[n / 2]);
+  return shared;
+}
+
 bool curl_first(std::vector<CandidateResult>& ranked, double significant) {
   const auto curl = std::find_if(ranked.begin(), ranked.end(), [&](const CandidateResult& c) {
     return c.effect == Effect::kCurl && c.confirmed && c.shrinkage >= significant;
@@ -532,8 +551,26 @@ sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& base
   a.curl_promoted = others.fold_unlike_model && curl_first(a.candidates, settings.significant_shrinkage);
   if (a.curl_promoted)
     sim::logger()->info("attribution: the placements fold less alike than the fitted model's drapes; curl first");
+  if (const auto shared = common_bending(a.candidates, floors, settings.common_bending_effects);
+      shared && !a.bar_within_floors) {
+    // Unlike effects each within the floors: the bending scale they share, validated as the bar is.
+    CandidateResult common;
+    common.alpha_scale = std::exp(shared->ln_scale);
+    if (sim::Status s = validate(model, others.second.model, others.held_out.model,
+                                 scaled_bending(baseline, shared->ln_scale), nullptr, settings, common);
+        !s) {
+      return s.error();
+    }
+    const double common_excess = common.validated_excess(floors);
+    common.shrinkage = gap_shrinkage(baseline_excess, common_excess);
+    a.common_within_floors = common_excess == 0.0;
+    a.common_effects = shared->effects;
+    sim::logger()->info("attribution: {} effects within the floors; the bending alone at x{:.2f} {}",
+                        shared->effects.size(), common.alpha_scale, a.common_within_floors ? "is as well" : "is not");
+    a.common_bending = std::move(common);
+  }
   if (!a.candidates.empty()) {
-    a.named = !a.bar_within_floors && a.candidates[0].confirmed &&
+    a.named = !a.bending_within_floors() && a.candidates[0].confirmed &&
               a.candidates[0].shrinkage >= settings.significant_shrinkage;
     a.confidence = 1.0;
     if (a.candidates.size() > 1) {

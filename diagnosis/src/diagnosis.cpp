@@ -166,6 +166,19 @@ nlohmann::json ablated_json(const CandidateResult& c, const Floors& floors) {
   return j;
 }
 
+/// The common bending of unlike effects each within the floors (null where fewer did): their effects, the median
+/// scale and its validation.
+nlohmann::json common_bending_json(const Attribution& a, const Floors& floors) {
+  if (!a.common_bending) return nullptr;
+  nlohmann::json effects = nlohmann::json::array();
+  for (Effect e : a.common_effects) effects.push_back(effect_name(e));
+  return {{"effects", effects},
+          {"alpha_scale", a.common_bending->alpha_scale},
+          {"validated", validated_json(*a.common_bending, floors)},
+          {"shrinkage", a.common_bending->shrinkage},
+          {"within_floors", a.common_within_floors}};
+}
+
 }  // namespace
 
 DiagnosisSettings DiagnosisSettings::quick() {
@@ -422,7 +435,7 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
     if (!attribution) return attribution.error();
     r.attribution = std::move(*attribution);
     const auto& c = r.attribution.candidates;
-    if (r.attribution.bar_within_floors) {
+    if (r.attribution.bending_within_floors()) {
       r.verdict = "none";  // within the floors once the bending is refitted: the gap was the baseline fit's
     } else {
       r.verdict = r.attribution.named ? std::string(effect_name(c[0].effect)) : "unexplained";
@@ -445,7 +458,7 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
   j["runner_up"] = r.runner_up;
   j["confidence"] = r.attribution.confidence;
   j["within_floors"] = r.within_floors;
-  j["within_floors_after_bending_refit"] = r.attribution.bar_within_floors;
+  j["within_floors_after_bending_refit"] = r.attribution.bending_within_floors();
   j["gap_mm"] = {{"all_views", r.gap_all * 1e3}, {"fit_views", r.gap_fit * 1e3}, {"held_out_view", r.gap_held_out * 1e3}};
   nlohmann::json states = nlohmann::json::array();
   for (const auto& d : r.validated.states) {
@@ -615,6 +628,7 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                         {"objective_mm", r.attribution.bar.objective * 1e3},
                         {"validated", ran ? validated_json(r.attribution.bar, r.floors) : nlohmann::json(nullptr)},
                         {"shrinkage", r.attribution.bar.shrinkage}}},
+                      {"common_bending", common_bending_json(r.attribution, r.floors)},
                       {"named", r.attribution.named},
                       {"confidence", r.attribution.confidence},
                       {"candidates", candidates}};

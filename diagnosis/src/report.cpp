@@ -141,6 +141,13 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
     md += "**Verdict: within the floors once the bending is refitted** (the baseline fit had stopped short of the "
           "fabric's bending; the refit of the bending alone is within sensor noise and multiple stable drapes); no "
           "effect is named.\n\n";
+  } else if (r.verdict == "none" && r.attribution.common_within_floors) {
+    std::string effects;
+    for (Effect e : r.attribution.common_effects) effects += std::string(effects.empty() ? "" : ", ") += effect_name(e);
+    md += fmt::format("**Verdict: within the floors once the bending is refitted** ({} unlike effects each brought the "
+                      "gap within the floors: {}; what they share, the baseline's bending at x{:.2f}, does as well); "
+                      "no effect is named.\n\n",
+                      r.attribution.common_effects.size(), effects, r.attribution.common_bending->alpha_scale);
   } else if (r.verdict == "none") {
     md += "**Verdict: the gap is within the floors** (sensor noise and multiple stable drapes); no effect is named.\n\n";
   } else if (r.verdict == "not attributed") {

@@ -157,3 +157,33 @@ TEST(CurlFirst, MovesAConfirmedSignificantCurlToTheFrontKeepingTheOthersOrder) {
   std::vector<CandidateResult> none{ranked(Effect::kYield, true, 0.9, 5e-3, 0.0)};
   EXPECT_FALSE(curl_first(none, 0.25));
 }
+
+TEST(CommonBending, TheMedianScaleOfConfirmedCandidatesWithinTheFloors) {
+  // Seed 22's none_01 in kind: four unlike effects each within the floors at x1.80 .. x2.72, a fifth confirmed above
+  // them, a sixth within them but not confirmed (it must not count).
+  const Floors f = floors_of(3e-3, 1.15);
+  auto candidate = [&](Effect effect, bool confirmed, double scale, double shape) {
+    CandidateResult c = ranked(effect, confirmed, 0.0, 0.0, 0.0);
+    c.alpha_scale = scale;
+    c.validated = drape_of(2e-3, shape);
+    return c;
+  };
+  std::vector<CandidateResult> cs{candidate(Effect::kShear, true, 2.72, 1.0), candidate(Effect::kYield, true, 2.25, 1.1),
+                                  candidate(Effect::kCurl, true, 2.12, 0.9), candidate(Effect::kFriction, true, 1.80, 1.15),
+                                  candidate(Effect::kSensor, true, 1.0, 1.3), candidate(Effect::kMisalignment, false, 1.0, 0.5)};
+  const auto shared = common_bending(cs, f, 3);
+  ASSERT_TRUE(shared);
+  EXPECT_EQ(shared->effects, (std::vector<Effect>{Effect::kShear, Effect::kYield, Effect::kCurl, Effect::kFriction}));
+  EXPECT_NEAR(shared->ln_scale, 0.5 * (std::log(2.12) + std::log(2.25)), 1e-12);  // the middle two of four
+  EXPECT_TRUE(common_bending(cs, f, 4));
+  EXPECT_FALSE(common_bending(cs, f, 5));  // four, not five
+  EXPECT_FALSE(common_bending(cs, f, 0));  // off
+  // Three: the middle one's scale.
+  cs.erase(cs.begin());
+  const auto three = common_bending(cs, f, 3);
+  ASSERT_TRUE(three);
+  EXPECT_NEAR(three->ln_scale, std::log(2.12), 1e-12);
+  // Two within the floors are not enough (friction and the sensor error often both are: seeds 17 and 19).
+  cs.erase(cs.begin());
+  EXPECT_FALSE(common_bending(cs, f, 3));
+}

@@ -182,6 +182,13 @@ struct AttributionSettings {
   bool sensor_bending = false;
   static constexpr double kSensorBendingScales[] = {0.5, 1.0, 1.5};  // ln of the bending scale (clamped to the bounds)
   static constexpr double kSensorBendingGains[] = {15.0, 30.0};      // multipath gain, mm
+  /// Where at least this many confirmed candidates each bring the gate within the floors, the data single out none
+  /// of them, and what they share is the bending scale each refitted: the baseline's bending at the median of their
+  /// scales is validated as the bar is (Attribution::common_bending), and within the floors it is the verdict (none).
+  /// The bar's 1-D simplex from x1 often stops short of that scale on a multistable objective; on seeds 17-22 every
+  /// capture with three or more such candidates was misnamed, three of them controls (docs/DIAGNOSIS.md, "Session
+  /// 29"). 0: off.
+  int common_bending_effects = 3;
   std::uint64_t validation_seed = 2000;
   int jobs = 1;                     // candidate refits in parallel (one forward model per thread)
   std::vector<Effect> candidates{std::begin(kAllEffects), std::end(kAllEffects)};
@@ -201,6 +208,17 @@ struct Attribution {
   bool bar_within_floors = false;
   /// curl_first moved the curl candidate to the front (OtherCaptures::fold_unlike_model).
   bool curl_promoted = false;
+  /// The effects of the confirmed candidates that each brought the gate within the floors, where there were
+  /// AttributionSettings::common_bending_effects or more (and the bar was not within the floors itself); else empty.
+  std::vector<Effect> common_effects;
+  /// Then: the baseline's bending at the median of those candidates' scales, validated as the bar is (its shrinkage
+  /// against the baseline's excess).
+  std::optional<CandidateResult> common_bending;
+  /// The common bending's validated drape is within the floors: as for the bar, the gap was the baseline fit's, and
+  /// no effect is named.
+  bool common_within_floors = false;
+  /// The bending alone explains the capture: the bar or the common bending is within the floors.
+  [[nodiscard]] bool bending_within_floors() const { return bar_within_floors || common_within_floors; }
 };
 
 /// The validation states: fresh initial states (flat, then sine) that no fit selects on.
@@ -212,6 +230,15 @@ struct Attribution {
                                                    const Evaluation& fit, const Evaluation& validated,
                                                    const Floors& floors, const AttributionSettings& settings,
                                                    const ModelFactory& make_model = {}, const OtherCaptures& others = {});
+
+/// Unlike effects each within the floors (AttributionSettings::common_bending_effects): the confirmed candidates whose
+/// validated excess is 0, and the median of their ln bending scales; unset where fewer than `at_least` (or 0) are.
+struct CommonBending {
+  std::vector<Effect> effects;
+  double ln_scale = 0.0;
+};
+[[nodiscard]] std::optional<CommonBending> common_bending(const std::vector<CandidateResult>& candidates,
+                                                          const Floors& floors, int at_least);
 
 /// The attribution's order of candidates (true: `x` ranks before `y`): confirmed ones first, then the larger shrinkage
 /// of the gate's excess; among equal shrinkages (in practice several candidates that each bring the excess to 0: the
