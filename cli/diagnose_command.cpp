@@ -46,6 +46,7 @@ struct DiagnoseOptions {
   bool gap_only = false;
   bool ablation = false;
   bool sensor_bending = false;
+  int common_bending = -1;  // < 0: the settings' value
   double held_out_tolerance = diagnosis::AttributionSettings{}.held_out_tolerance;
   bool verbose = false;
 };
@@ -68,6 +69,9 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (o.starts && (*o.starts < 0 || *o.starts > 100)) return fail("--starts must be 0 (the guess alone) .. 100");
   if (o.refit_scan < -1 || o.refit_scan == 1 || o.refit_scan > 100) {
     return fail("--refit-scan must be 0 (off) or 2 .. 100");
+  }
+  if (o.common_bending < -1 || o.common_bending == 1 || o.common_bending > 6) {
+    return fail("--common-bending must be 0 (off) or 2 .. 6");
   }
   if (o.yield_trade < -1 || o.yield_trade == 1 || o.yield_trade > 100) {
     return fail("--yield-trade must be 0 (off) or 2 .. 100");
@@ -118,6 +122,7 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (o.refit_evaluations > 0) settings.attribution.optimiser.max_evaluations = o.refit_evaluations;
   if (o.sensor_evaluations > 0) settings.attribution.sensor_evaluations = o.sensor_evaluations;
   settings.attribution.sensor_bending = o.sensor_bending;
+  if (o.common_bending >= 0) settings.attribution.common_bending_effects = o.common_bending;
   if (o.refit_scan >= 0) settings.attribution.scan_levels = o.refit_scan;
   if (o.yield_trade >= 0) settings.attribution.yield_trade_levels = o.yield_trade;
   if (!candidates.empty()) settings.attribution.candidates = candidates;
@@ -232,6 +237,12 @@ Runner add_diagnose_command(CLI::App& app) {
                "by simulation (a grid of 3 scales x 2 gains, a simplex within --refit-evaluations, the best without "
                "multipath), and keeps it if it beats both the re-rendering and that (off by default; "
                "docs/DIAGNOSIS.md, \"Session 29\")");
+  app.add_option("--common-bending", o->common_bending,
+                 fmt::format("Where this many confirmed candidates or more each bring the gap within the floors, "
+                             "validate the baseline's bending at the median of their scales, and within the floors "
+                             "read the capture as the bending's (verdict none) (default {}; 0: off, as before session "
+                             "29)",
+                             diagnosis::AttributionSettings{}.common_bending_effects));
   app.add_option("--refit-scan", o->refit_scan,
                  fmt::format("Refits of one-parameter effects (yield, shear, curl, friction) start with this many "
                              "strengths over the effect's range (bending as fitted), then refine from the best within "

@@ -587,6 +587,7 @@ foreach(i RANGE ${last})
   endif()
 endforeach()
 expect_failure(1 "--sensor-evaluations must be" diagnose --capture ${WORK}/capture --sensor-evaluations -3)
+expect_failure(1 "--common-bending must be" diagnose --capture ${WORK}/capture --common-bending 1)
 # --sensor-bending: the sensor candidate refits the bending scale with a multipath gain under the camera it found (a
 # grid of 3 scales x 2 gains, a simplex, the best without multipath), by simulation on all three placements, and keeps
 # it only where it beats both the re-rendering and that ablation.
