@@ -209,17 +209,22 @@ def verdicts(j):
 COLUMNS = ["none", "unexplained", "not attributed", "yield", "shear", "curl", "friction", "misalignment", "sensor"]
 
 
+def reports(root):
+    """(name, family, report) of every diagnosis of a run, its truth file read for the family alone."""
+    for f in sorted(glob.glob(os.path.join(root, "diagnoses", "*.json"))):
+        name = os.path.basename(f)[:-5]
+        with open(f) as fh:
+            j = json.load(fh)
+        with open(os.path.join(root, "truth", name + ".json")) as fh:
+            truth = json.load(fh)
+        yield name, FAMILY.get(truth["family"], truth["family"]) or "none", j
+
+
 def common(roots):
     """Where three or more confirmed candidates each bring the excess to 0 (session 29's common bending)."""
     fired = right = 0
     for root in roots:
-        for f in sorted(glob.glob(os.path.join(root, "diagnoses", "*.json"))):
-            name = os.path.basename(f)[:-5]
-            with open(f) as fh:
-                j = json.load(fh)
-            with open(os.path.join(root, "truth", name + ".json")) as fh:
-                truth = json.load(fh)
-            family = FAMILY.get(truth["family"], truth["family"]) or "none"
+        for name, family, j in reports(root):
             a = j.get("attribution") or {}
             if not a.get("ran"):
                 continue
@@ -251,15 +256,7 @@ def main(roots):
     if not roots:
         sys.exit(__doc__)
     for root in roots:
-        rows = []
-        for f in sorted(glob.glob(os.path.join(root, "diagnoses", "*.json"))):
-            name = os.path.basename(f)[:-5]
-            with open(f) as fh:
-                j = json.load(fh)
-            with open(os.path.join(root, "truth", name + ".json")) as fh:
-                truth = json.load(fh)
-            family = FAMILY.get(truth["family"], truth["family"]) or "none"
-            rows.append((name, family, verdicts(j)))
+        rows = [(name, family, verdicts(j)) for name, family, j in reports(root)]
         if matrix_rule:
             families = ["none"] + sorted({fam for _, fam, _ in rows if fam != "none"})
             print(f"{root}, rule {matrix_rule}:\n")
