@@ -71,6 +71,11 @@ sim::Expected<Evaluation> on_next_placement(ForwardModel& next, const ModelSetup
   return next.rescore(meshes, setup);
 }
 
+/// The refits' range of the ln bending scale, which always holds the fit itself (0).
+std::pair<double, double> bending_scale_bounds(const AttributionSettings& settings) {
+  return {std::min(0.0, settings.bending_scale_lower), std::max(0.0, settings.bending_scale_upper)};
+}
+
 /// `setup` with its bending's alpha and beta times exp(ln_scale).
 ModelSetup scaled_bending(ModelSetup setup, double ln_scale) {
   const double scale = std::exp(ln_scale);
@@ -141,7 +146,7 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
   std::vector<double> x0, step, lo, hi;
   const bool sim = bar || needs_simulation(*effect);
   if (sim) {  // the bending scale stays free: an effect may trade off against stiffness (and the bar refits it alone)
-    const double lower = std::min(0.0, settings.bending_scale_lower), upper = std::max(0.0, settings.bending_scale_upper);
+    const auto [lower, upper] = bending_scale_bounds(settings);
     // The first step goes up (the NelderMead reflects it down at the upper bound); a quarter of the range at most.
     x0.push_back(0.0), step.push_back(std::min(0.25, 0.25 * (upper - lower))), lo.push_back(lower), hi.push_back(upper);
   }
@@ -304,8 +309,7 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
       if (*value < stage_best) stage_best = *value, stage_drape = std::move(drape);
       return *value;
     };
-    const double lower = std::min(0.0, settings.bending_scale_lower);
-    const double upper = std::max(0.0, settings.bending_scale_upper);
+    const auto [lower, upper] = bending_scale_bounds(settings);
     const double gain_hi = hi[first + gain];
     std::vector<double> y_best;
     for (double s : AttributionSettings::kSensorBendingScales) {
