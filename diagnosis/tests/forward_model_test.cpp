@@ -3,12 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <string>
-#include <unistd.h>
 
-#include "drapegen/diagnosis/capture.hpp"
 #include "drapegen/diagnosis/forward_model.hpp"
-#include "drapegen/diagnosis/reality.hpp"
+#include "small_reality.hpp"
 
 namespace drapegen::diagnosis {
 namespace {
@@ -16,19 +13,13 @@ namespace {
 namespace fs = std::filesystem;
 
 TEST(ForwardModel, LaidAgainCarriesAYieldingSpecimensSetAndNothingOfAnElasticOne) {
-  const fs::path dir = fs::temp_directory_path() / ("drapegen_forward_laid_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  RealitySpec spec;
-  spec.bending.alpha = {13923, 11455, 8821};
-  spec.bending.beta = {-35390, -29660, -22042};
-  spec.resolution = 14;
+  RealitySpec spec = fixture::small_reality_spec();
   spec.noise = false;
-  ASSERT_TRUE(generate_reality(spec, dir.string()).has_value());
-  auto capture = read_capture(dir.string());
-  ASSERT_TRUE(capture.has_value()) << capture.error().message;
+  const auto made = fixture::generate_small_reality("laid_again", spec);
+  ASSERT_TRUE(made.has_value());
   FitSettings settings;
   settings.resolution = 12;
-  auto model = ForwardModel::create(*capture, settings);
+  auto model = ForwardModel::create(made->capture, settings);
   ASSERT_TRUE(model.has_value()) << model.error().message;
   const auto states = fit_initial_states(2, 7);
 
@@ -64,7 +55,7 @@ TEST(ForwardModel, LaidAgainCarriesAYieldingSpecimensSetAndNothingOfAnElasticOne
   auto evaluated_elastic = (*model)->evaluate(elastic, states);
   ASSERT_TRUE(evaluated_elastic.has_value()) << evaluated_elastic.error().message;
   EXPECT_EQ(evaluated_elastic->best.left.rest_angles.size(), 0);
-  fs::remove_all(dir);
+  fs::remove_all(made->dir);
 }
 
 }  // namespace

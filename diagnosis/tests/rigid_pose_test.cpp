@@ -3,20 +3,15 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
-#include <unistd.h>
 
-#include "drapegen/diagnosis/capture.hpp"
-#include "drapegen/diagnosis/reality.hpp"
 #include "drapegen/diagnosis/rigid_pose.hpp"
+#include "small_reality.hpp"
 
 namespace drapegen::diagnosis {
 namespace {
-
-namespace fs = std::filesystem;
 
 struct Generated {
   Capture capture;
@@ -24,21 +19,10 @@ struct Generated {
 };
 
 Generated generate(const std::string& name, const std::vector<std::string>& effects, std::uint64_t seed) {
-  const fs::path dir = fs::temp_directory_path() / ("drapegen_rigid_pose_test_" + std::to_string(::getpid())) / name;
-  fs::remove_all(dir);
-  RealitySpec spec;
-  spec.bending.alpha = {13923, 11455, 8821};
-  spec.bending.beta = {-35390, -29660, -22042};
-  spec.resolution = 14;
-  spec.seed = seed;
-  for (const auto& e : effects) spec.effects.push_back(*parse_reality_effect(e));
-  auto made = generate_reality(spec, dir.string());
-  EXPECT_TRUE(made.has_value()) << (made ? "" : made.error().message);
   Generated g;
+  const auto made = fixture::generate_small_reality(name, fixture::small_reality_spec(effects, seed));
   if (!made) return g;
-  auto capture = read_capture(dir.string());
-  EXPECT_TRUE(capture.has_value()) << (capture ? "" : capture.error().message);
-  if (capture) g.capture = std::move(capture).value();
+  g.capture = made->capture;
   std::ifstream in(made->truth_path);
   const auto truth = nlohmann::json::parse(in)["sensor"];
   for (int k = 0; k < 3; ++k) {
