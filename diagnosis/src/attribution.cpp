@@ -528,6 +528,7 @@ sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& base
   // the reference's, a tolerance for the noise of choosing the best validation drape there (confirms).
   Attribution a;
   a.held_out_tolerance = settings.held_out_tolerance;
+  a.significant_shrinkage = settings.significant_shrinkage;
   a.bar = std::move(results.back()->value());
   const double baseline_excess = excess_above_floors(gap_terms(validated.best, baseline_paired), floors);
   const double bar_excess = a.bar.validated_excess(floors);

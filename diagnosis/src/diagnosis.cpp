@@ -612,6 +612,7 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                       {"curl_first", r.attribution.curl_promoted},
                       {"confirmed_on", r.validated_held_out ? "held_out_capture" : "held_out_view"},
                       {"held_out_tolerance", ran ? nlohmann::json(r.attribution.held_out_tolerance) : nullptr},
+                      {"significant_shrinkage", ran ? nlohmann::json(r.attribution.significant_shrinkage) : nullptr},
                       {"refitted_on", r.validated_second ? "capture_and_second_capture" : "capture"},
                       {"alpha_scale_bounds", ran ? nlohmann::json::array({std::exp(r.refit_scale_lower),
                                                                            std::exp(r.refit_scale_upper)})

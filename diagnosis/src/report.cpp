@@ -152,9 +152,15 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
     md += "**Verdict: the gap is within the floors** (sensor noise and multiple stable drapes); no effect is named.\n\n";
   } else if (r.verdict == "not attributed") {
     md += "**Verdict: a gap above the floors; attribution was not run** (`--gap-only`).\n\n";
+  } else if (r.verdict == "unexplained" && r.attribution.candidates.empty()) {
+    md += "**Verdict: a gap above the floors; no candidate effect was refitted.**\n\n";
   } else if (r.verdict == "unexplained") {
-    md += fmt::format("**Verdict: a gap above the floors that no candidate effect shrinks by {:.0f}% or more** (best: {}).\n\n",
-                      100 * 0.25, r.runner_up);
+    // The ranking puts confirmed candidates first: the best is unconfirmed only if none is confirmed.
+    const auto& best = r.attribution.candidates.front();
+    md += fmt::format("**Verdict: a gap above the floors that no candidate effect both shrinks by {:.0f}% or more and "
+                      "holds on the held-out data** (best: {}, shrinkage {:.0f}%, {}).\n\n",
+                      100 * r.attribution.significant_shrinkage, r.runner_up, 100 * best.shrinkage,
+                      best.confirmed ? "confirmed" : "not confirmed");
   } else {
     const auto& c = r.attribution.candidates[0];
     md += fmt::format("**Verdict: {}** (confidence {:.2f} against the runner-up, {}); adding it shrinks the held-out gap "

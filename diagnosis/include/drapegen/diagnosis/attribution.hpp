@@ -202,6 +202,7 @@ struct Attribution {
   std::vector<CandidateResult> candidates;  // sorted by shrinkage, best first
   bool named = false;                       // the best is confirmed and shrinks the gap significantly
   double held_out_tolerance = 0.0;          // the confirmations' (AttributionSettings::held_out_tolerance)
+  double significant_shrinkage = 0.0;       // the naming threshold (AttributionSettings::significant_shrinkage)
   double confidence = 0.0;                  // bootstrap P(best beats runner-up on the held-out view)
   /// The bar's validated drape is within the floors (gate of the baseline's): the baseline model explains the capture
   /// once its bending is refitted, so the gap was the baseline fit's, and no effect is named.
