@@ -47,6 +47,7 @@ struct DiagnoseOptions {
   bool ablation = false;
   bool sensor_bending = false;
   int common_bending = -1;  // < 0: the settings' value
+  double tie_margin = diagnosis::AttributionSettings{}.tie_margin;
   double held_out_tolerance = diagnosis::AttributionSettings{}.held_out_tolerance;
   bool verbose = false;
 };
@@ -73,6 +74,7 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (o.common_bending < -1 || o.common_bending == 1 || o.common_bending > 6) {
     return fail("--common-bending must be 0 (off) or 2 .. 6");
   }
+  if (!(o.tie_margin >= 0.0 && o.tie_margin <= 1.0)) return fail("--tie-margin must be 0 (exact ties only) .. 1");
   if (o.yield_trade < -1 || o.yield_trade == 1 || o.yield_trade > 100) {
     return fail("--yield-trade must be 0 (off) or 2 .. 100");
   }
@@ -123,6 +125,7 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (o.sensor_evaluations > 0) settings.attribution.sensor_evaluations = o.sensor_evaluations;
   settings.attribution.sensor_bending = o.sensor_bending;
   if (o.common_bending >= 0) settings.attribution.common_bending_effects = o.common_bending;
+  settings.attribution.tie_margin = o.tie_margin;
   if (o.refit_scan >= 0) settings.attribution.scan_levels = o.refit_scan;
   if (o.yield_trade >= 0) settings.attribution.yield_trade_levels = o.yield_trade;
   if (!candidates.empty()) settings.attribution.candidates = candidates;
@@ -243,6 +246,11 @@ Runner add_diagnose_command(CLI::App& app) {
                              "read the capture as the bending's (verdict none) (default {}; 0: off, as before session "
                              "29)",
                              diagnosis::AttributionSettings{}.common_bending_effects));
+  app.add_option("--tie-margin", o->tie_margin,
+                 "Candidates whose shrinkage is within this of the first's are tied: among the confirmed ones that "
+                 "shrink the gap significantly, a physical effect before the sensor error, then the smaller refit "
+                 "objective is named (0: exact ties only, as before session 30)")
+      ->capture_default_str();
   app.add_option("--refit-scan", o->refit_scan,
                  fmt::format("Refits of one-parameter effects (yield, shear, curl, friction) start with this many "
                              "strengths over the effect's range (bending as fitted), then refine from the best within "

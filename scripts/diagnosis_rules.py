@@ -42,11 +42,18 @@ the main rule):
 One more lists where session 29's common bending would be validated (it needs a simulation, so no verdict here):
 - `--common DIR...`: per capture, the confirmed candidates that each bring the gate's excess to 0 (`common` when
   three or more, AttributionSettings::common_bending_effects), the verdict as run and whether it is right.
+And one lists where session 30's near ties change the verdict as run (reports made before it; near_ties_first):
+- `--near-ties M DIR...`: among the confirmed candidates at least THRESHOLD and within M of the first's shrinkage, a
+  physical effect before the sensor error, then the smaller refit objective, then the larger held-out shrinkage
+  (not applied where the run put curl first, or named none);
+- `--draw-noise DIR...`: how much the gate's excess changes, as a share of itself, when the second-best validation
+  drape by fit score is taken instead of the best (the noise a shrinkage carries; the margin's scale).
 
     scripts/diagnosis_rules.py out/s18all [more runs ...]
     scripts/diagnosis_rules.py --common out/s28s19all out/s28s20      # where the common bending fires
     scripts/diagnosis_rules.py --matrix without_ablation out/s21all     # one rule's confusion matrix
     scripts/diagnosis_rules.py --tolerance 0.05 out/s23all               # the tolerance rule at 5%
+    scripts/diagnosis_rules.py --near-ties 0.1 out/s28s20 out/s30s22all   # where a tie margin of 0.1 names otherwise
 """
 import glob
 import json
@@ -240,10 +247,62 @@ def common(roots):
     print(f"common bending fires on {fired} captures, {right} of them named right as run")
 
 
+def near_ties(margin, roots):
+    """Where candidates within `margin` of the first's shrinkage, tied, name another effect than the run did."""
+    changed = right = broken = 0
+    for root in roots:
+        for name, family, j in reports(root):
+            a = j.get("attribution") or {}
+            if not a.get("ran") or j["verdict"] in ("none", "unexplained") or a.get("curl_first"):
+                continue
+            first = a["candidates"][0]  # as ranked by the run (ranks_before)
+            tied = [c for c in a["candidates"] if c["confirmed"] and c["shrinkage"] >= THRESHOLD and
+                    c["shrinkage"] >= first["shrinkage"] - margin]
+            pick = min(tied, key=lambda c: (c["effect"] == "sensor", c["objective_mm"], -c["held_out_shrinkage"]))
+            if pick["effect"] == j["verdict"]:
+                continue
+            changed += 1
+            right += pick["effect"] == family
+            broken += j["verdict"] == family
+            print(f"{root:14s} {name:16s} {family:12s} {j['verdict']:13s} -> {pick['effect']:13s} "
+                  f"({first['effect']} {first['shrinkage']:.2f}, {pick['effect']} {pick['shrinkage']:.2f})")
+    print(f"margin {margin}: {changed} verdicts change, {right} to the right effect, {broken} right ones lost")
+
+
+def draw_noise(roots):
+    """The gate's excess of the second-best validation drape (by fit score) against the best's, as a share of the
+    excess, each paired with the second capture's terms as gap_terms pairs them: quartiles over the captures."""
+    shares = []
+    for root in roots:
+        for _, _, j in reports(root):
+            g = j["gap_tests"]
+            if not g.get("second_capture") or not g["excess_above_floors"] > 0:
+                continue
+            second = g["second_capture"]
+
+            def gate(d):
+                return excess(0.5 * (d["stable_mm"] + second["stable_mm"]), 0.5 * (d["shape"] + second["shape"]),
+                              g["stable_floor_mm"], g["shape_floor"])
+
+            best, runner = sorted(g["validation_drapes"], key=lambda d: d["fit_score_mm"])[:2]
+            shares.append(abs(gate(best) - gate(runner)) / g["excess_above_floors"])
+    shares.sort()
+    n = len(shares)
+    if n:
+        print(f"{n} captures above the floors: the share changes by {shares[n // 4]:.3f} / {shares[n // 2]:.3f} / "
+              f"{shares[3 * n // 4]:.3f} (quartiles)")
+
+
 def main(roots):
     global TOLERANCE
     if roots[:1] == ["--common"]:
         return common(roots[1:])
+    if roots[:1] == ["--draw-noise"]:
+        return draw_noise(roots[1:])
+    if roots[:1] == ["--near-ties"]:
+        if len(roots) < 3:
+            sys.exit("--near-ties M DIR...")
+        return near_ties(float(roots[1]), roots[2:])
     if roots[:1] == ["--tolerance"]:
         if len(roots) < 3:
             sys.exit("--tolerance T DIR...")

@@ -258,6 +258,18 @@ string(JSON significant GET "${out}" attribution significant_shrinkage)
 if(NOT significant EQUAL 0.25)
   message(FATAL_ERROR "naming threshold ${significant}, not the default 0.25")
 endif()
+# Near ties (session 30): the margin as run; a promoted candidate is the one named.
+string(JSON margin GET "${out}" attribution near_tie margin)
+string(JSON promoted GET "${out}" attribution near_tie promoted)
+if(NOT margin EQUAL 0.1)
+  message(FATAL_ERROR "near-tie margin ${margin}, not the default 0.1")
+endif()
+string(JSON named_first GET "${out}" attribution candidates 0 effect)
+string(JSON verdict_now GET "${out}" verdict)
+if(promoted AND NOT verdict_now STREQUAL named_first AND NOT verdict_now STREQUAL "none")
+  message(FATAL_ERROR "a near tie promoted ${named_first}, but the verdict is ${verdict_now}")
+endif()
+message(STATUS "near tie: margin ${margin}, promoted ${promoted}, first ${named_first}, verdict ${verdict_now}")
 math(EXPR last "${ncand} - 1")
 set(between 0)  # candidates that only the tolerance confirms
 foreach(i RANGE ${last})
@@ -592,6 +604,7 @@ foreach(i RANGE ${last})
 endforeach()
 expect_failure(1 "--sensor-evaluations must be" diagnose --capture ${WORK}/capture --sensor-evaluations -3)
 expect_failure(1 "--common-bending must be" diagnose --capture ${WORK}/capture --common-bending 1)
+expect_failure(1 "--tie-margin must be" diagnose --capture ${WORK}/capture --tie-margin 2)
 # --sensor-bending: the sensor candidate refits the bending scale with a multipath gain under the camera it found (a
 # grid of 3 scales x 2 gains, a simplex, the best without multipath), by simulation on all three placements, and keeps
 # it only where it beats both the re-rendering and that ablation.

@@ -415,12 +415,33 @@ bool curl_first(std::vector<CandidateResult>& ranked, double significant) {
   return true;
 }
 
-bool ranks_before(const CandidateResult& x, const CandidateResult& y) {
-  if (x.confirmed != y.confirmed) return x.confirmed;
-  if (x.shrinkage != y.shrinkage) return x.shrinkage > y.shrinkage;
+namespace {
+
+/// ranks_before's order among candidates of equal shrinkage.
+bool tie_before(const CandidateResult& x, const CandidateResult& y) {
   if (needs_simulation(x.effect) != needs_simulation(y.effect)) return needs_simulation(x.effect);
   if (x.objective != y.objective) return x.objective < y.objective;
   return x.held_out_shrinkage > y.held_out_shrinkage;
+}
+
+}  // namespace
+
+bool ranks_before(const CandidateResult& x, const CandidateResult& y) {
+  if (x.confirmed != y.confirmed) return x.confirmed;
+  if (x.shrinkage != y.shrinkage) return x.shrinkage > y.shrinkage;
+  return tie_before(x, y);
+}
+
+bool near_ties_first(std::vector<CandidateResult>& ranked, double margin, double significant) {
+  if (ranked.empty() || !ranked.front().confirmed || margin <= 0.0) return false;
+  const double from = ranked.front().shrinkage - margin;
+  auto best = ranked.begin();
+  for (auto it = ranked.begin() + 1; it != ranked.end(); ++it) {
+    if (it->confirmed && it->shrinkage >= significant && it->shrinkage >= from && tie_before(*it, *best)) best = it;
+  }
+  if (best == ranked.begin() || best->shrinkage < significant) return false;
+  std::rotate(ranked.begin(), best, best + 1);
+  return true;
 }
 
 bool confirms(double held_out_after, double held_out_before, double tolerance) {
@@ -553,6 +574,11 @@ sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& base
     a.candidates.push_back(std::move(c));
   }
   std::stable_sort(a.candidates.begin(), a.candidates.end(), ranks_before);
+  a.tie_margin = settings.tie_margin;
+  a.near_tie_promoted = near_ties_first(a.candidates, settings.tie_margin, settings.significant_shrinkage);
+  if (a.near_tie_promoted)
+    sim::logger()->info("attribution: {} within {:.2f} of the first's shrinkage; named first as a tie",
+                        effect_name(a.candidates[0].effect), settings.tie_margin);
   a.curl_promoted = others.fold_unlike_model && curl_first(a.candidates, settings.significant_shrinkage);
   if (a.curl_promoted)
     sim::logger()->info("attribution: the placements fold less alike than the fitted model's drapes; curl first");

@@ -610,6 +610,9 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
   }
   j["attribution"] = {{"ran", ran},
                       {"curl_first", r.attribution.curl_promoted},
+                      {"near_tie", ran ? nlohmann::json{{"margin", r.attribution.tie_margin},
+                                                        {"promoted", r.attribution.near_tie_promoted}}
+                                       : nlohmann::json(nullptr)},
                       {"confirmed_on", r.validated_held_out ? "held_out_capture" : "held_out_view"},
                       {"held_out_tolerance", ran ? nlohmann::json(r.attribution.held_out_tolerance) : nullptr},
                       {"significant_shrinkage", ran ? nlohmann::json(r.attribution.significant_shrinkage) : nullptr},

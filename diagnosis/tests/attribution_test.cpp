@@ -158,6 +158,40 @@ TEST(CurlFirst, MovesAConfirmedSignificantCurlToTheFrontKeepingTheOthersOrder) {
   EXPECT_FALSE(curl_first(none, 0.25));
 }
 
+TEST(NearTiesFirst, NamesThePreferredOfTheSignificantConfirmedCandidatesWithinTheMargin) {
+  // Seed 23's friction_04 in kind: the sensor error 0.03 ahead of friction, which fits with the smaller objective.
+  std::vector<CandidateResult> order{ranked(Effect::kSensor, true, 0.90, 7.49e-3, 0.125),
+                                     ranked(Effect::kFriction, true, 0.87, 7.11e-3, 0.126),
+                                     ranked(Effect::kShear, true, 0.16, 7.28e-3, 0.22)};
+  std::vector<CandidateResult> exact = order;
+  EXPECT_FALSE(near_ties_first(exact, 0.0, 0.25));  // a margin of 0: exact ties only (ranks_before's)
+  EXPECT_EQ(exact[0].effect, Effect::kSensor);
+  ASSERT_TRUE(near_ties_first(order, 0.1, 0.25));
+  EXPECT_EQ(order[0].effect, Effect::kFriction);
+  EXPECT_EQ(order[1].effect, Effect::kSensor);  // the others keep their order
+  EXPECT_EQ(order[2].effect, Effect::kShear);
+  EXPECT_FALSE(near_ties_first(order, 0.1, 0.25));  // already first
+  // Seed 20's curl_04 in kind: two physical effects 0.10 apart, the second with the smaller objective; just outside
+  // the margin, or with the larger objective, the first stays.
+  std::vector<CandidateResult> physical{ranked(Effect::kYield, true, 0.674, 8.77e-3, 0.081),
+                                        ranked(Effect::kCurl, true, 0.578, 7.95e-3, 0.172)};
+  std::vector<CandidateResult> outside = physical;
+  EXPECT_FALSE(near_ties_first(outside, 0.09, 0.25));
+  ASSERT_TRUE(near_ties_first(physical, 0.1, 0.25));
+  EXPECT_EQ(physical[0].effect, Effect::kCurl);
+  std::vector<CandidateResult> larger{ranked(Effect::kYield, true, 0.674, 7e-3, 0.0), ranked(Effect::kCurl, true, 0.6, 8e-3, 0.0)};
+  EXPECT_FALSE(near_ties_first(larger, 0.1, 0.25));
+  // Only a confirmed candidate that is significant itself, and only behind a confirmed first.
+  std::vector<CandidateResult> unconfirmed{ranked(Effect::kSensor, true, 0.9, 8e-3, 0.0), ranked(Effect::kCurl, false, 0.88, 7e-3, 0.0)};
+  EXPECT_FALSE(near_ties_first(unconfirmed, 0.1, 0.25));
+  std::vector<CandidateResult> weak{ranked(Effect::kYield, true, 0.3, 8e-3, 0.0), ranked(Effect::kCurl, true, 0.22, 7e-3, 0.0)};
+  EXPECT_FALSE(near_ties_first(weak, 0.1, 0.25));
+  std::vector<CandidateResult> none_confirmed{ranked(Effect::kSensor, false, 0.9, 8e-3, 0.0), ranked(Effect::kCurl, false, 0.88, 7e-3, 0.0)};
+  EXPECT_FALSE(near_ties_first(none_confirmed, 0.1, 0.25));
+  std::vector<CandidateResult> empty;
+  EXPECT_FALSE(near_ties_first(empty, 0.1, 0.25));
+}
+
 TEST(CommonBending, TheMedianScaleOfConfirmedCandidatesWithinTheFloors) {
   // Seed 22's none_01 in kind: four unlike effects each within the floors at x1.80 .. x2.72, a fifth confirmed above
   // them, a sixth within them but not confirmed (it must not count).

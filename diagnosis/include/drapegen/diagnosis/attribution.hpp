@@ -189,6 +189,11 @@ struct AttributionSettings {
   /// capture with three or more such candidates was misnamed, three of them controls (docs/DIAGNOSIS.md, "Session
   /// 29"). 0: off.
   int common_bending_effects = 3;
+  /// Shrinkages closer than this to the first's are tied (near_ties_first): each is the best of ten validation
+  /// drapes of a multistable specimen, and the order of two that differ by less than the draw's noise says nothing.
+  /// Derived on seeds 17-23 (docs/DIAGNOSIS.md, "Session 30"): at 0.1 it names two captures right that were named
+  /// after a rival 0.03-0.10 ahead, and changes no right verdict; at 0.2 it would. 0: exact ties only.
+  double tie_margin = 0.1;
   std::uint64_t validation_seed = 2000;
   int jobs = 1;                     // candidate refits in parallel (one forward model per thread)
   std::vector<Effect> candidates{std::begin(kAllEffects), std::end(kAllEffects)};
@@ -209,6 +214,9 @@ struct Attribution {
   bool bar_within_floors = false;
   /// curl_first moved the curl candidate to the front (OtherCaptures::fold_unlike_model).
   bool curl_promoted = false;
+  /// near_ties_first moved a candidate within AttributionSettings::tie_margin of the first's shrinkage to the front.
+  bool near_tie_promoted = false;
+  double tie_margin = 0.0;  // the margin it ran with
   /// The effects of the confirmed candidates that each brought the gate within the floors, where there were
   /// AttributionSettings::common_bending_effects or more (and the bar was not within the floors itself); else empty.
   std::vector<Effect> common_effects;
@@ -254,6 +262,12 @@ struct CommonBending {
 /// reproduced on seeds 17-20 (rule "repeat_curl", pre-registered before seed 20; docs/DIAGNOSIS.md, "Session 27").
 /// Returns whether it moved one.
 bool curl_first(std::vector<CandidateResult>& ranked, double significant);
+
+/// Near ties (AttributionSettings::tie_margin): among the confirmed candidates whose shrinkage is at least
+/// `significant` and within `margin` of the first's (`ranked` in ranks_before's order), the one ranks_before's tie
+/// order prefers (a physical effect before the sensor error, then the smaller refit objective) moves to the front
+/// (the others keep their order). Returns whether it moved one.
+bool near_ties_first(std::vector<CandidateResult>& ranked, double margin, double significant);
 
 /// The held-out confirmation: `held_out_after` (the candidate's confirmation_score) is at most (1 + tolerance) times
 /// `held_out_before` (the reference's).
