@@ -159,7 +159,7 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
     const auto& best = r.attribution.candidates.front();
     md += fmt::format("**Verdict: a gap above the floors that no candidate effect both shrinks by {:.0f}% or more and "
                       "holds on the held-out data** (best: {}, shrinkage {:.0f}%, {}).\n\n",
-                      100 * r.attribution.significant_shrinkage, r.runner_up, 100 * best.shrinkage,
+                      100 * r.attribution.significant_shrinkage, effect_name(best.effect), 100 * best.shrinkage,
                       best.confirmed ? "confirmed" : "not confirmed");
   } else {
     const auto& c = r.attribution.candidates[0];
