@@ -249,7 +249,8 @@ Runner add_diagnose_command(CLI::App& app) {
   app.add_option("--tie-margin", o->tie_margin,
                  "Candidates whose shrinkage is within this of the first's are tied: among the confirmed ones that "
                  "shrink the gap significantly, a physical effect before the sensor error, then the smaller refit "
-                 "objective is named (0: exact ties only, as before session 30)")
+                 "objective is named (0: exact ties only; 0.1 was negative on a fresh seed, docs/DIAGNOSIS.md, "
+                 "\"Session 30\")")
       ->capture_default_str();
   app.add_option("--refit-scan", o->refit_scan,
                  fmt::format("Refits of one-parameter effects (yield, shear, curl, friction) start with this many "
