@@ -258,7 +258,8 @@ def near_ties(margin, roots):
             first = a["candidates"][0]  # as ranked by the run (ranks_before)
             tied = [c for c in a["candidates"] if c["confirmed"] and c["shrinkage"] >= THRESHOLD and
                     c["shrinkage"] >= first["shrinkage"] - margin]
-            pick = min(tied, key=lambda c: (c["effect"] == "sensor", c["objective_mm"], -c["held_out_shrinkage"]))
+            pick = min(tied, key=lambda c: (TIES["physical_first"](c["effect"]), c["objective_mm"],
+                                            -c["held_out_shrinkage"]))
             if pick["effect"] == j["verdict"]:
                 continue
             changed += 1

@@ -439,7 +439,7 @@ bool near_ties_first(std::vector<CandidateResult>& ranked, double margin, double
   for (auto it = ranked.begin() + 1; it != ranked.end(); ++it) {
     if (it->confirmed && it->shrinkage >= significant && it->shrinkage >= from && tie_before(*it, *best)) best = it;
   }
-  if (best == ranked.begin() || best->shrinkage < significant) return false;
+  if (best == ranked.begin()) return false;  // (every other candidate it may pick is significant)
   std::rotate(ranked.begin(), best, best + 1);
   return true;
 }
