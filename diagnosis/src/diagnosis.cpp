@@ -508,6 +508,7 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                                               p.pose.rotation.z() * 1e3}},
                            {"translation_mm", {p.pose.translation.x() * 1e3, p.pose.translation.y() * 1e3,
                                                p.pose.translation.z() * 1e3}},
+                           {"top_lift_mm", p.top_lift * 1e3},
                            {"rms_recorded_mm", p.rms_recorded * 1e3},
                            {"rms_estimated_mm", p.rms_estimated * 1e3},
                            {"top_pixels", p.top_pixels},

@@ -198,6 +198,12 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
                       p.top_pixels, p.side_pixels, p.pose.rotation.x() * 1e3, p.pose.rotation.y() * 1e3,
                       p.pose.rotation.z() * 1e3, p.pose.translation.x() * 1e3, p.pose.translation.y() * 1e3,
                       p.pose.translation.z() * 1e3, p.rms_recorded * 1e3, p.rms_estimated * 1e3);
+    if (p.top_lift > 0.0) {
+      md += fmt::format("The cloth on the platform top lies {:.1f} mm above its contact offset and the bare side shows "
+                        "the camera where its calibration says: read as the specimen lifting off the top (one that "
+                        "slid on it), not as the camera.\n\n",
+                        p.top_lift * 1e3);
+    }
   } else {
     md += fmt::format("Camera from the rigid surfaces: not estimated ({}); the sensor candidate starts from the recorded "
                       "camera.\n\n", r.rigid_pose_error);

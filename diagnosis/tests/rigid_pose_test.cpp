@@ -110,5 +110,55 @@ TEST(RigidPose, SidePixelsStartBelowWhereTheSpecimenReaches) {
   EXPECT_NEAR(s.side_below, 0.15 * std::sqrt(2.0) - 0.05 + 0.01, 1e-12);
 }
 
+/// The capture with the cloth on the platform top moved `dz` along the platform axis (each top pixel's depth moved
+/// along its ray), the rest as it was: a specimen lifted off the top (dz > 0), or a top seen lower than its contact.
+Capture with_top_moved(Capture capture, const RigidSurfaces& s, double dz) {
+  for (auto& view : capture.views) {
+    const Eigen::Isometry3d to_specimen = view.camera.world_to_camera.inverse();
+    for (int y = 0; y < view.depth.height; ++y) {
+      for (int x = 0; x < view.depth.width; ++x) {
+        float& z = view.depth.depth[static_cast<std::size_t>(y) * view.depth.width + x];
+        if (z <= 0.0f) continue;
+        const Eigen::Vector3d ray = view.camera.ray(x, y);
+        const Eigen::Vector3d q = to_specimen * (static_cast<double>(z) * ray);
+        if (std::hypot(q.x(), q.y()) >= s.cylinder_radius - s.top_inset || std::abs(q.z() - s.top_height) > 0.005)
+          continue;
+        z += static_cast<float>(dz / (to_specimen.linear() * ray).z());
+      }
+    }
+  }
+  return capture;
+}
+
+TEST(RigidPose, ReadsATopAboveItsContactOffsetThatTheSideDoesNotConfirmAsTheClothLifted) {
+  // A camera that moved the platform's centre along its axis moves the top and not the side, as a cloth lying above
+  // the top does; a cloth cannot lie below it. Lifted 2 mm, the top is the cloth's: the camera stays as recorded.
+  const Generated g = generate("lifted", {}, 19020);
+  ASSERT_EQ(g.capture.views.size(), 4u);
+  const RigidSurfaces surfaces = RigidSurfaces::for_specimen(g.capture.specimen);
+  const Capture lifted = with_top_moved(g.capture, surfaces, 0.002);
+  auto estimate = estimate_rigid_pose(lifted, surfaces);
+  ASSERT_TRUE(estimate.has_value()) << estimate.error().message;
+  EXPECT_NEAR(estimate->top_lift, 0.002, 3e-4);
+  EXPECT_EQ(platform_displacement(estimate->pose, lifted), 0.0);
+  // Without the rule the camera takes the lift: it moves the platform's centre by about the lift.
+  RigidPoseSettings camera_only;
+  camera_only.min_lift = 1.0;
+  auto as_camera = estimate_rigid_pose(lifted, surfaces, camera_only);
+  ASSERT_TRUE(as_camera.has_value()) << as_camera.error().message;
+  EXPECT_EQ(as_camera->top_lift, 0.0);
+  EXPECT_GT(platform_displacement(as_camera->pose, lifted), 0.0015);
+  // Seen 2 mm lower, the top is the camera's.
+  const Capture lowered = with_top_moved(g.capture, surfaces, -0.002);
+  auto below = estimate_rigid_pose(lowered, surfaces);
+  ASSERT_TRUE(below.has_value()) << below.error().message;
+  EXPECT_EQ(below->top_lift, 0.0);
+  EXPECT_GT(platform_displacement(below->pose, lowered), 0.0015);
+  // The calibrated capture itself: neither lifted nor moved.
+  auto calibrated = estimate_rigid_pose(g.capture, surfaces);
+  ASSERT_TRUE(calibrated.has_value()) << calibrated.error().message;
+  EXPECT_EQ(calibrated->top_lift, 0.0);
+}
+
 }  // namespace
 }  // namespace drapegen::diagnosis

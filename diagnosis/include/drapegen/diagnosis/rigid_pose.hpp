@@ -6,7 +6,10 @@
 // (renderer/sensor_error.hpp: the camera really at delta * recorded) that brings the capture's rigid pixels back onto
 // the surfaces, by Levenberg-Marquardt over the pixels within a band of them that narrows as the pose improves.
 // Rotation about the platform axis leaves both surfaces unchanged: the damping keeps the steps out of that
-// direction (the outline turn of every drape absorbs it). docs/DIAGNOSIS.md, "The camera from the rigid surfaces".
+// direction (the outline turn of every drape absorbs it). A translation along the axis moves the top and not the
+// side, as a specimen lifting off the top does (one that slid rises over it): a top seen above the contact offset
+// whose camera the side does not confirm is read as the cloth's lift, one seen below as the camera's (no cloth lies
+// inside the platform). docs/DIAGNOSIS.md, "The camera from the rigid surfaces".
 
 #include <vector>
 
@@ -42,6 +45,13 @@ struct RigidPoseSettings {
   double last_band = 0.003;
   int min_top_pixels = 100;
   int min_side_pixels = 100;
+  /// The side confirms the estimate's camera when this share more of its pixels lie within the last band there than
+  /// at the recorded camera (a camera error moves the side: the benchmark's pose errors and depth biases add 80% or
+  /// more, the lifted top of a specimen that slid 0-3%; docs/DIAGNOSIS.md).
+  double side_confirms = 0.1;
+  /// m: a top seen this far above the contact offset (its mean over the first band, at the recorded camera) whose
+  /// estimate the side does not confirm is the cloth's lift: the estimate is the recorded camera.
+  double min_lift = 0.0005;
 };
 
 struct RigidPose {
@@ -49,6 +59,9 @@ struct RigidPose {
   /// m: RMS distance to the surfaces of the pixels within the last band, at the recorded pose and at the estimate.
   double rms_recorded = 0.0;
   double rms_estimated = 0.0;
+  /// m: how far the cloth on the top lies above its contact offset when it is read as lifted (then the pose is the
+  /// recorded camera's, no error); 0 when the offset is read as the camera's.
+  double top_lift = 0.0;
   int top_pixels = 0;   // at the estimate, within the last band
   int side_pixels = 0;
 };
