@@ -46,6 +46,8 @@ And one lists where session 30's near ties change the verdict as run (reports ma
 - `--near-ties M DIR...`: among the confirmed candidates at least THRESHOLD and within M of the first's shrinkage, a
   physical effect before the sensor error, then the smaller refit objective, then the larger held-out shrinkage
   (not applied where the run put curl first, or named none);
+- `--near-ties M --objective DIR...` (session 31's hypothesis): the same candidates, the smallest refit objective
+  named, where the first is not tied exactly (exact ties keep the run's order);
 - `--draw-noise DIR...`: how much the gate's excess changes, as a share of itself, when the second-best validation
   drape by fit score is taken instead of the best (the noise a shrinkage carries; the margin's scale).
 
@@ -247,8 +249,10 @@ def common(roots):
     print(f"common bending fires on {fired} captures, {right} of them named right as run")
 
 
-def near_ties(margin, roots):
-    """Where candidates within `margin` of the first's shrinkage, tied, name another effect than the run did."""
+def near_ties(margin, roots, order="physical_first"):
+    """Where candidates within `margin` of the first's shrinkage, tied, name another effect than the run did. Order
+    "physical_first" as session 30's near_ties_first; "objective" (session 31's hypothesis) names the smallest refit
+    objective among them, exact ties left in the run's order."""
     changed = right = broken = 0
     for root in roots:
         for name, family, j in reports(root):
@@ -258,8 +262,12 @@ def near_ties(margin, roots):
             first = a["candidates"][0]  # as ranked by the run (ranks_before)
             tied = [c for c in a["candidates"] if c["confirmed"] and c["shrinkage"] >= THRESHOLD and
                     c["shrinkage"] >= first["shrinkage"] - margin]
-            pick = min(tied, key=lambda c: (TIES["physical_first"](c["effect"]), c["objective_mm"],
-                                            -c["held_out_shrinkage"]))
+            if order == "objective":
+                exact = [c for c in tied if c["shrinkage"] == first["shrinkage"]]
+                pick = first if len(exact) > 1 else min(tied, key=lambda c: c["objective_mm"])
+            else:
+                pick = min(tied, key=lambda c: (TIES["physical_first"](c["effect"]), c["objective_mm"],
+                                                -c["held_out_shrinkage"]))
             if pick["effect"] == j["verdict"]:
                 continue
             changed += 1
@@ -267,7 +275,7 @@ def near_ties(margin, roots):
             broken += j["verdict"] == family
             print(f"{root:14s} {name:16s} {family:12s} {j['verdict']:13s} -> {pick['effect']:13s} "
                   f"({first['effect']} {first['shrinkage']:.2f}, {pick['effect']} {pick['shrinkage']:.2f})")
-    print(f"margin {margin}: {changed} verdicts change, {right} to the right effect, {broken} right ones lost")
+    print(f"margin {margin} ({order}): {changed} verdicts change, {right} to the right effect, {broken} right ones lost")
 
 
 def draw_noise(roots):
@@ -301,9 +309,12 @@ def main(roots):
     if roots[:1] == ["--draw-noise"]:
         return draw_noise(roots[1:])
     if roots[:1] == ["--near-ties"]:
+        order = "physical_first"
+        if roots[2:3] == ["--objective"]:
+            order, roots = "objective", roots[:2] + roots[3:]
         if len(roots) < 3:
-            sys.exit("--near-ties M DIR...")
-        return near_ties(float(roots[1]), roots[2:])
+            sys.exit("--near-ties M [--objective] DIR...")
+        return near_ties(float(roots[1]), roots[2:], order)
     if roots[:1] == ["--tolerance"]:
         if len(roots) < 3:
             sys.exit("--tolerance T DIR...")
