@@ -35,17 +35,18 @@ struct Residual {
   double value = 0.0;  // m
 };
 
-/// A specimen-frame point's signed distance to a surface (the top's plane, the side's cylinder).
-double distance_to(Surface surface, const Eigen::Vector3d& q, const RigidSurfaces& s) {
-  return surface == Surface::kTop ? q.z() - s.top_height : std::hypot(q.x(), q.y()) - s.cylinder_radius;
+/// A specimen-frame point's signed distance to a surface (the top's plane, `lift` above the cloth's contact offset;
+/// the side's cylinder).
+double distance_to(Surface surface, const Eigen::Vector3d& q, const RigidSurfaces& s, double lift = 0.0) {
+  return surface == Surface::kTop ? q.z() - s.top_height - lift : std::hypot(q.x(), q.y()) - s.cylinder_radius;
 }
 
 /// The surface a specimen-frame point lies on within `band`, and its signed distance to it.
-Residual classify(const Eigen::Vector3d& q, const RigidSurfaces& s, double band) {
+Residual classify(const Eigen::Vector3d& q, const RigidSurfaces& s, double band, double lift) {
   const double r = std::hypot(q.x(), q.y());
   for (Surface surface : {Surface::kTop, Surface::kSide}) {
     const bool there = surface == Surface::kTop ? r < s.cylinder_radius - s.top_inset : q.z() < -s.side_below;
-    const double d = distance_to(surface, q, s);
+    const double d = distance_to(surface, q, s, lift);
     if (there && std::abs(d) < band) return {surface, d};
   }
   return {};
@@ -68,13 +69,14 @@ class RigidFit {
     }
   }
 
-  /// The residuals of every pixel on a surface within `band` at x, with the surface each was classified on.
-  void residuals(const Pose& x, double band, std::vector<Residual>& out) const {
+  /// The residuals of every pixel on a surface within `band` at x (the top `lift` higher), with the surface each was
+  /// classified on.
+  void residuals(const Pose& x, double band, std::vector<Residual>& out, double lift = 0.0) const {
     const auto to_specimen = camera_to_specimen(sensor_of(x));
     out.resize(points_.size());
     for (std::size_t i = 0; i < points_.size(); ++i) {
       const RigidPoint& p = points_[i];
-      out[i] = classify(to_specimen[static_cast<std::size_t>(p.view)] * p.camera_point, surfaces_, band);
+      out[i] = classify(to_specimen[static_cast<std::size_t>(p.view)] * p.camera_point, surfaces_, band, lift);
     }
   }
 
@@ -149,16 +151,17 @@ class RigidFit {
     return x;
   }
 
-  /// The pixels within `band` of the surfaces at x: how many on each, the top's mean signed distance, the RMS.
+  /// The pixels within `band` of the surfaces at x (the top `lift` higher): how many on each, the top's mean signed
+  /// distance, the RMS.
   struct Fit {
     int top_pixels = 0;
     int side_pixels = 0;
     double top_mean = 0.0;  // m
     double rms = 0.0;       // m
   };
-  [[nodiscard]] Fit fit_at(const Pose& x, double band) const {
+  [[nodiscard]] Fit fit_at(const Pose& x, double band, double lift = 0.0) const {
     std::vector<Residual> on;
-    residuals(x, band, on);
+    residuals(x, band, on, lift);
     Fit f;
     double top_sum = 0.0, squares = 0.0;
     for (const Residual& r : on) {
@@ -226,25 +229,27 @@ sim::Expected<RigidPose> estimate_rigid_pose(const Capture& capture, const Rigid
   Pose x = fit.solve(fit.grid_start());
   const RigidFit::Fit recorded = fit.fit_at(Pose::Zero(), settings.last_band);
   RigidFit::Fit estimated = fit.fit_at(x, settings.last_band);
+  RigidPose result;
+  if (estimated.top_pixels < settings.min_top_pixels || estimated.side_pixels < settings.min_side_pixels) {
+    return sim::Error{fmt::format("rigid surfaces: {} pixels on the platform top and {} on its bare side within {:.0f} "
+                                  "mm (needs {} and {})",
+                                  estimated.top_pixels, estimated.side_pixels, settings.last_band * 1e3,
+                                  settings.min_top_pixels, settings.min_side_pixels)};
+  }
   // A camera that moved the top along the platform axis and the side not at all reads exactly as a specimen lying
   // off the top. A cloth lies on the top or above it, never below: a top seen above its contact offset (over the
-  // first band) whose camera the side does not confirm is the cloth's lift, read at the recorded camera.
+  // first band) whose camera the side does not confirm is the cloth's lift, read at the recorded camera (its pixels
+  // counted against the lifted top).
   const double top_offset = fit.fit_at(Pose::Zero(), settings.first_band).top_mean;
   const bool side_confirms =
       estimated.side_pixels > (1.0 + settings.side_confirms) * static_cast<double>(recorded.side_pixels);
-  RigidPose result;
   if (!side_confirms && top_offset >= settings.min_lift) {
-    x = Pose::Zero(), estimated = recorded;
+    x = Pose::Zero();
+    estimated = fit.fit_at(x, settings.last_band, top_offset);
     result.top_lift = top_offset;
   }
   result.top_pixels = estimated.top_pixels;
   result.side_pixels = estimated.side_pixels;
-  if (result.top_pixels < settings.min_top_pixels || result.side_pixels < settings.min_side_pixels) {
-    return sim::Error{fmt::format("rigid surfaces: {} pixels on the platform top and {} on its bare side within {:.0f} "
-                                  "mm (needs {} and {})",
-                                  result.top_pixels, result.side_pixels, settings.last_band * 1e3,
-                                  settings.min_top_pixels, settings.min_side_pixels)};
-  }
   result.pose = sensor_of(x);
   result.rms_estimated = estimated.rms;
   result.rms_recorded = recorded.rms;

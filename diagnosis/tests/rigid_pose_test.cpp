@@ -154,6 +154,16 @@ TEST(RigidPose, ReadsATopAboveItsContactOffsetThatTheSideDoesNotConfirmAsTheClot
   ASSERT_TRUE(below.has_value()) << below.error().message;
   EXPECT_EQ(below->top_lift, 0.0);
   EXPECT_GT(platform_displacement(below->pose, lowered), 0.0015);
+  // Every depth 6 mm short (a camera nearer along its axis): the top is seen higher, but the side moved as well and
+  // confirms the camera.
+  Capture nearer = g.capture;
+  for (auto& view : nearer.views)
+    for (float& z : view.depth.depth)
+      if (z > 0.0f) z -= 0.006f;
+  auto confirmed = estimate_rigid_pose(nearer, surfaces);
+  ASSERT_TRUE(confirmed.has_value()) << confirmed.error().message;
+  EXPECT_EQ(confirmed->top_lift, 0.0);
+  EXPECT_GT(platform_displacement(confirmed->pose, nearer), 0.003);
   // The calibrated capture itself: neither lifted nor moved.
   auto calibrated = estimate_rigid_pose(g.capture, surfaces);
   ASSERT_TRUE(calibrated.has_value()) << calibrated.error().message;

@@ -47,7 +47,8 @@ struct RigidPoseSettings {
   int min_side_pixels = 100;
   /// The side confirms the estimate's camera when this share more of its pixels lie within the last band there than
   /// at the recorded camera (a camera error moves the side: the benchmark's pose errors and depth biases add 80% or
-  /// more, the lifted top of a specimen that slid 0-3%; docs/DIAGNOSIS.md).
+  /// more, the lifted top of a specimen that slid 0-3%; docs/DIAGNOSIS.md). A camera error that moves the side by
+  /// well under the last band changes the count little: with a top seen lifted it is read as the cloth's.
   double side_confirms = 0.1;
   /// m: a top seen this far above the contact offset (its mean over the first band, at the recorded camera) whose
   /// estimate the side does not confirm is the cloth's lift: the estimate is the recorded camera.
@@ -60,7 +61,8 @@ struct RigidPose {
   double rms_recorded = 0.0;
   double rms_estimated = 0.0;
   /// m: how far the cloth on the top lies above its contact offset when it is read as lifted (then the pose is the
-  /// recorded camera's, no error); 0 when the offset is read as the camera's.
+  /// recorded camera's, no error, and the top's pixels and RMS are counted against the lifted top); 0 when the offset
+  /// is read as the camera's.
   double top_lift = 0.0;
   int top_pixels = 0;   // at the estimate, within the last band
   int side_pixels = 0;
