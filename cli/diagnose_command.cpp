@@ -248,9 +248,9 @@ Runner add_diagnose_command(CLI::App& app) {
                              diagnosis::AttributionSettings{}.common_bending_effects));
   app.add_option("--tie-margin", o->tie_margin,
                  "Candidates whose shrinkage is within this of the first's are tied: among the confirmed ones that "
-                 "shrink the gap significantly, a physical effect before the sensor error, then the smaller refit "
-                 "objective is named (0: exact ties only; 0.1 was negative on a fresh seed, docs/DIAGNOSIS.md, "
-                 "\"Session 30\")")
+                 "shrink the gap significantly, the smallest refit objective is named; a first tied exactly keeps "
+                 "the exact-tie order, a physical effect before the sensor error (0: exact ties only; "
+                 "docs/DIAGNOSIS.md, \"Session 31\")")
       ->capture_default_str();
   app.add_option("--refit-scan", o->refit_scan,
                  fmt::format("Refits of one-parameter effects (yield, shear, curl, friction) start with this many "

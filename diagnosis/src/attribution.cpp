@@ -415,29 +415,23 @@ bool curl_first(std::vector<CandidateResult>& ranked, double significant) {
   return true;
 }
 
-namespace {
-
-/// ranks_before's order among candidates of equal shrinkage.
-bool tie_before(const CandidateResult& x, const CandidateResult& y) {
+bool ranks_before(const CandidateResult& x, const CandidateResult& y) {
+  if (x.confirmed != y.confirmed) return x.confirmed;
+  if (x.shrinkage != y.shrinkage) return x.shrinkage > y.shrinkage;
   if (needs_simulation(x.effect) != needs_simulation(y.effect)) return needs_simulation(x.effect);
   if (x.objective != y.objective) return x.objective < y.objective;
   return x.held_out_shrinkage > y.held_out_shrinkage;
 }
 
-}  // namespace
-
-bool ranks_before(const CandidateResult& x, const CandidateResult& y) {
-  if (x.confirmed != y.confirmed) return x.confirmed;
-  if (x.shrinkage != y.shrinkage) return x.shrinkage > y.shrinkage;
-  return tie_before(x, y);
-}
-
 bool near_ties_first(std::vector<CandidateResult>& ranked, double margin, double significant) {
   if (ranked.empty() || !ranked.front().confirmed || margin <= 0.0) return false;
+  // A first tied exactly keeps ranks_before's order (a physical effect before the sensor error).
+  if (ranked.size() > 1 && ranked[1].confirmed && ranked[1].shrinkage == ranked.front().shrinkage) return false;
   const double from = ranked.front().shrinkage - margin;
   auto best = ranked.begin();
   for (auto it = ranked.begin() + 1; it != ranked.end(); ++it) {
-    if (it->confirmed && it->shrinkage >= significant && it->shrinkage >= from && tie_before(*it, *best)) best = it;
+    if (it->confirmed && it->shrinkage >= significant && it->shrinkage >= from && it->objective < best->objective)
+      best = it;
   }
   if (best == ranked.begin()) return false;  // (every other candidate it may pick is significant)
   std::rotate(ranked.begin(), best, best + 1);

@@ -168,8 +168,7 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
                       r.verdict, r.attribution.confidence, r.runner_up, 100.0 * c.shrinkage);
     if (r.attribution.near_tie_promoted && !r.attribution.curl_promoted)
       md += fmt::format("It is named ahead of a candidate whose shrinkage is larger by less than {:.2f}, a tie within "
-                        "the validation drapes' noise: a physical effect before the sensor error, then the smaller "
-                        "refit objective.\n\n",
+                        "the validation drapes' noise: the smaller refit objective names one.\n\n",
                         r.attribution.tie_margin);
     if (r.attribution.curl_promoted)
       md += "Curl is named ahead of the candidate its shrinkage ranks first: the capture's placements fold less "

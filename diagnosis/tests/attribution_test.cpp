@@ -158,18 +158,19 @@ TEST(CurlFirst, MovesAConfirmedSignificantCurlToTheFrontKeepingTheOthersOrder) {
   EXPECT_FALSE(curl_first(none, 0.25));
 }
 
-TEST(NearTiesFirst, NamesThePreferredOfTheSignificantConfirmedCandidatesWithinTheMargin) {
-  // Seed 23's friction_04 in kind: the sensor error 0.03 ahead of friction, which fits with the smaller objective.
-  std::vector<CandidateResult> order{ranked(Effect::kSensor, true, 0.90, 7.49e-3, 0.125),
-                                     ranked(Effect::kFriction, true, 0.87, 7.11e-3, 0.126),
-                                     ranked(Effect::kShear, true, 0.16, 7.28e-3, 0.22)};
+TEST(NearTiesFirst, NamesTheSmallestObjectiveOfTheSignificantConfirmedCandidatesWithinTheMargin) {
+  // Seed 28's sensor_04 in kind (a depth bias): shear 0.0003 ahead of the sensor error, which fits with the smaller
+  // objective.
+  std::vector<CandidateResult> order{ranked(Effect::kShear, true, 0.4446, 10.69e-3, 0.08),
+                                     ranked(Effect::kSensor, true, 0.4443, 10.17e-3, 0.33),
+                                     ranked(Effect::kFriction, true, 0.29, 13.29e-3, 0.14)};
   std::vector<CandidateResult> exact = order;
   EXPECT_FALSE(near_ties_first(exact, 0.0, 0.25));  // a margin of 0: exact ties only (ranks_before's)
-  EXPECT_EQ(exact[0].effect, Effect::kSensor);
+  EXPECT_EQ(exact[0].effect, Effect::kShear);
   ASSERT_TRUE(near_ties_first(order, 0.1, 0.25));
-  EXPECT_EQ(order[0].effect, Effect::kFriction);
-  EXPECT_EQ(order[1].effect, Effect::kSensor);  // the others keep their order
-  EXPECT_EQ(order[2].effect, Effect::kShear);
+  EXPECT_EQ(order[0].effect, Effect::kSensor);
+  EXPECT_EQ(order[1].effect, Effect::kShear);  // the others keep their order
+  EXPECT_EQ(order[2].effect, Effect::kFriction);
   EXPECT_FALSE(near_ties_first(order, 0.1, 0.25));  // already first
   // Seed 20's curl_04 in kind: two physical effects 0.10 apart, the second with the smaller objective; just outside
   // the margin, or with the larger objective, the first stays.
@@ -181,6 +182,13 @@ TEST(NearTiesFirst, NamesThePreferredOfTheSignificantConfirmedCandidatesWithinTh
   EXPECT_EQ(physical[0].effect, Effect::kCurl);
   std::vector<CandidateResult> larger{ranked(Effect::kYield, true, 0.674, 7e-3, 0.0), ranked(Effect::kCurl, true, 0.6, 8e-3, 0.0)};
   EXPECT_FALSE(near_ties_first(larger, 0.1, 0.25));
+  // A first tied exactly keeps ranks_before's order (friction before the sensor error at 1.0 on seeds 22-28), even
+  // with a third within the margin that fits better.
+  std::vector<CandidateResult> tied{ranked(Effect::kFriction, true, 1.0, 5.79e-3, 0.03),
+                                    ranked(Effect::kSensor, true, 1.0, 5.85e-3, 0.07),
+                                    ranked(Effect::kShear, true, 0.95, 5.2e-3, 0.19)};
+  EXPECT_FALSE(near_ties_first(tied, 0.1, 0.25));
+  EXPECT_EQ(tied[0].effect, Effect::kFriction);
   // Only a confirmed candidate that is significant itself, and only behind a confirmed first.
   std::vector<CandidateResult> unconfirmed{ranked(Effect::kSensor, true, 0.9, 8e-3, 0.0), ranked(Effect::kCurl, false, 0.88, 7e-3, 0.0)};
   EXPECT_FALSE(near_ties_first(unconfirmed, 0.1, 0.25));
