@@ -262,7 +262,7 @@ endif()
 # the first is named and lies within it.
 string(JSON margin GET "${out}" attribution near_tie margin)
 string(JSON promoted GET "${out}" attribution near_tie promoted)
-if(NOT margin STREQUAL "0.1")
+if(margin LESS 0.0999 OR margin GREATER 0.1001)  # (as written: 0.10000000000000001)
   message(FATAL_ERROR "near-tie margin ${margin}, not the default 0.1")
 endif()
 if(promoted)
