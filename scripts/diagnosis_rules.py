@@ -42,12 +42,13 @@ the main rule):
 One more lists where session 29's common bending would be validated (it needs a simulation, so no verdict here):
 - `--common DIR...`: per capture, the confirmed candidates that each bring the gate's excess to 0 (`common` when
   three or more, AttributionSettings::common_bending_effects), the verdict as run and whether it is right.
-And one lists where session 30's near ties change the verdict as run (reports made before it; near_ties_first):
+And one lists where near ties change the verdict as run (session 30's order, gone since session 31, and the order
+near_ties_first names by since then):
 - `--near-ties M DIR...`: among the confirmed candidates at least THRESHOLD and within M of the first's shrinkage, a
   physical effect before the sensor error, then the smaller refit objective, then the larger held-out shrinkage
   (not applied where the run put curl first, or named none);
-- `--near-ties M --objective DIR...` (session 31's hypothesis): the same candidates, the smallest refit objective
-  named, where the first is not tied exactly (exact ties keep the run's order);
+- `--near-ties M --objective DIR...` (session 31's hypothesis, the default since): the same candidates, the smallest
+  refit objective named, where the first is not tied exactly (exact ties keep the run's order);
 - `--draw-noise DIR...`: how much the gate's excess changes, as a share of itself, when the second-best validation
   drape by fit score is taken instead of the best (the noise a shrinkage carries; the margin's scale).
 
@@ -251,8 +252,8 @@ def common(roots):
 
 def near_ties(margin, roots, order="physical_first"):
     """Where candidates within `margin` of the first's shrinkage, tied, name another effect than the run did. Order
-    "physical_first" as session 30's near_ties_first; "objective" (session 31's hypothesis) names the smallest refit
-    objective among them, exact ties left in the run's order."""
+    "physical_first" as session 30's near_ties_first ran (gone since session 31); "objective" as near_ties_first names
+    since session 31: the smallest refit objective among them, exact ties left in the run's order."""
     changed = right = broken = 0
     for root in roots:
         for name, family, j in reports(root):
