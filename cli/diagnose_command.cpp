@@ -46,6 +46,7 @@ struct DiagnoseOptions {
   bool gap_only = false;
   bool ablation = false;
   bool sensor_bending = false;
+  bool free_sensor = false;
   int common_bending = -1;  // < 0: the settings' value
   double tie_margin = diagnosis::AttributionSettings{}.tie_margin;
   double held_out_tolerance = diagnosis::AttributionSettings{}.held_out_tolerance;
@@ -124,6 +125,7 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (o.refit_evaluations > 0) settings.attribution.optimiser.max_evaluations = o.refit_evaluations;
   if (o.sensor_evaluations > 0) settings.attribution.sensor_evaluations = o.sensor_evaluations;
   settings.attribution.sensor_bending = o.sensor_bending;
+  settings.hold_sensor = !o.free_sensor;
   if (o.common_bending >= 0) settings.attribution.common_bending_effects = o.common_bending;
   settings.attribution.tie_margin = o.tie_margin;
   if (o.refit_scan >= 0) settings.attribution.scan_levels = o.refit_scan;
@@ -240,6 +242,11 @@ Runner add_diagnose_command(CLI::App& app) {
                "by simulation (a grid of 3 scales x 2 gains, a simplex within --refit-evaluations, the best without "
                "multipath), and keeps it if it beats both the re-rendering and that (off by default; "
                "docs/DIAGNOSIS.md, \"Session 29\")");
+  app.add_flag("--free-sensor", o->free_sensor,
+               "Refit all nine parameters of the sensor candidate (camera pose, depth bias and slope, multipath) "
+               "wherever the camera sits. By default, where the rigid surfaces show the camera as recorded (it moves "
+               "the platform's centre less than 3 mm), the candidate keeps their camera and no depth bias and refits "
+               "only the multipath gain, which they cannot see (docs/DIAGNOSIS.md, \"Session 32\")");
   app.add_option("--common-bending", o->common_bending,
                  fmt::format("Where this many confirmed candidates or more each bring the gap within the floors, "
                              "validate the baseline's bending at the median of their scales, and within the floors "

@@ -179,7 +179,16 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
       x0[r] = std::clamp(start.rotation[k] * 1e3, lo[r], hi[r]);
       x0[t] = std::clamp(start.translation[k] * 1e3, lo[t], hi[t]);
     }
-    sim::logger()->debug("refit sensor: start from the rigid surfaces' pose {}", fmt::join(x0, ", "));
+    if (settings.sensor_held) {
+      // The camera as the rigid surfaces show it, no depth bias or slope: a box of one value holds each (nelder_mead).
+      const std::size_t gain = x0.size() - 1;  // multipath_mm, effect_space's last
+      for (std::size_t k = first; k < gain; ++k) {
+        if (k >= first + 6) x0[k] = 0.0;
+        lo[k] = hi[k] = x0[k];
+      }
+    }
+    sim::logger()->debug("refit sensor: start from the rigid surfaces' pose {}{}", fmt::join(x0, ", "),
+                         settings.sensor_held ? " (held; the multipath gain alone is refitted)" : "");
   }
 
   std::vector<sim::ClothMesh> meshes;
@@ -569,6 +578,7 @@ sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& base
   }
   std::stable_sort(a.candidates.begin(), a.candidates.end(), ranks_before);
   a.tie_margin = settings.tie_margin;
+  a.sensor_held = settings.sensor_held && settings.sensor_start.has_value();
   a.near_tie_promoted = near_ties_first(a.candidates, settings.tie_margin, settings.significant_shrinkage);
   if (a.near_tie_promoted)
     sim::logger()->info("attribution: {} within {:.2f} of the first's shrinkage; named first as a tie",

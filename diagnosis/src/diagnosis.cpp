@@ -427,7 +427,11 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
       attribution_settings.bending_scale_upper = hi[0] - r.fitted_reduced[0];
       attribution_settings.bending_scale_known = true;
     }
-    if (r.rigid_pose) attribution_settings.sensor_start = r.rigid_pose->pose;
+    if (r.rigid_pose) {
+      attribution_settings.sensor_start = r.rigid_pose->pose;
+      attribution_settings.sensor_held =
+          settings.hold_sensor && r.localisation.camera_moved < kCameraMovedAtPlatform;
+    }
     r.refit_scale_lower = attribution_settings.bending_scale_lower;
     r.refit_scale_upper = attribution_settings.bending_scale_upper;
     auto attribution = attribute(model, fitted, r.fit, r.validated, r.floors, attribution_settings, make_model,
@@ -614,6 +618,7 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                       {"near_tie", ran ? nlohmann::json{{"margin", r.attribution.tie_margin},
                                                         {"promoted", r.attribution.near_tie_promoted}}
                                        : nlohmann::json(nullptr)},
+                      {"sensor_held", ran ? nlohmann::json(r.attribution.sensor_held) : nullptr},
                       {"confirmed_on", r.validated_held_out ? "held_out_capture" : "held_out_view"},
                       {"held_out_tolerance", ran ? nlohmann::json(r.attribution.held_out_tolerance) : nullptr},
                       {"significant_shrinkage", ran ? nlohmann::json(r.attribution.significant_shrinkage) : nullptr},

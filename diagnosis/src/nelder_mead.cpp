@@ -16,6 +16,37 @@ NelderMeadResult nelder_mead(const std::function<double(const std::vector<double
   if (step.size() != n || lower.size() != n || upper.size() != n || n == 0) {
     throw std::invalid_argument("nelder_mead: x0, step and bounds must have the same non-zero size");
   }
+  // Coordinates boxed to a single value are held there: the simplex spans the others (a degenerate simplex would
+  // spend evaluations on the held directions and never leave the plane they pin).
+  std::vector<std::size_t> free;
+  for (std::size_t i = 0; i < n; ++i)
+    if (lower[i] < upper[i]) free.push_back(i);
+  if (free.size() < n) {
+    auto expand = [&](const std::vector<double>& y) {
+      std::vector<double> x(n);
+      for (std::size_t i = 0; i < n; ++i) x[i] = std::clamp(x0[i], lower[i], upper[i]);
+      for (std::size_t k = 0; k < free.size(); ++k) x[free[k]] = y[k];
+      return x;
+    };
+    if (free.empty()) {  // nothing to search: the one point
+      NelderMeadResult held;
+      held.x = expand({});
+      held.f = f(held.x);
+      if (!std::isfinite(held.f)) held.f = std::numeric_limits<double>::max();
+      held.evaluations = 1;
+      held.converged = true;
+      held.history = {held.f};
+      return held;
+    }
+    std::vector<double> y0, y_step, y_lower, y_upper;
+    for (std::size_t i : free) {
+      y0.push_back(x0[i]), y_step.push_back(step[i]), y_lower.push_back(lower[i]), y_upper.push_back(upper[i]);
+    }
+    NelderMeadResult reduced = nelder_mead([&](const std::vector<double>& y) { return f(expand(y)); }, y0, y_step,
+                                           y_lower, y_upper, options);
+    reduced.x = expand(reduced.x);
+    return reduced;
+  }
   NelderMeadResult result;
   double best = std::numeric_limits<double>::infinity();
   auto clamp = [&](std::vector<double> x) {

@@ -171,6 +171,13 @@ struct AttributionSettings {
   /// else none. The candidate only re-renders the baseline's drapes, so a start far from a large pose error was
   /// never reached (docs/DIAGNOSIS.md, "Session 28").
   std::optional<renderer::SensorError> sensor_start;
+  /// The rigid surfaces show the camera where its calibration puts it: diagnose() sets this (DiagnosisSettings::
+  /// hold_sensor) when the rigid estimate moves the platform's centre less than kCameraMovedAtPlatform (a top read as
+  /// lifted included). The sensor candidate then keeps sensor_start's pose and no depth bias or slope (each moves the
+  /// rigid surfaces as a camera error does) and refits only the multipath gain, which they cannot see. Free, its nine
+  /// parameters took a friction specimen's lifted top for a small camera error on 18 of 23 friction captures
+  /// (docs/DIAGNOSIS.md, "Session 32").
+  bool sensor_held = false;
   /// The sensor candidate also refits the bending under the camera it found, with a multipath gain, by simulation:
   /// a multipath error deepens the folds' valleys as seen, the baseline fit takes that for a softer fabric, and
   /// re-rendering its drapes with the true gain scores worse than without (docs/DIAGNOSIS.md, "Session 28"). After the
@@ -219,6 +226,7 @@ struct Attribution {
   /// near_ties_first moved a candidate within AttributionSettings::tie_margin of the first's shrinkage to the front.
   bool near_tie_promoted = false;
   double tie_margin = 0.0;  // the margin it ran with
+  bool sensor_held = false;  // the sensor candidate refitted the multipath gain alone (AttributionSettings)
   /// The effects of the confirmed candidates that each brought the gate within the floors, where there were
   /// AttributionSettings::common_bending_effects or more (and the bar was not within the floors itself); else empty.
   std::vector<Effect> common_effects;

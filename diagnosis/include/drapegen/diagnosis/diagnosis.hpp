@@ -42,6 +42,10 @@ struct DiagnosisSettings {
   /// within_factor the start_box. false: the capture's measured bending is not used (the fit starts at the
   /// drape-coefficient guess and searches the whole box).
   bool use_measured_bending = true;
+  /// Where the rigid surfaces show the camera as recorded (within kCameraMovedAtPlatform at the platform), the sensor
+  /// candidate refits only the multipath gain under their camera (AttributionSettings::sensor_held). false: its nine
+  /// parameters are free wherever the camera sits (before session 32).
+  bool hold_sensor = true;
   std::vector<double> start_ratios_mm{1.8, 3.6};  // about the 20% and 86% quantiles of fabrics618's -beta/alpha
   FloorSettings floors;
   AttributionSettings attribution;

@@ -22,7 +22,8 @@ struct NelderMeadResult {
   std::vector<double> history;  // best value after each evaluation
 };
 
-/// Minimises f from x0 with an initial simplex x0 + step_i e_i (step_i < 0 allowed), inside [lower, upper].
+/// Minimises f from x0 with an initial simplex x0 + step_i e_i (step_i < 0 allowed), inside [lower, upper]. A
+/// coordinate with lower_i == upper_i is held at that value: the simplex spans only the others (none: f once).
 [[nodiscard]] NelderMeadResult nelder_mead(const std::function<double(const std::vector<double>&)>& f,
                                            const std::vector<double>& x0, const std::vector<double>& step,
                                            const std::vector<double>& lower, const std::vector<double>& upper,
