@@ -245,7 +245,7 @@ Runner add_diagnose_command(CLI::App& app) {
   app.add_flag("--free-sensor", o->free_sensor,
                "Refit all nine parameters of the sensor candidate (camera pose, depth bias and slope, multipath) "
                "wherever the camera sits. By default, where the rigid surfaces show the camera as recorded (it moves "
-               "the platform's centre less than 3 mm), the candidate keeps their camera and no depth bias and refits "
+               "the platform's centre less than 3 mm), the candidate keeps their camera, no depth bias or slope, and refits "
                "only the multipath gain, which they cannot see (docs/DIAGNOSIS.md, \"Session 32\")");
   app.add_option("--common-bending", o->common_bending,
                  fmt::format("Where this many confirmed candidates or more each bring the gap within the floors, "

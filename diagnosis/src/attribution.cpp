@@ -578,7 +578,9 @@ sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& base
   }
   std::stable_sort(a.candidates.begin(), a.candidates.end(), ranks_before);
   a.tie_margin = settings.tie_margin;
-  a.sensor_held = settings.sensor_held && settings.sensor_start.has_value();
+  a.sensor_held = settings.sensor_held && settings.sensor_start.has_value() &&
+                  std::find(settings.candidates.begin(), settings.candidates.end(), Effect::kSensor) !=
+                      settings.candidates.end();
   a.near_tie_promoted = near_ties_first(a.candidates, settings.tie_margin, settings.significant_shrinkage);
   if (a.near_tie_promoted)
     sim::logger()->info("attribution: {} within {:.2f} of the first's shrinkage; named first as a tie",

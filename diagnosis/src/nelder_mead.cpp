@@ -19,8 +19,10 @@ NelderMeadResult nelder_mead(const std::function<double(const std::vector<double
   // Coordinates boxed to a single value are held there: the simplex spans the others (a degenerate simplex would
   // spend evaluations on the held directions and never leave the plane they pin).
   std::vector<std::size_t> free;
-  for (std::size_t i = 0; i < n; ++i)
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!(lower[i] <= upper[i])) throw std::invalid_argument("nelder_mead: a lower bound above its upper bound (or NaN)");
     if (lower[i] < upper[i]) free.push_back(i);
+  }
   if (free.size() < n) {
     auto expand = [&](const std::vector<double>& y) {
       std::vector<double> x(n);

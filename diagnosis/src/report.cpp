@@ -204,9 +204,10 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
                         p.top_lift * 1e3);
     }
     if (r.attribution.sensor_held)
-      md += "That camera is within 3 mm of its calibration at the platform: the sensor candidate keeps it, with no "
-            "depth bias (both would move the rigid surfaces), and refits only the multipath gain, which they cannot "
-            "see.\n\n";
+      md += fmt::format("That camera is within {:.0f} mm of its calibration at the platform: the sensor candidate keeps "
+                        "it, with no depth bias or slope (either would move the rigid surfaces), and refits only the "
+                        "multipath gain, which they cannot see.\n\n",
+                        kCameraMovedAtPlatform * 1e3);
   } else {
     md += fmt::format("Camera from the rigid surfaces: not estimated ({}); the sensor candidate starts from the recorded "
                       "camera.\n\n", r.rigid_pose_error);

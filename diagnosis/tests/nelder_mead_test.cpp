@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <stdexcept>
 
 #include "drapegen/diagnosis/nelder_mead.hpp"
 
@@ -76,4 +77,8 @@ TEST(NelderMead, HoldsCoordinatesBoxedToOneValue) {
   EXPECT_EQ(one.evaluations, 1);
   EXPECT_EQ(one.x, (std::vector<double>{7, 0.5, 0.5, 4.0}));
   EXPECT_NEAR(one.f, 36.0 + 36.0, 1e-12);
+
+  // A box upside down is an error, not a held coordinate.
+  EXPECT_THROW((void)nelder_mead(f, {0, 0, 0.5, 4.0}, {1, 1, 1, 1}, {-5, 1, 0.5, 4.0}, {5, -1, 0.5, 4.0}, o),
+               std::invalid_argument);
 }
