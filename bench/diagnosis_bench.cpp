@@ -85,6 +85,7 @@ int main(int argc, char** argv) {
   bool quick = false, generate_only = false, score_only = false, held_out_placement = false, second_placement = false;
   std::uint64_t seed = 1;
   std::vector<std::string> families{"yield", "shear", "curl", "friction", "misalignment", "sensor"};
+  std::vector<std::string> sensor_kinds{"pose", "bias", "multipath"};
   app.add_option("--out", out, "Benchmark directory (diagnoses already in it are kept: a rerun resumes)")->capture_default_str();
   app.add_option("--fabrics", fabrics_path, "fabrics618.csv")->capture_default_str();
   app.add_option("--drapegen", drapegen, "The drapegen program (default: beside this program)");
@@ -107,6 +108,10 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(CLI::Range(1, 10));
   std::vector<std::string> strength_overrides;
+  app.add_option("--sensor-kinds", sensor_kinds,
+                 "The sensor family's errors, drawn in turn over its captures (pose, bias, multipath; give the same "
+                 "list to --score-only)")
+      ->capture_default_str();
   app.add_option("--strength", strength_overrides, "NAME=LO:HI: draw that effect's strength in [LO, HI]");
   int screen_draws = 0;
   app.add_option("--visible-only", screen_draws,
@@ -137,6 +142,16 @@ int main(int argc, char** argv) {
       ->excludes("--held-out-placement");
   CLI11_PARSE(app, argc, argv);
   if (drapegen.empty()) drapegen = (fs::path(argv[0]).parent_path() / "drapegen").string();
+  if (sensor_kinds.empty()) {
+    std::cerr << "diagnosis_bench: error: --sensor-kinds: give at least one of pose, bias, multipath\n";
+    return 1;
+  }
+  for (const auto& k : sensor_kinds) {
+    if (k != "pose" && k != "bias" && k != "multipath") {
+      std::cerr << "diagnosis_bench: error: --sensor-kinds: unknown sensor error '" << k << "' (pose, bias, multipath)\n";
+      return 1;
+    }
+  }
   auto strength_range = kDefaultStrength;
   for (const auto& o : strength_overrides) {
     const auto eq = o.find('='), colon = o.find(':');
@@ -183,8 +198,7 @@ int main(int argc, char** argv) {
     if (family == "none") {
       c.effect = "";
     } else if (family == "sensor") {
-      static const char* kinds[] = {"pose", "bias", "multipath"};
-      c.effect = kinds[sensor_kind++ % 3];
+      c.effect = sensor_kinds[static_cast<std::size_t>(sensor_kind++) % sensor_kinds.size()];
     } else if (family == "misalignment") {
       c.effect = "misalign";
     } else {
