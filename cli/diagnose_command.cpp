@@ -244,9 +244,10 @@ Runner add_diagnose_command(CLI::App& app) {
                "docs/DIAGNOSIS.md, \"Session 29\")");
   app.add_flag("--free-sensor", o->free_sensor,
                "Refit all nine parameters of the sensor candidate (camera pose, depth bias and slope, multipath) "
-               "wherever the camera sits. By default, where the rigid surfaces show the camera as recorded (it moves "
-               "the platform's centre less than 3 mm), the candidate keeps their camera, no depth bias or slope, and refits "
-               "only the multipath gain, which they cannot see (docs/DIAGNOSIS.md, \"Session 32\")");
+               "wherever the camera sits. By default, where the rigid surfaces show the camera as recorded (it "
+               "moves the platform's centre less than 3 mm), the candidate keeps their camera, no depth bias or "
+               "slope, and refits only the multipath gain, which they cannot see (docs/DIAGNOSIS.md, \"Session "
+               "32\")");
   app.add_option("--common-bending", o->common_bending,
                  fmt::format("Where this many confirmed candidates or more each bring the gap within the floors, "
                              "validate the baseline's bending at the median of their scales, and within the floors "

@@ -20,7 +20,8 @@ NelderMeadResult nelder_mead(const std::function<double(const std::vector<double
   // spend evaluations on the held directions and never leave the plane they pin).
   std::vector<std::size_t> free;
   for (std::size_t i = 0; i < n; ++i) {
-    if (!(lower[i] <= upper[i])) throw std::invalid_argument("nelder_mead: a lower bound above its upper bound (or NaN)");
+    if (!(lower[i] <= upper[i]))
+      throw std::invalid_argument("nelder_mead: a lower bound above its upper bound (or NaN)");
     if (lower[i] < upper[i]) free.push_back(i);
   }
   if (free.size() < n) {
