@@ -49,6 +49,8 @@ near_ties_first names by since then):
   (not applied where the run put curl first, or named none);
 - `--near-ties M --objective DIR...` (session 31's hypothesis, the default since): the same candidates, the smallest
   refit objective named, where the first is not tied exactly (exact ties keep the run's order);
+- `--substitute EFFECT NEW OLD` (session 32): OLD's verdicts with EFFECT's candidate taken from NEW's reports of the
+  same captures (a run with `--candidates EFFECT` under a changed refit), ranked as attribute() ranks;
 - `--draw-noise DIR...`: how much the gate's excess changes, as a share of itself, when the second-best validation
   drape by fit score is taken instead of the best (the noise a shrinkage carries; the margin's scale).
 
@@ -303,8 +305,61 @@ def draw_noise(roots):
               f"{shares[3 * n // 4]:.3f} (quartiles)")
 
 
+def substitute(effect, new_root, old_root):
+    """The verdicts of old_root's reports with one candidate's refit taken from new_root's reports of the same
+    captures (e.g. a run with `--candidates sensor` under a changed sensor refit; every other candidate refits
+    deterministically, so the rest of the report stands): ranked as attribute() ranks (confirmed first, shrinkage,
+    a physical effect before the sensor error, objective), then session 31's near ties by the refit objective.
+    Captures where the run put curl first, or where the common bending's count of candidates within the floors
+    crosses three, need a diagnosis (a simulation): they are flagged, their verdict left as run."""
+    changed = right = broken = 0
+    for f in sorted(glob.glob(os.path.join(new_root, "diagnoses", "*.json"))):
+        name = os.path.basename(f)[:-5]
+        with open(f) as fh:
+            new = json.load(fh)
+        with open(os.path.join(old_root, "diagnoses", name + ".json")) as fh:
+            j = json.load(fh)
+        with open(os.path.join(old_root, "truth", name + ".json")) as fh:
+            truth = json.load(fh)
+        family = FAMILY.get(truth["family"], truth["family"]) or "none"
+        a = j.get("attribution") or {}
+        swapped = [c for c in (new.get("attribution") or {}).get("candidates", []) if c["effect"] == effect]
+        if not a.get("ran") or not swapped:
+            continue
+        before = next((c for c in a["candidates"] if c["effect"] == effect), None)
+        candidates = [c for c in a["candidates"] if c["effect"] != effect] + swapped
+        within = [len([c for c in cs if c["confirmed"] and c["validated"]["excess_above_floors"] == 0.0]) >= 3
+                  for cs in (a["candidates"], candidates)]
+        verdict, note = j["verdict"], ""
+        if a.get("curl_first") or within[0] != within[1]:
+            note = "needs a diagnosis (curl first or the common bending)"
+        elif not j.get("within_floors_after_bending_refit", False) and verdict != "none":
+            ranked = sorted(candidates, key=lambda c: (not c["confirmed"], -c["shrinkage"], c["effect"] == "sensor",
+                                                       c["objective_mm"]))
+            first = ranked[0]
+            if not first["confirmed"] or first["shrinkage"] < THRESHOLD:
+                verdict = "unexplained"
+            else:
+                tied = [c for c in ranked if c["confirmed"] and c["shrinkage"] >= THRESHOLD and
+                        c["shrinkage"] >= first["shrinkage"] - a.get("near_tie", {}).get("margin", 0.1)]
+                exact = [c for c in tied if c["shrinkage"] == first["shrinkage"]]
+                verdict = (first if len(exact) > 1 else min(tied, key=lambda c: c["objective_mm"]))["effect"]
+        if verdict != j["verdict"]:
+            changed += 1
+            right += verdict == family
+            broken += j["verdict"] == family
+        was = f"{before['shrinkage']:.2f}" if before else "-"
+        print(f"{name:16s} {family:12s} {j['verdict']:13s} -> {verdict:13s} {effect} {was} -> "
+              f"{swapped[0]['shrinkage']:.2f} {note}")
+    print(f"{effect} from {new_root}: {changed} verdicts change, {right} to the right effect, {broken} right ones lost")
+
+
 def main(roots):
     global TOLERANCE
+    if roots[:1] == ["--substitute"]:
+        if len(roots) != 4:
+            sys.exit("--substitute EFFECT NEW_DIR OLD_DIR")
+        return substitute(*roots[1:])
     if roots[:1] == ["--common"]:
         return common(roots[1:])
     if roots[:1] == ["--draw-noise"]:
