@@ -221,13 +221,14 @@ def verdicts(j):
 COLUMNS = ["none", "unexplained", "not attributed", "yield", "shear", "curl", "friction", "misalignment", "sensor"]
 
 
-def reports(root):
-    """(name, family, report) of every diagnosis of a run, its truth file read for the family alone."""
+def reports(root, truth_root=None):
+    """(name, family, report) of every diagnosis of a run, its truth file (in truth_root if given) read for the
+    family alone."""
     for f in sorted(glob.glob(os.path.join(root, "diagnoses", "*.json"))):
         name = os.path.basename(f)[:-5]
         with open(f) as fh:
             j = json.load(fh)
-        with open(os.path.join(root, "truth", name + ".json")) as fh:
+        with open(os.path.join(truth_root or root, "truth", name + ".json")) as fh:
             truth = json.load(fh)
         yield name, FAMILY.get(truth["family"], truth["family"]) or "none", j
 
@@ -313,15 +314,9 @@ def substitute(effect, new_root, old_root):
     Captures where the run put curl first, or where the common bending's count of candidates within the floors
     crosses three, need a diagnosis (a simulation): they are flagged, their verdict left as run."""
     changed = right = broken = 0
-    for f in sorted(glob.glob(os.path.join(new_root, "diagnoses", "*.json"))):
-        name = os.path.basename(f)[:-5]
-        with open(f) as fh:
-            new = json.load(fh)
+    for name, family, new in reports(new_root, truth_root=old_root):
         with open(os.path.join(old_root, "diagnoses", name + ".json")) as fh:
             j = json.load(fh)
-        with open(os.path.join(old_root, "truth", name + ".json")) as fh:
-            truth = json.load(fh)
-        family = FAMILY.get(truth["family"], truth["family"]) or "none"
         a = j.get("attribution") or {}
         swapped = [c for c in (new.get("attribution") or {}).get("candidates", []) if c["effect"] == effect]
         if not a.get("ran") or not swapped:
