@@ -253,6 +253,27 @@ def common(roots):
     print(f"common bending fires on {fired} captures, {right} of them named right as run")
 
 
+def ranks_before_key(c):
+    """attribute()'s order (ranks_before): confirmed first, the shrinkage, a physical effect before the sensor error,
+    the smaller objective, the larger held-out shrinkage."""
+    return (not c["confirmed"], -c["shrinkage"], TIES["physical_first"](c["effect"]), c["objective_mm"],
+            -c["held_out_shrinkage"])
+
+
+def tied_with_first(ranked, margin):
+    """The confirmed significant candidates within `margin` of the first's shrinkage (ranked as ranks_before)."""
+    first = ranked[0]
+    return [c for c in ranked if c["confirmed"] and c["shrinkage"] >= THRESHOLD and
+            c["shrinkage"] >= first["shrinkage"] - margin]
+
+
+def objective_pick(ranked, tied):
+    """near_ties_first since session 31: the smallest refit objective among `tied`, unless the first is tied exactly
+    (then the first)."""
+    exact = [c for c in tied if c["shrinkage"] == ranked[0]["shrinkage"]]
+    return ranked[0] if len(exact) > 1 else min(tied, key=lambda c: c["objective_mm"])
+
+
 def near_ties(margin, roots, order="physical_first"):
     """Where candidates within `margin` of the first's shrinkage, tied, name another effect than the run did. Order
     "physical_first" as session 30's near_ties_first ran (gone since session 31); "objective" as near_ties_first names
@@ -264,11 +285,9 @@ def near_ties(margin, roots, order="physical_first"):
             if not a.get("ran") or j["verdict"] in ("none", "unexplained") or a.get("curl_first"):
                 continue
             first = a["candidates"][0]  # as ranked by the run (ranks_before)
-            tied = [c for c in a["candidates"] if c["confirmed"] and c["shrinkage"] >= THRESHOLD and
-                    c["shrinkage"] >= first["shrinkage"] - margin]
+            tied = tied_with_first(a["candidates"], margin)
             if order == "objective":
-                exact = [c for c in tied if c["shrinkage"] == first["shrinkage"]]
-                pick = first if len(exact) > 1 else min(tied, key=lambda c: c["objective_mm"])
+                pick = objective_pick(a["candidates"], tied)
             else:
                 pick = min(tied, key=lambda c: (TIES["physical_first"](c["effect"]), c["objective_mm"],
                                                 -c["held_out_shrinkage"]))
@@ -329,16 +348,12 @@ def substitute(effect, new_root, old_root):
         if a.get("curl_first") or within[0] != within[1]:
             note = "needs a diagnosis (curl first or the common bending)"
         elif not j.get("within_floors_after_bending_refit", False) and verdict != "none":
-            ranked = sorted(candidates, key=lambda c: (not c["confirmed"], -c["shrinkage"], c["effect"] == "sensor",
-                                                       c["objective_mm"]))
-            first = ranked[0]
-            if not first["confirmed"] or first["shrinkage"] < THRESHOLD:
+            ranked = sorted(candidates, key=ranks_before_key)
+            if not ranked[0]["confirmed"] or ranked[0]["shrinkage"] < THRESHOLD:
                 verdict = "unexplained"
             else:
-                tied = [c for c in ranked if c["confirmed"] and c["shrinkage"] >= THRESHOLD and
-                        c["shrinkage"] >= first["shrinkage"] - a.get("near_tie", {}).get("margin", 0.1)]
-                exact = [c for c in tied if c["shrinkage"] == first["shrinkage"]]
-                verdict = (first if len(exact) > 1 else min(tied, key=lambda c: c["objective_mm"]))["effect"]
+                margin = (a.get("near_tie") or {}).get("margin", 0.1)
+                verdict = objective_pick(ranked, tied_with_first(ranked, margin))["effect"]
         if verdict != j["verdict"]:
             changed += 1
             right += verdict == family
