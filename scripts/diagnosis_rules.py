@@ -57,6 +57,7 @@ near_ties_first names by since then):
     scripts/diagnosis_rules.py out/s18all [more runs ...]
     scripts/diagnosis_rules.py --common out/s28s19all out/s28s20      # where the common bending fires
     scripts/diagnosis_rules.py --matrix without_ablation out/s21all     # one rule's confusion matrix
+    scripts/diagnosis_rules.py --matrix current --pooled out/s28s19all out/s30s22all   # one over several runs
     scripts/diagnosis_rules.py --tolerance 0.05 out/s23all               # the tolerance rule at 5%
     scripts/diagnosis_rules.py --near-ties 0.1 out/s28s20 out/s30s22all   # where a tie margin of 0.1 names otherwise
 """
@@ -364,6 +365,27 @@ def substitute(effect, new_root, old_root):
     print(f"{effect} from {new_root}: {changed} verdicts change, {right} to the right effect, {broken} right ones lost")
 
 
+def pooled_matrix(rule, roots):
+    """One confusion matrix of RULE over every root's captures, with the top-1 and the controls' share."""
+    if not roots:
+        sys.exit("--matrix RULE --pooled DIR...")
+    rows = [(family, verdicts(j)[rule]) for root in roots for _, family, j in reports(root)]
+    families = ["none"] + sorted({fam for fam, _ in rows if fam != "none"})
+    print(f"{len(roots)} runs, {len(rows)} captures, rule {rule}:\n")
+    print("| truth \\ verdict | " + " | ".join(COLUMNS) + " | top-1 |")
+    print("|---" * (len(COLUMNS) + 2) + "|")
+    for fam in families:
+        got = [v for f, v in rows if f == fam]
+        print(f"| {fam} | " + " | ".join(str(got.count(c)) for c in COLUMNS) + f" | {got.count(fam)}/{len(got)} |")
+    effects = [(f, v) for f, v in rows if f != "none"]
+    controls = [v for f, v in rows if f == "none"]
+    right = sum(f == v for f, v in effects)
+    detected = [(f, v) for f, v in effects if v != "none"]
+    print(f"\ntop-1 {right}/{len(effects)} ({100 * right / max(len(effects), 1):.0f}%); controls none "
+          f"{controls.count('none')}/{len(controls)}; effect captures named none {len(effects) - len(detected)}, "
+          f"of the others named correctly {right}/{len(detected)} ({100 * right / max(len(detected), 1):.0f}%)")
+
+
 def main(roots):
     global TOLERANCE
     if roots[:1] == ["--substitute"]:
@@ -390,6 +412,8 @@ def main(roots):
         if len(roots) < 3 or roots[1] not in RULES:
             sys.exit(f"--matrix RULE DIR...: RULE one of {', '.join(RULES)}")
         matrix_rule, roots = roots[1], roots[2:]
+        if roots[:1] == ["--pooled"]:
+            return pooled_matrix(matrix_rule, roots[1:])
     if not roots:
         sys.exit(__doc__)
     for root in roots:
