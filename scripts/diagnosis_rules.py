@@ -51,6 +51,8 @@ near_ties_first names by since then):
   refit objective named, where the first is not tied exactly (exact ties keep the run's order);
 - `--substitute EFFECT NEW OLD` (session 32): OLD's verdicts with EFFECT's candidate taken from NEW's reports of the
   same captures (a run with `--candidates EFFECT` under a changed refit), ranked as attribute() ranks;
+- `--gate-terms DIR...` (session 33): the gate's shape term over its floor as run (two placements) and with the
+  held-out capture averaged in, for controls, effect captures within the floors at the gate, and the rest;
 - `--draw-noise DIR...`: how much the gate's excess changes, as a share of itself, when the second-best validation
   drape by fit score is taken instead of the best (the noise a shrinkage carries; the margin's scale).
 
@@ -254,6 +256,36 @@ def common(roots):
     print(f"common bending fires on {fired} captures, {right} of them named right as run")
 
 
+def gate_terms(roots):
+    """The gate's shape term over its floor (the capture and the second capture's mean, as run) and the same with the
+    held-out capture averaged in, for the controls, the effect captures within the floors at the gate, and the others:
+    could a gate on all three placements tell the effects within the floors from the controls?"""
+    classes = {"controls": [], "effects within the floors at the gate": [], "effects above them": []}
+    for root in roots:
+        for name, family, j in reports(root):
+            g = j.get("gap_tests") or {}
+            if "shape" not in g or not g.get("held_out_capture") or not g.get("second_capture"):
+                continue
+            three = sum(g[k]["shape"] for k in ("capture", "second_capture", "held_out_capture")) / 3
+            key = ("controls" if family == "none" else
+                   "effects within the floors at the gate" if j["within_floors"] else "effects above them")
+            classes[key].append((g["shape"] / g["shape_floor"], three / g["shape_floor"]))
+    for key, v in classes.items():
+        if not v:
+            continue
+        two, three = sorted(x for x, _ in v), sorted(y for _, y in v)
+        print(f"{key} ({len(v)}): shape / floor, two placements: median {two[len(v) // 2]:.2f}, max {two[-1]:.2f}; "
+              f"three: median {three[len(v) // 2]:.2f}, max {three[-1]:.2f}")
+    controls = sorted(y for _, y in classes["controls"])
+    within = [y for _, y in classes["effects within the floors at the gate"]]
+    if controls and within:
+        # The three-placement threshold that keeps 90% of the controls below it, and what it would pass.
+        cut = controls[int(0.9 * len(controls)) - 1]
+        print(f"a three-placement gate at {cut:.2f} (90% of the controls below it) passes "
+              f"{sum(y > cut for y in within)}/{len(within)} of the effects within the floors at the gate, "
+              f"{sum(y > cut for y in controls)}/{len(controls)} controls")
+
+
 def ranks_before_key(c):
     """attribute()'s order (ranks_before): confirmed first, the shrinkage, a physical effect before the sensor error,
     the smaller objective, the larger held-out shrinkage."""
@@ -394,6 +426,8 @@ def main(roots):
         return substitute(*roots[1:])
     if roots[:1] == ["--common"]:
         return common(roots[1:])
+    if roots[:1] == ["--gate-terms"]:
+        return gate_terms(roots[1:])
     if roots[:1] == ["--draw-noise"]:
         return draw_noise(roots[1:])
     if roots[:1] == ["--near-ties"]:
