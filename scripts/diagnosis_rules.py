@@ -269,15 +269,18 @@ def gate_terms(roots):
             three = sum(g[k]["shape"] for k in ("capture", "second_capture", "held_out_capture")) / 3
             key = ("controls" if family == "none" else
                    "effects within the floors at the gate" if j["within_floors"] else "effects above them")
-            classes[key].append((g["shape"] / g["shape_floor"], three / g["shape_floor"]))
+            stable = sum(g[k]["stable_mm"] for k in ("capture", "second_capture", "held_out_capture")) / 3
+            classes[key].append((g["shape"] / g["shape_floor"], three / g["shape_floor"],
+                                 stable / g["stable_floor_mm"]))
     for key, v in classes.items():
         if not v:
             continue
-        two, three = sorted(x for x, _ in v), sorted(y for _, y in v)
+        two, three, stable = (sorted(x[k] for x in v) for k in range(3))
         print(f"{key} ({len(v)}): shape / floor, two placements: median {two[len(v) // 2]:.2f}, max {two[-1]:.2f}; "
-              f"three: median {three[len(v) // 2]:.2f}, max {three[-1]:.2f}")
-    controls = sorted(y for _, y in classes["controls"])
-    within = [y for _, y in classes["effects within the floors at the gate"]]
+              f"three: median {three[len(v) // 2]:.2f}, max {three[-1]:.2f}; stable / floor, three: "
+              f"{stable[0]:.2f} .. {stable[-1]:.2f}")
+    controls = sorted(x[1] for x in classes["controls"])
+    within = [x[1] for x in classes["effects within the floors at the gate"]]
     if controls and within:
         # The three-placement threshold that keeps 90% of the controls below it, and what it would pass.
         cut = controls[int(0.9 * len(controls)) - 1]
