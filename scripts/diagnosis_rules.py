@@ -236,6 +236,11 @@ def reports(root, truth_root=None):
         yield name, FAMILY.get(truth["family"], truth["family"]) or "none", j
 
 
+def within_floors(candidates):
+    """The confirmed candidates that each bring the gate's excess to 0 (session 29's common bending counts them)."""
+    return [c for c in candidates if c["confirmed"] and c["validated"]["excess_above_floors"] == 0.0]
+
+
 def common(roots):
     """Where three or more confirmed candidates each bring the excess to 0 (session 29's common bending)."""
     fired = right = 0
@@ -244,8 +249,7 @@ def common(roots):
             a = j.get("attribution") or {}
             if not a.get("ran"):
                 continue
-            within = [c for c in a["candidates"]
-                      if c["confirmed"] and c["validated"]["excess_above_floors"] == 0.0]
+            within = within_floors(a["candidates"])
             verdict = j["verdict"]
             fires = len(within) >= 3 and not j.get("within_floors_after_bending_refit", False)
             fired += fires
@@ -266,12 +270,12 @@ def gate_terms(roots):
             g = j.get("gap_tests") or {}
             if "shape" not in g or not g.get("held_out_capture") or not g.get("second_capture"):
                 continue
-            three = sum(g[k]["shape"] for k in ("capture", "second_capture", "held_out_capture")) / 3
+            def mean3(term):
+                return sum(g[k][term] for k in ("capture", "second_capture", "held_out_capture")) / 3
             key = ("controls" if family == "none" else
                    "effects within the floors at the gate" if j["within_floors"] else "effects above them")
-            stable = sum(g[k]["stable_mm"] for k in ("capture", "second_capture", "held_out_capture")) / 3
-            classes[key].append((g["shape"] / g["shape_floor"], three / g["shape_floor"],
-                                 stable / g["stable_floor_mm"]))
+            classes[key].append((g["shape"] / g["shape_floor"], mean3("shape") / g["shape_floor"],
+                                 mean3("stable_mm") / g["stable_floor_mm"]))
     for key, v in classes.items():
         if not v:
             continue
@@ -378,8 +382,7 @@ def substitute(effect, new_root, old_root):
             continue
         before = next((c for c in a["candidates"] if c["effect"] == effect), None)
         candidates = [c for c in a["candidates"] if c["effect"] != effect] + swapped
-        within = [len([c for c in cs if c["confirmed"] and c["validated"]["excess_above_floors"] == 0.0]) >= 3
-                  for cs in (a["candidates"], candidates)]
+        within = [len(within_floors(cs)) >= 3 for cs in (a["candidates"], candidates)]
         verdict, note = j["verdict"], ""
         if a.get("curl_first") or within[0] != within[1]:
             note = "needs a diagnosis (curl first or the common bending)"
@@ -400,18 +403,25 @@ def substitute(effect, new_root, old_root):
     print(f"{effect} from {new_root}: {changed} verdicts change, {right} to the right effect, {broken} right ones lost")
 
 
+def print_matrix(rows, top1=False):
+    """A markdown confusion matrix of (family, verdict) rows, the controls first; with top1, a column of each
+    family's right verdicts."""
+    families = ["none"] + sorted({fam for fam, _ in rows if fam != "none"})
+    print("| truth \\ verdict | " + " | ".join(COLUMNS) + (" | top-1 |" if top1 else " |"))
+    print("|---" * (len(COLUMNS) + 1 + top1) + "|")
+    for fam in families:
+        got = [v for f, v in rows if f == fam]
+        print(f"| {fam} | " + " | ".join(str(got.count(c)) for c in COLUMNS) +
+              (f" | {got.count(fam)}/{len(got)} |" if top1 else " |"))
+
+
 def pooled_matrix(rule, roots):
     """One confusion matrix of RULE over every root's captures, with the top-1 and the controls' share."""
     if not roots:
         sys.exit("--matrix RULE --pooled DIR...")
     rows = [(family, verdicts(j)[rule]) for root in roots for _, family, j in reports(root)]
-    families = ["none"] + sorted({fam for fam, _ in rows if fam != "none"})
     print(f"{len(roots)} runs, {len(rows)} captures, rule {rule}:\n")
-    print("| truth \\ verdict | " + " | ".join(COLUMNS) + " | top-1 |")
-    print("|---" * (len(COLUMNS) + 2) + "|")
-    for fam in families:
-        got = [v for f, v in rows if f == fam]
-        print(f"| {fam} | " + " | ".join(str(got.count(c)) for c in COLUMNS) + f" | {got.count(fam)}/{len(got)} |")
+    print_matrix(rows, top1=True)
     effects = [(f, v) for f, v in rows if f != "none"]
     controls = [v for f, v in rows if f == "none"]
     right = sum(f == v for f, v in effects)
@@ -456,13 +466,8 @@ def main(roots):
     for root in roots:
         rows = [(name, family, verdicts(j)) for name, family, j in reports(root)]
         if matrix_rule:
-            families = ["none"] + sorted({fam for _, fam, _ in rows if fam != "none"})
             print(f"{root}, rule {matrix_rule}:\n")
-            print("| truth \\ verdict | " + " | ".join(COLUMNS) + " |")
-            print("|---" * (len(COLUMNS) + 1) + "|")
-            for fam in families:
-                got = [v[matrix_rule] for _, f, v in rows if f == fam]
-                print(f"| {fam} | " + " | ".join(str(got.count(c)) for c in COLUMNS) + " |")
+            print_matrix([(fam, v[matrix_rule]) for _, fam, v in rows])
             continue
         print(f"{root}: {len(rows)} diagnoses")
         print(f"{'case':16s} " + " ".join(f"{r:>18s}" for r in RULES))
