@@ -1,0 +1,36 @@
+# drapegen_diagnosis_bench --score-only on hand-written reports and truth files (no simulation): the confusion
+# matrix and the split of detection from attribution count what the reports say.
+file(REMOVE_RECURSE ${WORK})
+file(MAKE_DIRECTORY ${WORK}/diagnoses ${WORK}/truth)
+
+# One report and its truth file: CASE, its family, the verdict, whether the gate found it within the floors.
+function(write_case name family verdict within)
+  file(WRITE ${WORK}/diagnoses/${name}.json
+       "{\"verdict\": \"${verdict}\", \"within_floors\": ${within}, \"shrinkage\": 1.0,
+         \"localisation\": {\"region\": \"skirt\"}, \"gap_mm\": {\"all_views\": 5.0},
+         \"floors\": {\"all_views_mm\": 4.0}, \"runtime\": {\"seconds\": 10.0}}")
+  file(WRITE ${WORK}/truth/${name}.json
+       "{\"family\": \"${family}\", \"regions\": [\"skirt\"], \"effects\": [{\"name\": \"${family}\", \"strength\": 1}]}")
+endfunction()
+
+write_case(yield_00 yield none true)    # within the floors at the gate
+write_case(yield_01 yield none false)   # within them once the bending alone is refitted
+write_case(yield_02 yield yield false)  # found, named right
+write_case(shear_00 shear curl false)   # found, named wrong
+
+execute_process(COMMAND ${BENCH} --out ${WORK} --score-only --families yield shear --per-family 3 --controls 0
+                        --fabrics ${FABRICS}
+                RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT code EQUAL 0)
+  message(FATAL_ERROR "--score-only failed (${code}): ${out} ${err}")
+endif()
+foreach(needle
+    "| yield | 2 | 0 | 0 | 1 | 0 | 0 | 0 | 0 | 0 |"
+    "| shear | 0 | 0 | 0 | 0 | 0 | 1 | 0 | 0 | 0 |"
+    "top-1 correct on effect captures: 1/4 (25%)"
+    "1 effect captures within the floors at the gate, 1 once the bending alone is refitted; of the 2 found above them, named correctly: 1 (50%)")
+  string(FIND "${out}" "${needle}" found)
+  if(found EQUAL -1)
+    message(FATAL_ERROR "the score does not say '${needle}':\n${out}")
+  endif()
+endforeach()
