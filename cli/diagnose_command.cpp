@@ -241,12 +241,12 @@ Runner add_diagnose_command(CLI::App& app) {
                "The sensor candidate also refits the bending scale with a multipath gain under the camera it found, "
                "by simulation (a grid of 3 scales x 2 gains, a simplex within --refit-evaluations, the best without "
                "multipath), and keeps it if it beats both the re-rendering and that (off by default; "
-               "docs/DIAGNOSIS.md, \"Session 29\")");
+               "docs/DIAGNOSIS_RESULTS.md, \"Session 29\")");
   app.add_flag("--free-sensor", o->free_sensor,
                "Refit all nine parameters of the sensor candidate (camera pose, depth bias and slope, multipath) "
                "wherever the camera sits. By default, where the rigid surfaces show the camera as recorded (it "
                "moves the platform's centre less than 3 mm), the candidate keeps their camera, no depth bias or "
-               "slope, and refits only the multipath gain, which they cannot see (docs/DIAGNOSIS.md, \"Session "
+               "slope, and refits only the multipath gain, which they cannot see (docs/DIAGNOSIS_RESULTS.md, \"Session "
                "32\")");
   app.add_option("--common-bending", o->common_bending,
                  fmt::format("Where this many confirmed candidates or more each bring the gap within the floors, "
@@ -258,7 +258,7 @@ Runner add_diagnose_command(CLI::App& app) {
                  "Candidates whose shrinkage is within this of the first's are tied: among the confirmed ones that "
                  "shrink the gap significantly, the smallest refit objective is named; a first tied exactly keeps "
                  "the exact-tie order, a physical effect before the sensor error (0: exact ties only; "
-                 "docs/DIAGNOSIS.md, \"Session 31\")")
+                 "docs/DIAGNOSIS_RESULTS.md, \"Session 31\")")
       ->capture_default_str();
   app.add_option("--refit-scan", o->refit_scan,
                  fmt::format("Refits of one-parameter effects (yield, shear, curl, friction) start with this many "
@@ -270,7 +270,7 @@ Runner add_diagnose_command(CLI::App& app) {
                  fmt::format("The yield refit starts with this many points along the trade of a stiffer bending (x1 "
                              ".. x{:.0f}) against a lower yield curvature ({:.0f} /m / the scale), then refines from "
                              "the best within --refit-evaluations, which must leave {} for that; replaces --refit-scan "
-                             "for yield (default 0: off; docs/DIAGNOSIS.md, \"Session 19\")",
+                             "for yield (default 0: off; docs/DIAGNOSIS_RESULTS.md, \"Session 19\")",
                              std::exp(diagnosis::AttributionSettings::kYieldScaleRange),
                              diagnosis::AttributionSettings::kYieldTradeCurvature,
                              diagnosis::AttributionSettings::kSimplexAfterScan));
@@ -287,10 +287,10 @@ Runner add_diagnose_command(CLI::App& app) {
   app.add_flag("--ablation", o->ablation,
                "Also validate each simulated candidate with its effect switched off at its refitted bending scale, and "
                "credit it only for what the effect adds beyond that (report.json: candidates' \"ablated\"; off by "
-               "default; docs/DIAGNOSIS.md, \"Session 19\")");
+               "default; docs/DIAGNOSIS_RESULTS.md, \"Session 19\")");
   app.add_option("--held-out-tolerance", o->held_out_tolerance,
                  "A candidate is confirmed when its score on the held-out view or capture is at most (1 + this) "
-                 "times the reference's (0: not worse at all; docs/DIAGNOSIS.md, \"Session 23\")")
+                 "times the reference's (0: not worse at all; docs/DIAGNOSIS_RESULTS.md, \"Session 23\")")
       ->capture_default_str();
   app.add_flag("--gap-only", o->gap_only,
                "Stop after the gap, floors and localisation (verdict \"not attributed\" above the floors)");

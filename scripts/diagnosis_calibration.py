@@ -14,8 +14,9 @@ held-out view is at most the run's held-out tolerance worse than the reference's
 
 With --multistability (a gap-only run whose report.json has gap_tests.validation_spread, branch diag-s7) it compares
 the constant shape floor with per-capture floors from the validation drapes' spread among themselves (the
-leave-one-out nearest-neighbour shape distances among them: docs/DIAGNOSIS.md, "Branch diag-s7"), prints each case's
-fabric stiffness from the truth file, and with --rule applies one rule with fixed constants (for the evaluation set):
+leave-one-out nearest-neighbour shape distances among them: docs/DIAGNOSIS_RESULTS.md, "Branch diag-s7"), prints
+each case's fabric stiffness from the truth file, and with --rule applies one rule with fixed constants (for the
+evaluation set):
 
     scripts/diagnosis_calibration.py out/calib_s7 --multistability
     scripts/diagnosis_calibration.py out/eval_s7 --multistability --rule floor --c0 0.8 --k 2.0
@@ -128,7 +129,7 @@ def spearman(x, y):
 
 
 def spread_stats(d, truth):
-    """The per-capture quantities of the multistability rules (docs/DIAGNOSIS.md, "Branch diag-s7")."""
+    """The per-capture quantities of the multistability rules (docs/DIAGNOSIS_RESULTS.md, "Branch diag-s7")."""
     t = d["gap_tests"]
     v = t["validation_spread"]
     loo = v["nearest_other_shape"]

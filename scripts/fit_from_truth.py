@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Diagnoses benchmark captures again with the baseline fit started at the true fabric (a benchmark tool: it reads the
-truth files), and compares with the diagnoses as run (docs/DIAGNOSIS.md, "Session 20").
+truth files), and compares with the diagnoses as run (docs/DIAGNOSIS_RESULTS.md, "Session 20").
 
     scripts/fit_from_truth.py [--box F] [--out DIR] DRAPEGEN RUN CASE...
 

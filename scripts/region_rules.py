@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Where the gap sits, under the localisation's rules, read off the report.json files of diagnosis benchmark runs
-(`drapegen_diagnosis_bench`; the truth files are read only to score). docs/DIAGNOSIS.md, "Session 24".
+(`drapegen_diagnosis_bench`; the truth files are read only to score). docs/DIAGNOSIS_RESULTS.md, "Session 24".
 
 - as_run: the report's `localisation.region`;
 - largest: the region of the feature group (or the stable term) furthest above its floor, outline groups "hem", skirt

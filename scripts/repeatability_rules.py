@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Fold repeatability against the gate, read off report.json files (docs/DIAGNOSIS.md, "Session 26"; the truth
+"""Fold repeatability against the gate, read off report.json files (docs/DIAGNOSIS_RESULTS.md, "Session 26"; the truth
 files are read only to score). Each report carries `gap_tests.fold_repeatability`: the fold correlation (the hem's
 fold content at the best turn) of every pair of the capture's placements and of every pair of the fitted model's
 drapes from the validation states' sine states.

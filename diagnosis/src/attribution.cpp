@@ -262,7 +262,7 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
     scanned_axes = {0, first};
   } else if (one_parameter && settings.scan_levels >= 2 && settings.scan_levels <= room) {
     // The strength over its range, the bending as fitted. A simplex from one fixed start rarely moved the strength
-    // within the budget (docs/DIAGNOSIS.md, session 10).
+    // within the budget (docs/DIAGNOSIS_RESULTS.md, session 10).
     const int n = settings.scan_levels;
     spacing = (hi[first] - lo[first]) / (n - 1);
     for (int k = 0; k < n; ++k) {

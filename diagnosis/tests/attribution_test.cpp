@@ -96,13 +96,13 @@ TEST(RanksBefore, ConfirmedFirstThenShrinkageThenPhysicalEffectsThenObjectiveAmo
   // The larger shrinkage first, whatever the objective.
   EXPECT_TRUE(ranks_before(ranked(Effect::kCurl, true, 0.8, 9e-3, 0.0), ranked(Effect::kShear, true, 0.7, 1e-3, 0.5)));
   // Both within the floors (shrinkage 1): the clipped excess cannot rank them, the smaller refit objective does,
-  // ahead of the held-out shrinkage (seed 6's friction captures, docs/DIAGNOSIS.md "Session 19").
+  // ahead of the held-out shrinkage (seed 6's friction captures, docs/DIAGNOSIS_RESULTS.md "Session 19").
   const CandidateResult friction = ranked(Effect::kFriction, true, 1.0, 4.74e-3, 0.31);
   const CandidateResult shear = ranked(Effect::kShear, true, 1.0, 5.50e-3, 0.32);
   EXPECT_TRUE(ranks_before(friction, shear));
   EXPECT_FALSE(ranks_before(shear, friction));
   // A physical effect before the sensor error at equal shrinkage, even at a larger objective (seed 13's friction_02,
-  // docs/DIAGNOSIS.md "Session 25")...
+  // docs/DIAGNOSIS_RESULTS.md "Session 25")...
   const CandidateResult sensor = ranked(Effect::kSensor, true, 1.0, 4.0e-3, 0.4);
   EXPECT_TRUE(ranks_before(friction, sensor));
   EXPECT_FALSE(ranks_before(sensor, friction));
@@ -118,7 +118,8 @@ TEST(Confirms, AllowsTheToleranceAboveTheReferenceAndNoMore) {
   EXPECT_TRUE(confirms(5.0e-3, 6.0e-3, 0.0));   // better
   EXPECT_TRUE(confirms(6.0e-3, 6.0e-3, 0.0));   // equal
   EXPECT_FALSE(confirms(6.1e-3, 6.0e-3, 0.0));  // worse, no tolerance
-  // 10%: 9.7% worse on the held-out capture (seed 10's yield_04, docs/DIAGNOSIS.md "Session 23") is confirmed ...
+  // 10%: 9.7% worse on the held-out capture (seed 10's yield_04, docs/DIAGNOSIS_RESULTS.md "Session 23") is
+  // confirmed ...
   EXPECT_TRUE(confirms(5.968e-3, 5.44e-3, 0.1));
   // ... 10.5% worse is not.
   EXPECT_FALSE(confirms(6.012e-3, 5.44e-3, 0.1));

@@ -129,7 +129,7 @@ struct AttributionSettings {
   /// A candidate is confirmed when its held-out confirmation score is at most (1 + held_out_tolerance) times the
   /// reference's (confirms). Both are the best of the validation drapes chosen on the held-out capture's own fit views,
   /// a noisy selection: in 11 of the 270 effect diagnoses of seeds 4-10 the right effect's refit was up to 10% worse
-  /// than the reference there, and the tolerance names it (and a wrong effect in 6 others; docs/DIAGNOSIS.md,
+  /// than the reference there, and the tolerance names it (and a wrong effect in 6 others; docs/DIAGNOSIS_RESULTS.md,
   /// "Session 23"). 0: must not be worse at all (before session 23).
   double held_out_tolerance = 0.1;
   int bootstrap_samples = 1000;
@@ -158,7 +158,7 @@ struct AttributionSettings {
   /// ablation), and credited only for what the effect adds beyond it: the shrinkage is measured from the smaller of
   /// the reference's excess and the ablation's, and the confirmation must not be worse than either. A candidate that
   /// wins by the bending scale it was refitted with (its effect ended where it vanishes, e.g. shear at the membrane's
-  /// stiffness) then shrinks nothing. Off by default (docs/DIAGNOSIS.md, "Session 19").
+  /// stiffness) then shrinks nothing. Off by default (docs/DIAGNOSIS_RESULTS.md, "Session 19").
   bool ablation = false;
   /// The refits' bending scale s (alpha and beta of the baseline fit times e^s): its bounds, lower <= 0 <= upper
   /// (x0.22 .. x4.5 by default; for a known bending's box, a measured bending or DiagnosisSettings::start_box,
@@ -169,19 +169,19 @@ struct AttributionSettings {
   bool bending_scale_known = false;
   /// The sensor candidate's start: the camera pose read off the rigid surfaces (rigid_pose.hpp; diagnose() sets it),
   /// else none. The candidate only re-renders the baseline's drapes, so a start far from a large pose error was
-  /// never reached (docs/DIAGNOSIS.md, "Session 28").
+  /// never reached (docs/DIAGNOSIS_RESULTS.md, "Session 28").
   std::optional<renderer::SensorError> sensor_start;
   /// The rigid surfaces show the camera where its calibration puts it: diagnose() sets this (DiagnosisSettings::
   /// hold_sensor) when the rigid estimate moves the platform's centre less than kCameraMovedAtPlatform (a top read as
   /// lifted included). The sensor candidate then keeps sensor_start's pose and no depth bias or slope (each moves the
   /// rigid surfaces as a camera error does) and refits only the multipath gain, which they cannot see. Free, its nine
   /// parameters took a friction specimen's lifted top for a small camera error on 18 of 23 friction captures
-  /// (docs/DIAGNOSIS.md, "Session 32").
+  /// (docs/DIAGNOSIS_RESULTS.md, "Session 32").
   bool sensor_held = false;
   /// The sensor candidate also refits the bending under the camera it found, with a multipath gain, by simulation:
   /// a multipath error deepens the folds' valleys as seen, the baseline fit takes that for a softer fabric, and
-  /// re-rendering its drapes with the true gain scores worse than without (docs/DIAGNOSIS.md, "Session 28"). After the
-  /// render-only refit, the bending scale and the gain are scored on a grid (kSensorBendingScales x
+  /// re-rendering its drapes with the true gain scores worse than without (docs/DIAGNOSIS_RESULTS.md, "Session 28").
+  /// After the render-only refit, the bending scale and the gain are scored on a grid (kSensorBendingScales x
   /// kSensorBendingGains, the rest of the camera as refitted), refined by a simplex from the best within
   /// optimiser.max_evaluations simulations, and the best is scored once more without multipath (its ablation). The
   /// candidate keeps it, and is then validated by simulation, only if it beats both the render-only refit and its
@@ -193,15 +193,15 @@ struct AttributionSettings {
   /// of them, and what they share is the bending scale each refitted: the baseline's bending at the median of their
   /// scales is validated as the bar is (Attribution::common_bending), and within the floors it is the verdict (none).
   /// The bar's 1-D simplex from x1 often stops short of that scale on a multistable objective; on seeds 17-22 every
-  /// capture with three or more such candidates was misnamed, three of them controls (docs/DIAGNOSIS.md, "Session
-  /// 29"). 0: off.
+  /// capture with three or more such candidates was misnamed, three of them controls
+  /// (docs/DIAGNOSIS_RESULTS.md, "Session 29"). 0: off.
   int common_bending_effects = 3;
   /// Shrinkages closer than this to the first's are tied (near_ties_first): each is the best of ten validation
   /// drapes of a multistable specimen, and the order of two that differ by less than the draw's noise says little;
   /// the smaller refit objective (the capture and the second capture, in sample) names one. Since session 31: derived
   /// on seeds 17-27 (two captures named right, none lost), then pre-registered on fresh seed 28 (one named right, a
   /// depth bias 0.0003 behind shear, none lost). Session 30's order (a physical effect first, then the objective)
-  /// failed on seed 27. 0: exact ties only (docs/DIAGNOSIS.md, "Session 31").
+  /// failed on seed 27. 0: exact ties only (docs/DIAGNOSIS_RESULTS.md, "Session 31").
   double tie_margin = 0.1;
   std::uint64_t validation_seed = 2000;
   int jobs = 1;                     // candidate refits in parallel (one forward model per thread)
@@ -262,15 +262,15 @@ struct CommonBending {
 /// The attribution's order of candidates (true: `x` ranks before `y`): confirmed ones first, then the larger shrinkage
 /// of the gate's excess; among equal shrinkages (in practice several candidates that each bring the excess to 0: the
 /// excess is clipped at the floors, so it cannot rank them) a physical effect before the sensor error (its nine camera
-/// parameters absorb a local change of the drape that a one-parameter effect explains as well; docs/DIAGNOSIS.md,
-/// "Session 25"), then the smaller refit objective, then the larger held-out shrinkage.
+/// parameters absorb a local change of the drape that a one-parameter effect explains as well;
+/// docs/DIAGNOSIS_RESULTS.md, "Session 25"), then the smaller refit objective, then the larger held-out shrinkage.
 [[nodiscard]] bool ranks_before(const CandidateResult& x, const CandidateResult& y);
 
 /// Where the capture's placements fold less alike than the fitted model's drapes, a curl candidate that is confirmed
 /// and shrinks the gap by at least `significant` moves to the front of `ranked` (the others keep their order): edges
 /// that roll settle differently on every placement, which neither a softer elastic fit nor a yielding one laid again
-/// reproduced on seeds 17-20 (rule "repeat_curl", pre-registered before seed 20; docs/DIAGNOSIS.md, "Session 27").
-/// Returns whether it moved one.
+/// reproduced on seeds 17-20 (rule "repeat_curl", pre-registered before seed 20;
+/// docs/DIAGNOSIS_RESULTS.md, "Session 27"). Returns whether it moved one.
 bool curl_first(std::vector<CandidateResult>& ranked, double significant);
 
 /// Near ties (AttributionSettings::tie_margin): among the confirmed candidates whose shrinkage is at least

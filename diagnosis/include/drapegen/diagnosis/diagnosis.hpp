@@ -27,7 +27,7 @@ struct DiagnosisSettings {
   /// below the first's). The drape coefficient hardly changes with alpha for soft-looking drapes, and a strong
   /// softening (-beta/alpha) looks soft, so the guess alone can sit in another basin than the fabric. 0, the default:
   /// the guess's simplex alone. Off because on the evaluation set the better baseline fits absorbed shear and friction
-  /// signatures: top-1 11/30 with 4 levels against 15/30 without, controls 5/5 against 4/5 (docs/DIAGNOSIS.md,
+  /// signatures: top-1 11/30 with 4 levels against 15/30 without, controls 5/5 against 4/5 (docs/DIAGNOSIS_RESULTS.md,
   /// "Session 12").
   int start_levels = 0;
   /// The baseline fit's start instead of the drape-coefficient guess (e.g. an estimate from a cantilever test or the
@@ -59,10 +59,10 @@ struct DiagnosisSettings {
   /// Small budgets for tests and the --quick benchmark.
   [[nodiscard]] static DiagnosisSettings quick();
   /// quick()'s budgets on a finer fitting mesh (kFineResolution), with the shape floor calibrated for that mesh
-  /// (kFineShapeFloor): the --fine preset, which spends more of the 10-minute budget on fidelity (docs/DIAGNOSIS.md,
-  /// "Branch diag-s6"). 1.05: the largest validated shape distance of 16 calibration controls (--seed 2, 60x60
-  /// reality, this preset, session 9: the stiffness range scaled with density) was 0.95, plus 10% (1.17 before,
-  /// from 1.06; at 24x24 the same controls needed 1.42).
+  /// (kFineShapeFloor): the --fine preset, which spends more of the 10-minute budget on fidelity
+  /// (docs/DIAGNOSIS_RESULTS.md, "Branch diag-s6"). 1.05: the largest validated shape distance of 16 calibration
+  /// controls (--seed 2, 60x60 reality, this preset, session 9: the stiffness range scaled with density) was 0.95,
+  /// plus 10% (1.17 before, from 1.06; at 24x24 the same controls needed 1.42).
   [[nodiscard]] static DiagnosisSettings fine();
   static constexpr int kFineResolution = 32;
   static constexpr double kFineShapeFloor = 1.05;

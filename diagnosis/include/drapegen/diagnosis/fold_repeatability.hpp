@@ -4,7 +4,7 @@
 // several initial states). A specimen that keeps creases from its last drape (a yield moment, hysteresis) is laid
 // again from them and folds elsewhere. The fold content of two outlines (the hem radius against angle without its
 // low orders) is compared at the turn that matches them best, since the specimen's orientation on the table is
-// unknown. docs/DIAGNOSIS.md, "Session 26".
+// unknown. docs/DIAGNOSIS_RESULTS.md, "Session 26".
 
 #include <vector>
 
@@ -54,7 +54,7 @@ struct FoldRepeatability {
 /// The capture's placements fold less alike than the fitted model's drapes: every capture pair below the model pairs'
 /// 10th percentile (sorted, element floor(0.1 n)) minus kFoldsUnlikeMargin ("repeat_excess", pre-registered in
 /// session 26; on seeds 17-20 it held for 9 of 20 curled specimens, 1 of 20 yielding ones and none of the other 85,
-/// controls included: docs/DIAGNOSIS.md, "Session 27"). False unless measured().
+/// controls included: docs/DIAGNOSIS_RESULTS.md, "Session 27"). False unless measured().
 [[nodiscard]] bool folds_less_alike(const FoldRepeatability& f);
 inline constexpr double kFoldsUnlikeMargin = 0.1;
 

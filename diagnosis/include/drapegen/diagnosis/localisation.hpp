@@ -91,8 +91,9 @@ void localise_against_floors(Localisation& localisation, const std::array<double
 /// group but the centre offset); place_gap counts it for the skirt where the skirt's residual is the denser.
 [[nodiscard]] bool follows_skirt(FeatureGroup group);
 /// The stable term's ratio to its floor from which stable_region calls a lifted platform top a sensor error
-/// (everywhere) rather than the specimen's contact with the platform (calibrated on seeds 4-13, docs/DIAGNOSIS.md
-/// "Session 25": a specimen lifted by friction reached 1.64, a camera pose error that lifts the top 3.15).
+/// (everywhere) rather than the specimen's contact with the platform (calibrated on seeds 4-13,
+/// docs/DIAGNOSIS_RESULTS.md, "Session 25": a specimen lifted by friction reached 1.64, a camera pose error that lifts
+/// the top 3.15).
 inline constexpr double kLiftedTopSensorRatio = 2.25;
 /// m: the camera_moved from which place_gap calls the gap a camera error's (everywhere) whatever leads (session 28,
 /// seeds 17-20: pose and bias errors 4.6-24 mm; friction, whose cloth sits higher on the top, at most 2.2 mm;

@@ -2,7 +2,7 @@
 // The spread of the validation drapes among themselves: the fitted parameters simulated from the validation states
 // form as many stable drapes, and how far these lie from each other (shape distance, all views) measures the fitted
 // fabric's multistability for this capture, against which the capture's own distance to its nearest validation drape
-// can be compared. docs/DIAGNOSIS.md, "Branch diag-s7".
+// can be compared. docs/DIAGNOSIS_RESULTS.md, "Branch diag-s7".
 
 #include <vector>
 
