@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Verdicts of alternative attribution rules, read off the report.json files of a diagnosis benchmark run made with
 three placements (`drapegen_diagnosis_bench --placements 3 --second-placement`); the truth files are read only to
-score. Hypotheses for the next evaluation, not the diagnosis's rule (docs/DIAGNOSIS.md, "Session 18"):
+score. Hypotheses for the next evaluation, not the diagnosis's rule (docs/DIAGNOSIS_RESULTS.md, "Session 18"):
 
 - current: the verdict as run;
 - tie_objective: the verdict as run, but among confirmed candidates with the top shrinkage (in practice several
@@ -15,6 +15,9 @@ score. Hypotheses for the next evaluation, not the diagnosis's rule (docs/DIAGNO
 - held_out_excess: the same on the held-out capture's terms alone;
 - held_out_rank: among the confirmed candidates that shrink the gate's excess by the threshold, the largest held-out
   score shrinkage;
+- tie_held_out_view (session 34): the verdict as run, but among the confirmed candidates tied exactly at the top
+  shrinkage (physical effects before the sensor error) the smallest score on the capture's held-out view, which no
+  refit sees, instead of the smallest refit objective;
 - min_objective: the candidate whose refit objective (in-sample: the capture and the second capture) is the smallest;
   it ignores the held-out data, which the issue's attribution must use: a diagnostic of the refits, not a rule.
 
@@ -71,7 +74,8 @@ import sys
 THRESHOLD = 0.25  # AttributionSettings::significant_shrinkage
 TOLERANCE = 0.1  # AttributionSettings::held_out_tolerance (since session 23); --tolerance sets the rule's
 RULES = ["current", "strict", "tolerance", "objective_ties", "parsimony", "tie_objective", "no_bar", "no_bar_unconfirmed",
-         "mean3", "held_out_excess", "held_out_rank", "min_objective", "without_ablation", "reach", "reach_objective"]
+         "mean3", "held_out_excess", "held_out_rank", "min_objective", "without_ablation", "reach", "reach_objective",
+         "tie_held_out_view"]
 PARAMETERS = {"sensor": 9, "misalignment": 2}  # effect_space's dimension; the others have 1
 # How each rule orders candidates of equal shrinkage before their objectives (confirmation_rule).
 TIES = {"physical_first": lambda effect: effect == "sensor",  # attribute() since session 25 (needs_simulation)
@@ -183,6 +187,9 @@ def verdicts(j):
     tied = [c for c in cands if c["confirmed"] and c["shrinkage"] == top["shrinkage"]]
     v["tie_objective"] = min(tied, key=lambda c: c["objective_mm"])["effect"] if (
         j["verdict"] not in ("none", "unexplained") and tied) else j["verdict"]
+    physical = [c for c in tied if c["effect"] != "sensor"] or tied  # attribute()'s order: physical effects first
+    v["tie_held_out_view"] = min(physical, key=lambda c: c["held_out_score_mm"])["effect"] if (
+        j["verdict"] not in ("none", "unexplained") and tied and not a.get("curl_first")) else j["verdict"]
     e0 = g["excess_above_floors"]
     h0 = g["held_out_capture"]["all_views_score_mm"]
 
