@@ -173,6 +173,17 @@ foreach(f report.json report.md residual.png views.png)
     message(FATAL_ERROR "report lacks ${f}")
   endif()
 endforeach()
+# The human report states the verdict report.json holds; a named effect with the shrinkage it was named for (the
+# gate's, on fresh drapes) and, apart, the held-out score's.
+file(READ ${WORK}/report/report.md report_md)
+string(JSON named GET "${out}" attribution named)
+if(named)
+  if(NOT report_md MATCHES "\\*\\*Verdict: ${verdict}\\*\\* [^\n]* shrinks the gap's excess above the floors by -?[0-9]+% \\(the capture's drapes from fresh initial states\\) and the score on the held-out view by -?[0-9]+%")
+    message(FATAL_ERROR "report.md's verdict line does not state ${verdict} and its shrinkages")
+  endif()
+elseif(NOT report_md MATCHES "\\*\\*Verdict: ")
+  message(FATAL_ERROR "report.md states no verdict")
+endif()
 message(STATUS "diagnosis: verdict ${verdict}, gap ${gap} mm, floor ${floor} mm, region ${region} (led by '${led}', stable ratio ${stable_ratio}, top mean ${top_mean} mm)")
 
 # --gap-only: the same gate, and no attribution (the capture is above the floors, so the verdict says so).

@@ -8,7 +8,6 @@ namespace {
 
 constexpr Region kRegions[] = {Region::kTop, Region::kRim, Region::kSkirt, Region::kHem, Region::kCylinder};
 constexpr double kMinPixelShare = 0.02;
-constexpr double kMinEnrichment = 1.3;
 
 }  // namespace
 
@@ -197,7 +196,7 @@ Localisation localise(const ForwardModel& model, const ScoredDrape& drape) {
       L.pixel_region = r;
     }
   }
-  if (best < kMinEnrichment) L.pixel_region = Region::kGlobal;
+  if (best < kMinRegionEnrichment) L.pixel_region = Region::kGlobal;
   for (double e : E.view_energy) L.view_share.push_back(total_energy > 0.0 ? e / total_energy : 0.0);
 
   const HemProfile capture_outline = hem_profile_from_capture(capture);

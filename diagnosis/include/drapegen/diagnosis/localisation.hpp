@@ -56,7 +56,8 @@ struct Localisation {
   /// drape over the largest floor sample's (at least half the group's scale).
   std::vector<double> group_ratio;
   double stable_ratio = 0.0;
-  /// The residual maps' most enriched region, kGlobal if none stands out (pixel residuals: fold placement shows).
+  /// The residual maps' most enriched region, kGlobal if none reaches kMinRegionEnrichment (pixel residuals: fold
+  /// placement shows).
   Region pixel_region = Region::kGlobal;
   /// The region whose pixel residuals exceed their own floor the most (RegionShare::floor_ratio, among regions with
   /// enough pixels), kGlobal if none exceeds it (localise_against_floors).
@@ -99,6 +100,9 @@ inline constexpr double kLiftedTopSensorRatio = 2.25;
 /// seeds 17-20: pose and bias errors 4.6-24 mm; friction, whose cloth sits higher on the top, at most 2.2 mm;
 /// anything else at most 1.2 mm).
 inline constexpr double kCameraMovedAtPlatform = 0.003;
+/// A region stands out in the residual maps (Localisation::pixel_region) from this enrichment: its share of the
+/// residual energy over its share of the pixels.
+inline constexpr double kMinRegionEnrichment = 1.3;
 /// Where the stable term's excess (platform top, bare cylinder) sits, from the rigid regions' residuals (their
 /// floor_ratio set): the bare cylinder (kCylinder) if the platform top is within its own floor; everywhere (kGlobal)
 /// if the top is seen further from the camera than the fitted cloth (mean residual > 0: cloth cannot lie below the
