@@ -6,13 +6,6 @@
 namespace drapegen::renderer {
 namespace {
 
-std::uint64_t splitmix(std::uint64_t& x) {
-  std::uint64_t z = (x += 0x9e3779b97f4a7c15ULL);
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-  return z ^ (z >> 31);
-}
-
 /// Inverse of the standard normal CDF by bisection on std::erfc (only used to build the table once).
 double inverse_normal_cdf(double p) {
   double lo = -10.0, hi = 10.0;
@@ -45,8 +38,7 @@ const std::vector<float>& gaussian_table() {
 }  // namespace
 
 std::uint64_t mix_seed(std::uint64_t seed, std::uint64_t stream) {
-  std::uint64_t x = seed ^ splitmix(stream);
-  return splitmix(x);
+  return sim::splitmix64_mix(seed ^ sim::splitmix64_mix(stream));
 }
 
 std::uint64_t Rng::below_threshold(double p) {

@@ -10,13 +10,8 @@
 
 namespace drapegen::sampler {
 
-/// SplitMix64's finaliser: a bijective 64-bit mix.
-[[nodiscard]] constexpr std::uint64_t mix64(std::uint64_t x) {
-  x += 0x9e3779b97f4a7c15ULL;
-  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
-  return x ^ (x >> 31);
-}
+/// SplitMix64's finaliser: a bijective 64-bit mix (the project's one, sim::splitmix64_mix).
+[[nodiscard]] constexpr std::uint64_t mix64(std::uint64_t x) { return sim::splitmix64_mix(x); }
 
 /// A seed for the stream named by `ids` under `seed` (order matters; seed 0 is an ordinary seed).
 [[nodiscard]] std::uint64_t derive_seed(std::uint64_t seed, std::initializer_list<std::uint64_t> ids);
