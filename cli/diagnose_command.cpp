@@ -51,6 +51,7 @@ struct DiagnoseOptions {
   double tie_margin = diagnosis::AttributionSettings{}.tie_margin;
   double held_out_tolerance = diagnosis::AttributionSettings{}.held_out_tolerance;
   bool verbose = false;
+  bool quiet = false;
 };
 
 int fail(const std::string& message, int code = kExitUsage) {
@@ -102,7 +103,8 @@ int run_diagnose(const DiagnoseOptions& o) {
     }
     candidates.push_back(*effect);
   }
-  if (o.verbose) sim::logger()->set_level(spdlog::level::debug);
+  // Each stage's end by default (a diagnosis takes minutes); every evaluation with --verbose; warnings with --quiet.
+  sim::logger()->set_level(o.verbose ? spdlog::level::debug : o.quiet ? spdlog::level::warn : spdlog::level::info);
   auto capture = diagnosis::read_capture(o.capture);
   if (!capture) return fail(capture.error().message);
   std::optional<diagnosis::Capture> held_out, second;
@@ -294,7 +296,9 @@ Runner add_diagnose_command(CLI::App& app) {
       ->capture_default_str();
   app.add_flag("--gap-only", o->gap_only,
                "Stop after the gap, floors and localisation (verdict \"not attributed\" above the floors)");
-  app.add_flag("-v,--verbose", o->verbose, "Log progress on stderr");
+  app.add_flag("-v,--verbose", o->verbose, "Log every simulation of the fit and the refits on stderr (by default: "
+                                           "each stage's end)");
+  app.add_flag("-q,--quiet", o->quiet, "Log only warnings and errors on stderr")->excludes("--verbose");
   return [o] { return run_diagnose(*o); };
 }
 

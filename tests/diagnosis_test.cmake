@@ -188,6 +188,21 @@ message(STATUS "diagnosis: verdict ${verdict}, gap ${gap} mm, floor ${floor} mm,
 
 # --gap-only: the same gate, and no attribution (the capture is above the floors, so the verdict says so).
 run_ok(out diagnose --capture ${WORK}/capture --quick --resolution 10 --states 2 --evaluations 8 --gap-only --json)
+# Progress: each stage's end on stderr by default (the JSON alone on stdout), nothing but warnings with --quiet.
+foreach(flag "" --quiet)
+  execute_process(COMMAND ${DRAPEGEN} diagnose --capture ${WORK}/capture --quick --resolution 10 --states 2
+                          --evaluations 4 --gap-only --json ${flag}
+                  RESULT_VARIABLE code OUTPUT_VARIABLE json ERROR_VARIABLE err)
+  string(JSON quiet_verdict ERROR_VARIABLE not_json GET "${json}" verdict)
+  if(NOT code EQUAL 0 OR not_json)
+    message(FATAL_ERROR "diagnose ${flag}: exit ${code}, stdout not the JSON alone (${not_json})")
+  endif()
+  if(flag STREQUAL "" AND NOT err MATCHES "diagnosis: baseline fit .*diagnosis: stable term .*diagnosis: verdict")
+    message(FATAL_ERROR "diagnose logs no stage's end by default: ${err}")
+  elseif(flag STREQUAL "--quiet" AND NOT err STREQUAL "")
+    message(FATAL_ERROR "diagnose --quiet logs: ${err}")
+  endif()
+endforeach()
 string(JSON verdict GET "${out}" verdict)
 string(JSON ran GET "${out}" attribution ran)
 string(JSON ncand LENGTH "${out}" attribution candidates)

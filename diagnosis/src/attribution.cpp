@@ -385,6 +385,8 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
   c.held_out_score = c.drape.held_out_score;
   c.all_score = c.drape.all_score;
   c.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  sim::logger()->info("attribution: {} refitted, objective {:.2f} mm after {} evaluations ({:.0f} s)",
+                      bar ? "the bending alone" : effect_name(*effect), c.objective * 1e3, c.evaluations, c.seconds);
   return c;
 }
 

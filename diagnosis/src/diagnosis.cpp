@@ -352,6 +352,8 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
   r.fitted_reduced = {nm.x[0], nm.x[1], nm.x[2], nm.x[3]};
   r.fitted = from_reduced(r.fitted_reduced);
   r.seconds_fit = since(start);
+  sim::logger()->info("diagnosis: baseline fit {:.2f} mm after {} evaluations ({:.0f} s); floors next",
+                      nm.f * 1e3, r.baseline_evaluations, r.seconds_fit);
   const ModelSetup fitted = baseline_setup(r.fitted_reduced);
 
   // 2. Floors and the gap.
@@ -397,6 +399,15 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
   // measured on the same excess.
   r.within_floors = excess_above_floors(r.gap(), r.floors) == 0.0;
   r.seconds_floors = since(floors_start);
+  const GapTerms gate = r.gap();
+  sim::logger()->info("diagnosis: stable term {:.2f} mm (floor {:.2f}), shape distance {:.2f} (floor {:.2f}): {} "
+                      "({:.0f} s){}",
+                      gate.stable * 1e3, r.floors.stable * 1e3, gate.shape, r.floors.shape,
+                      r.within_floors ? "within the floors" : "above the floors", r.seconds_floors,
+                      r.within_floors || !settings.attribute
+                          ? ""
+                          : fmt::format("; refitting {} candidates and the bending alone",
+                                        settings.attribution.candidates.size()));
 
   // 3. Where the gap sits.
   r.localisation = localise(model, gap);
