@@ -17,7 +17,8 @@ score. Hypotheses for the next evaluation, not the diagnosis's rule (docs/DIAGNO
   score shrinkage;
 - tie_held_out_view (session 34): the verdict as run, but among the confirmed candidates tied exactly at the top
   shrinkage (physical effects before the sensor error) the smallest score on the capture's held-out view, which no
-  refit sees, instead of the smallest refit objective;
+  refit sees, instead of the smallest refit objective (3 more right on seeds 17-32; pre-registered on fresh seed 33,
+  it named one fewer: negative, not the diagnosis's rule);
 - min_objective: the candidate whose refit objective (in-sample: the capture and the second capture) is the smallest;
   it ignores the held-out data, which the issue's attribution must use: a diagnostic of the refits, not a rule.
 
