@@ -238,7 +238,7 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
   md += fmt::format("| stable term (platform top, bare cylinder) | cylinder if the top is within its floor; global if "
                     "the top is seen below the cloth or lifted from {:g}; else top | {:.2f} |\n\n",
                     kLiftedTopSensorRatio, r.localisation.stable_ratio);
-  // kGlobal: no region stands out (localise_features).
+  // kGlobal: no region stands out (localise, localise_against_floors).
   auto or_none = [](Region region, const std::string& none) {
     return region == Region::kGlobal ? none : std::string(region_name(region));
   };

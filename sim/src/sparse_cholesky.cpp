@@ -46,8 +46,7 @@ class SerialOpenMp {
 /// CHOLMOD's supernodal factorisation and solve call BLAS, and Debian's serial OpenBLAS is not safe to call from two
 /// threads at once: concurrent drapes in one process (diagnose --jobs 2) got results that differed from run to run,
 /// and identical ones with the reference BLAS (docs/DIAGNOSIS_RESULTS.md, "Session 7"). So every CHOLMOD call that
-/// may reach BLAS holds
-/// this lock; uncontended (one drape per process: workers, drapegen simulate) it costs nothing.
+/// may reach BLAS holds this lock; uncontended (one drape per process: workers, drapegen simulate) it costs nothing.
 std::mutex& blas_mutex() {
   static std::mutex m;
   return m;
