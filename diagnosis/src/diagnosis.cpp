@@ -397,9 +397,9 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
   // Within the floors: neither the stable-region term (sensor errors) nor the shape distance (physical effects)
   // exceeds what sensor noise and other stable drapes of the fitted fabric produce. The attribution's shrinkage is
   // measured on the same excess.
-  r.within_floors = excess_above_floors(r.gap(), r.floors) == 0.0;
-  r.seconds_floors = since(floors_start);
   const GapTerms gate = r.gap();
+  r.within_floors = excess_above_floors(gate, r.floors) == 0.0;
+  r.seconds_floors = since(floors_start);
   sim::logger()->info("diagnosis: stable term {:.2f} mm (floor {:.2f}), shape distance {:.2f} (floor {:.2f}): {} "
                       "({:.0f} s){}",
                       gate.stable * 1e3, r.floors.stable * 1e3, gate.shape, r.floors.shape,
