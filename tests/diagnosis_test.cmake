@@ -27,6 +27,7 @@ function(run_ok out_var)
     message(FATAL_ERROR "'${ARGN}' failed (${code}): ${out} ${err}")
   endif()
   set(${out_var} "${out}" PARENT_SCOPE)
+  set(${out_var}_log "${err}" PARENT_SCOPE)  # stderr: the log
 endfunction()
 
 # A small gap-only diagnosis of `capture` (more options after it): sets `out` to its report.json and `from` to where
@@ -188,21 +189,6 @@ message(STATUS "diagnosis: verdict ${verdict}, gap ${gap} mm, floor ${floor} mm,
 
 # --gap-only: the same gate, and no attribution (the capture is above the floors, so the verdict says so).
 run_ok(out diagnose --capture ${WORK}/capture --quick --resolution 10 --states 2 --evaluations 8 --gap-only --json)
-# Progress: each stage's end on stderr by default (the JSON alone on stdout), nothing but warnings with --quiet.
-foreach(flag "" --quiet)
-  execute_process(COMMAND ${DRAPEGEN} diagnose --capture ${WORK}/capture --quick --resolution 10 --states 2
-                          --evaluations 4 --gap-only --json ${flag}
-                  RESULT_VARIABLE code OUTPUT_VARIABLE json ERROR_VARIABLE err)
-  string(JSON quiet_verdict ERROR_VARIABLE not_json GET "${json}" verdict)
-  if(NOT code EQUAL 0 OR not_json)
-    message(FATAL_ERROR "diagnose ${flag}: exit ${code}, stdout not the JSON alone (${not_json})")
-  endif()
-  if(flag STREQUAL "" AND NOT err MATCHES "diagnosis: baseline fit .*diagnosis: stable term .*diagnosis: verdict")
-    message(FATAL_ERROR "diagnose logs no stage's end by default: ${err}")
-  elseif(flag STREQUAL "--quiet" AND NOT err STREQUAL "")
-    message(FATAL_ERROR "diagnose --quiet logs: ${err}")
-  endif()
-endforeach()
 string(JSON verdict GET "${out}" verdict)
 string(JSON ran GET "${out}" attribution ran)
 string(JSON ncand LENGTH "${out}" attribution candidates)
@@ -213,6 +199,16 @@ string(JSON starts GET "${out}" baseline start_evaluations)
 string(JSON guess_only_score GET "${out}" baseline fit_score_mm)
 if(NOT starts EQUAL 0)
   message(FATAL_ERROR "by default the fit scores no starts besides the guess: ${starts}")
+endif()
+# Progress: each stage's end on stderr by default (the JSON parsed above is stdout alone), nothing but warnings with
+# --quiet.
+if(NOT out_log MATCHES "diagnosis: baseline fit .*diagnosis: stable term .*diagnosis: verdict")
+  message(FATAL_ERROR "diagnose logs no stage's end by default: ${out_log}")
+endif()
+run_ok(quiet diagnose --capture ${WORK}/capture --quick --resolution 10 --states 2 --evaluations 4 --gap-only --json
+       --quiet)
+if(NOT quiet_log STREQUAL "")
+  message(FATAL_ERROR "diagnose --quiet logs: ${quiet_log}")
 endif()
 
 # --starts 1: after the guess's simplex, the guess's alpha and one level, each at both softening ratios (4 starts),
