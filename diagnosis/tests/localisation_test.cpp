@@ -231,3 +231,85 @@ TEST(PlaceGap, ACameraTheRigidSurfacesMoveFromItsCalibrationPlacesTheGapEverywhe
   EXPECT_EQ(L.dominant, Region::kSkirt);
   EXPECT_EQ(L.dominant_feature, "skirt_height");
 }
+
+TEST(ExplainedEnrichment, IsEachRegionsShareOfTheDropOverItsPixelShare) {
+  RegionEnergy before, after;
+  const int hem = static_cast<int>(Region::kHem), skirt = static_cast<int>(Region::kSkirt),
+            top = static_cast<int>(Region::kTop), rim = static_cast<int>(Region::kRim);
+  before.pixels[hem] = 200.0, before.pixels[skirt] = 600.0, before.pixels[top] = 199.0, before.pixels[rim] = 1.0;
+  before.energy[hem] = 5.0, before.energy[skirt] = 6.0, before.energy[top] = 1.0, before.energy[rim] = 1.0;
+  // The hem drops by 4, the skirt by 2 and the top grows by 1: a drop of 5 (the rim, 0.1% of the pixels, also drops).
+  after.energy[hem] = 1.0, after.energy[skirt] = 4.0, after.energy[top] = 2.0, after.energy[rim] = 0.0;
+  const auto e = explained_enrichment(before, after);
+  // total drop 4 + 2 - 1 + 1 = 6 over 1000 pixels.
+  EXPECT_NEAR(e[hem], (4.0 / 6.0) / 0.2, 1e-12);
+  EXPECT_NEAR(e[skirt], (2.0 / 6.0) / 0.6, 1e-12);
+  EXPECT_NEAR(e[top], (-1.0 / 6.0) / 0.199, 1e-12);
+  EXPECT_EQ(e[rim], 0.0);  // below 2% of the pixels
+  // No drop overall (the refit is no closer): nothing is explained anywhere.
+  after.energy[skirt] = 12.0;
+  for (double x : explained_enrichment(before, after)) EXPECT_EQ(x, 0.0);
+}
+
+TEST(PlaceExplainedGap, ChoosesTheHemOrTheSkirtByWhereTheNamedEffectRemovesTheGap) {
+  auto with_explained = [](Localisation L, double skirt, double hem) {
+    for (auto& s : L.regions) {
+      if (s.region == Region::kSkirt) s.explained_enrichment = skirt;
+      if (s.region == Region::kHem) s.explained_enrichment = hem;
+    }
+    return L;
+  };
+  // The skirt's residual is the denser (place_gap: skirt), but the named effect's refit removes it at the hem.
+  Localisation L = with_explained(excess(FeatureGroup::kSortedRadii, 2.0, 0.9, 1.6, 1.2), 0.7, 1.9);
+  place_gap(L);
+  EXPECT_EQ(L.dominant, Region::kSkirt);
+  place_explained_gap(L);
+  EXPECT_EQ(L.dominant, Region::kHem);
+  EXPECT_TRUE(L.placed_by_refit);
+  EXPECT_EQ(L.placed_by_features, Region::kSkirt);
+  // A skirt group leads, the refit removes the gap at the skirt.
+  L = with_explained(excess(FeatureGroup::kSkirtHeight, 2.0, 0.9, 0.8, 1.3), 1.5, 0.4);
+  place_gap(L);
+  place_explained_gap(L);
+  EXPECT_EQ(L.dominant, Region::kSkirt);
+  EXPECT_TRUE(L.placed_by_refit);
+  // No drop in either: left as placed.
+  L = with_explained(excess(FeatureGroup::kSortedRadii, 2.0, 0.9, 1.6, 1.2), 0.0, -0.5);
+  place_gap(L);
+  place_explained_gap(L);
+  EXPECT_EQ(L.dominant, Region::kSkirt);
+  EXPECT_FALSE(L.placed_by_refit);
+}
+
+TEST(PlaceExplainedGap, LeavesTheCentreOffsetTheRigidSurfacesAndNothingAboveItsFloorAsPlaced) {
+  auto hem_explained = [](Localisation L) {
+    for (auto& s : L.regions) s.explained_enrichment = s.region == Region::kSkirt ? 3.0 : 0.1;
+    return L;
+  };
+  // A shifted centre stays the hem's however the refit's drop falls.
+  Localisation L = hem_explained(excess(FeatureGroup::kOffCentre, 2.0, 0.9, 1.6, 1.2));
+  place_gap(L);
+  place_explained_gap(L);
+  EXPECT_EQ(L.dominant, Region::kHem);
+  EXPECT_FALSE(L.placed_by_refit);
+  // A camera the rigid surfaces moved: everywhere.
+  L = hem_explained(excess(FeatureGroup::kSortedRadii, 2.0, 0.9, 1.2, 1.6));
+  L.camera_moved = kCameraMovedAtPlatform;
+  place_gap(L);
+  place_explained_gap(L);
+  EXPECT_EQ(L.dominant, Region::kGlobal);
+  // The stable term leads (a lifted top below the sensor ratio would be the top's; here it exceeds it: everywhere).
+  L = hem_explained(excess(FeatureGroup::kSortedRadii, 1.2, 3.0, 1.2, 1.6));
+  place_gap(L);
+  const Region by_stable = L.dominant;
+  place_explained_gap(L);
+  EXPECT_EQ(L.dominant_feature, "stable");
+  EXPECT_EQ(L.dominant, by_stable);
+  EXPECT_FALSE(L.placed_by_refit);
+  // Nothing above its floor: global.
+  L = hem_explained(excess(FeatureGroup::kHemHeight, 0.95, 0.97, 1.6, 1.2));
+  place_gap(L);
+  place_explained_gap(L);
+  EXPECT_EQ(L.dominant, Region::kGlobal);
+  EXPECT_FALSE(L.placed_by_refit);
+}
