@@ -428,9 +428,6 @@ int main(int argc, char** argv) {
   int effect_total = 0, effect_correct = 0, control_total = 0, control_within = 0, region_total = 0, region_match = 0;
   // The region furthest above its own floor (localisation.floor_region, since session 22; absent in older reports).
   int floor_region_total = 0, floor_region_match = 0;
-  // The region place_gap gave before the named effect's refit placed it (localisation.region_by_features, since
-  // session 35; absent in older reports).
-  int feature_region_total = 0, feature_region_match = 0;
   std::map<std::string, std::pair<int, int>> region_by_family;  // localised region: matched, scored
   // The screen (--visible-only): per family, draws made and draws visible; the verdicts on visible captures.
   std::map<std::string, std::pair<int, int>> screen_draws_by_family;
@@ -509,10 +506,6 @@ int main(int argc, char** argv) {
         ++floor_region_total;
         floor_region_match += is_true_region(d["localisation"]["floor_region"].get<std::string>());
       }
-      if (d["localisation"].contains("region_by_features")) {
-        ++feature_region_total;
-        feature_region_match += is_true_region(d["localisation"]["region_by_features"].get<std::string>());
-      }
     }
     // The effect and its strength as generated (the truth file), not as this run would draw them: a run may score
     // captures an earlier run generated with other --controls or --seed, whose draws differ.
@@ -588,11 +581,6 @@ int main(int argc, char** argv) {
   if (floor_region_total > 0) {
     md += fmt::format("- the region furthest above its own floor (floor_region) matches it: {}/{}\n",
                       floor_region_match, floor_region_total);
-  }
-  if (feature_region_total > 0) {
-    md += fmt::format("- the region by the feature groups alone, before the named effect's refit placed it on the hem "
-                      "or the skirt (region_by_features), matches it: {}/{}\n",
-                      feature_region_match, feature_region_total);
   }
   md += fmt::format("- runtime per capture: median {:.0f} s, max {:.0f} s\n", median(seconds),
                     seconds.empty() ? 0.0 : *std::max_element(seconds.begin(), seconds.end()));

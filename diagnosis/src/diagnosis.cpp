@@ -455,8 +455,6 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
     } else {
       r.verdict = r.attribution.named ? std::string(effect_name(c[0].effect)) : "unexplained";
       if (c.size() > 1) r.runner_up = effect_name(c[r.attribution.named ? 1 : 0].effect);
-      // Where the named effect removes the gap: hem or skirt by its refit's drop rather than the residual's density.
-      if (r.attribution.named) explain_gap(r.localisation, model, gap, c[0].validated);
     }
   }
   r.seconds_attribution = since(attribution_start);
@@ -566,8 +564,7 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                        {"rms_mm", s.rms * 1e3},
                        {"mean_mm", s.mean * 1e3},
                        {"view_mean_mm", millimetres(s.view_mean)},
-                       {"floor_ratio", s.floor_ratio},
-                       {"explained_enrichment", s.explained_enrichment}});
+                       {"floor_ratio", s.floor_ratio}});
   }
   nlohmann::json harmonics = nlohmann::json::array();
   for (const auto& h : L.hem_difference) {
@@ -582,8 +579,6 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
         {"difference_mm", diff[k] * 1e3}, {"floor_mm", floor[k] * 1e3}, {"ratio", L.group_ratio[k]}};
   }
   j["localisation"] = {{"region", region_name(L.dominant)},
-                       {"region_by_features", region_name(L.placed_by_features)},
-                       {"placed_by_refit", L.placed_by_refit},
                        {"dominant_feature", L.dominant_feature.empty() ? nlohmann::json(nullptr)
                                                                        : nlohmann::json(L.dominant_feature)},
                        {"feature_groups", groups},

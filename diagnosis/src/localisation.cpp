@@ -74,9 +74,7 @@ Region stable_region(const Localisation& L) {
   return L.stable_ratio < kLiftedTopSensorRatio ? Region::kTop : Region::kGlobal;
 }
 
-namespace {
-
-void place_by_features(Localisation& L) {
+void place_gap(Localisation& L) {
   if (L.camera_moved >= kCameraMovedAtPlatform) {  // the rigid surfaces show the camera elsewhere than recorded
     L.dominant_feature = "camera";
     L.dominant = Region::kGlobal;
@@ -117,14 +115,6 @@ void place_by_features(Localisation& L) {
   }
 }
 
-}  // namespace
-
-void place_gap(Localisation& L) {
-  place_by_features(L);
-  L.placed_by_features = L.dominant;
-  L.placed_by_refit = false;
-}
-
 double RegionEnergy::mean_square(Region region) const {
   const int k = static_cast<int>(region);
   return k < kCount && pixels[k] > 0.0 ? energy[k] / pixels[k] : 0.0;
@@ -144,7 +134,10 @@ double RegionEnergy::view_mean(std::size_t view, Region region) const {
   return view_sum[view][k] / view_pixels[view][k];
 }
 
-RegionEnergy region_energy(const ForwardModel& model, const ScoredDrape& drape, const HemProfile& outline) {
+namespace {
+
+/// region_energy with the drape's outline (turned as rendered) given.
+RegionEnergy region_energy(const ForwardModel& model, const ScoredDrape& drape, const HemProfile& model_outline) {
   RegionEnergy E;
   const Capture& capture = model.capture();
   const double R = 0.5 * capture.specimen.cylinder_diameter;
@@ -161,7 +154,7 @@ RegionEnergy region_energy(const ForwardModel& model, const ScoredDrape& drape, 
       if (!std::isfinite(res) || cmp.depth[i] <= 0.0f) continue;
       const int u = static_cast<int>(i % W), row = static_cast<int>(i / W);
       const Eigen::Vector3d p = to_specimen * (static_cast<double>(cmp.depth[i]) * view.camera.ray(u, row));
-      const int k = static_cast<int>(classify_point(p, outline, R));
+      const int k = static_cast<int>(classify_point(p, model_outline, R));
       const double e = static_cast<double>(res) * res;
       E.energy[k] += e;
       E.pixels[k] += 1.0;
@@ -172,6 +165,8 @@ RegionEnergy region_energy(const ForwardModel& model, const ScoredDrape& drape, 
   }
   return E;
 }
+
+}  // namespace
 
 RegionEnergy region_energy(const ForwardModel& model, const ScoredDrape& drape) {
   return region_energy(model, drape, rotate(hem_profile_from_mesh(drape.mesh), drape.angle));
@@ -217,39 +212,6 @@ Localisation localise(const ForwardModel& model, const ScoredDrape& drape) {
   L.capture_drape_coefficient = drape_coefficient(capture_outline, capture.specimen);
   L.model_drape_coefficient = drape_coefficient(model_outline, capture.specimen);
   return L;
-}
-
-std::array<double, RegionEnergy::kCount> explained_enrichment(const RegionEnergy& before, const RegionEnergy& after) {
-  std::array<double, RegionEnergy::kCount> enrichment{};
-  double drop = 0.0, pixels = 0.0;
-  for (int k = 0; k < RegionEnergy::kCount; ++k) drop += before.energy[k] - after.energy[k], pixels += before.pixels[k];
-  if (!(drop > 0.0) || pixels <= 0.0) return enrichment;
-  for (int k = 0; k < RegionEnergy::kCount; ++k) {
-    const double pixel_share = before.pixels[k] / pixels;
-    if (pixel_share >= kMinPixelShare)
-      enrichment[k] = (before.energy[k] - after.energy[k]) / drop / pixel_share;
-  }
-  return enrichment;
-}
-
-void explain_gap(Localisation& L, const ForwardModel& model, const ScoredDrape& fitted, const ScoredDrape& refitted) {
-  const HemProfile outline = rotate(hem_profile_from_mesh(fitted.mesh), fitted.angle);
-  const auto enrichment =
-      explained_enrichment(region_energy(model, fitted, outline), region_energy(model, refitted, outline));
-  for (auto& s : L.regions) s.explained_enrichment = enrichment[static_cast<int>(s.region)];
-  place_explained_gap(L);
-}
-
-void place_explained_gap(Localisation& L) {
-  // The stable term and the camera place the gap by the rigid surfaces; a shift of the centre is the hem's own.
-  if (L.dominant_feature.empty() || L.dominant_feature == "stable" || L.dominant_feature == "camera" ||
-      L.dominant_feature == feature_group_name(FeatureGroup::kOffCentre))
-    return;
-  const RegionShare *skirt = region_share(L, Region::kSkirt), *hem = region_share(L, Region::kHem);
-  const double at_skirt = skirt ? skirt->explained_enrichment : 0.0, at_hem = hem ? hem->explained_enrichment : 0.0;
-  if (at_skirt <= 0.0 && at_hem <= 0.0) return;
-  L.dominant = at_skirt > at_hem ? Region::kSkirt : Region::kHem;
-  L.placed_by_refit = true;
 }
 
 void localise_against_floors(Localisation& L, const std::array<double, RegionEnergy::kCount>& floor_mean_square) {

@@ -88,12 +88,6 @@ std::string leading_feature_text(const Localisation& L) {
                               : "led by the stable term, the platform top lifted at a camera error's scale";
     }
   }
-  if (L.placed_by_refit) {
-    return fmt::format("led by {}; the named effect's refit removes the gap more densely at the {} than at the {} "
-                       "(the baseline residual's density alone: {})",
-                       led, region_name(L.dominant), L.dominant == Region::kHem ? "skirt" : "hem",
-                       region_name(L.placed_by_features));
-  }
   for (FeatureGroup g : kFeatureGroups) {
     if (feature_group_name(g) == led && follows_skirt(g) && L.dominant == Region::kSkirt) {
       return fmt::format("led by {}, an outline group; the skirt's residual is denser than the hem's, so the outline "
@@ -252,14 +246,11 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
                     or_none(r.localisation.pixel_region,
                             fmt::format("none to {:g} x its pixel share", kMinRegionEnrichment)),
                     or_none(r.localisation.floor_region, "none above its floor"));
-  const bool named = r.attribution.named && r.verdict != "none";
   md += "| region | energy share | pixel share | enrichment | RMS (mm) | mean (mm; > 0: the capture farther) | RMS / "
-        "floor's |";
-  md += named ? " named effect's drop share / pixel share |\n|---|---|---|---|---|---|---|---|\n" : "\n|---|---|---|---|---|---|---|\n";
+        "floor's |\n|---|---|---|---|---|---|---|\n";
   for (const auto& s : r.localisation.regions) {
-    md += fmt::format("| {} | {:.2f} | {:.2f} | {:.2f} | {:.1f} | {:+.1f} | {:.2f} |", region_name(s.region),
+    md += fmt::format("| {} | {:.2f} | {:.2f} | {:.2f} | {:.1f} | {:+.1f} | {:.2f} |\n", region_name(s.region),
                       s.energy_share, s.pixel_share, s.enrichment, s.rms * 1e3, s.mean * 1e3, s.floor_ratio);
-    md += named ? fmt::format(" {:.2f} |\n", s.explained_enrichment) : "\n";
   }
   md += fmt::format("\nDominant region: **{}** ({}). Per-view share of the residual energy:",
                     region_name(r.localisation.dominant), leading_feature_text(r.localisation));

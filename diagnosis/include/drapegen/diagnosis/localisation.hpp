@@ -26,10 +26,6 @@ struct RegionShare {
   /// The region's RMS over the largest floor sample's in the same region (localise_against_floors; 0 if the floors
   /// have no pixels there): how far this part of the specimen is from what noise and other stable drapes leave.
   double floor_ratio = 0.0;
-  /// With an effect named: the region's share of the drop in residual energy from the fitted drape to the named
-  /// effect's refitted one, over its pixel share (explain_gap; 0 if none was named or the residual did not drop). Where
-  /// the effect removes the gap rather than where the residual sits.
-  double explained_enrichment = 0.0;
 };
 
 /// A drape's residual maps back-projected onto the specimen: squared residuals and pixels per region (indexed by
@@ -50,10 +46,6 @@ struct Localisation {
   /// Where the gap sits (place_gap): from the shape-feature group or the stable term that exceeds its floor the most
   /// (dominant_feature), kGlobal if nothing exceeds its floor.
   Region dominant = Region::kGlobal;
-  /// place_gap's region before the attribution (dominant may be placed again by place_explained_gap).
-  Region placed_by_features = Region::kGlobal;
-  /// place_explained_gap chose between the hem and the skirt by where the named effect removes the gap.
-  bool placed_by_refit = false;
   /// That feature: a feature group's name, "stable" for the stable term, "camera" for the rigid surfaces' camera
   /// (camera_moved), empty if nothing exceeds its floor.
   std::string dominant_feature;
@@ -86,20 +78,6 @@ struct Localisation {
 
 /// `drape` scored against the capture (or a floor sample, with the capture's cameras): its residuals per region.
 [[nodiscard]] RegionEnergy region_energy(const ForwardModel& model, const ScoredDrape& drape);
-/// The same with the regions drawn around `outline` (the specimen-frame outline of a drape, turned as rendered)
-/// instead of the drape's own.
-[[nodiscard]] RegionEnergy region_energy(const ForwardModel& model, const ScoredDrape& drape, const HemProfile& outline);
-
-/// Per region (indexed by Region, kGlobal unused): its share of the drop in residual energy from `before` to `after`
-/// over its share of `before`'s pixels (regions below 2% of the pixels: 0). All 0 if the total energy does not drop.
-/// A region whose residual grows has a negative share.
-[[nodiscard]] std::array<double, RegionEnergy::kCount> explained_enrichment(const RegionEnergy& before,
-                                                                           const RegionEnergy& after);
-
-/// Sets each region's explained_enrichment from the fitted drape (`fitted`, the gap's) and the named effect's refitted
-/// drape (`refitted`), both classified around the fitted drape's outline, then place_explained_gap.
-void explain_gap(Localisation& localisation, const ForwardModel& model, const ScoredDrape& fitted,
-                 const ScoredDrape& refitted);
 
 /// `drape` is the fitted drape scored against the capture (its residual maps).
 [[nodiscard]] Localisation localise(const ForwardModel& model, const ScoredDrape& drape);
@@ -146,12 +124,5 @@ void localise_features(Localisation& localisation, const ScoredDrape& drape, con
 /// The other hem groups (harmonics, sorted radii, hem height): kSkirt if the skirt's pixel residual is denser than the
 /// hem's (the outline carries a change of the skirt above it), else kHem. Nothing above 1: kGlobal.
 void place_gap(Localisation& localisation);
-
-/// Once an effect is named: where place_gap put the gap on the outline or the skirt by a feature group other than the
-/// centre offset (not by the stable term or the camera; a shifted centre is the hem's own), the hem or the skirt, whichever has the larger
-/// explained_enrichment (placed_by_refit). The baseline's residual density (place_gap) counts where other stable drapes
-/// place folds as much as where the effect acts; the drop the named effect brings is the effect's own (session 35).
-/// Left as placed if the residual did not drop in either.
-void place_explained_gap(Localisation& localisation);
 
 }  // namespace drapegen::diagnosis
