@@ -1,6 +1,7 @@
 #include "drapegen/diagnosis/attribution.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -512,6 +513,18 @@ sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& base
     std::vector<std::thread> threads;
     std::mutex mutex;
     std::optional<sim::Error> error;
+    // Each thread takes the next task when it is free: the refits differ in length several times over (a
+    // misalignment refit can take as long as three others), so a fixed share per thread left one idle. The longest
+    // go first: those that simulate before those that re-render, the most parameters first.
+    std::vector<std::size_t> order(tasks);
+    for (std::size_t k = 0; k < tasks; ++k) order[k] = k;
+    auto cost = [&](std::size_t k) {
+      const std::optional<Effect> e = task_effect(k);
+      const bool simulates = !e || needs_simulation(*e);
+      return std::pair(simulates, e ? effect_space(*e).names.size() : 0);
+    };
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return cost(a) > cost(b); });
+    std::atomic<std::size_t> next{0};
     for (int j = 0; j < jobs; ++j) {
       threads.emplace_back([&, j] {
         // Thread 0 uses the given models, every other thread its own of each capture.
@@ -531,7 +544,8 @@ sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& base
         ForwardModel* second = model_of(others.second.model);
         ForwardModel* held_out = model_of(others.held_out.model);
         if (!m || (others.second && !second) || (others.held_out && !held_out)) return;
-        for (std::size_t k = static_cast<std::size_t>(j); k < tasks; k += jobs) {
+        for (std::size_t n = next++; n < tasks; n = next++) {
+          const std::size_t k = order[n];
           auto r = refit(*m, second, held_out, task_effect(k), baseline, fit, validated, settings);
           std::lock_guard lock(mutex);
           results[k] = std::move(r);
