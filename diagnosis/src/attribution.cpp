@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <mutex>
+#include <numeric>
 #include <optional>
 #include <utility>
 #include <thread>
@@ -517,7 +518,7 @@ sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& base
     // misalignment refit can take as long as three others), so a fixed share per thread left one idle. The longest
     // go first: those that simulate before those that re-render, the most parameters first.
     std::vector<std::size_t> order(tasks);
-    for (std::size_t k = 0; k < tasks; ++k) order[k] = k;
+    std::iota(order.begin(), order.end(), std::size_t{0});
     auto cost = [&](std::size_t k) {
       const std::optional<Effect> e = task_effect(k);
       const bool simulates = !e || needs_simulation(*e);
