@@ -280,7 +280,10 @@ Runner add_diagnose_command(CLI::App& app) {
                  "The candidate effects to refit, comma-separated (default: yield, shear, curl, friction, "
                  "misalignment, sensor)")
       ->delimiter(',');
-  app.add_option("--jobs", o->jobs, "Candidate refits in parallel threads (same result as --jobs 1)")->capture_default_str();
+  app.add_option("--jobs", o->jobs,
+                 "Threads: the fit's and the floors' initial states, then the candidate refits, in parallel (same "
+                 "result as --jobs 1)")
+      ->capture_default_str();
   app.add_option("--shape-floor", o->shape_floor,
                  fmt::format("Shape-distance floor (default and quick: calibrated {:.2f}; fine: {:.2f}, with "
                              "--held-out-capture or --second-capture {:.2f}; 0: the largest floor sample)",

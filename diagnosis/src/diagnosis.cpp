@@ -246,6 +246,13 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
     if (!m) return m.error();
     *made = std::move(*m);
   }
+  // Until the refits (which run settings.attribution.jobs at a time, each simulating on one thread), every evaluation
+  // simulates its initial states on that many threads.
+  const auto set_threads = [&](int threads) {
+    for (ForwardModel* m : {&model, second_model.get(), held_out_model.get()})
+      if (m != nullptr) m->set_threads(threads);
+  };
+  set_threads(settings.attribution.jobs);
   DiagnosisResult r;
   // 0. The camera from the rigid surfaces (no simulation): the sensor candidate's start.
   if (auto pose = estimate_rigid_pose(capture, RigidSurfaces::for_specimen(capture.specimen))) {
@@ -445,6 +452,7 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
     }
     r.refit_scale_lower = attribution_settings.bending_scale_lower;
     r.refit_scale_upper = attribution_settings.bending_scale_upper;
+    set_threads(1);
     auto attribution = attribute(model, fitted, r.fit, r.validated, r.floors, attribution_settings, make_model,
                                  other_captures);
     if (!attribution) return attribution.error();

@@ -1,9 +1,11 @@
 #include "drapegen/diagnosis/forward_model.hpp"
 
 #include <Eigen/Geometry>
+#include <atomic>
 #include <chrono>
 #include <fmt/format.h>
 #include <limits>
+#include <thread>
 
 #include "drapegen/renderer/noise.hpp"
 #include "drapegen/renderer/random.hpp"
@@ -81,8 +83,11 @@ sim::Expected<sim::ClothMesh> ForwardModel::simulate(const ModelSetup& setup, co
   config.solver.max_iterations = settings_.max_newton_iterations;
   config.solver.tolerance = settings_.tolerance;
   auto result = sim::simulate_drape(config);
-  ++simulations_;
-  simulation_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  {
+    std::lock_guard lock(counters_);
+    ++simulations_;
+    simulation_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
   if (!result) return result.error();
   if (converged != nullptr) *converged = result->report.outcome == sim::SolveOutcome::kConverged;
   if (rest_angles != nullptr) *rest_angles = std::move(result->rest_angles);
@@ -230,16 +235,33 @@ sim::Expected<Evaluation> ForwardModel::evaluate(const ModelSetup& setup,
   double best = std::numeric_limits<double>::infinity();
   const bool yields = setup.effects.bending_yield_curvature.has_value();
   if (yields && simulated) return sim::Error{"evaluate: a yielding setup's drapes are always simulated"};
-  for (std::size_t k = 0; k < states.size(); ++k) {
+  // Every drape first (on threads_ threads, each taking the next state), then scored in the states' order.
+  struct Drape {
+    sim::Expected<sim::ClothMesh> mesh = sim::ClothMesh{};
     bool converged = true;
     Eigen::VectorXd rest_angles;
-    sim::Expected<sim::ClothMesh> mesh = sim::ClothMesh{};
-    if (simulated && simulated->state == k) {
-      *mesh = simulated->mesh;
-      converged = simulated->converged;
-    } else {
-      mesh = simulate(setup, states[k], &converged, yields ? &rest_angles : nullptr);
+  };
+  std::vector<Drape> drapes(states.size());
+  std::atomic<std::size_t> next{0};
+  auto work = [&] {
+    for (std::size_t k = next++; k < states.size(); k = next++) {
+      Drape& d = drapes[k];
+      if (simulated && simulated->state == k) {
+        *d.mesh = simulated->mesh;
+        d.converged = simulated->converged;
+      } else {
+        d.mesh = simulate(setup, states[k], &d.converged, yields ? &d.rest_angles : nullptr);
+      }
     }
+  };
+  {
+    std::vector<std::jthread> helpers;
+    const std::size_t extra = std::min<std::size_t>(static_cast<std::size_t>(threads_), states.size());
+    for (std::size_t t = 1; t < extra; ++t) helpers.emplace_back(work);
+    work();
+  }
+  for (std::size_t k = 0; k < states.size(); ++k) {
+    auto& [mesh, converged, rest_angles] = drapes[k];
     if (!mesh) return mesh.error();
     auto scored = score(*mesh, setup);
     if (!scored) return scored.error();

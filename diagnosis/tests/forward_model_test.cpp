@@ -58,5 +58,38 @@ TEST(ForwardModel, LaidAgainCarriesAYieldingSpecimensSetAndNothingOfAnElasticOne
   fs::remove_all(made->dir);
 }
 
+TEST(ForwardModel, EvaluatesOnSeveralThreadsAsOnOne) {
+  // The initial states simulated on three threads: the same drapes, scores, best state and plastic sets as on one,
+  // each state simulated once.
+  RealitySpec spec = fixture::small_reality_spec();
+  const auto made = fixture::generate_small_reality("threads", spec);
+  ASSERT_TRUE(made.has_value());
+  FitSettings settings;
+  settings.resolution = 12;
+  auto model = ForwardModel::create(made->capture, settings);
+  ASSERT_TRUE(model.has_value()) << model.error().message;
+  const auto states = fit_initial_states(3, 5);
+  ModelSetup yielding;
+  yielding.bending = spec.bending;
+  yielding.effects.bending_yield_curvature = 10.0;
+
+  auto one = (*model)->evaluate(yielding, states);
+  ASSERT_TRUE(one.has_value()) << one.error().message;
+  const int simulations = (*model)->simulations();
+  (*model)->set_threads(3);
+  auto three = (*model)->evaluate(yielding, states);
+  ASSERT_TRUE(three.has_value()) << three.error().message;
+  EXPECT_EQ((*model)->simulations(), 2 * simulations);
+  EXPECT_EQ(three->best.state, one->best.state);
+  ASSERT_EQ(three->states.size(), states.size());
+  for (std::size_t k = 0; k < states.size(); ++k) {
+    EXPECT_EQ(three->states[k].state, static_cast<int>(k));
+    EXPECT_EQ(three->states[k].mesh.positions, one->states[k].mesh.positions) << "state " << k;
+    EXPECT_EQ(three->states[k].fit_score, one->states[k].fit_score) << "state " << k;
+    EXPECT_EQ(three->states[k].left.rest_angles, one->states[k].left.rest_angles) << "state " << k;
+  }
+  fs::remove_all(made->dir);
+}
+
 }  // namespace
 }  // namespace drapegen::diagnosis

@@ -3,7 +3,9 @@
 // turned to the capture's outline (the specimen's orientation on the table is arbitrary), rendered into the
 // capture's cameras and compared view by view; the best initial state counts (multiple stable drapes).
 
+#include <algorithm>
 #include <memory>
+#include <mutex>
 #include <vector>
 
 #include "drapegen/diagnosis/capture.hpp"
@@ -128,6 +130,10 @@ class ForwardModel {
   [[nodiscard]] const std::vector<sim::InitialStateSpec>& initial_states() const { return states_; }
   [[nodiscard]] int simulations() const { return simulations_; }
   [[nodiscard]] double simulation_seconds() const { return simulation_seconds_; }
+  /// Threads that evaluate() simulates its initial states on (default 1). The drapes are scored and rendered on the
+  /// calling thread, in the states' order, so the result does not depend on it.
+  void set_threads(int threads) { threads_ = std::max(1, threads); }
+  [[nodiscard]] int threads() const { return threads_; }
   /// Means over the fit views / held-out views / all of per-view scores.
   [[nodiscard]] double fit_mean(const std::vector<ViewComparison>& views) const;
   [[nodiscard]] double held_out_mean(const std::vector<ViewComparison>& views) const;
@@ -140,6 +146,8 @@ class ForwardModel {
   Target target_;
   std::vector<sim::InitialStateSpec> states_;
   std::vector<bool> is_fit_view_;
+  int threads_ = 1;
+  std::mutex counters_;  // simulate() may run on several threads (set_threads)
   int simulations_ = 0;
   double simulation_seconds_ = 0.0;
 };
