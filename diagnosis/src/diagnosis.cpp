@@ -466,7 +466,8 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
     }
   }
   r.seconds_attribution = since(attribution_start);
-  r.simulations = model.simulations();  // the main thread's, on every placement's model
+  // The simulations of every placement's own model (their helper threads' too; not the refit threads' models).
+  r.simulations = model.simulations();
   for (const auto& m : {second_model.get(), held_out_model.get()})
     if (m) r.simulations += m->simulations();
   r.seconds = since(start);

@@ -255,9 +255,9 @@ sim::Expected<Evaluation> ForwardModel::evaluate(const ModelSetup& setup,
     }
   };
   {
-    std::vector<std::jthread> helpers;
-    const std::size_t extra = std::min<std::size_t>(static_cast<std::size_t>(threads_), states.size());
-    for (std::size_t t = 1; t < extra; ++t) helpers.emplace_back(work);
+    std::vector<std::jthread> helpers;  // joined at the end of this block
+    const std::size_t threads = std::min<std::size_t>(static_cast<std::size_t>(threads_), states.size());
+    for (std::size_t t = 1; t < threads; ++t) helpers.emplace_back(work);
     work();
   }
   for (std::size_t k = 0; k < states.size(); ++k) {
