@@ -3,6 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
 
 #include "drapegen/diagnosis/forward_model.hpp"
 #include "small_reality.hpp"
@@ -12,20 +15,35 @@ namespace {
 
 namespace fs = std::filesystem;
 
-TEST(ForwardModel, LaidAgainCarriesAYieldingSpecimensSetAndNothingOfAnElasticOne) {
+/// A noiseless capture of the fixture's fabric (generated into a directory named `name`) and a 12x12 forward model
+/// of it; unset, with the reason reported as a test failure, if either fails.
+struct SmallModel {
+  fixture::SmallReality made;
+  std::unique_ptr<ForwardModel> model;
+};
+std::optional<SmallModel> small_model(const std::string& name) {
   RealitySpec spec = fixture::small_reality_spec();
   spec.noise = false;
-  const auto made = fixture::generate_small_reality("laid_again", spec);
-  ASSERT_TRUE(made.has_value());
+  auto made = fixture::generate_small_reality(name, spec);
+  if (!made) return std::nullopt;
   FitSettings settings;
   settings.resolution = 12;
   auto model = ForwardModel::create(made->capture, settings);
-  ASSERT_TRUE(model.has_value()) << model.error().message;
+  EXPECT_TRUE(model.has_value()) << (model ? "" : model.error().message);
+  if (!model) return std::nullopt;
+  return SmallModel{std::move(*made), std::move(*model)};
+}
+
+TEST(ForwardModel, LaidAgainCarriesAYieldingSpecimensSetAndNothingOfAnElasticOne) {
+  auto small = small_model("laid_again");
+  ASSERT_TRUE(small.has_value());
+  const RealitySpec& spec = small->made.spec;
+  auto& model = small->model;
   const auto states = fit_initial_states(2, 7);
 
   ModelSetup elastic;
   elastic.bending = spec.bending;
-  auto elastic_again = (*model)->laid_again(elastic, states[1]);
+  auto elastic_again = model->laid_again(elastic, states[1]);
   ASSERT_TRUE(elastic_again.has_value()) << elastic_again.error().message;
   const Eigen::VectorXd& none = elastic_again->plastic_set.rest_angles;
   ASSERT_GT(none.size(), 0);
@@ -34,12 +52,12 @@ TEST(ForwardModel, LaidAgainCarriesAYieldingSpecimensSetAndNothingOfAnElasticOne
 
   ModelSetup yielding = elastic;
   yielding.effects.bending_yield_curvature = 10.0;  // 1/m: the drape's folds bend well past it
-  auto once = (*model)->laid_again(yielding, states[1]);
+  auto once = model->laid_again(yielding, states[1]);
   ASSERT_TRUE(once.has_value()) << once.error().message;
   EXPECT_GT(once->plastic_set.rest_angles.cwiseAbs().maxCoeff(), 0.1);
   EXPECT_EQ(once->plastic_set.specimen_seed, states[1].seed);
   // Laid a second time from another state: still the first drape's specimen, its set grown from the first one's.
-  auto twice = (*model)->laid_again(*once, states[0]);
+  auto twice = model->laid_again(*once, states[0]);
   ASSERT_TRUE(twice.has_value()) << twice.error().message;
   EXPECT_EQ(twice->plastic_set.specimen_seed, states[1].seed);
   EXPECT_EQ(twice->plastic_set.rest_angles.size(), once->plastic_set.rest_angles.size());
@@ -47,39 +65,35 @@ TEST(ForwardModel, LaidAgainCarriesAYieldingSpecimensSetAndNothingOfAnElasticOne
 
   // evaluate keeps the set each yielding drape leaves, so laying it again needs no second simulation: the same set as
   // laid_again's from that state; an elastic setup's drapes keep none.
-  auto evaluated = (*model)->evaluate(yielding, states);
+  auto evaluated = model->evaluate(yielding, states);
   ASSERT_TRUE(evaluated.has_value()) << evaluated.error().message;
   const ModelSetup kept = ForwardModel::laid_again(yielding, evaluated->states[1]);
   EXPECT_EQ(kept.plastic_set.specimen_seed, once->plastic_set.specimen_seed);
   EXPECT_EQ(kept.plastic_set.rest_angles, once->plastic_set.rest_angles);
-  auto evaluated_elastic = (*model)->evaluate(elastic, states);
+  auto evaluated_elastic = model->evaluate(elastic, states);
   ASSERT_TRUE(evaluated_elastic.has_value()) << evaluated_elastic.error().message;
   EXPECT_EQ(evaluated_elastic->best.left.rest_angles.size(), 0);
-  fs::remove_all(made->dir);
+  fs::remove_all(small->made.dir);
 }
 
 TEST(ForwardModel, EvaluatesOnSeveralThreadsAsOnOne) {
   // The initial states simulated on three threads: the same drapes, scores, best state and plastic sets as on one,
   // each state simulated once.
-  RealitySpec spec = fixture::small_reality_spec();
-  const auto made = fixture::generate_small_reality("threads", spec);
-  ASSERT_TRUE(made.has_value());
-  FitSettings settings;
-  settings.resolution = 12;
-  auto model = ForwardModel::create(made->capture, settings);
-  ASSERT_TRUE(model.has_value()) << model.error().message;
+  auto small = small_model("threads");
+  ASSERT_TRUE(small.has_value());
+  auto& model = small->model;
   const auto states = fit_initial_states(3, 5);
   ModelSetup yielding;
-  yielding.bending = spec.bending;
+  yielding.bending = small->made.spec.bending;
   yielding.effects.bending_yield_curvature = 10.0;
 
-  auto one = (*model)->evaluate(yielding, states);
+  auto one = model->evaluate(yielding, states);
   ASSERT_TRUE(one.has_value()) << one.error().message;
-  const int simulations = (*model)->simulations();
-  (*model)->set_threads(3);
-  auto three = (*model)->evaluate(yielding, states);
+  const int simulations = model->simulations();
+  model->set_threads(3);
+  auto three = model->evaluate(yielding, states);
   ASSERT_TRUE(three.has_value()) << three.error().message;
-  EXPECT_EQ((*model)->simulations(), 2 * simulations);
+  EXPECT_EQ(model->simulations(), 2 * simulations);
   EXPECT_EQ(three->best.state, one->best.state);
   ASSERT_EQ(three->states.size(), states.size());
   for (std::size_t k = 0; k < states.size(); ++k) {
@@ -88,7 +102,7 @@ TEST(ForwardModel, EvaluatesOnSeveralThreadsAsOnOne) {
     EXPECT_EQ(three->states[k].fit_score, one->states[k].fit_score) << "state " << k;
     EXPECT_EQ(three->states[k].left.rest_angles, one->states[k].left.rest_angles) << "state " << k;
   }
-  fs::remove_all(made->dir);
+  fs::remove_all(small->made.dir);
 }
 
 }  // namespace
