@@ -93,7 +93,9 @@ int main(int argc, char** argv) {
   app.add_option("--controls", controls, "No-effect captures (sensor noise only)")->capture_default_str();
   app.add_option("--families", families, "Effect families to include")->capture_default_str();
   app.add_option("--jobs", jobs, "Diagnoses run at once (processes)")->capture_default_str();
-  app.add_option("--diagnose-jobs", diagnose_jobs, "--jobs of each diagnosis (refit threads)")->capture_default_str();
+  app.add_option("--diagnose-jobs", diagnose_jobs,
+                 "--jobs of each diagnosis (its threads: the fit's states, then the refits)")
+      ->capture_default_str();
   std::string diagnose_args;
   app.add_option("--diagnose-args", diagnose_args, "More options for drapegen diagnose (e.g. \"--shape-floor 0\")");
   // 60x60 (5 mm spacing): real cloth is continuous, so the reality mesh must resolve what the coarse fitting mesh
