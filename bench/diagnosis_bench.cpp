@@ -8,7 +8,6 @@
 // not converge, e.g. a specimen sliding off the cylinder on a slippery top, is not a drape to diagnose).
 #include <CLI/CLI.hpp>
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -20,10 +19,10 @@
 #include <mutex>
 #include <optional>
 #include <nlohmann/json.hpp>
-#include <thread>
 
 #include "drapegen/diagnosis/bending_json.hpp"
 #include "drapegen/diagnosis/reality.hpp"
+#include "drapegen/diagnosis/work_sharing.hpp"
 #include "drapegen/renderer/random.hpp"
 #include "drapegen/sampler/fabric_data.hpp"
 #include "drapegen/sim/blas_kernels.hpp"
@@ -390,35 +389,31 @@ int main(int argc, char** argv) {
 
   // 2. Diagnose, J at a time.
   if (!score_only) {
-    std::atomic<std::size_t> next{0};
+    diagnosis::WorkQueue queue(cases.size());
     std::mutex io;
-    std::vector<std::thread> workers;
-    for (int j = 0; j < std::max(1, jobs); ++j) {
-      workers.emplace_back([&] {
-        for (std::size_t k = next++; k < cases.size(); k = next++) {
-          const auto& c = cases[k];
-          const fs::path dir = fs::path(out) / "captures" / c.name;
-          const fs::path result = fs::path(out) / "diagnoses" / (c.name + ".json");
-          if (fs::exists(result) && fs::file_size(result) > 0) continue;
-          fs::create_directories(result.parent_path());
-          const std::string second =
-              second_placement     ? fmt::format(" --second-capture '{0}.p1' --held-out-capture '{0}.p2'", dir.string())
-              : held_out_placement ? fmt::format(" --held-out-capture '{}.p1'", dir.string())
-                                   : std::string();
-          const std::string cmd =
-              fmt::format("'{}' diagnose --capture '{}'{} --json{} --jobs {} {} > '{}.tmp' 2> '{}.err'", drapegen,
-                          dir.string(), second, quick ? " --quick" : "", diagnose_jobs, diagnose_args,
-                          result.string(), result.string());
-          const auto t0 = std::chrono::steady_clock::now();
-          const int rc = std::system(cmd.c_str());
-          const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-          if (rc == 0) fs::rename(result.string() + ".tmp", result);
-          std::lock_guard lock(io);
-          std::cout << fmt::format("diagnosed {} in {:.0f} s (exit {})\n", c.name, s, rc) << std::flush;
-        }
-      });
-    }
-    for (auto& w : workers) w.join();
+    diagnosis::run_on_threads(jobs, [&](int) {
+      while (const auto k = queue.take()) {
+        const auto& c = cases[*k];
+        const fs::path dir = fs::path(out) / "captures" / c.name;
+        const fs::path result = fs::path(out) / "diagnoses" / (c.name + ".json");
+        if (fs::exists(result) && fs::file_size(result) > 0) continue;
+        fs::create_directories(result.parent_path());
+        const std::string second =
+            second_placement     ? fmt::format(" --second-capture '{0}.p1' --held-out-capture '{0}.p2'", dir.string())
+            : held_out_placement ? fmt::format(" --held-out-capture '{}.p1'", dir.string())
+                                 : std::string();
+        const std::string cmd =
+            fmt::format("'{}' diagnose --capture '{}'{} --json{} --jobs {} {} > '{}.tmp' 2> '{}.err'", drapegen,
+                        dir.string(), second, quick ? " --quick" : "", diagnose_jobs, diagnose_args,
+                        result.string(), result.string());
+        const auto t0 = std::chrono::steady_clock::now();
+        const int rc = std::system(cmd.c_str());
+        const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        if (rc == 0) fs::rename(result.string() + ".tmp", result);
+        std::lock_guard lock(io);
+        std::cout << fmt::format("diagnosed {} in {:.0f} s (exit {})\n", c.name, s, rc) << std::flush;
+      }
+    });
   }
 
   // 3. Score.

@@ -1,12 +1,12 @@
 #include "drapegen/diagnosis/forward_model.hpp"
 
 #include <Eigen/Geometry>
-#include <atomic>
+#include <algorithm>
 #include <chrono>
 #include <fmt/format.h>
 #include <limits>
-#include <thread>
 
+#include "drapegen/diagnosis/work_sharing.hpp"
 #include "drapegen/renderer/noise.hpp"
 #include "drapegen/renderer/random.hpp"
 #include "drapegen/renderer/rig.hpp"
@@ -242,24 +242,18 @@ sim::Expected<Evaluation> ForwardModel::evaluate(const ModelSetup& setup,
     Eigen::VectorXd rest_angles;
   };
   std::vector<Drape> drapes(states.size());
-  std::atomic<std::size_t> next{0};
-  auto work = [&] {
-    for (std::size_t k = next++; k < states.size(); k = next++) {
-      Drape& d = drapes[k];
-      if (simulated && simulated->state == k) {
+  WorkQueue queue(states.size());
+  run_on_threads(std::min(threads_, static_cast<int>(states.size())), [&](int) {
+    while (const auto k = queue.take()) {
+      Drape& d = drapes[*k];
+      if (simulated && simulated->state == *k) {
         *d.mesh = simulated->mesh;
         d.converged = simulated->converged;
       } else {
-        d.mesh = simulate(setup, states[k], &d.converged, yields ? &d.rest_angles : nullptr);
+        d.mesh = simulate(setup, states[*k], &d.converged, yields ? &d.rest_angles : nullptr);
       }
     }
-  };
-  {
-    std::vector<std::jthread> helpers;  // joined at the end of this block
-    const std::size_t threads = std::min<std::size_t>(static_cast<std::size_t>(threads_), states.size());
-    for (std::size_t t = 1; t < threads; ++t) helpers.emplace_back(work);
-    work();
-  }
+  });
   for (std::size_t k = 0; k < states.size(); ++k) {
     auto& [mesh, converged, rest_angles] = drapes[k];
     if (!mesh) return mesh.error();
