@@ -36,6 +36,7 @@ struct DiagnoseOptions {
   int sensor_evaluations = 0;
   int refit_scan = -1;  // < 0: the settings' value
   int yield_trade = -1;  // < 0: the settings' value
+  int drift_scan = -1;   // < 0: the settings' value
   std::vector<std::string> candidates;  // empty: every effect
   std::optional<int> starts;  // unset: the settings' value
   std::string start_alpha, start_beta;  // empty: the drape-coefficient guess
@@ -80,6 +81,7 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (o.yield_trade < -1 || o.yield_trade == 1 || o.yield_trade > 100) {
     return fail("--yield-trade must be 0 (off) or 2 .. 100");
   }
+  if (o.drift_scan < -1 || o.drift_scan > 100) return fail("--drift-scan must be 0 (off) .. 100");
   std::optional<diagnosis::BendingParameters> start;
   if (o.start_alpha.empty() != o.start_beta.empty()) return fail("--start-alpha and --start-beta go together");
   if (!o.start_alpha.empty()) {
@@ -132,6 +134,7 @@ int run_diagnose(const DiagnoseOptions& o) {
   settings.attribution.tie_margin = o.tie_margin;
   if (o.refit_scan >= 0) settings.attribution.scan_levels = o.refit_scan;
   if (o.yield_trade >= 0) settings.attribution.yield_trade_levels = o.yield_trade;
+  if (o.drift_scan >= 0) settings.attribution.drift_scan_levels = o.drift_scan;
   if (!candidates.empty()) settings.attribution.candidates = candidates;
   if (o.starts) settings.start_levels = *o.starts;
   settings.start = start;
@@ -139,7 +142,8 @@ int run_diagnose(const DiagnoseOptions& o) {
   settings.use_measured_bending = !o.ignore_measured_bending;
   constexpr int kKeep = diagnosis::AttributionSettings::kSimplexAfterScan;
   for (auto [levels, option] : {std::pair{settings.attribution.scan_levels, "--refit-scan"},
-                                 std::pair{settings.attribution.yield_trade_levels, "--yield-trade"}}) {
+                                 std::pair{settings.attribution.yield_trade_levels, "--yield-trade"},
+                                 std::pair{std::max(o.drift_scan, 0), "--drift-scan"}}) {
     if (levels > settings.attribution.optimiser.max_evaluations - kKeep) {
       return fail(fmt::format("{} ({}) must leave the refit's simplex {} of its {} evaluations", option, levels, kKeep,
                               settings.attribution.optimiser.max_evaluations));
@@ -276,6 +280,14 @@ Runner add_diagnose_command(CLI::App& app) {
                              std::exp(diagnosis::AttributionSettings::kYieldScaleRange),
                              diagnosis::AttributionSettings::kYieldTradeCurvature,
                              diagnosis::AttributionSettings::kSimplexAfterScan));
+  app.add_option("--drift-scan", o->drift_scan,
+                 fmt::format("The misalignment refit starts with this many drift sizes evenly spaced below its bound "
+                             "(3: 10, 20 and 30 mm), bending as fitted, then refines from the best within "
+                             "--refit-evaluations, which must leave {} for that (default {}, skipped where the "
+                             "budget is smaller; 0: off, the start from the hem's first harmonics as before session "
+                             "37)",
+                             diagnosis::AttributionSettings::kSimplexAfterScan,
+                             diagnosis::AttributionSettings{}.drift_scan_levels));
   app.add_option("--candidates", o->candidates,
                  "The candidate effects to refit, comma-separated (default: yield, shear, curl, friction, "
                  "misalignment, sensor)")

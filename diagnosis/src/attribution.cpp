@@ -1,7 +1,6 @@
 #include "drapegen/diagnosis/attribution.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -9,11 +8,11 @@
 #include <numeric>
 #include <optional>
 #include <utility>
-#include <thread>
 
 #include <fmt/ranges.h>
 
 #include "drapegen/diagnosis/fold_repeatability.hpp"
+#include "drapegen/diagnosis/work_sharing.hpp"
 #include "drapegen/renderer/random.hpp"
 #include "drapegen/sim/logging.hpp"
 
@@ -169,7 +168,7 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
       const double vertical = std::max(0.0, captured[1] - modelled[1]);
       x0[first] = std::clamp(std::hypot(radial, vertical) * 1e3, 0.0, space.upper[0]);
     }
-    sim::logger()->debug("refit misalignment: start drift {:.1f} mm", x0[first]);
+    sim::logger()->debug("refit misalignment: start drift {:.1f} mm (before any scan)", x0[first]);
   }
   lo.insert(lo.end(), space.lower.begin(), space.lower.end());
   hi.insert(hi.end(), space.upper.begin(), space.upper.end());
@@ -270,6 +269,17 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
     for (int k = 0; k < n; ++k) {
       std::vector<double> x = x0;
       x[first] = k + 1 == n ? hi[first] : lo[first] + spacing * k;
+      scan.push_back(std::move(x));
+    }
+    scanned_axes = {first};
+  } else if (effect == Effect::kMisalignment && settings.drift_scan_levels >= 1 &&
+             settings.drift_scan_levels <= room) {
+    // Drift sizes along the warp (AttributionSettings::drift_scan_levels), no turn, the bending as fitted.
+    const int n = settings.drift_scan_levels;
+    spacing = hi[first] / (n + 1);
+    for (int k = 1; k <= n; ++k) {
+      std::vector<double> x = x0;
+      x[0] = 0.0, x[first] = spacing * k, x[first + 1] = 0.0;
       scan.push_back(std::move(x));
     }
     scanned_axes = {first};
@@ -511,7 +521,6 @@ sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& base
                          settings);
     }
   } else {
-    std::vector<std::thread> threads;
     std::mutex mutex;
     std::optional<sim::Error> error;
     // Each thread takes the next task when it is free: the refits differ in length several times over (a
@@ -525,35 +534,32 @@ sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& base
       return std::pair(simulates, e ? effect_space(*e).names.size() : 0);
     };
     std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return cost(a) > cost(b); });
-    std::atomic<std::size_t> next{0};
-    for (int j = 0; j < jobs; ++j) {
-      threads.emplace_back([&, j] {
-        // Thread 0 uses the given models, every other thread its own of each capture.
-        std::vector<std::unique_ptr<ForwardModel>> own;
-        auto model_of = [&](ForwardModel* given) -> ForwardModel* {
-          if (j == 0 || !given) return given;
-          auto created = make_model(given->capture());
-          if (!created) {
-            std::lock_guard lock(mutex);
-            error = created.error();
-            return nullptr;
-          }
-          own.push_back(std::move(*created));
-          return own.back().get();
-        };
-        ForwardModel* m = model_of(&model);
-        ForwardModel* second = model_of(others.second.model);
-        ForwardModel* held_out = model_of(others.held_out.model);
-        if (!m || (others.second && !second) || (others.held_out && !held_out)) return;
-        for (std::size_t n = next++; n < tasks; n = next++) {
-          const std::size_t k = order[n];
-          auto r = refit(*m, second, held_out, task_effect(k), baseline, fit, validated, settings);
+    WorkQueue queue(tasks);
+    run_on_threads(jobs, [&](int j) {
+      // Thread 0 uses the given models, every other thread its own of each capture.
+      std::vector<std::unique_ptr<ForwardModel>> own;
+      auto model_of = [&](ForwardModel* given) -> ForwardModel* {
+        if (j == 0 || !given) return given;
+        auto created = make_model(given->capture());
+        if (!created) {
           std::lock_guard lock(mutex);
-          results[k] = std::move(r);
+          error = created.error();
+          return nullptr;
         }
-      });
-    }
-    for (auto& t : threads) t.join();
+        own.push_back(std::move(*created));
+        return own.back().get();
+      };
+      ForwardModel* m = model_of(&model);
+      ForwardModel* second = model_of(others.second.model);
+      ForwardModel* held_out = model_of(others.held_out.model);
+      if (!m || (others.second && !second) || (others.held_out && !held_out)) return;
+      while (const auto n = queue.take()) {
+        const std::size_t k = order[*n];
+        auto r = refit(*m, second, held_out, task_effect(k), baseline, fit, validated, settings);
+        std::lock_guard lock(mutex);
+        results[k] = std::move(r);
+      }
+    });
     if (error) return *error;
   }
   for (auto& r : results)

@@ -142,6 +142,12 @@ struct AttributionSettings {
   /// from the best with the rest of the same budget (optimiser.max_evaluations simulations in all). 0: the simplex
   /// from the effect's fixed start (effect_space) alone; so is a value above the budget - kSimplexAfterScan.
   int scan_levels = 0;
+  /// The misalignment refit first evaluates drifts of this many sizes along the warp, evenly spaced below the drift's
+  /// bound (3: 10, 20 and 30 mm of 40), the bending as fitted; the simplex (bending scale and drift) then refines from
+  /// the best within the same budget. The turn makes the direction arbitrary, so the size is what the start must get
+  /// right: from the capture's first hem harmonics (the start without a scan) it was often ~0, the baseline itself,
+  /// and the refit never left it (docs/DIAGNOSIS_RESULTS.md, "Session 37"). 0: that start alone.
+  int drift_scan_levels = 3;
   /// New evaluations the simplex keeps after a strength scan (its two new vertices and one move, at least).
   static constexpr int kSimplexAfterScan = 3;
   /// The yield refit first evaluates this many points along the trade of a stiffer bending against a lower yield
