@@ -143,7 +143,7 @@ int run_diagnose(const DiagnoseOptions& o) {
   constexpr int kKeep = diagnosis::AttributionSettings::kSimplexAfterScan;
   for (auto [levels, option] : {std::pair{settings.attribution.scan_levels, "--refit-scan"},
                                  std::pair{settings.attribution.yield_trade_levels, "--yield-trade"},
-                                 std::pair{std::max(o.drift_scan, 0), "--drift-scan"}}) {
+                                 std::pair{settings.attribution.drift_scan_levels, "--drift-scan"}}) {
     if (levels > settings.attribution.optimiser.max_evaluations - kKeep) {
       return fail(fmt::format("{} ({}) must leave the refit's simplex {} of its {} evaluations", option, levels, kKeep,
                               settings.attribution.optimiser.max_evaluations));
@@ -283,11 +283,9 @@ Runner add_diagnose_command(CLI::App& app) {
   app.add_option("--drift-scan", o->drift_scan,
                  fmt::format("The misalignment refit starts with this many drift sizes evenly spaced below its bound "
                              "(3: 10, 20 and 30 mm), bending as fitted, then refines from the best within "
-                             "--refit-evaluations, which must leave {} for that (default {}, skipped where the "
-                             "budget is smaller; 0: off, the start from the hem's first harmonics as before session "
-                             "37)",
-                             diagnosis::AttributionSettings::kSimplexAfterScan,
-                             diagnosis::AttributionSettings{}.drift_scan_levels));
+                             "--refit-evaluations, which must leave {} for that (default 0: off, the start from the "
+                             "hem's first harmonics; docs/DIAGNOSIS_RESULTS.md, \"Session 37\")",
+                             diagnosis::AttributionSettings::kSimplexAfterScan));
   app.add_option("--candidates", o->candidates,
                  "The candidate effects to refit, comma-separated (default: yield, shear, curl, friction, "
                  "misalignment, sensor)")

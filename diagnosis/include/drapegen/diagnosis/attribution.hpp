@@ -145,9 +145,10 @@ struct AttributionSettings {
   /// The misalignment refit first evaluates drifts of this many sizes along the warp, evenly spaced below the drift's
   /// bound (3: 10, 20 and 30 mm of 40), the bending as fitted; the simplex (bending scale and drift) then refines from
   /// the best within the same budget. The turn makes the direction arbitrary, so the size is what the start must get
-  /// right: from the capture's first hem harmonics (the start without a scan) it was often ~0, the baseline itself,
-  /// and the refit never left it (docs/DIAGNOSIS_RESULTS.md, "Session 37"). 0: that start alone.
-  int drift_scan_levels = 3;
+  /// right; 0 (off): the start from the capture's first hem harmonics, sometimes ~0, the baseline itself. With 3 the
+  /// refitted drift's size came closer to the truth on 9 of 10 fresh captures (median error 8.4 -> 4.5 mm), but the
+  /// shrinkage reached the same 9 of 10, short of the pre-registered +2 (docs/DIAGNOSIS_RESULTS.md, "Session 37").
+  int drift_scan_levels = 0;
   /// New evaluations the simplex keeps after a strength scan (its two new vertices and one move, at least).
   static constexpr int kSimplexAfterScan = 3;
   /// The yield refit first evaluates this many points along the trade of a stiffer bending against a lower yield
