@@ -279,7 +279,7 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
     spacing = hi[first] / (n + 1);
     for (int k = 1; k <= n; ++k) {
       std::vector<double> x = x0;
-      x[0] = 0.0, x[first] = spacing * k, x[first + 1] = 0.0;
+      x[first] = spacing * k;  // x0 holds the fitted bending (scale 0) and no drift across
       scan.push_back(std::move(x));
     }
     scanned_axes = {first};
