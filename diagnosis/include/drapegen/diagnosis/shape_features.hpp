@@ -3,7 +3,7 @@
 // (no phases) and sorted radii, the hem's height, the skirt's mean height and spread against the radius, and the
 // fold count. Two stable drapes of the same fabric differ in fold phase, much less in these; the unmodelled effects
 // change them (misalignment: the first harmonic; curl: the hem's height; yield, shear, friction: fold count, fold
-// depth and the skirt's slope). docs/DIAGNOSIS.md, "Shape features".
+// depth and the skirt's slope). docs/DIAGNOSIS.md, "Method", "Objective".
 
 #include <Eigen/Core>
 #include <string>
