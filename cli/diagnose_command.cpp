@@ -29,26 +29,27 @@ struct DiagnoseOptions {
   bool json = false;
   bool quick = false;
   bool fine = false;
-  int resolution = 0;
-  int states = 0;
-  int evaluations = 0;
-  int refit_evaluations = 0;
-  int sensor_evaluations = 0;
-  int refit_scan = -1;  // < 0: the settings' value
-  int yield_trade = -1;  // < 0: the settings' value
-  int drift_scan = -1;   // < 0: the settings' value
+  // Unset options keep the settings' value (default, --quick or --fine).
+  std::optional<int> resolution;
+  std::optional<int> states;
+  std::optional<int> evaluations;
+  std::optional<int> refit_evaluations;
+  std::optional<int> sensor_evaluations;
+  std::optional<int> refit_scan;
+  std::optional<int> yield_trade;
+  std::optional<int> drift_scan;
   std::vector<std::string> candidates;  // empty: every effect
-  std::optional<int> starts;  // unset: the settings' value
+  std::optional<int> starts;
   std::string start_alpha, start_beta;  // empty: the drape-coefficient guess
   double start_box = 0.0;               // 0: the whole box
   bool ignore_measured_bending = false;
   int jobs = 1;
-  double shape_floor = -1.0;  // < 0: the settings' calibrated value
+  std::optional<double> shape_floor;
   bool gap_only = false;
   bool ablation = false;
   bool sensor_bending = false;
   bool free_sensor = false;
-  int common_bending = -1;  // < 0: the settings' value
+  std::optional<int> common_bending;
   double tie_margin = diagnosis::AttributionSettings{}.tie_margin;
   double held_out_tolerance = diagnosis::AttributionSettings{}.held_out_tolerance;
   bool verbose = false;
@@ -62,26 +63,28 @@ int fail(const std::string& message, int code = kExitUsage) {
 
 int run_diagnose(const DiagnoseOptions& o) {
   if (o.jobs < 1 || o.jobs > 64) return fail("--jobs must be 1 .. 64");
-  if (o.resolution != 0 && (o.resolution < 6 || o.resolution > 60)) return fail("--resolution must be 6 .. 60");
-  if (o.states < 0 || o.states > 16) return fail("--states must be 1 .. 16");
-  if (o.evaluations < 0 || o.evaluations > 10000 || o.refit_evaluations < 0 || o.refit_evaluations > 10000 ||
-      o.sensor_evaluations < 0 || o.sensor_evaluations > 10000) {
-    return fail("--evaluations, --refit-evaluations and --sensor-evaluations must be 1 .. 10000");
+  const auto outside = [](const std::optional<int>& value, int lo, int hi) {
+    return value && (*value < lo || *value > hi);
+  };
+  // A scan of N levels: 0 (off) or 2 .. hi (one level is no scan).
+  const auto bad_scan = [&](const std::optional<int>& value, int hi) { return outside(value, 0, hi) || value == 1; };
+  if (outside(o.resolution, 6, 60)) return fail("--resolution must be 6 .. 60");
+  if (outside(o.states, 1, 16)) return fail("--states must be 1 .. 16");
+  for (auto [value, option] : {std::pair{&o.evaluations, "--evaluations"},
+                               std::pair{&o.refit_evaluations, "--refit-evaluations"},
+                               std::pair{&o.sensor_evaluations, "--sensor-evaluations"}}) {
+    if (outside(*value, 1, 10000)) return fail(fmt::format("{} must be 1 .. 10000", option));
   }
-  if (o.shape_floor > 100.0) return fail("--shape-floor must be 0 (from the floor samples) .. 100");
+  if (o.shape_floor && !(*o.shape_floor >= 0.0 && *o.shape_floor <= 100.0)) {
+    return fail("--shape-floor must be 0 (from the floor samples) .. 100");
+  }
   if (!(o.held_out_tolerance >= 0.0 && o.held_out_tolerance <= 1.0)) return fail("--held-out-tolerance must be 0 .. 1");
-  if (o.starts && (*o.starts < 0 || *o.starts > 100)) return fail("--starts must be 0 (the guess alone) .. 100");
-  if (o.refit_scan < -1 || o.refit_scan == 1 || o.refit_scan > 100) {
-    return fail("--refit-scan must be 0 (off) or 2 .. 100");
-  }
-  if (o.common_bending < -1 || o.common_bending == 1 || o.common_bending > 6) {
-    return fail("--common-bending must be 0 (off) or 2 .. 6");
-  }
+  if (outside(o.starts, 0, 100)) return fail("--starts must be 0 (the guess alone) .. 100");
+  if (bad_scan(o.refit_scan, 100)) return fail("--refit-scan must be 0 (off) or 2 .. 100");
+  if (bad_scan(o.common_bending, 6)) return fail("--common-bending must be 0 (off) or 2 .. 6");
   if (!(o.tie_margin >= 0.0 && o.tie_margin <= 1.0)) return fail("--tie-margin must be 0 (exact ties only) .. 1");
-  if (o.yield_trade < -1 || o.yield_trade == 1 || o.yield_trade > 100) {
-    return fail("--yield-trade must be 0 (off) or 2 .. 100");
-  }
-  if (o.drift_scan < -1 || o.drift_scan > 100) return fail("--drift-scan must be 0 (off) .. 100");
+  if (bad_scan(o.yield_trade, 100)) return fail("--yield-trade must be 0 (off) or 2 .. 100");
+  if (outside(o.drift_scan, 0, 100)) return fail("--drift-scan must be 0 (off) .. 100");
   std::optional<diagnosis::BendingParameters> start;
   if (o.start_alpha.empty() != o.start_beta.empty()) return fail("--start-alpha and --start-beta go together");
   if (!o.start_alpha.empty()) {
@@ -123,18 +126,18 @@ int run_diagnose(const DiagnoseOptions& o) {
   diagnosis::DiagnosisSettings settings = o.fine    ? diagnosis::DiagnosisSettings::fine()
                                           : o.quick ? diagnosis::DiagnosisSettings::quick()
                                                     : diagnosis::DiagnosisSettings{};
-  if (o.resolution > 0) settings.fit.resolution = o.resolution;
-  if (o.states > 0) settings.fit.initial_states = o.states;
-  if (o.evaluations > 0) settings.baseline_optimiser.max_evaluations = o.evaluations;
-  if (o.refit_evaluations > 0) settings.attribution.optimiser.max_evaluations = o.refit_evaluations;
-  if (o.sensor_evaluations > 0) settings.attribution.sensor_evaluations = o.sensor_evaluations;
+  if (o.resolution) settings.fit.resolution = *o.resolution;
+  if (o.states) settings.fit.initial_states = *o.states;
+  if (o.evaluations) settings.baseline_optimiser.max_evaluations = *o.evaluations;
+  if (o.refit_evaluations) settings.attribution.optimiser.max_evaluations = *o.refit_evaluations;
+  if (o.sensor_evaluations) settings.attribution.sensor_evaluations = *o.sensor_evaluations;
   settings.attribution.sensor_bending = o.sensor_bending;
   settings.hold_sensor = !o.free_sensor;
-  if (o.common_bending >= 0) settings.attribution.common_bending_effects = o.common_bending;
+  if (o.common_bending) settings.attribution.common_bending_effects = *o.common_bending;
   settings.attribution.tie_margin = o.tie_margin;
-  if (o.refit_scan >= 0) settings.attribution.scan_levels = o.refit_scan;
-  if (o.yield_trade >= 0) settings.attribution.yield_trade_levels = o.yield_trade;
-  if (o.drift_scan >= 0) settings.attribution.drift_scan_levels = o.drift_scan;
+  if (o.refit_scan) settings.attribution.scan_levels = *o.refit_scan;
+  if (o.yield_trade) settings.attribution.yield_trade_levels = *o.yield_trade;
+  if (o.drift_scan) settings.attribution.drift_scan_levels = *o.drift_scan;
   if (!candidates.empty()) settings.attribution.candidates = candidates;
   if (o.starts) settings.start_levels = *o.starts;
   settings.start = start;
@@ -153,7 +156,7 @@ int run_diagnose(const DiagnoseOptions& o) {
   settings.attribute = !o.gap_only;
   settings.attribution.ablation = o.ablation;
   settings.attribution.held_out_tolerance = o.held_out_tolerance;
-  if (o.shape_floor >= 0.0) settings.floors.shape_threshold = settings.held_out_shape_threshold = o.shape_floor;
+  if (o.shape_floor) settings.floors.shape_threshold = settings.held_out_shape_threshold = *o.shape_floor;
   auto result = diagnosis::diagnose(*capture, settings,
                                     {.second = second ? &*second : nullptr, .held_out = held_out ? &*held_out : nullptr});
   if (!result) return fail(result.error().message);
@@ -269,23 +272,26 @@ Runner add_diagnose_command(CLI::App& app) {
   app.add_option("--refit-scan", o->refit_scan,
                  fmt::format("Refits of one-parameter effects (yield, shear, curl, friction) start with this many "
                              "strengths over the effect's range (bending as fitted), then refine from the best within "
-                             "--refit-evaluations, which must leave {} for that (default 0: off; report.json lists the "
-                             "scan per candidate)",
-                             diagnosis::AttributionSettings::kSimplexAfterScan));
+                             "--refit-evaluations, which must leave {} for that (0: off; default {}; report.json lists "
+                             "the scan per candidate)",
+                             diagnosis::AttributionSettings::kSimplexAfterScan,
+                             diagnosis::AttributionSettings{}.scan_levels));
   app.add_option("--yield-trade", o->yield_trade,
                  fmt::format("The yield refit starts with this many points along the trade of a stiffer bending (x1 "
                              ".. x{:.0f}) against a lower yield curvature ({:.0f} /m / the scale), then refines from "
                              "the best within --refit-evaluations, which must leave {} for that; replaces --refit-scan "
-                             "for yield (default 0: off; docs/DIAGNOSIS_RESULTS.md, \"Session 19\")",
+                             "for yield (0: off; default {}; docs/DIAGNOSIS_RESULTS.md, \"Session 19\")",
                              std::exp(diagnosis::AttributionSettings::kYieldScaleRange),
                              diagnosis::AttributionSettings::kYieldTradeCurvature,
-                             diagnosis::AttributionSettings::kSimplexAfterScan));
+                             diagnosis::AttributionSettings::kSimplexAfterScan,
+                             diagnosis::AttributionSettings{}.yield_trade_levels));
   app.add_option("--drift-scan", o->drift_scan,
                  fmt::format("The misalignment refit starts with this many drift sizes evenly spaced below its bound "
                              "(3: 10, 20 and 30 mm), bending as fitted, then refines from the best within "
-                             "--refit-evaluations, which must leave {} for that (default 0: off, the start from the "
-                             "hem's first harmonics; docs/DIAGNOSIS_RESULTS.md, \"Session 37\")",
-                             diagnosis::AttributionSettings::kSimplexAfterScan));
+                             "--refit-evaluations, which must leave {} for that (0: off, the start from the "
+                             "hem's first harmonics; default {}; docs/DIAGNOSIS_RESULTS.md, \"Session 37\")",
+                             diagnosis::AttributionSettings::kSimplexAfterScan,
+                             diagnosis::AttributionSettings{}.drift_scan_levels));
   app.add_option("--candidates", o->candidates,
                  "The candidate effects to refit, comma-separated (default: yield, shear, curl, friction, "
                  "misalignment, sensor)")

@@ -381,6 +381,13 @@ if(NOT drifts MATCHES "^6 3 10\\.?0*${one} 20\\.?0*${one} 30\\.?0*${one}$")
 endif()
 expect_failure(1 "--drift-scan (4) must leave" diagnose --capture ${WORK}/capture --refit-evaluations 6 --drift-scan 4)
 expect_failure(1 "--drift-scan must be" diagnose --capture ${WORK}/capture --drift-scan -3)
+# Each option is either unset (the settings' value) or checked: no value of it means "the default".
+expect_failure(1 "--drift-scan must be" diagnose --capture ${WORK}/capture --drift-scan -1)
+expect_failure(1 "--shape-floor must be" diagnose --capture ${WORK}/capture --shape-floor -1)
+expect_failure(1 "--evaluations must be 1" diagnose --capture ${WORK}/capture --evaluations 0)
+expect_failure(1 "--refit-evaluations must be 1" diagnose --capture ${WORK}/capture --refit-evaluations 0)
+expect_failure(1 "--states must be" diagnose --capture ${WORK}/capture --states 0)
+expect_failure(1 "--resolution must be" diagnose --capture ${WORK}/capture --resolution 0)
 # The bar (the bending scale refitted alone, a candidate with no effect) spends the candidates' budget on a 1-D
 # simplex within the scale's range (its bending, the baseline's times that scale, is reported: GET fails otherwise).
 string(JSON bar_evaluations GET "${out}" attribution bending_refit_bar evaluations)
