@@ -41,7 +41,7 @@ struct DiagnoseOptions {
   std::vector<std::string> candidates;  // empty: every effect
   std::optional<int> starts;
   std::string start_alpha, start_beta;  // empty: the drape-coefficient guess
-  double start_box = 0.0;               // 0: the whole box
+  std::optional<double> start_box;      // unset: the whole box
   bool ignore_measured_bending = false;
   int jobs = 1;
   std::optional<double> shape_floor;
@@ -95,7 +95,7 @@ int run_diagnose(const DiagnoseOptions& o) {
     if (!(alpha->warp > 0 && alpha->bias > 0 && alpha->weft > 0)) return fail("--start-alpha must be positive");
     start = diagnosis::BendingParameters{.alpha = *alpha, .beta = *beta};
   }
-  if (o.start_box != 0.0 && (!start || !(o.start_box > 1.0 && o.start_box <= 100.0))) {
+  if (o.start_box && (!start || !(*o.start_box > 1.0 && *o.start_box <= 100.0))) {
     return fail("--start-box must be 1 .. 100 (exclusive of 1) and needs --start-alpha/--start-beta");
   }
   std::vector<diagnosis::Effect> candidates;
@@ -141,7 +141,7 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (!candidates.empty()) settings.attribution.candidates = candidates;
   if (o.starts) settings.start_levels = *o.starts;
   settings.start = start;
-  settings.start_box = o.start_box;
+  settings.start_box = o.start_box.value_or(0.0);
   settings.use_measured_bending = !o.ignore_measured_bending;
   constexpr int kKeep = diagnosis::AttributionSettings::kSimplexAfterScan;
   for (auto [levels, option] : {std::pair{settings.attribution.scan_levels, "--refit-scan"},

@@ -500,6 +500,7 @@ if(fitted_ln_alpha LESS 8.177 OR fitted_ln_alpha GREATER 8.368)
   message(FATAL_ERROR "--start-box 1.1: the fit left the box (ln mean alpha ${fitted_ln_alpha}, box 8.177 .. 8.368)")
 endif()
 expect_failure(1 "--start-box must be" diagnose --capture ${WORK}/capture --start-box 1.3)
+expect_failure(1 "--start-box must be" diagnose --capture ${WORK}/capture --start-alpha 5000,4000,3000 --start-beta=-1,-1,-1 --start-box 0)
 expect_failure(1 "--start-box must be" diagnose --capture ${WORK}/capture --start-alpha 5000,4000,3000
                --start-beta=-1,-1,-1 --start-box 0.5)
 expect_failure(1 "--start-alpha and --start-beta go together" diagnose --capture ${WORK}/capture --start-alpha 1,2,3)
