@@ -144,6 +144,9 @@ int run_diagnose(const DiagnoseOptions& o) {
   settings.start_box = o.start_box.value_or(0.0);
   settings.use_measured_bending = !o.ignore_measured_bending;
   constexpr int kKeep = diagnosis::AttributionSettings::kSimplexAfterScan;
+  // The default drift scan is off where --refit-evaluations leaves it no room; a scan asked for must fit.
+  if (!o.drift_scan && settings.attribution.drift_scan_levels > settings.attribution.optimiser.max_evaluations - kKeep)
+    settings.attribution.drift_scan_levels = 0;
   for (auto [levels, option] : {std::pair{settings.attribution.scan_levels, "--refit-scan"},
                                  std::pair{settings.attribution.yield_trade_levels, "--yield-trade"},
                                  std::pair{settings.attribution.drift_scan_levels, "--drift-scan"}}) {
@@ -289,7 +292,8 @@ Runner add_diagnose_command(CLI::App& app) {
                  fmt::format("The misalignment refit starts with this many drift sizes evenly spaced below its bound "
                              "(3: 10, 20 and 30 mm), bending as fitted, then refines from the best within "
                              "--refit-evaluations, which must leave {} for that (0: off, the start from the "
-                             "hem's first harmonics; default {}; docs/DIAGNOSIS_RESULTS.md, \"Session 37\")",
+                             "hem's first harmonics; default {}, off where --refit-evaluations leaves it no room; "
+                             "docs/DIAGNOSIS_RESULTS.md, \"Session 37\" and \"Session 39\")",
                              diagnosis::AttributionSettings::kSimplexAfterScan,
                              diagnosis::AttributionSettings{}.drift_scan_levels));
   app.add_option("--candidates", o->candidates,

@@ -242,11 +242,11 @@ expect_failure(1 "--starts must be" diagnose --capture ${WORK}/capture --starts 
 # every candidate is validated on both (the depth bias is the rig's, so it is in both placements).
 run_ok(out reality ${FABRIC} --effect bias=12 --resolution 14 --seed 4 --placement 1 --out ${WORK}/capture.p1)
 file(REMOVE ${WORK}/capture.p1/truth.json)
-# (With --refit-scan 3: the one-parameter effects' refits start with three strengths over their range; with
-# --drift-scan 3 the misalignment refit with three drift sizes.)
+# (With --refit-scan 3: the one-parameter effects' refits start with three strengths over their range; the
+# misalignment refit with three drift sizes by default, --drift-scan 3, which 6 evaluations leave room for.)
 # (And --held-out-tolerance 0.3: a candidate up to 30% worse than the reference on the held-out capture is confirmed.)
 run_ok(out diagnose --capture ${WORK}/capture --held-out-capture ${WORK}/capture.p1 --quick --resolution 10 --states 2
-       --evaluations 8 --refit-evaluations 6 --refit-scan 3 --drift-scan 3 --held-out-tolerance 0.3 --json)
+       --evaluations 8 --refit-evaluations 6 --refit-scan 3 --held-out-tolerance 0.3 --json)
 string(JSON shape GET "${out}" gap_tests shape)
 string(JSON shape_a GET "${out}" gap_tests capture shape)
 string(JSON shape_b GET "${out}" gap_tests held_out_capture shape)
@@ -373,11 +373,16 @@ candidate_scan("${out}" yield scanned)
 if(NOT scanned MATCHES "^6 3 1\\.0986[0-9]*${one} 3\\.5450[0-9]*${one} 5\\.9914[0-9]*${one}$")
   message(FATAL_ERROR "--refit-scan 3: yield refit (evaluations, scan size, level/scale/score) = '${scanned}'")
 endif()
-# The misalignment refit's drift scan (--drift-scan 3): 10, 20, 30 mm of its 40 mm bound along the warp, the bending
-# as fitted, then the simplex with the rest of the 6 simulations.
+# The misalignment refit's drift scan (by default, --drift-scan 3): 10, 20, 30 mm of its 40 mm bound along the warp,
+# the bending as fitted, then the simplex with the rest of the 6 simulations.
 candidate_scan("${out}" misalignment drifts)
 if(NOT drifts MATCHES "^6 3 10\\.?0*${one} 20\\.?0*${one} 30\\.?0*${one}$")
   message(FATAL_ERROR "--drift-scan 3: misalignment refit (evaluations, scan size, drift/scale/score) = '${drifts}'")
+endif()
+# The first run's 4 refit evaluations leave the default scan no room: the misalignment refit runs without it.
+candidate_scan("${out_first}" misalignment no_drifts)
+if(NOT no_drifts STREQUAL "4 0")
+  message(FATAL_ERROR "--refit-evaluations 4: misalignment refit (evaluations, scan size) = '${no_drifts}'")
 endif()
 expect_failure(1 "--drift-scan (4) must leave" diagnose --capture ${WORK}/capture --refit-evaluations 6 --drift-scan 4)
 expect_failure(1 "--drift-scan must be" diagnose --capture ${WORK}/capture --drift-scan -3)
