@@ -150,7 +150,7 @@ int run_diagnose(const DiagnoseOptions& o) {
   for (auto [levels, option] : {std::pair{settings.attribution.scan_levels, "--refit-scan"},
                                  std::pair{settings.attribution.yield_trade_levels, "--yield-trade"},
                                  std::pair{settings.attribution.drift_scan_levels, "--drift-scan"}}) {
-    if (levels > settings.attribution.optimiser.max_evaluations - kKeep) {
+    if (levels > 0 && levels > settings.attribution.optimiser.max_evaluations - kKeep) {  // 0: off, nothing to fit
       return fail(fmt::format("{} ({}) must leave the refit's simplex {} of its {} evaluations", option, levels, kKeep,
                               settings.attribution.optimiser.max_evaluations));
     }

@@ -385,6 +385,13 @@ if(NOT no_drifts STREQUAL "4 0")
   message(FATAL_ERROR "--refit-evaluations 4: misalignment refit (evaluations, scan size) = '${no_drifts}'")
 endif()
 expect_failure(1 "--drift-scan (4) must leave" diagnose --capture ${WORK}/capture --refit-evaluations 6 --drift-scan 4)
+# A refit budget too small for any scan is valid where no scan is asked for (before, a scan of 0 had to leave it 3).
+run_ok(small diagnose --capture ${WORK}/capture --quick --resolution 6 --states 1 --evaluations 2 --refit-evaluations 2
+       --gap-only --json)
+string(JSON small_ran GET "${small}" attribution ran)
+if(small_ran)
+  message(FATAL_ERROR "--gap-only with --refit-evaluations 2: the attribution ran")
+endif()
 expect_failure(1 "--drift-scan must be" diagnose --capture ${WORK}/capture --drift-scan -3)
 # Each option is either unset (the settings' value) or checked: no value of it means "the default".
 expect_failure(1 "--drift-scan must be" diagnose --capture ${WORK}/capture --drift-scan -1)

@@ -332,13 +332,19 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
     };
     const auto [lower, upper] = bending_scale_bounds(settings);
     const double gain_hi = hi[first + gain];
-    std::vector<double> y_best;
+    // The grid's distinct points (scales clamped to narrow bounds coincide), as many as the budget holds.
+    std::vector<std::vector<double>> points;
     for (double s : AttributionSettings::kSensorBendingScales) {
       for (double m : AttributionSettings::kSensorBendingGains) {
         std::vector<double> y{std::clamp(s, lower, upper), std::min(m, gain_hi)};
-        if (const double v = g(y); y_best.empty() || v <= stage_best) y_best = y;
-        if (error) return *error;
+        if (std::find(points.begin(), points.end(), y) == points.end()) points.push_back(std::move(y));
       }
+    }
+    points.resize(std::min(points.size(), static_cast<std::size_t>(std::max(1, settings.optimiser.max_evaluations))));
+    std::vector<double> y_best;
+    for (const auto& y : points) {
+      if (const double v = g(y); y_best.empty() || v <= stage_best) y_best = y;
+      if (error) return *error;
     }
     const int grid = static_cast<int>(c.scan.size());
     NelderMeadOptions refine = settings.optimiser;

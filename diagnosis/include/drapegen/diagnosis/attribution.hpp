@@ -191,8 +191,9 @@ struct AttributionSettings {
   /// a multipath error deepens the folds' valleys as seen, the baseline fit takes that for a softer fabric, and
   /// re-rendering its drapes with the true gain scores worse than without (docs/DIAGNOSIS_RESULTS.md, "Session 28").
   /// After the render-only refit, the bending scale and the gain are scored on a grid (kSensorBendingScales x
-  /// kSensorBendingGains, the rest of the camera as refitted), refined by a simplex from the best within
-  /// optimiser.max_evaluations simulations, and the best is scored once more without multipath (its ablation). The
+  /// kSensorBendingGains, the rest of the camera as refitted; its distinct points, the first optimiser.max_evaluations
+  /// of them at most), refined by a simplex from the best within optimiser.max_evaluations simulations in all (grid
+  /// included), and the best is scored once more without multipath (its ablation). The
   /// candidate keeps it, and is then validated by simulation, only if it beats both the render-only refit and its
   /// ablation. Off by default.
   bool sensor_bending = false;
