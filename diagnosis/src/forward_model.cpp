@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <fmt/format.h>
 #include <limits>
 
@@ -268,6 +269,8 @@ sim::Expected<Evaluation> ForwardModel::evaluate(const ModelSetup& setup,
     }
     e.states.push_back(std::move(*scored));
   }
+  // No state scored finitely: e.best would be an empty drape with a score of 0, a perfect fit.
+  if (!std::isfinite(best)) return sim::Error{"no initial state's drape has a finite score"};
   return e;
 }
 
@@ -284,6 +287,8 @@ sim::Expected<Evaluation> ForwardModel::rescore(const std::vector<sim::ClothMesh
     }
     e.states.push_back(std::move(*scored));
   }
+  // No state scored finitely: e.best would be an empty drape with a score of 0, a perfect fit.
+  if (!std::isfinite(best)) return sim::Error{"no initial state's drape has a finite score"};
   return e;
 }
 
