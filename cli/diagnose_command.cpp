@@ -181,7 +181,7 @@ int run_diagnose(const DiagnoseOptions& o) {
     std::cout << fmt::format("  localised: {}\n", diagnosis::region_name(r.localisation.dominant));
     if (r.verdict == "none") {
       std::cout << fmt::format("  verdict: within the floors{} (no effect named)\n",
-                               r.attribution.bar_within_floors ? " once the bending is refitted" : "");
+                               r.attribution.bending_within_floors() ? " once the bending is refitted" : "");
     } else if (r.verdict == "unexplained") {
       std::cout << "  verdict: above the floors, no candidate shrinks it significantly\n";
     } else if (r.verdict == "not attributed") {
