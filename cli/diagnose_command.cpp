@@ -143,15 +143,12 @@ int run_diagnose(const DiagnoseOptions& o) {
   settings.start = start;
   settings.start_box = o.start_box.value_or(0.0);
   settings.use_measured_bending = !o.ignore_measured_bending;
+  // A scan asked for must leave the refit's simplex its room; a default one that does not is skipped by the refit.
   constexpr int kKeep = diagnosis::AttributionSettings::kSimplexAfterScan;
-  // The default drift scan is off where --refit-evaluations leaves it no room; a scan asked for must fit.
-  if (!o.drift_scan && settings.attribution.drift_scan_levels > settings.attribution.optimiser.max_evaluations - kKeep)
-    settings.attribution.drift_scan_levels = 0;
-  for (auto [levels, option] : {std::pair{settings.attribution.scan_levels, "--refit-scan"},
-                                 std::pair{settings.attribution.yield_trade_levels, "--yield-trade"},
-                                 std::pair{settings.attribution.drift_scan_levels, "--drift-scan"}}) {
-    if (levels > 0 && levels > settings.attribution.optimiser.max_evaluations - kKeep) {  // 0: off, nothing to fit
-      return fail(fmt::format("{} ({}) must leave the refit's simplex {} of its {} evaluations", option, levels, kKeep,
+  for (auto [levels, option] : {std::pair{o.refit_scan, "--refit-scan"}, std::pair{o.yield_trade, "--yield-trade"},
+                                 std::pair{o.drift_scan, "--drift-scan"}}) {
+    if (levels && *levels > 0 && *levels > settings.attribution.optimiser.max_evaluations - kKeep) {  // 0: off, nothing to fit
+      return fail(fmt::format("{} ({}) must leave the refit's simplex {} of its {} evaluations", option, *levels, kKeep,
                               settings.attribution.optimiser.max_evaluations));
     }
   }
