@@ -332,17 +332,8 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
     };
     const auto [lower, upper] = bending_scale_bounds(settings);
     const double gain_hi = hi[first + gain];
-    // The grid's distinct points (scales clamped to narrow bounds coincide), as many as the budget holds.
-    std::vector<std::vector<double>> points;
-    for (double s : AttributionSettings::kSensorBendingScales) {
-      for (double m : AttributionSettings::kSensorBendingGains) {
-        std::vector<double> y{std::clamp(s, lower, upper), std::min(m, gain_hi)};
-        if (std::find(points.begin(), points.end(), y) == points.end()) points.push_back(std::move(y));
-      }
-    }
-    points.resize(std::min(points.size(), static_cast<std::size_t>(std::max(1, settings.optimiser.max_evaluations))));
     std::vector<double> y_best;
-    for (const auto& y : points) {
+    for (const auto& y : sensor_bending_grid(lower, upper, gain_hi, settings.optimiser.max_evaluations)) {
       if (const double v = g(y); y_best.empty() || v <= stage_best) y_best = y;
       if (error) return *error;
     }
@@ -412,6 +403,18 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
 
 std::vector<sim::InitialStateSpec> validation_states(const AttributionSettings& settings) {
   return fit_initial_states(settings.validation_states, settings.validation_seed);
+}
+
+std::vector<std::vector<double>> sensor_bending_grid(double lower, double upper, double gain_hi, int budget) {
+  std::vector<std::vector<double>> points;
+  for (double s : AttributionSettings::kSensorBendingScales) {
+    for (double m : AttributionSettings::kSensorBendingGains) {
+      std::vector<double> y{std::clamp(s, lower, upper), std::min(m, gain_hi)};
+      if (std::find(points.begin(), points.end(), y) == points.end()) points.push_back(std::move(y));
+    }
+  }
+  points.resize(std::min(points.size(), static_cast<std::size_t>(std::max(1, budget))));
+  return points;
 }
 
 double confirmation_score(const ScoredDrape& drape, const ScoredDrape* held_out_capture) {

@@ -184,6 +184,7 @@ Target ForwardModel::make_target(const std::vector<renderer::DepthImage>& depth)
 
 sim::Expected<ScoredDrape> ForwardModel::score(const sim::ClothMesh& mesh, const ModelSetup& setup,
                                                const Target& target) {
+  if (!mesh.positions.allFinite()) return sim::Error{"the drape to score has non-finite positions"};
   ScoredDrape d;
   d.mesh = mesh;
   d.angle = align_orientation(hem_profile_from_mesh(mesh), target.outline).angle;

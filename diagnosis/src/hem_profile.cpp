@@ -55,7 +55,7 @@ HemProfile hem_profile_from_points(const Eigen::Matrix3Xd& points, int bins) {
   std::vector<std::vector<double>> radii(bins);
   for (int i = 0; i < points.cols(); ++i) {
     const Eigen::Vector3d p = points.col(i);
-    if (p.z() >= kBelowTop) continue;
+    if (!p.allFinite() || p.z() >= kBelowTop) continue;  // a non-finite point has no bin
     radii[bin_of(std::atan2(p.y(), p.x()), bins)].push_back(std::hypot(p.x(), p.y()));
   }
   HemProfile h;
@@ -75,7 +75,7 @@ HemProfile hem_profile_from_mesh(const sim::ClothMesh& mesh, int bins) {
   HemProfile h;
   h.radius.assign(bins, std::numeric_limits<double>::quiet_NaN());
   auto add = [&](const Eigen::Vector3d& p) {
-    if (p.z() >= kBelowTop) return;
+    if (!p.allFinite() || p.z() >= kBelowTop) return;  // a non-finite point has no bin
     double& r = h.radius[bin_of(std::atan2(p.y(), p.x()), bins)];
     const double rp = std::hypot(p.x(), p.y());
     if (!std::isfinite(r) || rp > r) r = rp;

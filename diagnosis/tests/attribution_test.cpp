@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
 
 #include "drapegen/diagnosis/attribution.hpp"
 #include "drapegen/diagnosis/floors.hpp"
@@ -138,6 +139,21 @@ TEST(ValidationStates, AreFreshStatesNoFitOrFloorSelectsOn) {
     for (const auto& f : fit) EXPECT_FALSE(v.shape == f.shape && v.seed == f.seed);
     for (const auto& f : floors) EXPECT_FALSE(v.shape == f.shape && v.seed == f.seed);
   }
+}
+
+TEST(SensorBendingGrid, IsTheScalesTimesTheGainsInOrderWithinTheBoundsAndTheBudget) {
+  using V = std::vector<std::vector<double>>;
+  // The default bounds (ln x0.22 .. x4.5) and a gain bound above both gains: all six points, scales first.
+  EXPECT_EQ(sensor_bending_grid(-1.5, 1.5, 50.0, 14),
+            (V{{0.5, 15.0}, {0.5, 30.0}, {1.0, 15.0}, {1.0, 30.0}, {1.5, 15.0}, {1.5, 30.0}}));
+  // A budget below six keeps the first points; none at all still scores one.
+  EXPECT_EQ(sensor_bending_grid(-1.5, 1.5, 50.0, 4), (V{{0.5, 15.0}, {0.5, 30.0}, {1.0, 15.0}, {1.0, 30.0}}));
+  EXPECT_EQ(sensor_bending_grid(-1.5, 1.5, 50.0, 0), (V{{0.5, 15.0}}));
+  // A measured bending's narrow box clamps the three scales to one: two distinct points, not six.
+  EXPECT_EQ(sensor_bending_grid(-0.1, 0.2, 50.0, 14), (V{{0.2, 15.0}, {0.2, 30.0}}));
+  // A gain bound below 30 mm clamps the second gain; both gains clamped to it coincide.
+  EXPECT_EQ(sensor_bending_grid(-0.1, 0.2, 20.0, 14), (V{{0.2, 15.0}, {0.2, 20.0}}));
+  EXPECT_EQ(sensor_bending_grid(-0.1, 0.2, 10.0, 14), (V{{0.2, 10.0}}));
 }
 
 TEST(CurlFirst, MovesAConfirmedSignificantCurlToTheFrontKeepingTheOthersOrder) {

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -102,6 +103,36 @@ TEST(ForwardModel, EvaluatesOnSeveralThreadsAsOnOne) {
     EXPECT_EQ(three->states[k].fit_score, one->states[k].fit_score) << "state " << k;
     EXPECT_EQ(three->states[k].left.rest_angles, one->states[k].left.rest_angles) << "state " << k;
   }
+  fs::remove_all(small->made.dir);
+}
+
+TEST(ForwardModel, RescoresDrapesAsEvaluatedAndRefusesNonFiniteOnes) {
+  // rescore scores given drapes as evaluate scored them. A drape with a non-finite position, and no drape that scores
+  // finitely, are errors: never an empty best drape scored 0 (a perfect fit to whatever optimiser asked).
+  auto small = small_model("rescore");
+  ASSERT_TRUE(small.has_value());
+  auto& model = small->model;
+  ModelSetup elastic;
+  elastic.bending = small->made.spec.bending;
+  auto evaluated = model->evaluate(elastic, fit_initial_states(1, 3));
+  ASSERT_TRUE(evaluated.has_value()) << evaluated.error().message;
+  const sim::ClothMesh& drape = evaluated->best.mesh;
+
+  auto again = model->rescore({drape}, elastic);
+  ASSERT_TRUE(again.has_value()) << again.error().message;
+  EXPECT_EQ(again->best.fit_score, evaluated->best.fit_score);
+  EXPECT_GT(again->best.fit_score, 0.0);
+
+  // A drape with a NaN position (a diverged simulation's) is an error, not a score.
+  sim::ClothMesh broken = drape;
+  broken.positions(2, 0) = std::numeric_limits<double>::quiet_NaN();
+  auto nan = model->rescore({drape, broken}, elastic);
+  ASSERT_FALSE(nan.has_value()) << "a drape with a NaN position scored " << nan->states[1].fit_score;
+  EXPECT_NE(nan.error().message.find("non-finite positions"), std::string::npos) << nan.error().message;
+  // No drape at all: no best one.
+  auto none = model->rescore({}, elastic);
+  ASSERT_FALSE(none.has_value());
+  EXPECT_NE(none.error().message.find("finite score"), std::string::npos) << none.error().message;
   fs::remove_all(small->made.dir);
 }
 

@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 
 #include "drapegen/diagnosis/hem_profile.hpp"
 
@@ -81,4 +82,18 @@ TEST(HemProfile, OrientationFollowsTheOffCentreNotTheFolds) {
   const auto h = harmonics(low_pass(target, kOrientationOrders), 8);
   EXPECT_NEAR(h[1].amplitude, 0.010, 1e-4);
   EXPECT_LT(h[8].amplitude, 1e-4);
+}
+
+TEST(HemProfile, SkipsNonFinitePoints) {
+  // A NaN point has no angle and so no bin: skipped, the outline the same as without it.
+  Eigen::Matrix3Xd p = lobed_points(0.0);
+  const HemProfile clean = hem_profile_from_points(p);
+  p.col(7).setConstant(std::numeric_limits<double>::quiet_NaN());
+  p.col(8) << std::numeric_limits<double>::infinity(), 0.0, -0.1;
+  const HemProfile skipped = hem_profile_from_points(p);
+  ASSERT_EQ(skipped.bins(), clean.bins());
+  for (int k = 0; k < clean.bins(); ++k) {
+    ASSERT_TRUE(std::isfinite(skipped.radius[k])) << "bin " << k;
+    EXPECT_NEAR(skipped.radius[k], clean.radius[k], 1e-4) << "bin " << k;
+  }
 }

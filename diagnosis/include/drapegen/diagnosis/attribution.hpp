@@ -253,6 +253,12 @@ struct Attribution {
 /// The validation states: fresh initial states (flat, then sine) that no fit selects on.
 [[nodiscard]] std::vector<sim::InitialStateSpec> validation_states(const AttributionSettings& settings);
 
+/// The sensor candidate's grid (AttributionSettings::sensor_bending): points {ln bending scale, multipath gain in mm}
+/// of kSensorBendingScales x kSensorBendingGains in that order, each scale clamped to [lower, upper] and each gain to
+/// at most gain_hi, the distinct points only (clamped scales coincide), the first `budget` of them (at least one).
+[[nodiscard]] std::vector<std::vector<double>> sensor_bending_grid(double lower, double upper, double gain_hi,
+                                                                   int budget);
+
 /// `baseline` is the fitted setup, `fit` its evaluation (fit states) and `validated` its evaluation from the
 /// validation states; `floors` from measure_floors. make_model creates forward models for other threads (jobs > 1).
 [[nodiscard]] sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& baseline,

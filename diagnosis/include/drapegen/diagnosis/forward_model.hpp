@@ -92,7 +92,8 @@ class ForwardModel {
   [[nodiscard]] sim::Expected<ModelSetup> laid_again(const ModelSetup& setup, const sim::InitialStateSpec& state);
   /// The same without simulating again: `setup` with the set that `drape`, its drape from evaluate, left.
   [[nodiscard]] static ModelSetup laid_again(const ModelSetup& setup, const ScoredDrape& drape);
-  /// Turns `mesh` to match `target` (the capture's outline unless given), renders with setup.sensor, compares.
+  /// Turns `mesh` to match `target` (the capture's outline unless given), renders with setup.sensor, compares. A mesh
+  /// with a non-finite position is an error.
   [[nodiscard]] sim::Expected<ScoredDrape> score(const sim::ClothMesh& mesh, const ModelSetup& setup,
                                                  const Target& target);
   /// The target of a capture with these views (same cameras as the capture).
@@ -115,7 +116,8 @@ class ForwardModel {
   [[nodiscard]] sim::Expected<Evaluation> evaluate(const ModelSetup& setup,
                                                    const std::vector<sim::InitialStateSpec>& states,
                                                    const Simulated* simulated = nullptr);
-  /// Re-scores given meshes (no simulation): the sensor candidate's refit.
+  /// Re-scores given meshes (no simulation): the sensor candidate's refit. As evaluate, an error where no mesh scores
+  /// finitely (none given included).
   [[nodiscard]] sim::Expected<Evaluation> rescore(const std::vector<sim::ClothMesh>& meshes, const ModelSetup& setup);
 
   /// Clean renders of `mesh` turned by `angle` in every view (with the setup's sensor error).
