@@ -88,6 +88,10 @@ sim::Status check_view(const CaptureView& view) {
     if (z < 0.0f) {
       return sim::Error{fmt::format("{}: negative depth {} at pixel ({}, {})", view.file, z, i % d.width, i / d.width)};
     }
+    if (z > kFarthestDepth) {
+      return sim::Error{fmt::format("{}: depth {} m at pixel ({}, {}) is beyond {} m; use 0 for no return", view.file, z,
+                                    i % d.width, i / d.width, kFarthestDepth)};
+    }
     returns += z > 0.0f;
   }
   if (returns == 0) return sim::Error{fmt::format("{}: all-zero depth (no return in the whole view)", view.file)};
@@ -161,12 +165,22 @@ sim::Expected<Capture> read_capture(const std::string& directory) {
       auto K = matrix_from(jv.at("K"), 3, 3, what + ".K");
       if (!K) return K.error();
       if ((*K)(2, 0) != 0.0 || (*K)(2, 1) != 0.0 || (*K)(2, 2) != 1.0) return sim::Error{what + ".K: last row must be 0 0 1"};
+      if (!((*K)(0, 0) > 0.0 && (*K)(1, 1) > 0.0)) {
+        return sim::Error{what + ".K: the focal lengths K[0][0] and K[1][1] must be positive"};
+      }
       view.camera.intrinsics.K = *K;
       auto T = matrix_from(jv.at("world_to_camera"), 4, 4, what + ".world_to_camera");
       if (!T) return T.error();
       const Eigen::Matrix3d R = T->topLeftCorner(3, 3);
       if ((R.transpose() * R - Eigen::Matrix3d::Identity()).norm() > 1e-4 || R.determinant() < 0.0) {
         return sim::Error{what + ".world_to_camera: not a rigid transform (rotation part not orthonormal)"};
+      }
+      if (T->row(3) != Eigen::RowVector4d(0.0, 0.0, 0.0, 1.0)) {
+        return sim::Error{what + ".world_to_camera: not a rigid transform (last row must be 0 0 0 1)"};
+      }
+      if (T->topRightCorner(3, 1).norm() > kFarthestDepth) {
+        return sim::Error{fmt::format("{}.world_to_camera: the camera is more than {} m from the specimen", what,
+                                      kFarthestDepth)};
       }
       view.camera.world_to_camera.matrix() = *T;
       auto depth = read_depth_exr((dir / view.file).string());

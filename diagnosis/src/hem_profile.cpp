@@ -274,11 +274,10 @@ RadialProfile radial_profile(const Eigen::Matrix3Xd& points, double cylinder_rad
   p.count.assign(bins, 0);
   for (int i = 0; i < points.cols(); ++i) {
     const Eigen::Vector3d q = points.col(i);
-    if (q.z() >= kBelowTop) continue;
+    if (!q.allFinite() || q.z() >= kBelowTop) continue;
     const double t = (std::hypot(q.x(), q.y()) - r0) / kStep;  // the cylinder side (r ~ R) stays out
-    if (t < 0.0) continue;
+    if (!(t >= 0.0 && t < bins)) continue;  // compared before the cast: a far point's t is beyond an int
     const int k = static_cast<int>(t);
-    if (k < 0 || k >= bins) continue;
     sum[k] += q.z();
     ++p.count[k];
   }

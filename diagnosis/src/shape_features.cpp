@@ -66,7 +66,7 @@ ShapeFeatures shape_features(const Eigen::Matrix3Xd& points, double cylinder_rad
   };
   for (int i = 0; i < points.cols(); ++i) {
     const Eigen::Vector3d p = points.col(i);
-    if (p.z() >= kBelowTop) continue;
+    if (!p.allFinite() || p.z() >= kBelowTop) continue;  // a non-finite point has no bin
     const double r = std::hypot(p.x(), p.y());
     const int b = bin_of(p.x(), p.y());
     ++seen[b];
@@ -75,9 +75,8 @@ ShapeFeatures shape_features(const Eigen::Matrix3Xd& points, double cylinder_rad
       ++hem_n[b];
     }
     const double t = (r - cylinder_radius - 0.005) / kAnnulus;
-    if (t < 0.0) continue;
+    if (!(t >= 0.0 && t < annuli)) continue;  // compared before the cast: a far point's t is beyond an int
     const int k = static_cast<int>(t);
-    if (k >= annuli) continue;
     sum[k] += p.z(), sum_sq[k] += p.z() * p.z(), ++count[k];
   }
   std::vector<double> radii, heights;

@@ -156,6 +156,40 @@ TEST(Capture, NaNDepth) {
   EXPECT_NE(e.find("non-finite depth"), std::string::npos) << e;
 }
 
+TEST(Capture, FarDepthIsAClearError) {
+  // A sensor's "no return" sentinel (FLT_MAX) rather than 0: beyond any tester, refused before it is back-projected.
+  const std::string dir = fresh_dir("far");
+  Capture c = plane_capture();
+  c.views[2].depth.at(50, 60) = std::numeric_limits<float>::max();
+  ASSERT_TRUE(write_capture(dir, c).ok());
+  const std::string e = read_error(dir);
+  EXPECT_NE(e.find("view 2"), std::string::npos) << e;
+  EXPECT_NE(e.find("at pixel (50, 60) is beyond 100 m; use 0 for no return"), std::string::npos) << e;
+}
+
+TEST(Capture, ACameraThatIsNoneIsAClearError) {
+  // Each camera fault written into capture.json, one at a time: a focal length of 0 (every ray the same: no image)
+  // or negative, a pose whose last row is not 0 0 0 1, a camera a kilometre away.
+  const std::string dir = fresh_dir("camera");
+  ASSERT_TRUE(write_capture(dir, plane_capture()).ok());
+  const nlohmann::json good = nlohmann::json::parse(std::ifstream(fs::path(dir) / "capture.json"));
+  auto with = [&](const char* field, int row, int col, double value) {
+    nlohmann::json j = good;
+    j["views"][1][field][row][col] = value;
+    std::ofstream(fs::path(dir) / "capture.json") << j.dump();
+    return read_error(dir);
+  };
+  EXPECT_NE(with("K", 0, 0, 0.0).find("views[1].K: the focal lengths K[0][0] and K[1][1] must be positive"),
+            std::string::npos);
+  EXPECT_NE(with("K", 1, 1, -300.0).find("must be positive"), std::string::npos);
+  EXPECT_NE(with("world_to_camera", 3, 0, 0.5).find("last row must be 0 0 0 1"), std::string::npos);
+  const std::string far = with("world_to_camera", 0, 3, 1000.0);
+  EXPECT_NE(far.find("views[1].world_to_camera: the camera is more than 100 m from the specimen"), std::string::npos)
+      << far;
+  std::ofstream(fs::path(dir) / "capture.json") << good.dump();
+  EXPECT_TRUE(read_capture(dir).has_value());
+}
+
 TEST(Capture, NotAnExrAndBadJson) {
   const std::string dir = fresh_dir("garbage");
   ASSERT_TRUE(write_capture(dir, plane_capture()).ok());

@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 
 #include "drapegen/diagnosis/shape_features.hpp"
 
@@ -100,4 +101,24 @@ TEST(ShapeFeatures, PartialViewsLeaveTheOutlineGroupsOut) {
   const ShapeFeatures none = shape_features(Eigen::Matrix3Xd(3, 0), kR, true);
   EXPECT_FALSE(none.valid);
   for (double x : group_differences(none, f)) EXPECT_LT(x, 0.0);
+}
+
+TEST(ShapeFeatures, SkipNonFiniteAndFarPoints) {
+  // Points a camera of a broken calibration back-projects (NaN, inf, a "no return" sentinel depth thousands of km
+  // away) have no bin and no annulus: skipped, the features the same as without them.
+  Eigen::Matrix3Xd p = drape_points(Drape{});
+  const ShapeFeatures clean = shape_features(p, kR, true);
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  p.col(0) << nan, nan, nan;
+  p.col(1) << 0.1, nan, -0.1;
+  p.col(2) << inf, 0.0, -0.1;
+  p.col(3) << 3e7, 1e7, -0.1;  // finite, but its annulus index is beyond an int
+  const ShapeFeatures skipped = shape_features(p, kR, true);
+  ASSERT_TRUE(clean.valid && skipped.valid);
+  EXPECT_EQ(skipped.folds, clean.folds);
+  const auto d = group_differences(clean, skipped);
+  for (std::size_t k = 0; k < d.size(); ++k) {
+    EXPECT_GE(d[k], 0.0) << feature_group_name(kFeatureGroups[k]);
+    EXPECT_LT(d[k], 2e-3) << feature_group_name(kFeatureGroups[k]);
+  }
 }

@@ -19,6 +19,9 @@ constexpr double kStepsPerDecayLength = 50.0;
 // Smallest trial tip angle from the vertical. The clamp angle grows from it by up to exp(2/3 sqrt(Gamma)), so this
 // bounds the Gamma that double precision can represent (about 5e5).
 constexpr double kSmallestTipAngle = 1e-280;
+// The Gamma at which that growth reaches 1 / kSmallestTipAngle (about 9.3e5). Beyond it no tip angle is resolved, and
+// the boundary layer's step count (kStepsPerDecayLength sqrt(Gamma)) would only grow, past an int's range from 1.6e15.
+const double kLargestGamma = std::pow(1.5 * std::log(1.0 / kSmallestTipAngle), 2);
 constexpr int kMaxBisections = 200;
 // Accepted mismatch of the clamp angle from horizontal after shooting (radians).
 constexpr double kClampAngleTolerance = 1e-8;
@@ -178,6 +181,9 @@ Expected<CantileverCurve> solve_heavy_cantilever(double length, double alpha, do
   }
   const double gamma = areal_density * gravity * length * length * length / alpha;
   if (!std::isfinite(gamma)) return Error{"solve_heavy_cantilever: Gamma = rho*g*L^3/alpha overflows"};
+  if (gamma > kLargestGamma) {
+    return Error{"solve_heavy_cantilever: Gamma = rho*g*L^3/alpha is too large to resolve in double precision"};
+  }
 
   const int intervals = samples - 1;
   CantileverCurve curve;

@@ -185,6 +185,12 @@ TEST(HeavyCantilever, RejectsBadInput) {
   EXPECT_FALSE(master_curve_height_over_width(nan).has_value());
   // Beyond what double precision can resolve (the tip angle would underflow): an error, not garbage.
   EXPECT_FALSE(master_curve_height_over_width(1e7).has_value());
+  // Far beyond it (a strip of almost no stiffness): the same error at once, not a count of integration steps past an
+  // int's range.
+  EXPECT_FALSE(master_curve_height_over_width(1e20).has_value());
+  const Expected<CantileverCurve> limp = solve_heavy_cantilever(0.1, 1e-20, 0.0, 0.3);
+  ASSERT_FALSE(limp.has_value());
+  EXPECT_NE(limp.error().message.find("too large to resolve"), std::string::npos) << limp.error().message;
 }
 
 TEST(HeavyCantilever, WeightlessStripStaysStraight) {

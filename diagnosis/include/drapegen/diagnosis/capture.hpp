@@ -49,10 +49,14 @@ struct Capture {
 
 /// The number of views a capture must have (the tester's four).
 constexpr int kCaptureViews = 4;
+/// m: no depth and no camera of a drape tester lies farther than this from the specimen (a depth beyond it is a
+/// sensor's "no return" sentinel, or another unit).
+constexpr double kFarthestDepth = 100.0;
 
 /// Reads DIR/capture.json and its depth files. Every failure is one line naming the file and the problem: missing
-/// capture.json or view, malformed JSON, wrong view count, depth size not the camera's, NaN/infinite/negative depth,
-/// a view without any return, implausible specimen facts.
+/// capture.json or view, malformed JSON, wrong view count, depth size not the camera's, NaN/infinite/negative depth
+/// or depth beyond kFarthestDepth, a view without any return, a camera that is not one (focal lengths not positive, a
+/// pose not rigid or farther than kFarthestDepth), implausible specimen facts.
 [[nodiscard]] sim::Expected<Capture> read_capture(const std::string& directory);
 
 /// Writes the depth EXRs (float), then capture.json (through a temporary file, so that it is whole or absent), into
@@ -62,7 +66,7 @@ constexpr int kCaptureViews = 4;
 /// read from `directory` whose description changes (e.g. a measured bending added), the depth files stay as they are.
 [[nodiscard]] sim::Status write_capture_json(const std::string& directory, const Capture& capture);
 
-/// Checks one view's depth: size, finite, non-negative, some return.
+/// Checks one view's depth: size, finite, non-negative, within kFarthestDepth, some return.
 [[nodiscard]] sim::Status check_view(const CaptureView& view);
 
 }  // namespace drapegen::diagnosis
