@@ -328,5 +328,35 @@ TEST(Service, StopsCleanlyOnSigterm) {
   EXPECT_EQ(recorded_jobs(manifest), 16);
 }
 
+// One coordinator per output directory: a second one, `--resume` of the live run included, is refused before it
+// removes anything (resume removes the files the manifest does not record, which for a live run are files it is
+// writing or about to commit); once the first has stopped, the resume proceeds.
+TEST(Service, ASecondCoordinatorOnALiveOutputIsRefused) {
+  const fs::path dir = test_dir("second_coordinator");
+  const fs::path out = dir / "run";
+  write_text(dir / "run.toml", small_config(out, 2, 1));
+  const fs::path manifest = out / "manifest.sqlite";
+  auto [first, endpoint] = start_coordinator({"--config", (dir / "run.toml").string()}, out, dir / "first");
+  ASSERT_FALSE(endpoint.empty()) << first.err();
+  const fs::path unrecorded = out / "data" / "in_flight.exr";  // as a file the live run is about to commit
+  write_text(unrecorded, "not yet recorded");
+
+  Process resume({"run", "--resume", manifest.string()}, (dir / "resume").string());
+  ASSERT_EQ(resume.wait(30s), 1) << resume.err();
+  EXPECT_NE(resume.err().find(out.string() + " is in use by another coordinator (pid " + std::to_string(first.pid())),
+            std::string::npos)
+      << resume.err();
+  EXPECT_TRUE(fs::exists(unrecorded));
+  EXPECT_TRUE(first.running());
+
+  ::kill(first.pid(), SIGTERM);
+  ASSERT_EQ(first.wait(30s), 4) << first.err();
+  // The lock went with the process: the resume runs, and removes the file no run recorded.
+  ASSERT_TRUE(resume_to_completion(manifest, out, dir, 1));
+  EXPECT_FALSE(fs::exists(unrecorded));
+  check_manifest(manifest, 2);
+  EXPECT_EQ(recorded_jobs(manifest), 2);
+}
+
 }  // namespace
 }  // namespace drapegen::test

@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <unistd.h>
@@ -27,6 +28,7 @@
 #include "drapegen/proto/recipe.hpp"
 #include "drapegen/storage/atomic_file.hpp"
 #include "drapegen/storage/manifest.hpp"
+#include "drapegen/storage/output_lock.hpp"
 #include "drapegen/storage/sha256.hpp"
 
 namespace drapegen::coordinator {
@@ -87,6 +89,7 @@ struct Coordinator::Impl {
   RunConfig config;
   CoordinatorOptions options;
   std::string manifest_path, out_dir, data_dir;
+  std::optional<storage::OutputLock> lock;  // OUTPUT/.lock: this run's alone (released last)
   std::unique_ptr<storage::Manifest> manifest;
   std::vector<storage::SampleRecord> samples;
   std::vector<JobSlot> jobs;  // index = id - 1
@@ -804,6 +807,14 @@ sim::Expected<std::unique_ptr<Coordinator>> Coordinator::create(const std::strin
   std::error_code ec;
   fs::create_directories(impl->data_dir, ec);
   if (ec) return sim::Error{fmt::format("cannot create {}: {}", impl->data_dir, ec.message())};
+  auto lock = storage::OutputLock::acquire(impl->out_dir);
+  if (!lock) return lock.error();
+  impl->lock.emplace(std::move(lock).value());
+  // Checked again under the lock: another coordinator may have created it since.
+  if (fs::exists(impl->manifest_path)) {
+    return sim::Error{fmt::format("{} exists already: continue it with drapegen run --resume {}", impl->manifest_path,
+                                  impl->manifest_path)};
+  }
   // Bind before planning, so a taken port fails fast and leaves no manifest behind.
   if (sim::Status s = impl->bind(options.bind_override.empty() ? config->bind : options.bind_override, ""); !s) {
     return s.error();
@@ -847,6 +858,10 @@ sim::Expected<std::unique_ptr<Coordinator>> Coordinator::resume(const std::strin
   std::error_code ec;
   fs::create_directories(impl->data_dir, ec);
   if (ec) return sim::Error{fmt::format("cannot create {}: {}", impl->data_dir, ec.message())};
+  // Before anything is removed: the files a live run has not yet recorded are not orphans.
+  auto lock = storage::OutputLock::acquire(impl->out_dir);
+  if (!lock) return lock.error();
+  impl->lock.emplace(std::move(lock).value());
   if (sim::Status s = impl->remove_orphans(); !s) return s.error();
   const std::string preferred = options.bind_override.empty() ? run->endpoint : options.bind_override;
   if (sim::Status s = impl->bind(preferred, options.bind_override.empty() ? config->bind : ""); !s) return s.error();
