@@ -1,6 +1,7 @@
 // Acceptance 4: random bytes, truncated frames, wrong protocol versions, and results for unknown or finished jobs
 // sent to the coordinator's port leave it running and the manifest unchanged.
 #include <arpa/inet.h>
+#include <cmath>
 #include <netinet/in.h>
 #include <random>
 #include <sys/socket.h>
@@ -304,6 +305,42 @@ TEST(Service, ResultOfAnotherBendingModelIsRefused) {
   EXPECT_NE(failures[0].message.find("triangle"), std::string::npos) << failures[0].message;
   for (const auto& j : all(reader->jobs())) EXPECT_EQ(j.state, storage::JobState::kDone);
   EXPECT_EQ(all(reader->results()).size(), 1u);
+}
+
+// A result whose metrics are not finite (SQLite would store NaN as NULL in a NOT NULL column) is a failed attempt
+// with its reason, not a storage error that stops the run; the job is retried and the run completes.
+TEST(Service, ANonFiniteResultIsAFailedAttempt) {
+  const fs::path dir = test_dir("non_finite_result");
+  const fs::path out = dir / "run";
+  write_text(dir / "run.toml", small_config(out, 1, 1, "[testing]\nmode = \"noop\"\n[retry]\nmax_attempts = 3\n"));
+  const fs::path manifest = out / "manifest.sqlite";
+  Process coordinator({"run", "--config", (dir / "run.toml").string()}, (dir / "coordinator").string());
+  const std::string endpoint = wait_endpoint(out, coordinator, 30s);
+  ASSERT_FALSE(endpoint.empty()) << coordinator.err();
+  zmq::context_t context(1);
+  FakeWorker a(context, endpoint);
+  a.send(ready("nan"));
+  auto job = a.expect(v1::Envelope::kJob, 5s);
+  ASSERT_TRUE(job);
+  v1::Envelope bad = result(job->job().job_id(), job->job().attempt());
+  bad.mutable_result()->mutable_metrics()->set_residual(std::nan(""));
+  a.send(bad);
+  // The retry comes back to the only worker: answered properly, the run completes.
+  auto retry = a.expect(v1::Envelope::kJob, 5s);
+  ASSERT_TRUE(retry) << coordinator.err();
+  EXPECT_EQ(retry->job().job_id(), job->job().job_id());
+  EXPECT_EQ(retry->job().attempt(), job->job().attempt() + 1);
+  a.send(result(retry->job().job_id(), retry->job().attempt()));
+  ASSERT_EQ(coordinator.wait(10s), 0) << coordinator.err();
+  auto reader = storage::ManifestReader::open(manifest.string());
+  ASSERT_TRUE(reader);
+  const auto failures = all(reader->failures());
+  ASSERT_EQ(failures.size(), 1u);
+  EXPECT_EQ(failures[0].reason, "diverged");
+  EXPECT_EQ(failures[0].worker, "nan");
+  EXPECT_NE(failures[0].message.find("non-finite residual"), std::string::npos) << failures[0].message;
+  EXPECT_EQ(all(reader->results()).size(), 1u);
+  for (const auto& j : all(reader->jobs())) EXPECT_EQ(j.state, storage::JobState::kDone);
 }
 
 }  // namespace

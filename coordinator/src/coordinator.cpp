@@ -4,6 +4,7 @@
 #include <array>
 #include <cerrno>
 #include <chrono>
+#include <cmath>
 #include <cstring>
 #include <cstdio>
 #include <deque>
@@ -17,6 +18,7 @@
 #include <unistd.h>
 #include <unordered_map>
 #include <unordered_set>
+#include <utility>
 #include <zmq.hpp>
 #include <zmq_addon.hpp>
 
@@ -406,6 +408,21 @@ struct Coordinator::Impl {
       f.set_message(fmt::format("worker {} computed the drape with the {} bending model, the run asks for {} (a worker "
                                 "older than this run's drapegen?)",
                                 w.name, model.empty() ? "dihedral (unnamed)" : model, config.bending_model));
+      return on_failure(w, f);
+    }
+    // Metrics the manifest cannot hold (its REAL columns are NOT NULL; SQLite stores NaN as NULL) make a failed
+    // attempt of the job, not a storage error that would stop the run.
+    const auto& metrics = r.metrics();
+    for (const auto& [name, value] : {std::pair{"residual", metrics.residual()}, {"energy", metrics.energy()},
+                                      {"drape_coefficient", metrics.drape_coefficient()},
+                                      {"sim_seconds", metrics.sim_seconds()},
+                                      {"render_seconds", metrics.render_seconds()}}) {
+      if (std::isfinite(value)) continue;
+      v1::Failure f;
+      f.set_job_id(r.job_id());
+      f.set_attempt(r.attempt());
+      f.set_reason(v1::FAILURE_REASON_DIVERGED);
+      f.set_message(fmt::format("result with a non-finite {} ({}) from worker {}", name, value, w.name));
       return on_failure(w, f);
     }
     // Files first (temporary file, fsync, rename); the directory is synced before the manifest commits.

@@ -78,12 +78,15 @@ sim::Status check(const v1::Envelope& e) {
   switch (e.body_case()) {
     case v1::Envelope::kReady:
       if (e.ready().worker_name().size() > 256) return sim::Error{"ready: worker name too long"};
+      if (e.ready().interval_ms() > kMaxHeartbeatMs) return sim::Error{"ready: heartbeat interval too long"};
       return {};
     case v1::Envelope::kJob:
       if (e.job().job_id() == 0) return sim::Error{"job: id 0"};
       if (e.job().attempt() == 0) return sim::Error{"job: attempt 0"};
       return check_spec(e.job().spec());
     case v1::Envelope::kHeartbeat:
+      if (e.heartbeat().interval_ms() > kMaxHeartbeatMs) return sim::Error{"heartbeat: interval too long"};
+      if (e.heartbeat().liveness() > kMaxLiveness) return sim::Error{"heartbeat: liveness too large"};
       return {};
     case v1::Envelope::kResult:
       if (e.result().job_id() == 0) return sim::Error{"result: job id 0"};

@@ -96,6 +96,21 @@ TEST(Codec, ChecksFieldRules) {
   f.mutable_failure()->set_reason(v1::FAILURE_REASON_DIVERGED);
   EXPECT_TRUE(decode(encode(f)));
   EXPECT_STREQ(reason_name(v1::FAILURE_REASON_DIVERGED), "diverged");
+  // Heartbeat intervals and liveness within what `drapegen worker` accepts (beyond, they overflow int timers).
+  v1::Envelope h;
+  h.mutable_heartbeat()->set_interval_ms(kMaxHeartbeatMs);
+  h.mutable_heartbeat()->set_liveness(kMaxLiveness);
+  EXPECT_TRUE(decode(encode(h)));
+  h.mutable_heartbeat()->set_interval_ms(kMaxHeartbeatMs + 1);
+  EXPECT_FALSE(decode(encode(h)));
+  h.mutable_heartbeat()->set_interval_ms(100);
+  h.mutable_heartbeat()->set_liveness(kMaxLiveness + 1);
+  EXPECT_FALSE(decode(encode(h)));
+  v1::Envelope r;
+  r.mutable_ready()->set_interval_ms(kMaxHeartbeatMs);
+  EXPECT_TRUE(decode(encode(r)));
+  r.mutable_ready()->set_interval_ms(0x80000000u);  // negative as an int
+  EXPECT_FALSE(decode(encode(r)));
 }
 
 }  // namespace

@@ -18,6 +18,10 @@ namespace v1 = ::drapegen::proto::v1;
 inline constexpr std::uint32_t kProtocolVersion = v1::PROTOCOL_VERSION_CURRENT;
 /// Largest frame either side accepts (a drape's mesh and EXR files are far below it).
 inline constexpr std::size_t kMaxFrameBytes = 256u << 20;
+/// The longest heartbeat interval (ms) and the largest liveness a peer may announce (as `drapegen worker` accepts):
+/// larger values would not fit the coordinator's int timers.
+inline constexpr std::uint32_t kMaxHeartbeatMs = 600000;
+inline constexpr std::uint32_t kMaxLiveness = 1000;
 
 /// Serializes `envelope` with protocol_version set to kProtocolVersion.
 [[nodiscard]] std::string encode(v1::Envelope envelope);
