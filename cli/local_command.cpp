@@ -1,4 +1,6 @@
 // drapegen local: a coordinator plus N worker processes on this machine, then the run's statistics.
+#include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <csignal>
 #include <fmt/format.h>
@@ -40,10 +42,18 @@ int fail(const std::string& message, int code = kExitUsage) {
   return code;
 }
 
-/// The worker processes: started after the coordinator binds, restarted if one dies before the run ends.
+/// The worker processes: started after the coordinator binds, restarted if one dies before the run ends (at most
+/// kRestartsPerWorker x N restarts over the run). halt() is the flag the coordinator runs until: set by SIGINT/SIGTERM
+/// (`signal_stop`), or when every worker has died and no restart is left, since no worker would ever come again.
 class WorkerPool {
  public:
-  WorkerPool(std::string endpoint, int count) : endpoint_(std::move(endpoint)), count_(count) {}
+  static constexpr int kRestartsPerWorker = 3;
+  WorkerPool(std::string endpoint, int count, const std::atomic<bool>& signal_stop)
+      : endpoint_(std::move(endpoint)), count_(count), signal_stop_(signal_stop) {}
+
+  [[nodiscard]] const std::atomic<bool>& halt() const { return halt_; }
+  /// The pool halted the run: every worker died and the restarts were spent.
+  [[nodiscard]] bool exhausted() const { return exhausted_; }
 
   sim::Status start() {
     for (int k = 0; k < count_; ++k) {
@@ -96,27 +106,42 @@ class WorkerPool {
   void supervise() {
     int restarts = 0;
     while (!finishing_) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(200));
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      if (signal_stop_) halt_ = true;
       for (std::size_t k = 0; k < pids_.size() && !finishing_; ++k) {
         int status = 0;
         if (pids_[k] <= 0 || ::waitpid(pids_[k], &status, WNOHANG) != pids_[k]) continue;
         pids_[k] = -1;
         const bool clean_exit = WIFEXITED(status) && WEXITSTATUS(status) == 0;  // told to shut down
-        if (finishing_ || clean_exit || restarts >= 3 * count_) continue;
-        coordinator::logger()->warn("worker local-{} exited ({}); starting another", k,
-                                    WIFSIGNALED(status) ? fmt::format("signal {}", WTERMSIG(status))
-                                                        : fmt::format("status {}", WEXITSTATUS(status)));
+        const std::string how = WIFSIGNALED(status) ? fmt::format("signal {}", WTERMSIG(status))
+                                                    : fmt::format("status {}", WEXITSTATUS(status));
+        if (finishing_ || clean_exit) continue;
+        if (restarts >= kRestartsPerWorker * count_) {
+          coordinator::logger()->warn("worker local-{} exited ({}); no restart left", k, how);
+          continue;
+        }
+        coordinator::logger()->warn("worker local-{} exited ({}); starting another", k, how);
         if (auto pid = spawn(static_cast<int>(k))) pids_[k] = *pid;
         ++restarts;
+      }
+      const bool none_left = std::all_of(pids_.begin(), pids_.end(), [](pid_t pid) { return pid <= 0; });
+      if (!finishing_ && !halt_ && none_left && restarts >= kRestartsPerWorker * count_) {
+        coordinator::logger()->error("every worker has died and the {} restarts are spent: stopping the run",
+                                     kRestartsPerWorker * count_);
+        exhausted_ = true;
+        halt_ = true;
       }
     }
   }
 
   std::string endpoint_;
   int count_;
+  const std::atomic<bool>& signal_stop_;
   std::vector<pid_t> pids_;
   std::thread supervisor_;
   std::atomic<bool> finishing_{false};
+  std::atomic<bool> halt_{false};
+  std::atomic<bool> exhausted_{false};
 };
 
 }  // namespace
@@ -163,10 +188,14 @@ Runner add_local_command(CLI::App& app) {
       c = coordinator::Coordinator::create(text, name, options);
     }
     if (!c) return fail(c.error().message);
-    WorkerPool pool((*c)->endpoint(), o->workers);
+    WorkerPool pool((*c)->endpoint(), o->workers, stop);
     if (sim::Status s = pool.start(); !s) return fail(s.error().message);
-    const auto summary = (*c)->run(stop);
+    const auto summary = (*c)->run(pool.halt());
     pool.finish();
+    if (pool.exhausted() && summary.outcome == coordinator::RunOutcome::kStopped) {
+      std::cerr << "drapegen local: error: every worker died (the log above says how) and their restarts are spent; "
+                   "find the cause before resuming\n";
+    }
     const int code = report_run(summary, (*c)->manifest_path(), "local");
     if (summary.outcome == coordinator::RunOutcome::kComplete) {
       auto stats = coordinator::compute_stats((*c)->manifest_path(), {});

@@ -358,5 +358,34 @@ TEST(Service, ASecondCoordinatorOnALiveOutputIsRefused) {
   EXPECT_EQ(recorded_jobs(manifest), 2);
 }
 
+// `drapegen local` restarts a worker that dies, up to 3 x N times over the run; once every worker has died and no
+// restart is left it stops the run (exit 4, the cause named) instead of waiting for workers that never come.
+TEST(Service, LocalStopsWhenEveryWorkerHasDiedAndNoRestartIsLeft) {
+  const fs::path dir = test_dir("local_workers_die");
+  const fs::path out = dir / "run";
+  write_text(dir / "run.toml", small_config(out, 40, 2));
+  const fs::path manifest = out / "manifest.sqlite";
+  Process local({"local", "--workers", "1", "--config", (dir / "run.toml").string()}, (dir / "local").string());
+  ASSERT_FALSE(wait_endpoint(out, local, 30s).empty()) << local.err();
+  // Kill the worker process (local's only child) each time one runs: the first and its 3 restarts. A child is listed
+  // under the thread that started it (the restarts: the supervisor's), so every thread's list is read.
+  const fs::path tasks = fs::path("/proc") / std::to_string(local.pid()) / "task";
+  int kills = 0;
+  const auto until = std::chrono::steady_clock::now() + 60s;
+  while (local.running() && std::chrono::steady_clock::now() < until) {
+    std::error_code ec;
+    for (const auto& task : fs::directory_iterator(tasks, ec)) {
+      std::istringstream pids(Process::slurp((task.path() / "children").string()));
+      for (pid_t pid = 0; pids >> pid;) kills += ::kill(pid, SIGKILL) == 0;
+    }
+    std::this_thread::sleep_for(20ms);
+  }
+  ASSERT_EQ(local.wait(1s), 4) << local.err();
+  EXPECT_GE(kills, 4);
+  EXPECT_NE(local.err().find("every worker has died and the 3 restarts are spent"), std::string::npos) << local.err();
+  EXPECT_NE(local.err().find("--resume " + manifest.string()), std::string::npos) << local.err();
+  check_manifest(manifest, 2);
+}
+
 }  // namespace
 }  // namespace drapegen::test
