@@ -302,6 +302,16 @@ struct Coordinator::Impl {
     send(w.identity, std::move(e));
   }
 
+  /// Heartbeats to the workers that have heard nothing for an interval. Also between the results of one long pass
+  /// (each result's files are fsync'ed): on a slow disk a pass can outlast a worker's liveness, and a worker that
+  /// hears nothing reconnects and throws its computation away.
+  void send_due_heartbeats() {
+    const auto now = Clock::now();
+    for (auto& [identity, w] : workers) {
+      if (now - w.last_sent >= std::chrono::milliseconds(config.heartbeat_ms)) send_heartbeat(w);
+    }
+  }
+
   void reject(const std::string& identity, const std::string& why) {
     ++rejected;
     const auto now = Clock::now();
@@ -635,9 +645,9 @@ struct Coordinator::Impl {
                                 fmt::format("no result within the lease of {} s", config.lease_s), w.name);
         }
       }
-      if (now - w.last_sent >= std::chrono::milliseconds(config.heartbeat_ms)) send_heartbeat(w);
       ++it;
     }
+    send_due_heartbeats();
   }
 
   void progress(bool force) {
@@ -759,6 +769,7 @@ struct Coordinator::Impl {
           // with its computation. (Safe: a lease is never persisted, and a result is only ever committed after
           // the results it depends on, in the same or an earlier commit.)
           dispatch();
+          send_due_heartbeats();
         }
       }
       timers();
