@@ -343,5 +343,26 @@ TEST(Service, ANonFiniteResultIsAFailedAttempt) {
   for (const auto& j : all(reader->jobs())) EXPECT_EQ(j.state, storage::JobState::kDone);
 }
 
+// A worker of another drapegen version is served, with a warning naming both versions (worker.proto: Ready).
+TEST(Service, AWorkerOfAnotherVersionIsWarnedAbout) {
+  const fs::path dir = test_dir("other_version");
+  const fs::path out = dir / "run";
+  write_text(dir / "run.toml", small_config(out, 1, 1, "[testing]\nmode = \"noop\"\n"));
+  Process coordinator({"run", "--config", (dir / "run.toml").string()}, (dir / "coordinator").string());
+  const std::string endpoint = wait_endpoint(out, coordinator, 30s);
+  ASSERT_FALSE(endpoint.empty()) << coordinator.err();
+  zmq::context_t context(1);
+  FakeWorker a(context, endpoint);
+  v1::Envelope hello = ready("older");
+  hello.mutable_ready()->set_code_version("0.0.1-test");
+  a.send(hello);
+  auto job = a.expect(v1::Envelope::kJob, 5s);
+  ASSERT_TRUE(job) << coordinator.err();
+  a.send(result(job->job().job_id(), job->job().attempt()));
+  ASSERT_EQ(coordinator.wait(10s), 0) << coordinator.err();
+  EXPECT_NE(coordinator.err().find("worker older runs drapegen 0.0.1-test, this coordinator "), std::string::npos)
+      << coordinator.err();
+}
+
 }  // namespace
 }  // namespace drapegen::test

@@ -338,6 +338,10 @@ struct Coordinator::Impl {
       w.last_seen = w.last_sent = Clock::now();
       if (e.ready().interval_ms() > 0) w.interval_ms = static_cast<int>(e.ready().interval_ms());
       log->info("worker {} joined ({} connected)", w.name, workers.size() + 1);
+      if (const std::string& version = e.ready().code_version(); !version.empty() && version != DRAPEGEN_VERSION) {
+        log->warn("worker {} runs drapegen {}, this coordinator {}: its drapes may differ from the others'", w.name,
+                  version, DRAPEGEN_VERSION);
+      }
       workers.emplace(identity, std::move(w));
       send_heartbeat(workers.at(identity));
       return;
