@@ -187,7 +187,7 @@ Runner add_local_command(CLI::App& app) {
       }
       c = coordinator::Coordinator::create(text, name, options);
     }
-    if (!c) return fail(c.error().message);
+    if (!c) return fail(c.error().message, c.error().io ? kExitIo : kExitUsage);
     WorkerPool pool((*c)->endpoint(), o->workers, stop);
     if (sim::Status s = pool.start(); !s) return fail(s.error().message);
     const auto summary = (*c)->run(pool.halt());

@@ -94,7 +94,7 @@ Runner add_run_command(CLI::App& app) {
     } else {
       c = coordinator::Coordinator::resume(o->resume, options);
     }
-    if (!c) return fail(c.error().message);
+    if (!c) return fail(c.error().message, c.error().io ? kExitIo : kExitUsage);
     const auto summary = (*c)->run(stop);
     return report_run(summary, (*c)->manifest_path(), "run");
   };

@@ -387,5 +387,19 @@ TEST(Service, LocalStopsWhenEveryWorkerHasDiedAndNoRestartIsLeft) {
   check_manifest(manifest, 2);
 }
 
+// An output that cannot be created (its parent a regular file) is the file system's failure: exit 3, as a result
+// that cannot be written mid-run, not 1 (bad input); nothing is left behind.
+TEST(Service, AnOutputThatCannotBeCreatedExitsWith3) {
+  const fs::path dir = test_dir("output_not_creatable");
+  write_text(dir / "file", "a regular file");
+  const fs::path out = dir / "file" / "run";
+  write_text(dir / "run.toml", small_config(out, 2, 1));
+  Process run({"run", "--config", (dir / "run.toml").string()}, (dir / "run").string());
+  ASSERT_EQ(run.wait(30s), 3) << run.err();
+  EXPECT_NE(run.err().find("cannot create " + (out / "data").string()), std::string::npos) << run.err();
+  Process local({"local", "--workers", "1", "--config", (dir / "run.toml").string()}, (dir / "local").string());
+  ASSERT_EQ(local.wait(30s), 3) << local.err();
+}
+
 }  // namespace
 }  // namespace drapegen::test

@@ -40,6 +40,12 @@ using Clock = std::chrono::steady_clock;
 
 namespace {
 
+/// The error, as the file system's (sim::Error::io): the output could not be created or written.
+sim::Error io_error(sim::Error e) {
+  e.io = true;
+  return e;
+}
+
 double unix_now() {
   return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
 }
@@ -838,7 +844,7 @@ sim::Expected<std::unique_ptr<Coordinator>> Coordinator::create(const std::strin
   }
   std::error_code ec;
   fs::create_directories(impl->data_dir, ec);
-  if (ec) return sim::Error{fmt::format("cannot create {}: {}", impl->data_dir, ec.message())};
+  if (ec) return sim::Error{fmt::format("cannot create {}: {}", impl->data_dir, ec.message()), true};
   auto lock = storage::OutputLock::acquire(impl->out_dir);
   if (!lock) return lock.error();
   impl->lock.emplace(std::move(lock).value());
@@ -862,12 +868,12 @@ sim::Expected<std::unique_ptr<Coordinator>> Coordinator::create(const std::strin
   run.code_version = DRAPEGEN_VERSION;
   run.endpoint = impl->endpoint;
   auto manifest = storage::Manifest::create(impl->manifest_path, run, plan->samples, plan->jobs);
-  if (!manifest) return manifest.error();
+  if (!manifest) return io_error(manifest.error());
   impl->manifest = std::make_unique<storage::Manifest>(std::move(manifest).value());
-  if (sim::Status s = impl->load_state(); !s) return s.error();
+  if (sim::Status s = impl->load_state(); !s) return io_error(s.error());
   impl->log->info("run planned: {} jobs in {}; listening on {}", impl->jobs.size(), impl->manifest_path,
                   impl->endpoint);
-  if (sim::Status s = impl->publish_endpoint(); !s) return s.error();
+  if (sim::Status s = impl->publish_endpoint(); !s) return io_error(s.error());
   return std::unique_ptr<Coordinator>(new Coordinator(std::move(impl)));
 }
 
@@ -889,18 +895,18 @@ sim::Expected<std::unique_ptr<Coordinator>> Coordinator::resume(const std::strin
   impl->manifest = std::make_unique<storage::Manifest>(std::move(manifest).value());
   std::error_code ec;
   fs::create_directories(impl->data_dir, ec);
-  if (ec) return sim::Error{fmt::format("cannot create {}: {}", impl->data_dir, ec.message())};
+  if (ec) return sim::Error{fmt::format("cannot create {}: {}", impl->data_dir, ec.message()), true};
   // Before anything is removed: the files a live run has not yet recorded are not orphans.
   auto lock = storage::OutputLock::acquire(impl->out_dir);
   if (!lock) return lock.error();
   impl->lock.emplace(std::move(lock).value());
-  if (sim::Status s = impl->remove_orphans(); !s) return s.error();
+  if (sim::Status s = impl->remove_orphans(); !s) return io_error(s.error());
   const std::string preferred = options.bind_override.empty() ? run->endpoint : options.bind_override;
   if (sim::Status s = impl->bind(preferred, options.bind_override.empty() ? config->bind : ""); !s) return s.error();
-  if (sim::Status s = impl->load_state(); !s) return s.error();
+  if (sim::Status s = impl->load_state(); !s) return io_error(s.error());
   impl->log->info("resumed {}: {} of {} jobs done, {} failed; listening on {}", manifest_path, impl->done,
                   impl->jobs.size(), impl->failed, impl->endpoint);
-  if (sim::Status s = impl->publish_endpoint(); !s) return s.error();
+  if (sim::Status s = impl->publish_endpoint(); !s) return io_error(s.error());
   return std::unique_ptr<Coordinator>(new Coordinator(std::move(impl)));
 }
 

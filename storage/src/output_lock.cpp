@@ -15,7 +15,7 @@ namespace drapegen::storage {
 sim::Expected<OutputLock> OutputLock::acquire(const std::string& directory) {
   std::string path = directory + "/.lock";
   const int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-  if (fd < 0) return sim::Error{fmt::format("cannot open {}: {}", path, std::strerror(errno))};
+  if (fd < 0) return sim::Error{fmt::format("cannot open {}: {}", path, std::strerror(errno)), true};
   if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
     const int error = errno;
     std::string holder;
@@ -27,14 +27,14 @@ sim::Expected<OutputLock> OutputLock::acquire(const std::string& directory) {
                                     "that one first",
                                     directory, holder)};
     }
-    return sim::Error{fmt::format("cannot lock {}: {}", path, std::strerror(error))};
+    return sim::Error{fmt::format("cannot lock {}: {}", path, std::strerror(error)), true};
   }
   // The holder's pid, for the message above (informational: the lock is the flock, not the file's content).
   const std::string pid = std::to_string(::getpid());
   if (::ftruncate(fd, 0) != 0 || ::pwrite(fd, pid.data(), pid.size(), 0) != static_cast<ssize_t>(pid.size())) {
     const int error = errno;
     ::close(fd);
-    return sim::Error{fmt::format("cannot write {}: {}", path, std::strerror(error))};
+    return sim::Error{fmt::format("cannot write {}: {}", path, std::strerror(error)), true};
   }
   return OutputLock(fd, std::move(path));
 }

@@ -10,6 +10,9 @@ namespace drapegen::sim {
 /// Why an operation failed, in one line a person can act on.
 struct Error {
   std::string message;
+  /// The file system failed (an output could not be created or written), not the input: a command exits with its
+  /// I/O code rather than its bad-input code. Set where the failure is known to be the file system's.
+  bool io = false;
 };
 
 template <class T>
