@@ -347,6 +347,10 @@ TEST(Service, ASecondCoordinatorOnALiveOutputIsRefused) {
             std::string::npos)
       << resume.err();
   EXPECT_TRUE(fs::exists(unrecorded));
+  // A new run with the same configuration, while the first is live: refused the same way.
+  Process again({"run", "--config", (dir / "run.toml").string()}, (dir / "again").string());
+  ASSERT_EQ(again.wait(30s), 1) << again.err();
+  EXPECT_NE(again.err().find("is in use by another coordinator"), std::string::npos) << again.err();
   EXPECT_TRUE(first.running());
 
   ::kill(first.pid(), SIGTERM);
@@ -356,6 +360,12 @@ TEST(Service, ASecondCoordinatorOnALiveOutputIsRefused) {
   EXPECT_FALSE(fs::exists(unrecorded));
   check_manifest(manifest, 2);
   EXPECT_EQ(recorded_jobs(manifest), 2);
+  // With no coordinator left, a new run on that output is told to resume instead.
+  Process after({"run", "--config", (dir / "run.toml").string()}, (dir / "after").string());
+  ASSERT_EQ(after.wait(30s), 1) << after.err();
+  EXPECT_NE(after.err().find(manifest.string() + " exists already: continue it with drapegen run --resume"),
+            std::string::npos)
+      << after.err();
 }
 
 // `drapegen local` restarts a worker that dies, up to 3 x N times over the run; once every worker has died and no

@@ -268,6 +268,18 @@ struct Coordinator::Impl {
 
   /// Removes files in data/ that the manifest does not list (results of a transaction that never committed) and
   /// stray temporary files.
+  /// Creates the output's data directory and takes the output's lock (storage::OutputLock) for this coordinator's
+  /// life: before a new run looks for an existing manifest, and before a resumed one removes anything.
+  sim::Status claim_output() {
+    std::error_code ec;
+    fs::create_directories(data_dir, ec);
+    if (ec) return sim::Error{fmt::format("cannot create {}: {}", data_dir, ec.message()), true};
+    auto acquired = storage::OutputLock::acquire(out_dir);
+    if (!acquired) return acquired.error();
+    lock.emplace(std::move(acquired).value());
+    return {};
+  }
+
   sim::Status remove_orphans() {
     auto files = manifest->reader().files();
     if (!files) return files.error();
@@ -404,31 +416,33 @@ struct Coordinator::Impl {
     return result_stem(slot.rec.sample, slot.rec.slot) + suffix;
   }
 
+  /// A result the coordinator cannot record as it came: a failed attempt of its job, for `reason`.
+  void refuse_result(Worker& w, const v1::Result& r, v1::FailureReason reason, std::string message) {
+    v1::Failure f;
+    f.set_job_id(r.job_id());
+    f.set_attempt(r.attempt());
+    f.set_reason(reason);
+    f.set_message(std::move(message));
+    on_failure(w, f);
+  }
+
   void on_result(Worker& w, const v1::Result& r) {
     JobSlot* slot = leased_slot(w, r.job_id(), r.attempt(), "result");
     if (!slot) return;
     const bool noop = slot->rec.mode == "noop";
     if (!noop && (r.mesh_ply().empty() || r.exr_size() != config.orientations)) {
-      v1::Failure f;
-      f.set_job_id(r.job_id());
-      f.set_attempt(r.attempt());
-      f.set_reason(v1::FAILURE_REASON_RENDER_ERROR);
-      f.set_message(fmt::format("incomplete result: {} mesh bytes, {} of {} EXR files", r.mesh_ply().size(),
-                                r.exr_size(), config.orientations));
-      return on_failure(w, f);
+      return refuse_result(w, r, v1::FAILURE_REASON_RENDER_ERROR,
+                           fmt::format("incomplete result: {} mesh bytes, {} of {} EXR files", r.mesh_ply().size(),
+                                       r.exr_size(), config.orientations));
     }
     // A worker that does not know the run's bending model (older than the field) drapes with the paper's: its result
     // would be mislabelled data, so it counts as a failed attempt and the job goes to another worker.
     const std::string& model = r.metrics().bending_model();
     if (!noop && proto::bending_model_name(model) != config.bending_model) {
-      v1::Failure f;
-      f.set_job_id(r.job_id());
-      f.set_attempt(r.attempt());
-      f.set_reason(v1::FAILURE_REASON_INVALID_JOB);
-      f.set_message(fmt::format("worker {} computed the drape with the {} bending model, the run asks for {} (a worker "
-                                "older than this run's drapegen?)",
-                                w.name, model.empty() ? "dihedral (unnamed)" : model, config.bending_model));
-      return on_failure(w, f);
+      return refuse_result(w, r, v1::FAILURE_REASON_INVALID_JOB,
+                           fmt::format("worker {} computed the drape with the {} bending model, the run asks for {} "
+                                       "(a worker older than this run's drapegen?)",
+                                       w.name, model.empty() ? "dihedral (unnamed)" : model, config.bending_model));
     }
     // Metrics the manifest cannot hold (its REAL columns are NOT NULL; SQLite stores NaN as NULL) make a failed
     // attempt of the job, not a storage error that would stop the run.
@@ -438,12 +452,8 @@ struct Coordinator::Impl {
                                       {"sim_seconds", metrics.sim_seconds()},
                                       {"render_seconds", metrics.render_seconds()}}) {
       if (std::isfinite(value)) continue;
-      v1::Failure f;
-      f.set_job_id(r.job_id());
-      f.set_attempt(r.attempt());
-      f.set_reason(v1::FAILURE_REASON_DIVERGED);
-      f.set_message(fmt::format("result with a non-finite {} ({}) from worker {}", name, value, w.name));
-      return on_failure(w, f);
+      return refuse_result(w, r, v1::FAILURE_REASON_DIVERGED,
+                           fmt::format("result with a non-finite {} ({}) from worker {}", name, value, w.name));
     }
     // Files first (temporary file, fsync, rename); the directory is synced before the manifest commits.
     std::vector<storage::FileRecord> files;
@@ -838,17 +848,8 @@ sim::Expected<std::unique_ptr<Coordinator>> Coordinator::create(const std::strin
   impl->out_dir = config->output;
   impl->data_dir = config->output + "/data";
   impl->manifest_path = config->output + "/manifest.sqlite";
-  if (fs::exists(impl->manifest_path)) {
-    return sim::Error{fmt::format("{} exists already: continue it with drapegen run --resume {}", impl->manifest_path,
-                                  impl->manifest_path)};
-  }
-  std::error_code ec;
-  fs::create_directories(impl->data_dir, ec);
-  if (ec) return sim::Error{fmt::format("cannot create {}: {}", impl->data_dir, ec.message()), true};
-  auto lock = storage::OutputLock::acquire(impl->out_dir);
-  if (!lock) return lock.error();
-  impl->lock.emplace(std::move(lock).value());
-  // Checked again under the lock: another coordinator may have created it since.
+  if (sim::Status s = impl->claim_output(); !s) return s.error();
+  // Checked under the lock: no other coordinator creates it meanwhile.
   if (fs::exists(impl->manifest_path)) {
     return sim::Error{fmt::format("{} exists already: continue it with drapegen run --resume {}", impl->manifest_path,
                                   impl->manifest_path)};
@@ -893,13 +894,8 @@ sim::Expected<std::unique_ptr<Coordinator>> Coordinator::resume(const std::strin
   impl->out_dir = manifest->reader().directory();
   impl->data_dir = impl->out_dir + "/data";
   impl->manifest = std::make_unique<storage::Manifest>(std::move(manifest).value());
-  std::error_code ec;
-  fs::create_directories(impl->data_dir, ec);
-  if (ec) return sim::Error{fmt::format("cannot create {}: {}", impl->data_dir, ec.message()), true};
   // Before anything is removed: the files a live run has not yet recorded are not orphans.
-  auto lock = storage::OutputLock::acquire(impl->out_dir);
-  if (!lock) return lock.error();
-  impl->lock.emplace(std::move(lock).value());
+  if (sim::Status s = impl->claim_output(); !s) return s.error();
   if (sim::Status s = impl->remove_orphans(); !s) return io_error(s.error());
   const std::string preferred = options.bind_override.empty() ? run->endpoint : options.bind_override;
   if (sim::Status s = impl->bind(preferred, options.bind_override.empty() ? config->bind : ""); !s) return s.error();

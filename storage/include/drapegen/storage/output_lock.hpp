@@ -6,6 +6,7 @@
 // are files it is still writing or about to commit.
 
 #include <string>
+#include <utility>
 
 #include "drapegen/sim/expected.hpp"
 
