@@ -5,6 +5,7 @@
 #include <string>
 
 #include "commands.hpp"
+#include "drapegen/build_id.hpp"
 #include "drapegen/sim/blas_kernels.hpp"
 
 int main(int argc, char** argv) {
@@ -12,7 +13,7 @@ int main(int argc, char** argv) {
   drapegen::sim::relaunch_with_blas_kernels(argv);
   CLI::App app{"drapegen - cloth drape simulation for learning fabric bending stiffness"};
   app.require_subcommand(1);
-  app.set_version_flag("--version", "drapegen 0.1.0");
+  app.set_version_flag("--version", "drapegen " DRAPEGEN_BUILD_ID);
   std::map<CLI::App*, drapegen::cli::Runner> runners;
   auto add = [&](const char* name, const char* description, auto factory) {
     CLI::App* sub = app.add_subcommand(name, description);

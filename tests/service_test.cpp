@@ -40,6 +40,12 @@ TEST(Service, EndToEndWithTwoWorkers) {
   ASSERT_EQ(stats.wait(30s), 0) << stats.err();
   EXPECT_NE(stats.out().find("\"done\": 8"), std::string::npos) << stats.out();
   EXPECT_NE(stats.out().find("\"bending_model\": \"dihedral\""), std::string::npos) << stats.out();
+  // The run records the build that planned it, as `drapegen --version` names it (version, commit, local changes).
+  Process version({"--version"}, (dir / "version").string());
+  ASSERT_EQ(version.wait(10s), 0) << version.err();
+  const std::string id = version.out().substr(0, version.out().find('\n')).substr(std::string("drapegen ").size());
+  EXPECT_TRUE(id.starts_with(DRAPEGEN_PROJECT_VERSION)) << version.out();
+  EXPECT_NE(stats.out().find("\"code_version\": \"" + id + "\""), std::string::npos) << id << "\n" << stats.out();
   EXPECT_TRUE(fs::exists(dir / "plots" / "drape_coefficient.svg"));
   // A second run into the same output refuses, naming --resume, in one line.
   Process again({"run", "--config", (dir / "run.toml").string()}, (dir / "again").string());

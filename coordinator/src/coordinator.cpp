@@ -22,6 +22,7 @@
 #include <zmq.hpp>
 #include <zmq_addon.hpp>
 
+#include "drapegen/build_id.hpp"
 #include "drapegen/coordinator/curve_keys.hpp"
 #include "drapegen/coordinator/job_message.hpp"
 #include "drapegen/coordinator/logging.hpp"
@@ -356,9 +357,9 @@ struct Coordinator::Impl {
       w.last_seen = w.last_sent = Clock::now();
       if (e.ready().interval_ms() > 0) w.interval_ms = static_cast<int>(e.ready().interval_ms());
       log->info("worker {} joined ({} connected)", w.name, workers.size() + 1);
-      if (const std::string& version = e.ready().code_version(); !version.empty() && version != DRAPEGEN_VERSION) {
+      if (const std::string& version = e.ready().code_version(); !version.empty() && version != DRAPEGEN_BUILD_ID) {
         log->warn("worker {} runs drapegen {}, this coordinator {}: its drapes may differ from the others'", w.name,
-                  version, DRAPEGEN_VERSION);
+                  version, DRAPEGEN_BUILD_ID);
       }
       workers.emplace(identity, std::move(w));
       send_heartbeat(workers.at(identity));
@@ -866,7 +867,7 @@ sim::Expected<std::unique_ptr<Coordinator>> Coordinator::create(const std::strin
   run.created_at = unix_now();
   run.seed = config->seed;
   run.config_toml = config_text;
-  run.code_version = DRAPEGEN_VERSION;
+  run.code_version = DRAPEGEN_BUILD_ID;
   run.endpoint = impl->endpoint;
   auto manifest = storage::Manifest::create(impl->manifest_path, run, plan->samples, plan->jobs);
   if (!manifest) return io_error(manifest.error());

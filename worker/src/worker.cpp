@@ -13,6 +13,7 @@
 #include <unistd.h>
 #include <zmq.hpp>
 
+#include "drapegen/build_id.hpp"
 #include "drapegen/coordinator/curve_keys.hpp"
 #include "drapegen/coordinator/logging.hpp"
 #include "drapegen/proto/codec.hpp"
@@ -156,7 +157,7 @@ sim::Status run_worker(const WorkerOptions& o, const std::atomic<bool>& stop) {
     {
       v1::Envelope ready;
       ready.mutable_ready()->set_worker_name(name);
-      ready.mutable_ready()->set_code_version(DRAPEGEN_VERSION);
+      ready.mutable_ready()->set_code_version(DRAPEGEN_BUILD_ID);
       ready.mutable_ready()->set_interval_ms(static_cast<std::uint32_t>(o.heartbeat_ms));
       send(std::move(ready));
     }

@@ -23,7 +23,7 @@ struct RunRecord {
   double created_at = 0.0;     // unix seconds
   std::uint64_t seed = 0;
   std::string config_toml;     // the configuration as given (resume re-reads it from here)
-  std::string code_version;    // drapegen version that planned the run
+  std::string code_version;    // build id of the drapegen that planned the run (`drapegen --version`)
   std::int64_t total_jobs = 0;
   std::string state = "running";  // running, stopped, complete
   std::string endpoint;        // the coordinator's bound endpoint (resume binds it again)
