@@ -37,6 +37,7 @@ struct DiagnoseOptions {
   std::optional<int> sensor_evaluations;
   std::optional<int> refit_scan;
   std::optional<int> yield_trade;
+  std::optional<int> shear_trade;
   std::optional<int> drift_scan;
   std::vector<std::string> candidates;  // empty: every effect
   std::optional<int> starts;
@@ -84,6 +85,7 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (bad_scan(o.common_bending, 6)) return fail("--common-bending must be 0 (off) or 2 .. 6");
   if (!(o.tie_margin >= 0.0 && o.tie_margin <= 1.0)) return fail("--tie-margin must be 0 (exact ties only) .. 1");
   if (bad_scan(o.yield_trade, 100)) return fail("--yield-trade must be 0 (off) or 2 .. 100");
+  if (bad_scan(o.shear_trade, 100)) return fail("--shear-trade must be 0 (off) or 2 .. 100");
   if (outside(o.drift_scan, 0, 100)) return fail("--drift-scan must be 0 (off) .. 100");
   std::optional<diagnosis::BendingParameters> start;
   if (o.start_alpha.empty() != o.start_beta.empty()) return fail("--start-alpha and --start-beta go together");
@@ -137,6 +139,7 @@ int run_diagnose(const DiagnoseOptions& o) {
   settings.attribution.tie_margin = o.tie_margin;
   if (o.refit_scan) settings.attribution.scan_levels = *o.refit_scan;
   if (o.yield_trade) settings.attribution.yield_trade_levels = *o.yield_trade;
+  if (o.shear_trade) settings.attribution.shear_trade_levels = *o.shear_trade;
   if (o.drift_scan) settings.attribution.drift_scan_levels = *o.drift_scan;
   if (!candidates.empty()) settings.attribution.candidates = candidates;
   if (o.starts) settings.start_levels = *o.starts;
@@ -146,7 +149,7 @@ int run_diagnose(const DiagnoseOptions& o) {
   // A scan asked for must leave the refit's simplex its room; a default one that does not is skipped by the refit.
   constexpr int kKeep = diagnosis::AttributionSettings::kSimplexAfterScan;
   for (auto [levels, option] : {std::pair{o.refit_scan, "--refit-scan"}, std::pair{o.yield_trade, "--yield-trade"},
-                                 std::pair{o.drift_scan, "--drift-scan"}}) {
+                                 std::pair{o.shear_trade, "--shear-trade"}, std::pair{o.drift_scan, "--drift-scan"}}) {
     if (levels && *levels > 0 && *levels > settings.attribution.optimiser.max_evaluations - kKeep) {  // 0: off, nothing to fit
       return fail(fmt::format("{} ({}) must leave the refit's simplex {} of its {} evaluations", option, *levels, kKeep,
                               settings.attribution.optimiser.max_evaluations));
@@ -285,6 +288,17 @@ Runner add_diagnose_command(CLI::App& app) {
                              diagnosis::AttributionSettings::kYieldTradeCurvature,
                              diagnosis::AttributionSettings::kSimplexAfterScan,
                              diagnosis::AttributionSettings{}.yield_trade_levels));
+  app.add_option("--shear-trade", o->shear_trade,
+                 fmt::format("The shear refit starts with this many points along the trade of a stiffer bending (x1 "
+                             ".. the refits' upper bound, x{:.1f} unless a known bending's box sets it) against a more "
+                             "compliant membrane ({:.0f} kg/s^2 / the scale^{:.0f}), then refines from the best within "
+                             "--refit-evaluations, which must leave {} for that; replaces --refit-scan for shear (0: "
+                             "off; default {}; docs/DIAGNOSIS_RESULTS.md, \"Session 41\")",
+                             std::exp(diagnosis::AttributionSettings{}.bending_scale_upper),
+                             diagnosis::AttributionSettings::kShearTradeStiffness,
+                             diagnosis::AttributionSettings::kShearTradePower,
+                             diagnosis::AttributionSettings::kSimplexAfterScan,
+                             diagnosis::AttributionSettings{}.shear_trade_levels));
   app.add_option("--drift-scan", o->drift_scan,
                  fmt::format("The misalignment refit starts with this many drift sizes evenly spaced below its bound "
                              "(3: 10, 20 and 30 mm), bending as fitted, then refines from the best within "

@@ -36,7 +36,13 @@ def main(args):
           "parameters, shrinkage | new refit |")
     print("|---|---|---|---|---|---|")
     score = {}
-    for f in sorted(glob.glob(os.path.join(args[0], "*.json"))):
+    files = sorted(glob.glob(os.path.join(args[0], "*.json")))
+    # The candidate refitted again (captures within the floors at the gate have none to tell it).
+    effects = {c["effect"] for f in files for c in json.load(open(f))["attribution"]["candidates"]}
+    if len(effects) != 1:
+        sys.exit(f"{args[0]}: candidates {sorted(effects)} (one effect expected: --candidates EFFECT)")
+    effect = effects.pop()
+    for f in files:
         label, case = os.path.basename(f)[:-5].split("_", 1)
         if label not in runs:
             continue
@@ -47,6 +53,14 @@ def main(args):
         g, a = new["gap_tests"], new["attribution"]
         if abs(g["excess_above_floors"] - old["gap_tests"]["excess_above_floors"]) > 1e-9:
             sys.exit(f"{f}: the gate's excess differs from the run's (another baseline fit)")
+        if new["within_floors"]:
+            # Within the floors at the gate: no candidate is refitted, the verdict is "none" either way.
+            s = score.setdefault(family == effect, [0, 0, 0])
+            print(f"| {label} {case} | {family} | {old['verdict']} | none (within the floors) | - | - |")
+            s[0] += 1
+            s[1] += old["verdict"] == family
+            s[2] += family == "none"
+            continue
         if len(a["candidates"]) != 1:
             sys.exit(f"{f}: {len(a['candidates'])} candidates (one expected: --candidates EFFECT)")
         swapped = a["candidates"][0]

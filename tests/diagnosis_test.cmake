@@ -412,37 +412,48 @@ if(bar_scale LESS 0.2231 OR bar_scale GREATER 4.4817)
   message(FATAL_ERROR "the bar's bending scale ${bar_scale} is outside exp(-1.5) .. exp(1.5)")
 endif()
 
+# `diagnose --candidates effect option 3` on the small capture (6 refit simulations): one candidate, a scan of three
+# points, point k's bending scale and effect parameter within the k-th "lo hi" of scale_bounds and level_bounds.
+function(expect_trade effect option scale_bounds level_bounds)
+  run_ok(out diagnose --capture ${WORK}/capture --quick --resolution 10 --states 2 --evaluations 8
+         --refit-evaluations 6 --candidates ${effect} ${option} 3 --json)
+  string(JSON ncand LENGTH "${out}" attribution candidates)
+  string(JSON got_effect GET "${out}" attribution candidates 0 effect)
+  string(JSON evaluations GET "${out}" attribution candidates 0 evaluations)
+  string(JSON nscan LENGTH "${out}" attribution candidates 0 scan)
+  if(NOT ncand EQUAL 1 OR NOT got_effect STREQUAL effect OR NOT nscan EQUAL 3 OR evaluations GREATER 6)
+    message(FATAL_ERROR "--candidates ${effect} ${option} 3: ${ncand} candidates (${got_effect}), scan of ${nscan}, "
+                        "${evaluations} evaluations")
+  endif()
+  foreach(k 0 1 2)
+    string(JSON scale GET "${out}" attribution candidates 0 scan ${k} alpha_scale)
+    string(JSON level GET "${out}" attribution candidates 0 scan ${k} parameter)
+    list(GET scale_bounds ${k} sb)
+    list(GET level_bounds ${k} lb)
+    separate_arguments(sb)
+    separate_arguments(lb)
+    list(GET sb 0 s_lo)
+    list(GET sb 1 s_hi)
+    list(GET lb 0 l_lo)
+    list(GET lb 1 l_hi)
+    if(scale LESS s_lo OR scale GREATER s_hi OR level LESS l_lo OR level GREATER l_hi)
+      message(FATAL_ERROR "${option} 3: point ${k} at scale ${scale}, parameter ${level} (expected ${sb}, ${lb})")
+    endif()
+  endforeach()
+endfunction()
+
 # --candidates restricts the refits; --yield-trade 3 starts the yield refit with three points along the trade of a
 # stiffer bending against a lower yield curvature: scales x1, x e^1.5, x e^3 at 100 /m over the scale (ln K = ln 100
-# - ln scale), then the simplex with the rest of the 6 simulations.
-run_ok(out diagnose --capture ${WORK}/capture --quick --resolution 10 --states 2 --evaluations 8 --refit-evaluations 6
-       --candidates yield --yield-trade 3 --json)
-string(JSON ncand LENGTH "${out}" attribution candidates)
-string(JSON effect GET "${out}" attribution candidates 0 effect)
-string(JSON evaluations GET "${out}" attribution candidates 0 evaluations)
-string(JSON nscan LENGTH "${out}" attribution candidates 0 scan)
-if(NOT ncand EQUAL 1 OR NOT effect STREQUAL "yield" OR NOT nscan EQUAL 3 OR evaluations GREATER 6)
-  message(FATAL_ERROR "--candidates yield --yield-trade 3: ${ncand} candidates (${effect}), scan of ${nscan}, "
-                      "${evaluations} evaluations")
-endif()
-# exp(0, 1.5, 3) = 1, 4.4817, 20.0855; ln 100 - (0, 1.5, 3) = 4.6052, 3.1052, 1.6052 (bounds +-0.0001)
-set(scale_bounds "0.9999 1.0001" "4.4816 4.4818" "20.0854 20.0856")
-set(level_bounds "4.6051 4.6053" "3.1051 3.1053" "1.6051 1.6053")
-foreach(k 0 1 2)
-  string(JSON scale GET "${out}" attribution candidates 0 scan ${k} alpha_scale)
-  string(JSON level GET "${out}" attribution candidates 0 scan ${k} parameter)
-  list(GET scale_bounds ${k} sb)
-  list(GET level_bounds ${k} lb)
-  separate_arguments(sb)
-  separate_arguments(lb)
-  list(GET sb 0 s_lo)
-  list(GET sb 1 s_hi)
-  list(GET lb 0 l_lo)
-  list(GET lb 1 l_hi)
-  if(scale LESS s_lo OR scale GREATER s_hi OR level LESS l_lo OR level GREATER l_hi)
-    message(FATAL_ERROR "--yield-trade 3: point ${k} at scale ${scale}, ln K ${level} (expected ${sb}, ${lb})")
-  endif()
-endforeach()
+# - ln scale), then the simplex with the rest of the 6 simulations. exp(0, 1.5, 3) = 1, 4.4817, 20.0855;
+# ln 100 - (0, 1.5, 3) = 4.6052, 3.1052, 1.6052 (bounds +-0.0001).
+expect_trade(yield --yield-trade "0.9999 1.0001;4.4816 4.4818;20.0854 20.0856"
+             "4.6051 4.6053;3.1051 3.1053;1.6051 1.6053")
+# --shear-trade 3 starts the shear refit with three points along the trade of a stiffer bending against a more
+# compliant membrane: scales x1, x e^0.75, x e^1.5 (the refits' upper bound) at 3 kg/s^2 over the scale squared
+# (ln G = ln 3 - 2 ln scale), then the simplex. exp(0, 0.75, 1.5) = 1, 2.1170, 4.4817; ln 3 - 2 (0, 0.75, 1.5) =
+# 1.0986, -0.4014, -1.9014 (bounds +-0.0001).
+expect_trade(shear --shear-trade "0.9999 1.0001;2.1169 2.1171;4.4816 4.4818"
+             "1.0985 1.0987;-0.4015 -0.4013;-1.9015 -1.9013")
 # --ablation: each simulated candidate is validated with its effect switched off at its refitted bending scale as
 # well (report.json "ablated"); the sensor candidate re-renders the baseline's drapes and has none.
 run_ok(out diagnose --capture ${WORK}/capture --quick --resolution 10 --states 2 --evaluations 8 --refit-evaluations 4
@@ -484,6 +495,7 @@ foreach(i 0 1)
 endforeach()
 expect_same_with_jobs("the bar's objective" attribution bending_refit_bar objective_mm)
 expect_failure(1 "--yield-trade must be 0" diagnose --capture ${WORK}/capture --yield-trade 1)
+expect_failure(1 "--shear-trade must be 0" diagnose --capture ${WORK}/capture --shear-trade 1)
 expect_failure(1 "unknown effect 'bogus'" diagnose --capture ${WORK}/capture --candidates yield,bogus)
 expect_failure(1 "'curl' given twice" diagnose --capture ${WORK}/capture --candidates curl,shear,curl)
 # --start-alpha/--start-beta: the fit starts at the given bending instead of the drape-coefficient guess (report:

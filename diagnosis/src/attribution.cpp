@@ -261,6 +261,20 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
       scan.push_back(std::move(x));
     }
     scanned_axes = {0, first};
+  } else if (one_parameter && effect == Effect::kShear && settings.shear_trade_levels >= 2 &&
+             settings.shear_trade_levels <= room && hi[0] > 0.01) {
+    // Stiffer bending against a more compliant membrane (AttributionSettings::shear_trade_levels).
+    const int n = settings.shear_trade_levels;
+    spacing = hi[0] / (n - 1);
+    for (int k = 0; k < n; ++k) {
+      std::vector<double> x = x0;
+      x[0] = k + 1 == n ? hi[0] : spacing * k;
+      x[first] = std::clamp(std::log(AttributionSettings::kShearTradeStiffness) -
+                                AttributionSettings::kShearTradePower * x[0],
+                            lo[first], hi[first]);
+      scan.push_back(std::move(x));
+    }
+    scanned_axes = {0, first};
   } else if (one_parameter && settings.scan_levels >= 2 && settings.scan_levels <= room) {
     // The strength over its range, the bending as fitted. A simplex from one fixed start rarely moved the strength
     // within the budget (docs/DIAGNOSIS_RESULTS.md, session 10).

@@ -64,7 +64,8 @@ struct CandidateResult {
   struct ScanLevel {
     double parameter = 0.0, alpha_scale = 1.0, objective = 0.0;
   };
-  /// The scan that preceded the simplex, if one ran (AttributionSettings::scan_levels, yield_trade_levels); for the
+  /// The scan that preceded the simplex, if one ran (AttributionSettings::scan_levels, yield_trade_levels,
+  /// shear_trade_levels, drift_scan_levels); for the
   /// sensor candidate with AttributionSettings::sensor_bending, every simulation of its bending refit (parameter: the
   /// multipath gain, mm): the grid, the simplex, then the best's ablation (gain 0).
   std::vector<ScanLevel> scan;
@@ -163,6 +164,18 @@ struct AttributionSettings {
   int yield_trade_levels = 0;
   static constexpr double kYieldScaleRange = 3.0;
   static constexpr double kYieldTradeCurvature = 100.0;  // 1/m
+  /// The shear refit first evaluates this many points along the trade of a stiffer bending against a more compliant
+  /// membrane (0: off, the simplex from effect_space's start; replaces scan_levels for shear): the bending scale s
+  /// from x1 to the refits' upper bound (bending_scale_upper) evenly in ln, the shear stiffness
+  /// kShearTradeStiffness / s^2 (the line through the refit's usual start, x1 and 3 kg/s^2, to 0.15 kg/s^2 at x4.5).
+  /// A membrane that shears easily folds where a stiff one cannot, so the baseline fit of such a specimen stops soft
+  /// (x0.18-0.38 of the true bending on fresh seed 37's five shear captures), and a refit that scales the bending
+  /// alone or the stiffness alone from x1 and 3 kg/s^2 stayed there on three of them, while the true bending with
+  /// the true membrane drapes within the floors on all five (drapegen_absorption_probe; docs/DIAGNOSIS_RESULTS.md,
+  /// "Session 41"). The simplex refines from the best point within the same budget.
+  int shear_trade_levels = 0;
+  static constexpr double kShearTradeStiffness = 3.0;  // kg/s^2 at x1
+  static constexpr double kShearTradePower = 2.0;      // the stiffness falls as this power of the bending scale
   /// Each simulated candidate is also validated with its effect switched off at its refitted bending scale (its
   /// ablation), and credited only for what the effect adds beyond it: the shrinkage is measured from the smaller of
   /// the reference's excess and the ablation's, and the confirmation must not be worse than either. A candidate that
