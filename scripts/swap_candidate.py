@@ -8,7 +8,9 @@ Session 19's yield-trade table (docs/DIAGNOSIS.md) was made with
     scripts/swap_candidate.py out/ytrade s17=out/s17all s18=out/s18all s19=out/s19all s20=out/s20all
 
 where out/ytrade holds LABEL_CASE.json (e.g. s19_yield_02.json) and each LABEL=RUN names the run (diagnoses/ and
-truth/) the case belongs to.
+truth/) the case belongs to. The ranking is attribute()'s (confirmed, shrinkage, physical before sensor, near ties
+by the refit objective); where the common bending or curl first decided, or would now, the verdict needs the full
+diagnosis and is printed as "undetermined". Captures within the floors at the gate are "none" either way.
 """
 import glob
 import json
@@ -17,6 +19,8 @@ import os
 import sys
 
 THRESHOLD = 0.25  # AttributionSettings::significant_shrinkage
+TIE_MARGIN = 0.1  # AttributionSettings::tie_margin
+COMMON_BENDING = 3  # AttributionSettings::common_bending_effects
 FAMILY = {"pose": "sensor", "bias": "sensor", "multipath": "sensor", "misalign": "misalignment"}
 
 
@@ -81,13 +85,27 @@ def main(args):
                 ranked.append(entry)
         ranked.append(dict(effect=swapped["effect"], shrinkage=swapped["shrinkage"], confirmed=swapped["confirmed"],
                            objective=swapped["objective_mm"], held_out=swapped["held_out_shrinkage"], c=swapped))
-        # ranks_before (attribution.hpp): confirmed, shrinkage, objective, held-out shrinkage.
-        ranked.sort(key=lambda c: (not c["confirmed"], -c["shrinkage"], c["objective"], -c["held_out"]))
+        # ranks_before (attribution.hpp): confirmed, shrinkage, a physical effect before the sensor error, objective,
+        # held-out shrinkage.
+        ranked.sort(key=lambda c: (not c["confirmed"], -c["shrinkage"], c["effect"] == "sensor", c["objective"],
+                                   -c["held_out"]))
         top = ranked[0]
+        significant = [c for c in ranked if c["confirmed"] and c["shrinkage"] >= THRESHOLD]
+        at_zero = [c for c in ranked if c["confirmed"] and c["c"]["validated"]["excess_above_floors"] == 0]
         if new["within_floors_after_bending_refit"]:
             verdict = "none"
+        elif len(at_zero) >= COMMON_BENDING or old["attribution"].get("common_bending") or \
+                old["attribution"].get("curl_first"):
+            # The common bending (validated again at the median of the new scales) or curl first: not computed here.
+            verdict = "undetermined"
+        elif top in significant:
+            tied = [c for c in significant if c["shrinkage"] == top["shrinkage"]]
+            if len(tied) == 1:  # near ties (near_ties_first): the smallest refit objective within the margin
+                top = min((c for c in significant if top["shrinkage"] - c["shrinkage"] <= TIE_MARGIN),
+                          key=lambda c: c["objective"])
+            verdict = top["effect"]
         else:
-            verdict = top["effect"] if top["confirmed"] and top["shrinkage"] >= THRESHOLD else "unexplained"
+            verdict = "unexplained"
         ratio = math.exp(sum(math.log(t / f) for t, f in zip(truth["alpha"], old["baseline"]["fitted"]["alpha"])) / 3)
         strengths = ", ".join(f"{e['name']} {e.get('strength', 0):.3g}" for e in truth.get("effects", []))
         truth_text = f"{family} ({strengths + '; ' if strengths else ''}x{ratio:.1f})"
