@@ -246,32 +246,31 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
   double spacing = 0.0;
   const int room = options.max_evaluations - AttributionSettings::kSimplexAfterScan;
   const bool one_parameter = sim && !bar && space.start.size() == 1;
-  // The yield trade's reach: kYieldScaleRange, or a known bending's box (no room to trade when the fit is at its edge).
-  const double trade_reach = settings.bending_scale_known ? hi[0] : AttributionSettings::kYieldScaleRange;
-  if (one_parameter && effect == Effect::kYield && settings.yield_trade_levels >= 2 &&
-      settings.yield_trade_levels <= room && trade_reach > 0.01) {
-    // Stiffer bending against a lower yield curvature (AttributionSettings::yield_trade_levels).
-    const int n = settings.yield_trade_levels;
-    hi[0] = trade_reach;
+  // A trade of a stiffer bending against a weaker effect (AttributionSettings::yield_trade_levels, shear_trade_levels):
+  // `levels` points, the bending scale from x1 to e^reach evenly in ln, the effect's parameter at each anchor - power x
+  // the ln scale. The yield trade reaches kYieldScaleRange or a known bending's box (no room to trade when the fit is
+  // at its edge), beyond the other refits' bound; the shear trade reaches that bound.
+  struct Trade {
+    int levels = 0;
+    double reach = 0.0, anchor = 0.0, power = 1.0;
+  };
+  std::optional<Trade> trade;
+  if (one_parameter && effect == Effect::kYield) {
+    trade = Trade{settings.yield_trade_levels,
+                  settings.bending_scale_known ? hi[0] : AttributionSettings::kYieldScaleRange,
+                  std::log(AttributionSettings::kYieldTradeCurvature), 1.0};
+  } else if (one_parameter && effect == Effect::kShear) {
+    trade = Trade{settings.shear_trade_levels, hi[0], std::log(AttributionSettings::kShearTradeStiffness),
+                  AttributionSettings::kShearTradePower};
+  }
+  if (trade && trade->levels >= 2 && trade->levels <= room && trade->reach > 0.01) {
+    const int n = trade->levels;
+    hi[0] = trade->reach;
     spacing = hi[0] / (n - 1);
     for (int k = 0; k < n; ++k) {
       std::vector<double> x = x0;
       x[0] = k + 1 == n ? hi[0] : spacing * k;
-      x[first] = std::clamp(std::log(AttributionSettings::kYieldTradeCurvature) - x[0], lo[first], hi[first]);
-      scan.push_back(std::move(x));
-    }
-    scanned_axes = {0, first};
-  } else if (one_parameter && effect == Effect::kShear && settings.shear_trade_levels >= 2 &&
-             settings.shear_trade_levels <= room && hi[0] > 0.01) {
-    // Stiffer bending against a more compliant membrane (AttributionSettings::shear_trade_levels).
-    const int n = settings.shear_trade_levels;
-    spacing = hi[0] / (n - 1);
-    for (int k = 0; k < n; ++k) {
-      std::vector<double> x = x0;
-      x[0] = k + 1 == n ? hi[0] : spacing * k;
-      x[first] = std::clamp(std::log(AttributionSettings::kShearTradeStiffness) -
-                                AttributionSettings::kShearTradePower * x[0],
-                            lo[first], hi[first]);
+      x[first] = std::clamp(trade->anchor - trade->power * x[0], lo[first], hi[first]);
       scan.push_back(std::move(x));
     }
     scanned_axes = {0, first};

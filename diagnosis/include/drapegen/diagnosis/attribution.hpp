@@ -65,9 +65,9 @@ struct CandidateResult {
     double parameter = 0.0, alpha_scale = 1.0, objective = 0.0;
   };
   /// The scan that preceded the simplex, if one ran (AttributionSettings::scan_levels, yield_trade_levels,
-  /// shear_trade_levels, drift_scan_levels); for the
-  /// sensor candidate with AttributionSettings::sensor_bending, every simulation of its bending refit (parameter: the
-  /// multipath gain, mm): the grid, the simplex, then the best's ablation (gain 0).
+  /// shear_trade_levels, drift_scan_levels); for the sensor candidate with AttributionSettings::sensor_bending, every
+  /// simulation of its bending refit (parameter: the multipath gain, mm): the grid, the simplex, then the best's
+  /// ablation (gain 0).
   std::vector<ScanLevel> scan;
   /// The sensor candidate refitted the bending with its camera and kept it (AttributionSettings::sensor_bending): its
   /// drapes are simulated, not the baseline's re-rendered.
@@ -169,9 +169,9 @@ struct AttributionSettings {
   /// from x1 to the refits' upper bound (bending_scale_upper) evenly in ln, the shear stiffness
   /// kShearTradeStiffness / s^2 (the line through the refit's usual start, x1 and 3 kg/s^2, to 0.15 kg/s^2 at x4.5).
   /// A membrane that shears easily folds where a stiff one cannot, so the baseline fit of such a specimen stops soft
-  /// (x0.18-0.38 of the true bending on fresh seed 37's five shear captures), and a refit that scales the bending
-  /// alone or the stiffness alone from x1 and 3 kg/s^2 stayed there on three of them, while the true bending with
-  /// the true membrane drapes within the floors on all five (drapegen_absorption_probe; docs/DIAGNOSIS_RESULTS.md,
+  /// (x0.18-0.38 of the true bending on seed 37's five shear captures), and the refit's simplex (bending scale and
+  /// stiffness) from x1 and 3 kg/s^2 stayed near there on three of them, while the true bending with the true
+  /// membrane drapes within the floors on all five (drapegen_absorption_probe; docs/DIAGNOSIS_RESULTS.md,
   /// "Session 41"). The simplex refines from the best point within the same budget.
   int shear_trade_levels = 0;
   static constexpr double kShearTradeStiffness = 3.0;  // kg/s^2 at x1
