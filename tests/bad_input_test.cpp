@@ -344,7 +344,7 @@ TEST(Service, ANonFiniteResultIsAFailedAttempt) {
 }
 
 // A worker of another drapegen version is served, with a warning naming both versions (worker.proto: Ready).
-TEST(Service, AWorkerOfAnotherVersionIsWarnedAbout) {
+TEST(Service, AWorkerOfAnotherVersionOrOtherBlasKernelsIsWarnedAbout) {
   const fs::path dir = test_dir("other_version");
   const fs::path out = dir / "run";
   write_text(dir / "run.toml", small_config(out, 1, 1, "[testing]\nmode = \"noop\"\n"));
@@ -355,12 +355,16 @@ TEST(Service, AWorkerOfAnotherVersionIsWarnedAbout) {
   FakeWorker a(context, endpoint);
   v1::Envelope hello = ready("older");
   hello.mutable_ready()->set_code_version("0.0.1-test");
+  hello.mutable_ready()->set_blas_kernels("OpenBLAS Test");
   a.send(hello);
   auto job = a.expect(v1::Envelope::kJob, 5s);
   ASSERT_TRUE(job) << coordinator.err();
   a.send(result(job->job().job_id(), job->job().attempt()));
   ASSERT_EQ(coordinator.wait(10s), 0) << coordinator.err();
   EXPECT_NE(coordinator.err().find("worker older runs drapegen 0.0.1-test, this coordinator "), std::string::npos)
+      << coordinator.err();
+  EXPECT_NE(coordinator.err().find("worker older factorises with OpenBLAS Test, this coordinator with "),
+            std::string::npos)
       << coordinator.err();
 }
 

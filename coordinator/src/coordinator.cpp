@@ -29,6 +29,7 @@
 #include "drapegen/coordinator/planner.hpp"
 #include "drapegen/proto/codec.hpp"
 #include "drapegen/proto/recipe.hpp"
+#include "drapegen/sim/blas_kernels.hpp"
 #include "drapegen/storage/atomic_file.hpp"
 #include "drapegen/storage/manifest.hpp"
 #include "drapegen/storage/output_lock.hpp"
@@ -119,6 +120,7 @@ struct Coordinator::Impl {
   std::int64_t refused_handshakes = 0;
 
   std::shared_ptr<spdlog::logger> log = logger();
+  const std::string blas_kernels = sim::blas_kernels_description();  // a worker's other than these is warned about
   bool terminal_progress = false;
   Clock::time_point start = Clock::now(), last_progress = Clock::now(), last_reject_log{}, last_refuse_log{};
   std::int64_t done_at_start = 0;
@@ -360,6 +362,11 @@ struct Coordinator::Impl {
       if (const std::string& version = e.ready().code_version(); !version.empty() && version != DRAPEGEN_BUILD_ID) {
         log->warn("worker {} runs drapegen {}, this coordinator {}: its drapes may differ from the others'", w.name,
                   version, DRAPEGEN_BUILD_ID);
+      }
+      if (const std::string& kernels = e.ready().blas_kernels(); !kernels.empty() && kernels != blas_kernels) {
+        log->warn("worker {} factorises with {}, this coordinator with {}: its drapes may differ from the others' "
+                  "(OPENBLAS_CORETYPE chooses the kernels; docs/SERVICE.md, \"Determinism\")",
+                  w.name, kernels, blas_kernels);
       }
       workers.emplace(identity, std::move(w));
       send_heartbeat(workers.at(identity));

@@ -17,6 +17,7 @@
 #include "drapegen/coordinator/curve_keys.hpp"
 #include "drapegen/coordinator/logging.hpp"
 #include "drapegen/proto/codec.hpp"
+#include "drapegen/sim/blas_kernels.hpp"
 #include "drapegen/worker/job_runner.hpp"
 
 namespace drapegen::worker {
@@ -158,6 +159,7 @@ sim::Status run_worker(const WorkerOptions& o, const std::atomic<bool>& stop) {
       v1::Envelope ready;
       ready.mutable_ready()->set_worker_name(name);
       ready.mutable_ready()->set_code_version(DRAPEGEN_BUILD_ID);
+      ready.mutable_ready()->set_blas_kernels(sim::blas_kernels_description());
       ready.mutable_ready()->set_interval_ms(static_cast<std::uint32_t>(o.heartbeat_ms));
       send(std::move(ready));
     }
