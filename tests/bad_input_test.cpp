@@ -343,7 +343,7 @@ TEST(Service, ANonFiniteResultIsAFailedAttempt) {
   for (const auto& j : all(reader->jobs())) EXPECT_EQ(j.state, storage::JobState::kDone);
 }
 
-// A worker of another drapegen version is served, with a warning naming both versions (worker.proto: Ready).
+// A worker of another build or with other BLAS kernels is served, with a warning naming both (worker.proto: Ready).
 TEST(Service, AWorkerOfAnotherVersionOrOtherBlasKernelsIsWarnedAbout) {
   const fs::path dir = test_dir("other_version");
   const fs::path out = dir / "run";

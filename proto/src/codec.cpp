@@ -77,7 +77,10 @@ sim::Expected<v1::Envelope> decode(const void* data, std::size_t size) {
 sim::Status check(const v1::Envelope& e) {
   switch (e.body_case()) {
     case v1::Envelope::kReady:
-      if (e.ready().worker_name().size() > 256) return sim::Error{"ready: worker name too long"};
+      // Free text that goes into logs (and the manifest): bounded.
+      if (e.ready().worker_name().size() > kMaxReadyText) return sim::Error{"ready: worker name too long"};
+      if (e.ready().code_version().size() > kMaxReadyText) return sim::Error{"ready: code version too long"};
+      if (e.ready().blas_kernels().size() > kMaxReadyText) return sim::Error{"ready: BLAS kernels too long"};
       if (e.ready().interval_ms() > kMaxHeartbeatMs) return sim::Error{"ready: heartbeat interval too long"};
       return {};
     case v1::Envelope::kJob:

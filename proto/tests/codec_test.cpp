@@ -111,6 +111,18 @@ TEST(Codec, ChecksFieldRules) {
   EXPECT_TRUE(decode(encode(r)));
   r.mutable_ready()->set_interval_ms(0x80000000u);  // negative as an int
   EXPECT_FALSE(decode(encode(r)));
+  // Its free text (logged) is bounded: kMaxReadyText bytes pass, one more does not, in each field.
+  const std::string longest(kMaxReadyText, 'x'), too_long(kMaxReadyText + 1, 'x');
+  using Setter = void (*)(v1::Ready&, const std::string&);
+  for (Setter set : {Setter{[](v1::Ready& m, const std::string& v) { m.set_worker_name(v); }},
+                     Setter{[](v1::Ready& m, const std::string& v) { m.set_code_version(v); }},
+                     Setter{[](v1::Ready& m, const std::string& v) { m.set_blas_kernels(v); }}}) {
+    v1::Envelope t;
+    set(*t.mutable_ready(), longest);
+    EXPECT_TRUE(decode(encode(t)));
+    set(*t.mutable_ready(), too_long);
+    EXPECT_FALSE(decode(encode(t)));
+  }
 }
 
 }  // namespace

@@ -22,6 +22,8 @@ inline constexpr std::size_t kMaxFrameBytes = 256u << 20;
 /// larger values would not fit the coordinator's int timers.
 inline constexpr std::uint32_t kMaxHeartbeatMs = 600000;
 inline constexpr std::uint32_t kMaxLiveness = 1000;
+/// The longest free text a Ready may carry in each of its worker name, build id and BLAS kernels (bytes).
+inline constexpr std::size_t kMaxReadyText = 256;
 
 /// Serializes `envelope` with protocol_version set to kProtocolVersion.
 [[nodiscard]] std::string encode(v1::Envelope envelope);
