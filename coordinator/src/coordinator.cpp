@@ -269,20 +269,20 @@ struct Coordinator::Impl {
     return {};
   }
 
-  /// Removes files in data/ that the manifest does not list (results of a transaction that never committed) and
-  /// stray temporary files.
   /// Creates the output's data directory and takes the output's lock (storage::OutputLock) for this coordinator's
   /// life: before a new run looks for an existing manifest, and before a resumed one removes anything.
   sim::Status claim_output() {
     std::error_code ec;
     fs::create_directories(data_dir, ec);
-    if (ec) return sim::Error{fmt::format("cannot create {}: {}", data_dir, ec.message()), true};
+    if (ec) return io_error(sim::Error{fmt::format("cannot create {}: {}", data_dir, ec.message())});
     auto acquired = storage::OutputLock::acquire(out_dir);
     if (!acquired) return acquired.error();
     lock.emplace(std::move(acquired).value());
     return {};
   }
 
+  /// Removes files in data/ that the manifest does not list (results of a transaction that never committed) and
+  /// stray temporary files.
   sim::Status remove_orphans() {
     auto files = manifest->reader().files();
     if (!files) return files.error();
