@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "commands.hpp"
+#include "failure.hpp"
 #include "drapegen/sim/cantilever.hpp"
 #include "drapegen/sim/cantilever_fit.hpp"
 #include "drapegen/sim/elastica.hpp"
@@ -24,10 +25,7 @@ struct CantileverOptions {
   bool json = false;
 };
 
-int fail(const std::string& message) {
-  std::cerr << "drapegen cantilever: error: " << message << "\n";
-  return kExitUsage;
-}
+const Failure fail{"cantilever"};
 
 int run_cantilever(const CantileverOptions& o) {
   if (!(o.length > 0.0) || !std::isfinite(o.length)) return fail("--length must be positive (m)");

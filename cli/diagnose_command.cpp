@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 
 #include "commands.hpp"
+#include "failure.hpp"
 #include "drapegen/diagnosis/capture.hpp"
 #include "drapegen/diagnosis/diagnosis.hpp"
 #include "drapegen/diagnosis/report.hpp"
@@ -57,10 +58,7 @@ struct DiagnoseOptions {
   bool quiet = false;
 };
 
-int fail(const std::string& message, int code = kExitUsage) {
-  std::cerr << "drapegen diagnose: error: " << message << "\n";
-  return code;
-}
+const Failure fail{"diagnose"};
 
 int run_diagnose(const DiagnoseOptions& o) {
   if (o.jobs < 1 || o.jobs > 64) return fail("--jobs must be 1 .. 64");

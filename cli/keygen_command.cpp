@@ -3,6 +3,7 @@
 #include <memory>
 
 #include "commands.hpp"
+#include "failure.hpp"
 #include "drapegen/coordinator/curve_keys.hpp"
 
 namespace drapegen::cli {
@@ -12,14 +13,9 @@ Runner add_keygen_command(CLI::App& app) {
   app.add_option("--out", *prefix, "Write PREFIX.key (secret, mode 0600) and PREFIX.pub (public)")->required();
   return [prefix]() -> int {
     auto pair = coordinator::make_curve_keypair();
-    if (!pair) {
-      std::cerr << "drapegen keygen: error: " << pair.error().message << "\n";
-      return kExitUsage;
-    }
-    if (sim::Status s = coordinator::write_curve_keypair(*pair, *prefix); !s) {
-      std::cerr << "drapegen keygen: error: " << s.error().message << "\n";
-      return kExitIo;
-    }
+    const Failure fail{"keygen"};
+    if (!pair) return fail(pair.error().message);
+    if (sim::Status s = coordinator::write_curve_keypair(*pair, *prefix); !s) return fail(s.error().message, kExitIo);
     std::cout << pair->public_z85 << "\n";
     return kExitOk;
   };

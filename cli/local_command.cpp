@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "failure.hpp"
 #include "drapegen/coordinator/coordinator.hpp"
 #include "drapegen/coordinator/logging.hpp"
 #include "drapegen/coordinator/run_config.hpp"
@@ -37,10 +38,7 @@ struct LocalOptions {
   bool print_config = false;
 };
 
-int fail(const std::string& message, int code = kExitUsage) {
-  std::cerr << "drapegen local: error: " << message << "\n";
-  return code;
-}
+const Failure fail{"local"};
 
 /// The worker processes: started after the coordinator binds, restarted if one dies before the run ends (at most
 /// kRestartsPerWorker x N restarts over the run). halt() is the flag the coordinator runs until: set by SIGINT/SIGTERM
@@ -187,7 +185,7 @@ Runner add_local_command(CLI::App& app) {
       }
       c = coordinator::Coordinator::create(text, name, options);
     }
-    if (!c) return fail(c.error().message, c.error().io ? kExitIo : kExitUsage);
+    if (!c) return fail(c.error());
     WorkerPool pool((*c)->endpoint(), o->workers, stop);
     if (sim::Status s = pool.start(); !s) return fail(s.error().message);
     const auto summary = (*c)->run(pool.halt());

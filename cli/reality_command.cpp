@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "commands.hpp"
+#include "failure.hpp"
 #include "drapegen/diagnosis/reality.hpp"
 #include "parse.hpp"
 
@@ -27,10 +28,7 @@ struct RealityOptions {
   double measured_bending_error = 0.0;
 };
 
-int fail(const std::string& message, int code = kExitUsage) {
-  std::cerr << "drapegen reality: error: " << message << "\n";
-  return code;
-}
+const Failure fail{"reality"};
 
 int run_reality(const RealityOptions& o) {
   diagnosis::RealitySpec spec;

@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "commands.hpp"
+#include "failure.hpp"
 #include "drapegen/renderer/data_point.hpp"
 #include "drapegen/renderer/make_renderer.hpp"
 #include "drapegen/renderer/preview.hpp"
@@ -33,10 +34,7 @@ struct RenderOptions {
   double quantum = 0.0;
 };
 
-int fail(const std::string& message, int code = kExitUsage) {
-  std::cerr << "drapegen render: error: " << message << "\n";
-  return code;
-}
+const Failure fail{"render"};
 
 /// "out.exr" for one data point; "out_00.exr", "out_01.exr", ... for several.
 std::string output_path(const std::string& out, int index, int count) {

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "commands.hpp"
+#include "failure.hpp"
 #include "drapegen/coordinator/coordinator.hpp"
 #include "signals.hpp"
 
@@ -22,10 +23,7 @@ struct RunOptions {
   std::string endpoint_file;
 };
 
-int fail(const std::string& message, int code = kExitUsage) {
-  std::cerr << "drapegen run: error: " << message << "\n";
-  return code;
-}
+const Failure fail{"run"};
 
 coordinator::CoordinatorOptions::Progress parse_progress(const std::string& p) {
   using P = coordinator::CoordinatorOptions::Progress;
@@ -94,7 +92,7 @@ Runner add_run_command(CLI::App& app) {
     } else {
       c = coordinator::Coordinator::resume(o->resume, options);
     }
-    if (!c) return fail(c.error().message, c.error().io ? kExitIo : kExitUsage);
+    if (!c) return fail(c.error());
     const auto summary = (*c)->run(stop);
     return report_run(summary, (*c)->manifest_path(), "run");
   };

@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 
 #include "commands.hpp"
+#include "failure.hpp"
 #include "drapegen/sampler/coverage.hpp"
 #include "drapegen/sampler/fabric_data.hpp"
 #include "drapegen/sampler/parameter_sampler.hpp"
@@ -40,10 +41,7 @@ struct SampleOptions {
   bool no_plot = false;
 };
 
-int fail(const std::string& message, int code = kExitUsage) {
-  std::cerr << "drapegen sample: error: " << message << "\n";
-  return code;
-}
+const Failure fail{"sample"};
 
 int feature_index(const std::string& name) {
   for (int i = 0; i < sampler::kFeatureCount; ++i) {

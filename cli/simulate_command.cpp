@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 
 #include "commands.hpp"
+#include "failure.hpp"
 #include "drapegen/sim/blas_kernels.hpp"
 #include "drapegen/sim/drape.hpp"
 #include "drapegen/sim/logging.hpp"
@@ -66,10 +67,7 @@ sim::Expected<Eigen::Vector2d> parse_drift(const std::string& text, std::uint64_
   }
 }
 
-int fail(const std::string& message, int code = kExitUsage) {
-  std::cerr << "drapegen simulate: error: " << message << "\n";
-  return code;
-}
+const Failure fail{"simulate"};
 
 int run_simulate(const SimulateOptions& o) {
   const auto alpha = parse_directional(o.alpha, "--alpha");

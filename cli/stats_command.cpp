@@ -3,6 +3,7 @@
 #include <memory>
 
 #include "commands.hpp"
+#include "failure.hpp"
 #include "drapegen/coordinator/stats.hpp"
 
 namespace drapegen::cli {
@@ -15,10 +16,7 @@ struct StatsOptions {
   std::string fabrics;
 };
 
-int fail(const std::string& message, int code = kExitUsage) {
-  std::cerr << "drapegen stats: error: " << message << "\n";
-  return code;
-}
+const Failure fail{"stats"};
 
 }  // namespace
 

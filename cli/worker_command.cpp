@@ -5,6 +5,7 @@
 #include <memory>
 
 #include "commands.hpp"
+#include "failure.hpp"
 #include "drapegen/coordinator/logging.hpp"
 #include "drapegen/worker/worker.hpp"
 #include "signals.hpp"
@@ -37,11 +38,7 @@ Runner add_worker_command(CLI::App& app) {
     coordinator::logger()->set_level(spdlog::level::from_str(*level));
     const auto& stop = install_stop_signals();
     const sim::Status s = worker::run_worker(*o, stop);
-    int code = kExitOk;
-    if (!s) {
-      std::cerr << "drapegen worker: error: " << s.error().message << "\n";
-      code = kExitUsage;
-    }
+    const int code = s ? kExitOk : Failure{"worker"}(s.error().message);
     // A computation still running cannot be interrupted: leave without waiting for it.
     std::fflush(stdout);
     std::fflush(stderr);
