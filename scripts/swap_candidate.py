@@ -10,7 +10,9 @@ Session 19's yield-trade table (docs/DIAGNOSIS.md) was made with
 where out/ytrade holds LABEL_CASE.json (e.g. s19_yield_02.json) and each LABEL=RUN names the run (diagnoses/ and
 truth/) the case belongs to. The ranking is attribute()'s (confirmed, shrinkage, physical before sensor, near ties
 by the refit objective); where the common bending or curl first decided, or would now, the verdict needs the full
-diagnosis and is printed as "undetermined". Captures within the floors at the gate are "none" either way.
+diagnosis and is printed as "undetermined". Captures within the floors at the gate, or once the bending alone is
+refitted (the bar; the common bending depends on the candidates), are "none" either way: a run's capture of that
+kind needs no new report (any other does).
 """
 import glob
 import json
@@ -121,8 +123,32 @@ def main(args):
         s[0] += 1
         s[1] += old["verdict"] == family
         s[2] += verdict == family
+    # A run's captures without a new report: within the floors at the gate, or once the bending alone was refitted (the
+    # bar, not the common bending, which depends on the candidates), the verdict is "none" whatever the candidate does
+    # (the same computation), so they need not be run again.
+    covered = {os.path.basename(f)[:-5] for f in files}
+    missing = []
+    for label, run in sorted(runs.items()):
+        for path in sorted(glob.glob(os.path.join(run, "diagnoses", "*.json"))):
+            case = os.path.basename(path)[:-5]
+            if f"{label}_{case}" in covered:
+                continue
+            old = json.load(open(path))
+            bar = old["attribution"].get("bending_refit_bar") or {}
+            if not (old["within_floors"] or bar.get("validated", {}).get("within_floors", False)):
+                missing.append(f"{label}_{case}")
+                continue
+            truth = json.load(open(os.path.join(run, "truth", case + ".json")))
+            family = FAMILY.get(truth["family"], truth["family"]) or "none"
+            print(f"| {label} {case} | {family} | {old['verdict']} | none (within the floors as run; not rerun) | - | - |")
+            s = score.setdefault(family == effect, [0, 0, 0])
+            s[0] += 1
+            s[1] += old["verdict"] == family
+            s[2] += family == "none"
     for own, (n, was, now) in sorted(score.items()):
         print(f"{'its own family' if own else 'other captures'}: {n}, correct as run {was}, with the new refit {now}")
+    if missing:
+        sys.exit(f"no new report for {', '.join(missing)} (above the floors as run: diagnose them with the candidate)")
 
 
 if __name__ == "__main__":
