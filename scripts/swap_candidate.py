@@ -135,7 +135,7 @@ def main(args):
                 continue
             old = json.load(open(path))
             bar = old["attribution"].get("bending_refit_bar") or {}
-            if not (old["within_floors"] or bar.get("validated", {}).get("within_floors", False)):
+            if not (old["within_floors"] or (bar.get("validated") or {}).get("excess_above_floors") == 0):
                 missing.append(f"{label}_{case}")
                 continue
             truth = json.load(open(os.path.join(run, "truth", case + ".json")))
