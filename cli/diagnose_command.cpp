@@ -291,7 +291,8 @@ Runner add_diagnose_command(CLI::App& app) {
                              ".. the refits' upper bound, x{:.1f} unless a known bending's box sets it) against a more "
                              "compliant membrane ({:.0f} kg/s^2 / the scale^{:.0f}), then refines from the best within "
                              "--refit-evaluations, which must leave {} for that; replaces --refit-scan for shear (0: "
-                             "off; default {}; docs/DIAGNOSIS_RESULTS.md, \"Session 41\")",
+                             "off; default {}, off where --refit-evaluations leaves it no room; docs/DIAGNOSIS_RESULTS.md, "
+                             "\"Session 42\")",
                              std::exp(diagnosis::AttributionSettings{}.bending_scale_upper),
                              diagnosis::AttributionSettings::kShearTradeStiffness,
                              diagnosis::AttributionSettings::kShearTradePower,
