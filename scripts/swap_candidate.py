@@ -48,6 +48,15 @@ def main(args):
     if len(effects) != 1:
         sys.exit(f"{args[0]}: candidates {sorted(effects)} (one effect expected: --candidates EFFECT)")
     effect = effects.pop()
+
+    def score_none(label, case, family, verdict_as_run, why):
+        """A capture whose verdict is "none" whatever the candidate does: its row and its count."""
+        print(f"| {label} {case} | {family} | {verdict_as_run} | none ({why}) | - | - |")
+        s = score.setdefault(family == effect, [0, 0, 0])
+        s[0] += 1
+        s[1] += verdict_as_run == family
+        s[2] += family == "none"
+
     for f in files:
         label, case = os.path.basename(f)[:-5].split("_", 1)
         if label not in runs:
@@ -61,11 +70,7 @@ def main(args):
             sys.exit(f"{f}: the gate's excess differs from the run's (another baseline fit)")
         if new["within_floors"]:
             # Within the floors at the gate: no candidate is refitted, the verdict is "none" either way.
-            s = score.setdefault(family == effect, [0, 0, 0])
-            print(f"| {label} {case} | {family} | {old['verdict']} | none (within the floors) | - | - |")
-            s[0] += 1
-            s[1] += old["verdict"] == family
-            s[2] += family == "none"
+            score_none(label, case, family, old["verdict"], "within the floors")
             continue
         if len(a["candidates"]) != 1:
             sys.exit(f"{f}: {len(a['candidates'])} candidates (one expected: --candidates EFFECT)")
@@ -140,11 +145,7 @@ def main(args):
                 continue
             truth = json.load(open(os.path.join(run, "truth", case + ".json")))
             family = FAMILY.get(truth["family"], truth["family"]) or "none"
-            print(f"| {label} {case} | {family} | {old['verdict']} | none (within the floors as run; not rerun) | - | - |")
-            s = score.setdefault(family == effect, [0, 0, 0])
-            s[0] += 1
-            s[1] += old["verdict"] == family
-            s[2] += family == "none"
+            score_none(label, case, family, old["verdict"], "within the floors as run; not rerun")
     for own, (n, was, now) in sorted(score.items()):
         print(f"{'its own family' if own else 'other captures'}: {n}, correct as run {was}, with the new refit {now}")
     if missing:
