@@ -454,6 +454,22 @@ expect_trade(yield --yield-trade "0.9999 1.0001;4.4816 4.4818;20.0854 20.0856"
 # 1.0986, -0.4014, -1.9014 (bounds +-0.0001).
 expect_trade(shear --shear-trade "0.9999 1.0001;2.1169 2.1171;4.4816 4.4818"
              "1.0985 1.0987;-0.4015 -0.4013;-1.9015 -1.9013")
+# By default (session 42) the shear refit starts with five points along that trade where the budget leaves the simplex
+# its three: 8 evaluations scan 5; 7 leave no room, so no scan at all (the strength scan is off by default too).
+foreach(budget_scan "8;5" "7;0")
+  list(GET budget_scan 0 budget)
+  list(GET budget_scan 1 expected)
+  run_ok(out diagnose --capture ${WORK}/capture --quick --resolution 10 --states 2 --evaluations 8
+         --refit-evaluations ${budget} --candidates shear --json)
+  string(JSON nscan ERROR_VARIABLE no_scan LENGTH "${out}" attribution candidates 0 scan)
+  if(no_scan)
+    set(nscan 0)
+  endif()
+  if(NOT nscan EQUAL expected)
+    message(FATAL_ERROR "default shear trade, --refit-evaluations ${budget}: a scan of ${nscan} points (expected "
+                        "${expected})")
+  endif()
+endforeach()
 # --ablation: each simulated candidate is validated with its effect switched off at its refitted bending scale as
 # well (report.json "ablated"); the sensor candidate re-renders the baseline's drapes and has none.
 run_ok(out diagnose --capture ${WORK}/capture --quick --resolution 10 --states 2 --evaluations 8 --refit-evaluations 4
