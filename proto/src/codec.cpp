@@ -1,5 +1,7 @@
 #include "drapegen/proto/codec.hpp"
 
+#include "drapegen/proto/simulation.hpp"
+
 #include <cmath>
 #include <fmt/format.h>
 #include <google/protobuf/stubs/logging.h>
@@ -20,10 +22,16 @@ sim::Status check_parameters(const v1::Parameters& p) {
 }
 
 sim::Status check_spec(const v1::JobSpec& s) {
-  if (s.mode() != v1::JOB_MODE_DRAPE && s.mode() != v1::JOB_MODE_NOOP && s.mode() != v1::JOB_MODE_POISON) {
+  if (s.mode() != v1::JOB_MODE_DRAPE && s.mode() != v1::JOB_MODE_NOOP && s.mode() != v1::JOB_MODE_POISON &&
+      s.mode() != v1::JOB_MODE_SIMULATE) {
     return sim::Error{fmt::format("job: unknown mode {}", static_cast<int>(s.mode()))};
   }
   if (s.mode() == v1::JOB_MODE_NOOP) return {};
+  if (s.mode() == v1::JOB_MODE_SIMULATE) {
+    if (!s.has_simulation()) return sim::Error{"job: simulate without a simulation"};
+    if (auto config = from_proto(s.simulation()); !config) return sim::Error{"job: " + config.error().message};
+    return {};
+  }
   if (s.resolution() < 3 || s.resolution() > 1000) return sim::Error{"job: resolution outside 3..1000"};
   if (s.orientations() < 1 || s.orientations() > 360) return sim::Error{"job: orientations outside 1..360"};
   if (s.noise() != "kinect" && s.noise() != "none") return sim::Error{"job: noise must be kinect or none"};

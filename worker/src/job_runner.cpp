@@ -10,6 +10,7 @@
 
 #include "drapegen/proto/codec.hpp"
 #include "drapegen/proto/recipe.hpp"
+#include "drapegen/proto/simulation.hpp"
 #include "drapegen/renderer/data_point.hpp"
 #include "drapegen/renderer/make_renderer.hpp"
 #include "drapegen/renderer/scene.hpp"
@@ -79,6 +80,28 @@ sim::Expected<sim::DrapeConfig> drape_config(const v1::JobSpec& spec, const std:
   return config;
 }
 
+v1::Envelope JobRunner::simulate(const v1::Job& job) {
+  auto config = proto::from_proto(job.spec().simulation());
+  if (!config) return failure(job, v1::FAILURE_REASON_INVALID_JOB, config.error().message);
+  const auto start = std::chrono::steady_clock::now();
+  auto drape = sim::simulate_drape(*config);
+  if (!drape) return failure(job, v1::FAILURE_REASON_INVALID_JOB, drape.error().message);
+  // Whatever the solve's outcome: the sender judges the drape as it would its own.
+  v1::Envelope e;
+  auto* result = e.mutable_result();
+  result->set_job_id(job.job_id());
+  result->set_attempt(job.attempt());
+  auto* metrics = result->mutable_metrics();
+  metrics->set_outcome(std::string(sim::to_string(drape->report.outcome)));
+  metrics->set_iterations(drape->report.iterations);
+  metrics->set_coarse_iterations(drape->coarse_report.iterations);
+  metrics->set_residual(drape->report.residual);
+  metrics->set_energy(drape->report.energy);
+  metrics->set_sim_seconds(seconds_since(start));
+  *result->mutable_drape() = proto::to_proto(*drape);
+  return e;
+}
+
 JobRunner::JobRunner(std::string scratch_dir) : scratch_(std::move(scratch_dir)) {}
 JobRunner::JobRunner(JobRunner&&) noexcept = default;
 JobRunner& JobRunner::operator=(JobRunner&&) noexcept = default;
@@ -103,6 +126,7 @@ v1::Envelope JobRunner::compute(const v1::Job& job) {
     e.mutable_result()->mutable_metrics()->set_outcome("noop");
     return e;
   }
+  if (spec.mode() == v1::JOB_MODE_SIMULATE) return simulate(job);
   std::filesystem::create_directories(scratch_);
   const std::string source_path = fmt::format("{}/source_{}.ply", scratch_, job.job_id());
   const std::string mesh_path = fmt::format("{}/drape_{}.ply", scratch_, job.job_id());

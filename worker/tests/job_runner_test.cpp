@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include "drapegen/proto/recipe.hpp"
+#include "drapegen/proto/simulation.hpp"
 #include "drapegen/renderer/exr.hpp"
 #include "drapegen/sampler/recipe_generator.hpp"
 #include "drapegen/worker/job_runner.hpp"
@@ -171,6 +172,45 @@ TEST(JobRunner, NoopAnswersAtOnce) {
   ASSERT_EQ(answer.body_case(), v1::Envelope::kResult);
   EXPECT_EQ(answer.result().metrics().outcome(), "noop");
   EXPECT_TRUE(answer.result().mesh_ply().empty());
+}
+
+TEST(JobRunner, SimulatesTheDrapeItIsSentAsTheSenderWould) {
+  sim::DrapeConfig config;
+  config.specimen.vertices_x = config.specimen.vertices_y = 10;
+  config.specimen.seed = 3;
+  config.initial.shape = sim::InitialShape::kSine;
+  config.initial.seed = 2;
+  config.solver.max_iterations = 300;
+  config.effects.bending_yield_curvature = 40.0;
+  v1::Job job = tiny_job(v1::JOB_MODE_SIMULATE);
+  auto wire = proto::to_proto(config);
+  ASSERT_TRUE(wire) << wire.error().message;
+  *job.mutable_spec()->mutable_simulation() = *wire;
+  JobRunner runner(scratch());
+  const auto answer = runner.run(job);
+  ASSERT_EQ(answer.body_case(), v1::Envelope::kResult) << answer.failure().message();
+  EXPECT_TRUE(answer.result().mesh_ply().empty());
+  EXPECT_EQ(answer.result().exr_size(), 0);
+  auto drape = proto::from_proto(answer.result().drape());
+  ASSERT_TRUE(drape) << drape.error().message;
+  auto local = sim::simulate_drape(config);
+  ASSERT_TRUE(local);
+  EXPECT_EQ(drape->mesh.positions, local->mesh.positions);  // bit for bit
+  EXPECT_EQ(drape->rest_angles, local->rest_angles);
+  EXPECT_EQ(drape->report.outcome, local->report.outcome);
+  EXPECT_EQ(answer.result().metrics().outcome(), std::string(sim::to_string(local->report.outcome)));
+
+  // A drape that stops at the iteration limit comes back too (the sender judges it); one that cannot be built fails.
+  config.solver.max_iterations = 1;
+  *job.mutable_spec()->mutable_simulation() = *proto::to_proto(config);
+  const auto stopped = runner.run(job);
+  ASSERT_EQ(stopped.body_case(), v1::Envelope::kResult);
+  EXPECT_EQ(stopped.result().drape().outcome(), static_cast<int>(sim::SolveOutcome::kIterationLimit));
+  config.fabric.alpha.warp = -1.0;
+  *job.mutable_spec()->mutable_simulation() = *proto::to_proto(config);
+  const auto invalid = runner.run(job);
+  ASSERT_EQ(invalid.body_case(), v1::Envelope::kFailure);
+  EXPECT_EQ(invalid.failure().reason(), v1::FAILURE_REASON_INVALID_JOB);
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 #pragma once
 // One job, computed: the drape simulated from its (parameters, recipe, seeds), its data points rendered and encoded
-// as OpenEXR in memory, and the answer to the coordinator (a Result or a Failure with its reason).
+// as OpenEXR in memory, and the answer to the coordinator (a Result or a Failure with its reason). A job to simulate
+// (JOB_MODE_SIMULATE, the gap diagnosis's drapes) returns the drape alone.
 
 #include <map>
 #include <memory>
@@ -32,6 +33,9 @@ class JobRunner {
 
  private:
   proto::v1::Envelope compute(const proto::v1::Job& job);
+  /// JOB_MODE_SIMULATE: the drape of the job's Simulation, returned whatever its solve's outcome (a Failure only where
+  /// it cannot be built).
+  proto::v1::Envelope simulate(const proto::v1::Job& job);
   std::string scratch_;
   /// By JobSpec.renderer name, created on first use in the computing thread (an OSMesa context belongs to it).
   std::map<std::string, std::unique_ptr<renderer::Renderer>> renderers_;
