@@ -1,0 +1,359 @@
+#include "drapegen/coordinator/simulation_fleet.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <condition_variable>
+#include <deque>
+#include <fmt/format.h>
+#include <future>
+#include <map>
+#include <mutex>
+#include <thread>
+#include <zmq.hpp>
+#include <zmq_addon.hpp>
+
+#include "drapegen/build_id.hpp"
+#include "drapegen/coordinator/logging.hpp"
+#include "drapegen/proto/codec.hpp"
+#include "drapegen/proto/simulation.hpp"
+#include "drapegen/sim/blas_kernels.hpp"
+
+namespace drapegen::coordinator {
+namespace v1 = proto::v1;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+/// One drape asked for, from its submission to its answer.
+struct Task {
+  std::uint64_t id = 0;
+  v1::Simulation simulation;
+  int attempts = 0;  // started
+  Clock::time_point queued;
+  std::promise<sim::Expected<sim::DrapeResult>> answer;
+};
+
+std::string hex(const std::string& identity) {
+  std::string out;
+  for (unsigned char c : identity) out += fmt::format("{:02x}", c);
+  return out;
+}
+
+}  // namespace
+
+struct SimulationFleet::Impl {
+  struct Worker {
+    std::string identity, name;
+    Clock::time_point last_seen, last_sent;
+    int interval_ms = 1000;
+    std::shared_ptr<Task> task;  // the drape it computes (null: idle)
+  };
+
+  FleetOptions options;
+  zmq::context_t context{1};
+  zmq::socket_t socket{context, zmq::socket_type::router};
+  std::string endpoint;
+  std::shared_ptr<spdlog::logger> log = logger();
+  const std::string blas_kernels = sim::blas_kernels_description();
+
+  // Shared with the callers of simulate().
+  mutable std::mutex mutex;
+  std::condition_variable workers_changed;
+  std::deque<std::shared_ptr<Task>> queue;  // waiting for a worker, oldest first (a lost worker's drape at the front)
+  std::uint64_t next_id = 1;
+  bool stopping = false;
+  Counters counters;
+
+  // The serving thread's alone.
+  std::map<std::string, Worker> workers;
+  Clock::time_point last_worker = Clock::now();  // when a worker was last registered
+  Clock::time_point last_reject_log{};
+  std::atomic<bool> stop{false};
+  std::thread thread;
+
+  void send(const std::string& identity, v1::Envelope envelope) {
+    const std::string frame = proto::encode(std::move(envelope));
+    try {
+      socket.send(zmq::buffer(identity), zmq::send_flags::sndmore);
+      socket.send(zmq::buffer(frame), zmq::send_flags::none);
+    } catch (const zmq::error_t& e) {
+      log->warn("fleet: cannot send to worker {}: {}", hex(identity), e.what());
+    }
+    if (auto it = workers.find(identity); it != workers.end()) it->second.last_sent = Clock::now();
+  }
+
+  void heartbeat(const std::string& identity) {
+    v1::Envelope e;
+    e.mutable_heartbeat()->set_interval_ms(static_cast<std::uint32_t>(options.heartbeat_ms));
+    e.mutable_heartbeat()->set_liveness(static_cast<std::uint32_t>(options.liveness));
+    send(identity, std::move(e));
+  }
+
+  void reject(const std::string& identity, const std::string& why) {
+    std::lock_guard lock(mutex);
+    ++counters.rejected;
+    const auto now = Clock::now();
+    if (now - last_reject_log > std::chrono::seconds(1)) {
+      log->warn("fleet: dropped a message from {}: {} ({} dropped so far)", hex(identity), why, counters.rejected);
+      last_reject_log = now;
+    }
+  }
+
+  void update_worker_count() {
+    {
+      std::lock_guard lock(mutex);
+      counters.workers = static_cast<int>(workers.size());
+    }
+    workers_changed.notify_all();
+  }
+
+  /// The worker is gone: its drape goes to the next free worker, or fails after max_attempts.
+  void lose(Worker& w, const char* why) {
+    if (!w.task) return;
+    std::shared_ptr<Task> task = std::move(w.task);
+    std::lock_guard lock(mutex);
+    ++counters.lost_attempts;
+    if (task->attempts >= options.max_attempts) {
+      task->answer.set_value(sim::Error{fmt::format("drape {} lost with {} workers (the last {}: {})", task->id,
+                                                    task->attempts, w.name, why)});
+    } else {
+      queue.push_front(std::move(task));
+    }
+  }
+
+  void on_ready(const std::string& identity, const v1::Ready& ready) {
+    if (auto it = workers.find(identity); it != workers.end()) {
+      lose(it->second, "registered again");
+      workers.erase(it);
+    }
+    Worker w;
+    w.identity = identity;
+    w.name = ready.worker_name().empty() ? hex(identity) : ready.worker_name();
+    w.last_seen = w.last_sent = Clock::now();
+    if (ready.interval_ms() > 0) w.interval_ms = static_cast<int>(ready.interval_ms());
+    log->info("fleet: worker {} joined ({} connected)", w.name, workers.size() + 1);
+    if (!ready.code_version().empty() && ready.code_version() != DRAPEGEN_BUILD_ID) {
+      log->warn("fleet: worker {} runs drapegen {}, this process {}: its drapes may differ from local ones", w.name,
+                ready.code_version(), DRAPEGEN_BUILD_ID);
+    }
+    if (!ready.blas_kernels().empty() && ready.blas_kernels() != blas_kernels) {
+      log->warn("fleet: worker {} factorises with {}, this process with {}: its drapes may differ from local ones "
+                "(docs/SERVICE.md, \"Determinism\")",
+                w.name, ready.blas_kernels(), blas_kernels);
+    }
+    workers.emplace(identity, std::move(w));
+    last_worker = Clock::now();
+    {
+      std::lock_guard lock(mutex);
+      ++counters.workers_seen;
+    }
+    update_worker_count();
+    heartbeat(identity);
+  }
+
+  /// The task `w` holds if the answer is for its attempt; else the answer is stale or forged.
+  std::shared_ptr<Task> held(Worker& w, std::uint64_t id, std::uint32_t attempt, const char* what) {
+    if (!w.task || w.task->id != id || static_cast<std::uint32_t>(w.task->attempts) != attempt) {
+      reject(w.identity, fmt::format("{} for drape {} attempt {}, which this worker does not hold", what, id, attempt));
+      return nullptr;
+    }
+    return std::move(w.task);
+  }
+
+  void handle(const std::string& identity, const zmq::message_t& frame) {
+    auto decoded = proto::decode(frame.data(), frame.size());
+    if (!decoded) return reject(identity, decoded.error().message);
+    const v1::Envelope& e = *decoded;
+    if (e.body_case() == v1::Envelope::kReady) return on_ready(identity, e.ready());
+    auto it = workers.find(identity);
+    if (it == workers.end()) {
+      if (e.body_case() == v1::Envelope::kResult || e.body_case() == v1::Envelope::kFailure) {
+        reject(identity, fmt::format("{} from an unregistered worker", proto::body_name(e)));
+      }
+      if (e.body_case() != v1::Envelope::kDisconnect && e.body_case() != v1::Envelope::kShutdown) {
+        v1::Envelope d;
+        d.mutable_disconnect()->set_reason("unknown worker: send ready");
+        send(identity, std::move(d));
+      }
+      return;
+    }
+    Worker& w = it->second;
+    w.last_seen = Clock::now();
+    switch (e.body_case()) {
+      case v1::Envelope::kHeartbeat:
+        if (e.heartbeat().interval_ms() > 0) w.interval_ms = static_cast<int>(e.heartbeat().interval_ms());
+        return;
+      case v1::Envelope::kResult: {
+        auto task = held(w, e.result().job_id(), e.result().attempt(), "result");
+        if (!task) return;
+        auto drape = proto::from_proto(e.result().drape());
+        std::lock_guard lock(mutex);
+        if (drape) {
+          ++counters.simulated;
+          task->answer.set_value(std::move(drape).value());
+        } else {
+          task->answer.set_value(sim::Error{fmt::format("worker {}: {}", w.name, drape.error().message)});
+        }
+        return;
+      }
+      case v1::Envelope::kFailure: {
+        auto task = held(w, e.failure().job_id(), e.failure().attempt(), "failure");
+        if (!task) return;
+        std::lock_guard lock(mutex);
+        task->answer.set_value(sim::Error{fmt::format("worker {}: {}", w.name, e.failure().message())});
+        return;
+      }
+      default:
+        return reject(identity, fmt::format("unexpected {} from a worker", proto::body_name(e)));
+    }
+  }
+
+  void dispatch() {
+    for (auto& [identity, w] : workers) {
+      if (w.task) continue;
+      {
+        std::lock_guard lock(mutex);
+        if (queue.empty()) return;
+        w.task = std::move(queue.front());
+        queue.pop_front();
+        ++w.task->attempts;
+      }
+      v1::Envelope e;
+      auto* job = e.mutable_job();
+      job->set_job_id(w.task->id);
+      job->set_attempt(static_cast<std::uint32_t>(w.task->attempts));
+      job->mutable_spec()->set_mode(v1::JOB_MODE_SIMULATE);
+      *job->mutable_spec()->mutable_simulation() = w.task->simulation;
+      send(identity, std::move(e));
+    }
+  }
+
+  void timers() {
+    const auto now = Clock::now();
+    bool changed = false;
+    for (auto it = workers.begin(); it != workers.end();) {
+      Worker& w = it->second;
+      if (now - w.last_seen > std::chrono::milliseconds(static_cast<long>(w.interval_ms) * options.liveness)) {
+        log->warn("fleet: worker {} lost (silent for {} ms)", w.name,
+                  std::chrono::duration_cast<std::chrono::milliseconds>(now - w.last_seen).count());
+        lose(w, "silent beyond its liveness");
+        it = workers.erase(it);
+        changed = true;
+        continue;
+      }
+      if (now - w.last_sent >= std::chrono::milliseconds(options.heartbeat_ms)) heartbeat(w.identity);
+      ++it;
+    }
+    if (changed) update_worker_count();
+    if (!workers.empty()) {
+      last_worker = now;
+      return;
+    }
+    std::lock_guard lock(mutex);
+    const auto limit = std::chrono::duration<double>(options.wait_s);
+    for (auto it = queue.begin(); it != queue.end();) {
+      if (now - std::max((*it)->queued, last_worker) > limit) {
+        (*it)->answer.set_value(sim::Error{fmt::format("no worker connected to {} for {} s (start some with: drapegen "
+                                                       "worker --connect {})",
+                                                       endpoint, options.wait_s, endpoint)});
+        it = queue.erase(it);
+      } else {
+        ++it;
+      }
+    }
+  }
+
+  void serve() {
+    while (!stop.load()) {
+      zmq::pollitem_t item{socket.handle(), 0, ZMQ_POLLIN, 0};
+      try {
+        zmq::poll(&item, 1, std::chrono::milliseconds(5));
+        if (item.revents & ZMQ_POLLIN) {
+          zmq::multipart_t message;
+          while (message.recv(socket, static_cast<int>(zmq::recv_flags::dontwait))) {
+            if (message.size() != 2) {
+              reject(message.empty() ? std::string() : message.front().to_string(), "not one frame");
+            } else {
+              handle(message[0].to_string(), message[1]);
+            }
+            message.clear();
+          }
+        }
+      } catch (const zmq::error_t& e) {
+        if (e.num() == EINTR) continue;
+        log->error("fleet: {}", e.what());
+        break;
+      }
+      dispatch();
+      timers();
+    }
+    v1::Envelope shutdown;
+    shutdown.mutable_shutdown()->set_reason("the diagnosis is done");
+    for (const auto& [identity, w] : workers) send(identity, shutdown);
+    std::lock_guard lock(mutex);
+    stopping = true;
+    for (auto& [identity, w] : workers) {
+      if (w.task) w.task->answer.set_value(sim::Error{"the fleet stopped"});
+    }
+    for (auto& task : queue) task->answer.set_value(sim::Error{"the fleet stopped"});
+    queue.clear();
+  }
+};
+
+SimulationFleet::SimulationFleet(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+
+SimulationFleet::~SimulationFleet() {
+  impl_->stop = true;
+  if (impl_->thread.joinable()) impl_->thread.join();
+}
+
+sim::Expected<std::unique_ptr<SimulationFleet>> SimulationFleet::start(const FleetOptions& options) {
+  if (options.heartbeat_ms < 1 || options.liveness < 1 || options.max_attempts < 1 || !(options.wait_s > 0)) {
+    return sim::Error{"fleet: heartbeat, liveness, attempts and wait must be positive"};
+  }
+  auto impl = std::make_unique<Impl>();
+  impl->options = options;
+  impl->socket.set(zmq::sockopt::linger, 500);  // the Shutdowns leave before the socket closes
+  impl->socket.set(zmq::sockopt::maxmsgsize, static_cast<int64_t>(proto::kMaxFrameBytes));
+  try {
+    impl->socket.bind(options.bind);
+    impl->endpoint = impl->socket.get(zmq::sockopt::last_endpoint);
+  } catch (const zmq::error_t& e) {
+    return sim::Error{fmt::format("fleet: cannot bind {}: {}", options.bind, e.what())};
+  }
+  Impl* raw = impl.get();
+  impl->thread = std::thread([raw] { raw->serve(); });
+  return std::unique_ptr<SimulationFleet>(new SimulationFleet(std::move(impl)));
+}
+
+const std::string& SimulationFleet::endpoint() const { return impl_->endpoint; }
+
+sim::Expected<sim::DrapeResult> SimulationFleet::simulate(const sim::DrapeConfig& config) {
+  auto wire = proto::to_proto(config);
+  if (!wire) return wire.error();
+  auto task = std::make_shared<Task>();
+  task->simulation = std::move(wire).value();
+  task->queued = Clock::now();
+  auto answer = task->answer.get_future();
+  {
+    std::lock_guard lock(impl_->mutex);
+    if (impl_->stopping) return sim::Error{"the fleet stopped"};
+    task->id = impl_->next_id++;
+    impl_->queue.push_back(std::move(task));
+  }
+  return answer.get();
+}
+
+int SimulationFleet::wait_for_workers(int count, double timeout_s) {
+  std::unique_lock lock(impl_->mutex);
+  impl_->workers_changed.wait_for(lock, std::chrono::duration<double>(timeout_s),
+                                  [&] { return impl_->counters.workers >= count; });
+  return impl_->counters.workers;
+}
+
+SimulationFleet::Counters SimulationFleet::counters() const {
+  std::lock_guard lock(impl_->mutex);
+  return impl_->counters;
+}
+
+}  // namespace drapegen::coordinator

@@ -1,0 +1,161 @@
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <thread>
+#include <vector>
+#include <zmq.hpp>
+
+#include "drapegen/coordinator/simulation_fleet.hpp"
+#include "drapegen/proto/codec.hpp"
+#include "drapegen/worker/worker.hpp"
+
+namespace drapegen::coordinator {
+namespace {
+namespace v1 = proto::v1;
+
+sim::DrapeConfig small_drape(std::uint64_t seed) {
+  sim::DrapeConfig c;
+  c.specimen.vertices_x = c.specimen.vertices_y = 9;
+  c.specimen.seed = seed;
+  c.initial.shape = sim::InitialShape::kSine;
+  c.initial.seed = seed;
+  c.solver.max_iterations = 200;
+  return c;
+}
+
+/// `drapegen worker` loops on threads of this process, stopped (and joined) on destruction.
+class Workers {
+ public:
+  Workers(const std::string& endpoint, int count) {
+    for (int i = 0; i < count; ++i) {
+      threads_.emplace_back([this, endpoint, i] {
+        worker::WorkerOptions o;
+        o.endpoint = endpoint;
+        o.name = "test-" + std::to_string(i);
+        o.heartbeat_ms = 100;
+        (void)worker::run_worker(o, stop_);
+      });
+    }
+  }
+  ~Workers() {
+    stop_ = true;
+    for (auto& t : threads_) t.join();
+  }
+
+ private:
+  std::atomic<bool> stop_{false};
+  std::vector<std::thread> threads_;
+};
+
+FleetOptions fast_options() {
+  FleetOptions o;
+  o.heartbeat_ms = 50;
+  o.liveness = 4;
+  o.wait_s = 20.0;
+  return o;
+}
+
+TEST(SimulationFleet, ComputesDrapesOnItsWorkersAsALocalSolveWould) {
+  auto fleet = SimulationFleet::start(fast_options());
+  ASSERT_TRUE(fleet) << fleet.error().message;
+  Workers workers((*fleet)->endpoint(), 2);
+  ASSERT_EQ((*fleet)->wait_for_workers(2, 20.0), 2);
+  constexpr int kDrapes = 6;
+  std::vector<sim::Expected<sim::DrapeResult>> remote(kDrapes, sim::Error{"not run"});
+  std::vector<std::thread> callers;
+  for (int t = 0; t < 3; ++t) {
+    callers.emplace_back([&, t] {
+      for (int k = t; k < kDrapes; k += 3) remote[k] = (*fleet)->simulate(small_drape(k + 1));
+    });
+  }
+  for (auto& c : callers) c.join();
+  for (int k = 0; k < kDrapes; ++k) {
+    ASSERT_TRUE(remote[k]) << remote[k].error().message;
+    auto local = sim::simulate_drape(small_drape(k + 1));
+    ASSERT_TRUE(local);
+    EXPECT_EQ(remote[k]->mesh.positions, local->mesh.positions) << "drape " << k;
+    EXPECT_EQ(remote[k]->report.outcome, local->report.outcome);
+  }
+  const auto counters = (*fleet)->counters();
+  EXPECT_EQ(counters.simulated, kDrapes);
+  EXPECT_EQ(counters.workers_seen, 2);
+  EXPECT_EQ(counters.lost_attempts, 0);
+}
+
+TEST(SimulationFleet, PassesOnWhatTheWorkerCannotBuildAndWhatCannotBeSent) {
+  auto fleet = SimulationFleet::start(fast_options());
+  ASSERT_TRUE(fleet);
+  Workers workers((*fleet)->endpoint(), 1);
+  sim::DrapeConfig bad = small_drape(1);
+  bad.fabric.alpha.warp = -1.0;
+  auto failed = (*fleet)->simulate(bad);
+  ASSERT_FALSE(failed);
+  EXPECT_NE(failed.error().message.find("worker test-0"), std::string::npos) << failed.error().message;
+  sim::DrapeConfig mesh = small_drape(1);
+  mesh.initial.shape = sim::InitialShape::kMesh;
+  EXPECT_FALSE((*fleet)->simulate(mesh));
+}
+
+TEST(SimulationFleet, FailsADrapeThatNoWorkerComesFor) {
+  FleetOptions o = fast_options();
+  o.wait_s = 0.3;
+  auto fleet = SimulationFleet::start(o);
+  ASSERT_TRUE(fleet);
+  auto drape = (*fleet)->simulate(small_drape(1));
+  ASSERT_FALSE(drape);
+  EXPECT_NE(drape.error().message.find("no worker connected"), std::string::npos) << drape.error().message;
+}
+
+/// A worker that registers, takes one job and then falls silent.
+void take_a_job_and_vanish(const std::string& endpoint, std::atomic<bool>& took) {
+  zmq::context_t context{1};
+  zmq::socket_t socket(context, zmq::socket_type::dealer);
+  socket.set(zmq::sockopt::linger, 0);
+  socket.connect(endpoint);
+  v1::Envelope ready;
+  ready.mutable_ready()->set_worker_name("vanishing");
+  ready.mutable_ready()->set_interval_ms(50);
+  const std::string frame = proto::encode(ready);
+  socket.send(zmq::buffer(frame));
+  zmq::message_t message;
+  while (socket.recv(message)) {
+    auto e = proto::decode(message.data(), message.size());
+    if (e && e->body_case() == v1::Envelope::kJob) break;
+  }
+  took = true;
+}
+
+TEST(SimulationFleet, GivesALostWorkersDrapeToTheNextAndFailsItAfterMaxAttempts) {
+  auto fleet = SimulationFleet::start(fast_options());
+  ASSERT_TRUE(fleet);
+  const std::string endpoint = (*fleet)->endpoint();
+  std::atomic<bool> took{false};
+  std::thread vanishing([&] { take_a_job_and_vanish(endpoint, took); });
+  ASSERT_EQ((*fleet)->wait_for_workers(1, 20.0), 1);
+  std::optional<Workers> real;
+  std::thread starter([&] {
+    while (!took) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    real.emplace(endpoint, 1);  // only after the vanishing worker holds the drape
+  });
+  auto drape = (*fleet)->simulate(small_drape(3));
+  starter.join();
+  vanishing.join();
+  ASSERT_TRUE(drape) << drape.error().message;
+  EXPECT_EQ(drape->mesh.positions, sim::simulate_drape(small_drape(3))->mesh.positions);
+  EXPECT_EQ((*fleet)->counters().lost_attempts, 1);
+  real.reset();
+
+  FleetOptions once = fast_options();
+  once.max_attempts = 1;
+  auto strict = SimulationFleet::start(once);
+  ASSERT_TRUE(strict);
+  took = false;
+  std::thread vanishing_again([&] { take_a_job_and_vanish((*strict)->endpoint(), took); });
+  auto lost = (*strict)->simulate(small_drape(3));
+  vanishing_again.join();
+  ASSERT_FALSE(lost);
+  EXPECT_NE(lost.error().message.find("lost with 1 workers"), std::string::npos) << lost.error().message;
+}
+
+}  // namespace
+}  // namespace drapegen::coordinator
