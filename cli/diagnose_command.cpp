@@ -13,10 +13,12 @@
 
 #include "commands.hpp"
 #include "failure.hpp"
+#include "drapegen/coordinator/simulation_fleet.hpp"
 #include "drapegen/diagnosis/capture.hpp"
 #include "drapegen/diagnosis/diagnosis.hpp"
 #include "drapegen/diagnosis/report.hpp"
 #include "drapegen/sim/logging.hpp"
+#include "drapegen/storage/atomic_file.hpp"
 #include "parse.hpp"
 
 namespace drapegen::cli {
@@ -56,12 +58,19 @@ struct DiagnoseOptions {
   double held_out_tolerance = diagnosis::AttributionSettings{}.held_out_tolerance;
   bool verbose = false;
   bool quiet = false;
+  std::string fleet;  // empty: the drapes are computed here
+  int fleet_workers = 1;
+  double fleet_wait = coordinator::FleetOptions{}.wait_s;
+  std::string fleet_endpoint_file;
 };
 
 const Failure fail{"diagnose"};
 
 int run_diagnose(const DiagnoseOptions& o) {
   if (o.jobs < 1 || o.jobs > 64) return fail("--jobs must be 1 .. 64");
+  if (o.fleet.empty() && (!o.fleet_endpoint_file.empty())) return fail("--fleet-endpoint-file needs --fleet");
+  if (o.fleet_workers < 0 || o.fleet_workers > 10000) return fail("--fleet-workers must be 0 .. 10000");
+  if (!(o.fleet_wait > 0.0 && o.fleet_wait <= 86400.0)) return fail("--fleet-wait must be > 0 .. 86400 s");
   const auto outside = [](const std::optional<int>& value, int lo, int hi) {
     return value && (*value < lo || *value > hi);
   };
@@ -158,9 +167,38 @@ int run_diagnose(const DiagnoseOptions& o) {
   settings.attribution.ablation = o.ablation;
   settings.attribution.held_out_tolerance = o.held_out_tolerance;
   if (o.shape_floor) settings.floors.shape_threshold = settings.held_out_shape_threshold = *o.shape_floor;
+  // The fleet: the drapes go to workers; the renders, scores and the search stay here.
+  std::unique_ptr<coordinator::SimulationFleet> fleet;
+  if (!o.fleet.empty()) {
+    auto started = coordinator::SimulationFleet::start({.bind = o.fleet, .wait_s = o.fleet_wait});
+    if (!started) return fail(started.error().message);
+    fleet = std::move(started).value();
+    const std::string& endpoint = fleet->endpoint();
+    if (!o.fleet_endpoint_file.empty()) {
+      if (sim::Status s = storage::write_file_atomic(o.fleet_endpoint_file, endpoint + "\n"); !s) {
+        return fail(s.error().message, kExitIo);
+      }
+    }
+    sim::logger()->info("fleet: serving drapes at {}; waiting for {} worker(s) (drapegen worker --connect {})",
+                        endpoint, o.fleet_workers, endpoint);
+    if (fleet->wait_for_workers(o.fleet_workers, o.fleet_wait) < o.fleet_workers) {
+      return fail(fmt::format("fleet: fewer than {} worker(s) connected to {} within {} s", o.fleet_workers, endpoint,
+                              o.fleet_wait));
+    }
+    coordinator::SimulationFleet* f = fleet.get();
+    settings.fit.simulator = [f](const sim::DrapeConfig& config) { return f->simulate(config); };
+    settings.refit_state_threads = o.jobs;
+  }
   auto result = diagnosis::diagnose(*capture, settings,
                                     {.second = second ? &*second : nullptr, .held_out = held_out ? &*held_out : nullptr});
   if (!result) return fail(result.error().message);
+  if (fleet) {
+    const auto c = fleet->counters();
+    sim::logger()->info("fleet: {} drapes on {} worker(s) ({} attempts lost with a worker)", c.simulated,
+                        c.workers_seen, c.lost_attempts);
+    settings.fit.simulator = {};
+    fleet.reset();  // the workers are told to shut down
+  }
   if (!o.report.empty()) {
     auto model = diagnosis::ForwardModel::create(*capture, settings.fit);
     if (!model) return fail(model.error().message);
@@ -314,6 +352,23 @@ Runner add_diagnose_command(CLI::App& app) {
                  "Threads: the fit's and the floors' initial states, then the candidate refits, in parallel (same "
                  "result as --jobs 1)")
       ->capture_default_str();
+  app.add_option("--fleet", o->fleet,
+                 "Compute the drapes on worker processes instead of here: bind this endpoint (e.g. tcp://*:5600; "
+                 "tcp://127.0.0.1:* picks a free port, logged) and serve every drape to `drapegen worker --connect "
+                 "ENDPOINT` processes, on this machine or others, as they come and go; the renders, scores and "
+                 "searches stay here. --jobs then counts refits in flight, and each refit simulates its initial states "
+                 "on --jobs threads too. The same result as without, where the workers run this build on the same "
+                 "BLAS kernels (docs/DIAGNOSIS.md, \"Refits on workers\"). Plain TCP: bind a private network's "
+                 "address");
+  app.add_option("--fleet-workers", o->fleet_workers,
+                 "With --fleet: wait for this many workers before starting (more may join later)")
+      ->capture_default_str();
+  app.add_option("--fleet-wait", o->fleet_wait,
+                 "With --fleet: fail when the workers asked for have not all come within this many seconds, or a drape "
+                 "has waited this long with no worker connected")
+      ->capture_default_str();
+  app.add_option("--fleet-endpoint-file", o->fleet_endpoint_file,
+                 "With --fleet: also write the bound endpoint to this file (for job scripts that start the workers)");
   app.add_option("--shape-floor", o->shape_floor,
                  fmt::format("Shape-distance floor (default and quick: calibrated {:.2f}; fine: {:.2f}, with "
                              "--held-out-capture or --second-capture {:.2f}; 0: the largest floor sample)",

@@ -510,6 +510,36 @@ foreach(i 0 1)
   endforeach()
 endforeach()
 expect_same_with_jobs("the bar's objective" attribution bending_refit_bar objective_mm)
+# --fleet: the drapes computed by `drapegen worker` processes (two, on a local socket) instead of in this process. The
+# report is --jobs 1's line for line, but for its seconds.
+set(fleet ipc://${WORK}/fleet.ipc)
+# (The workers come first in the pipeline: each exits when told, and only the last command's stdout is not a pipe.)
+execute_process(
+  COMMAND ${DRAPEGEN} worker --connect ${fleet} --give-up 120 --log-level warn
+  COMMAND ${DRAPEGEN} worker --connect ${fleet} --give-up 120 --log-level warn
+  COMMAND ${DRAPEGEN} diagnose --capture ${WORK}/capture --quick --resolution 10 --states 2 --evaluations 8
+          --refit-evaluations 4 --candidates shear,sensor --ablation --jobs 2 --fleet ${fleet} --fleet-workers 2
+          --fleet-wait 120 --json -q
+  RESULTS_VARIABLE codes OUTPUT_VARIABLE fleet_json ERROR_VARIABLE err)
+if(NOT codes STREQUAL "0;0;0")
+  message(FATAL_ERROR "--fleet: exit codes ${codes} (worker, worker, diagnose): ${err}")
+endif()
+# Lines of time and of the main thread's share of the simulations (which --jobs sets) aside.
+set(varying "\n[^\n]*(seconds\"|simulations_main_thread)[^\n]*")
+string(REGEX REPLACE "${varying}" "" local_lines "${one_thread}")
+string(REGEX REPLACE "${varying}" "" fleet_lines "${fleet_json}")
+string(REGEX MATCHALL "\n" newlines "${local_lines}")
+list(LENGTH newlines local_count)
+if(local_count LESS 1000 OR NOT local_lines STREQUAL fleet_lines)
+  file(WRITE ${WORK}/one_thread.json "${one_thread}")
+  file(WRITE ${WORK}/fleet.json "${fleet_json}")
+  message(FATAL_ERROR "--fleet: the report differs from --jobs 1's (${local_count} lines compared; "
+                      "${WORK}/one_thread.json and fleet.json)")
+endif()
+expect_failure(1 "--fleet-endpoint-file needs --fleet" diagnose --capture ${WORK}/capture --fleet-endpoint-file x)
+expect_failure(1 "cannot bind" diagnose --capture ${WORK}/capture --fleet bogus://nowhere)
+expect_failure(1 "fewer than 1 worker(s) connected" diagnose --capture ${WORK}/capture --fleet ${fleet}
+               --fleet-wait 0.5 -q)
 expect_failure(1 "--yield-trade must be 0" diagnose --capture ${WORK}/capture --yield-trade 1)
 expect_failure(1 "--shear-trade must be 0" diagnose --capture ${WORK}/capture --shear-trade 1)
 expect_failure(1 "unknown effect 'bogus'" diagnose --capture ${WORK}/capture --candidates yield,bogus)

@@ -246,8 +246,8 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
     if (!m) return m.error();
     *made = std::move(*m);
   }
-  // Until the refits (which run settings.attribution.jobs at a time, each simulating on one thread), every evaluation
-  // simulates its initial states on that many threads.
+  // Until the refits (which run settings.attribution.jobs at a time, each simulating on refit_state_threads threads),
+  // every evaluation simulates its initial states on attribution.jobs threads.
   const auto set_threads = [&](int threads) {
     for (ForwardModel* m : {&model, second_model.get(), held_out_model.get()})
       if (m != nullptr) m->set_threads(threads);
@@ -431,7 +431,12 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
     r.verdict = "not attributed";
   } else {
     const FitSettings fit_settings = settings.fit;
-    auto make_model = [fit_settings](const Capture& c) { return ForwardModel::create(c, fit_settings); };
+    const int state_threads = std::max(1, settings.refit_state_threads);
+    auto make_model = [fit_settings, state_threads](const Capture& c) {
+      auto m = ForwardModel::create(c, fit_settings);
+      if (m) (*m)->set_threads(state_threads);
+      return m;
+    };
     OtherCaptures other_captures;
     if (second_model) other_captures.second = {second_model.get(), &r.validated_second->best};
     if (held_out_model) other_captures.held_out = {held_out_model.get(), &r.validated_held_out->best};
@@ -452,7 +457,7 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
     }
     r.refit_scale_lower = attribution_settings.bending_scale_lower;
     r.refit_scale_upper = attribution_settings.bending_scale_upper;
-    set_threads(1);
+    set_threads(state_threads);
     auto attribution = attribute(model, fitted, r.fit, r.validated, r.floors, attribution_settings, make_model,
                                  other_captures);
     if (!attribution) return attribution.error();

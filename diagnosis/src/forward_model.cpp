@@ -83,7 +83,7 @@ sim::Expected<sim::ClothMesh> ForwardModel::simulate(const ModelSetup& setup, co
   config.effects = setup.effects;
   config.solver.max_iterations = settings_.max_newton_iterations;
   config.solver.tolerance = settings_.tolerance;
-  auto result = sim::simulate_drape(config);
+  auto result = settings_.simulator ? settings_.simulator(config) : sim::simulate_drape(config);
   {
     std::lock_guard lock(counters_);
     ++simulations_;

@@ -55,6 +55,12 @@ struct DiagnosisSettings {
   /// The shape floor when the gate has a paired capture (a second or a held-out one: it then tests the mean of two
   /// captures' shape distances, which spreads less over controls than one capture's); 0: floors.shape_threshold.
   double held_out_shape_threshold = 0.0;
+  /// Threads each refit simulates an evaluation's initial states on (the refits themselves run attribution.jobs at a
+  /// time, and before them every evaluation simulates on attribution.jobs threads). 1: the refit's own thread alone,
+  /// right where the drapes are computed on this machine. More pays where they are computed elsewhere
+  /// (FitSettings::simulator: a fleet), so that up to attribution.jobs x this many are in flight. The result does not
+  /// depend on it (ForwardModel::set_threads).
+  int refit_state_threads = 1;
 
   /// Small budgets for tests and the --quick benchmark.
   [[nodiscard]] static DiagnosisSettings quick();

@@ -4,6 +4,7 @@
 // capture's cameras and compared view by view; the best initial state counts (multiple stable drapes).
 
 #include <algorithm>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <vector>
@@ -14,6 +15,7 @@
 #include "drapegen/diagnosis/model_setup.hpp"
 #include "drapegen/diagnosis/shape_features.hpp"
 #include "drapegen/renderer/depth_renderer.hpp"
+#include "drapegen/sim/drape.hpp"
 #include "drapegen/sim/expected.hpp"
 #include "drapegen/sim/initial_state.hpp"
 #include "drapegen/sim/mesh.hpp"
@@ -27,6 +29,10 @@ struct FitSettings {
   double tolerance = 2e-3;
   std::vector<int> fit_views{0, 1, 2}; // the rest are held out
   MetricWeights weights;
+  /// Computes a drape: sim::simulate_drape where unset, else e.g. a fleet of workers (coordinator::SimulationFleet;
+  /// docs/DIAGNOSIS.md, "Refits on workers"). It must give the drape simulate_drape would (the same build on the
+  /// same BLAS kernels does), or the diagnosis is another one. Called from several threads at once.
+  std::function<sim::Expected<sim::DrapeResult>(const sim::DrapeConfig&)> simulator;
 };
 
 /// The initial states of the fit: flat, then sine seeds 1.. (count in total).
