@@ -62,13 +62,17 @@ struct DiagnoseOptions {
   int fleet_workers = 1;
   double fleet_wait = coordinator::FleetOptions{}.wait_s;
   std::string fleet_endpoint_file;
+  std::string fleet_server_key, fleet_authorized_keys;  // CurveZMQ
 };
 
 const Failure fail{"diagnose"};
 
 int run_diagnose(const DiagnoseOptions& o) {
   if (o.jobs < 1 || o.jobs > 64) return fail("--jobs must be 1 .. 64");
-  if (o.fleet.empty() && (!o.fleet_endpoint_file.empty())) return fail("--fleet-endpoint-file needs --fleet");
+  if (o.fleet.empty() && !(o.fleet_endpoint_file.empty() && o.fleet_server_key.empty() &&
+                           o.fleet_authorized_keys.empty())) {
+    return fail("--fleet-endpoint-file, --fleet-server-key and --fleet-authorized-keys need --fleet");
+  }
   if (o.fleet_workers < 0 || o.fleet_workers > 10000) return fail("--fleet-workers must be 0 .. 10000");
   if (!(o.fleet_wait > 0.0 && o.fleet_wait <= 86400.0)) return fail("--fleet-wait must be > 0 .. 86400 s");
   const auto outside = [](const std::optional<int>& value, int lo, int hi) {
@@ -170,7 +174,10 @@ int run_diagnose(const DiagnoseOptions& o) {
   // The fleet: the drapes go to workers; the renders, scores and the search stay here.
   std::unique_ptr<coordinator::SimulationFleet> fleet;
   if (!o.fleet.empty()) {
-    auto started = coordinator::SimulationFleet::start({.bind = o.fleet, .wait_s = o.fleet_wait});
+    auto started = coordinator::SimulationFleet::start({.bind = o.fleet,
+                                                        .server_secret_key = o.fleet_server_key,
+                                                        .authorized_keys = o.fleet_authorized_keys,
+                                                        .wait_s = o.fleet_wait});
     if (!started) return fail(started.error().message);
     fleet = std::move(started).value();
     const std::string& endpoint = fleet->endpoint();
@@ -358,8 +365,8 @@ Runner add_diagnose_command(CLI::App& app) {
                  "ENDPOINT` processes, on this machine or others, as they come and go; the renders, scores and "
                  "searches stay here. --jobs then counts refits in flight, and each refit simulates its initial states "
                  "on --jobs threads too. The same result as without, where the workers run this build on the same "
-                 "BLAS kernels (docs/DIAGNOSIS.md, \"Refits on workers\"). Plain TCP: bind a private network's "
-                 "address");
+                 "BLAS kernels (docs/DIAGNOSIS.md, \"Refits on workers\"). An address other machines can reach needs "
+                 "--fleet-server-key and --fleet-authorized-keys");
   app.add_option("--fleet-workers", o->fleet_workers,
                  "With --fleet: wait for this many workers before starting (more may join later)")
       ->capture_default_str();
@@ -367,6 +374,11 @@ Runner add_diagnose_command(CLI::App& app) {
                  "With --fleet: fail when the workers asked for have not all come within this many seconds, or a drape "
                  "has waited this long with no worker connected")
       ->capture_default_str();
+  app.add_option("--fleet-server-key", o->fleet_server_key,
+                 "With --fleet: CurveZMQ, this side's secret key file (drapegen keygen; the workers connect with "
+                 "--server-key and --key)");
+  app.add_option("--fleet-authorized-keys", o->fleet_authorized_keys,
+                 "With --fleet: CurveZMQ, the workers' public keys it admits, one per line");
   app.add_option("--fleet-endpoint-file", o->fleet_endpoint_file,
                  "With --fleet: also write the bound endpoint to this file (for job scripts that start the workers)");
   app.add_option("--shape-floor", o->shape_floor,

@@ -536,7 +536,9 @@ if(local_count LESS 1000 OR NOT local_lines STREQUAL fleet_lines)
   message(FATAL_ERROR "--fleet: the report differs from --jobs 1's (${local_count} lines compared; "
                       "${WORK}/one_thread.json and fleet.json)")
 endif()
-expect_failure(1 "--fleet-endpoint-file needs --fleet" diagnose --capture ${WORK}/capture --fleet-endpoint-file x)
+expect_failure(1 "need --fleet" diagnose --capture ${WORK}/capture --fleet-endpoint-file x)
+expect_failure(1 "need --fleet" diagnose --capture ${WORK}/capture --fleet-server-key x)
+expect_failure(1 "without authentication" diagnose --capture ${WORK}/capture --fleet tcp://0.0.0.0:*)
 expect_failure(1 "cannot bind" diagnose --capture ${WORK}/capture --fleet bogus://nowhere)
 expect_failure(1 "fewer than 1 worker(s) connected" diagnose --capture ${WORK}/capture --fleet ${fleet}
                --fleet-wait 0.5 -q)

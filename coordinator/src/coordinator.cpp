@@ -23,6 +23,7 @@
 #include <zmq_addon.hpp>
 
 #include "drapegen/build_id.hpp"
+#include "curve_server.hpp"
 #include "drapegen/coordinator/curve_keys.hpp"
 #include "drapegen/coordinator/job_message.hpp"
 #include "drapegen/coordinator/logging.hpp"
@@ -61,12 +62,6 @@ std::string format_duration(double seconds) {
 }
 
 /// True for endpoints only this machine can reach.
-bool is_loopback(const std::string& endpoint) {
-  if (endpoint.rfind("ipc://", 0) == 0 || endpoint.rfind("inproc://", 0) == 0) return true;
-  const std::string rest = endpoint.substr(endpoint.find("://") + 3);
-  return rest.rfind("127.", 0) == 0 || rest.rfind("localhost:", 0) == 0 || rest.rfind("[::1]:", 0) == 0;
-}
-
 std::string printable(const std::string& identity) {
   std::string out;
   for (unsigned char c : identity) out += fmt::format("{:02x}", c);
@@ -112,17 +107,14 @@ struct Coordinator::Impl {
   bool files_written = false;
 
   zmq::context_t context{1};
-  zmq::socket_t zap{context, zmq::socket_type::rep};  // ZAP handler (CurveZMQ only); bound before the ROUTER
+  std::unique_ptr<CurveServer> curve;  // CurveZMQ only: set up before the ROUTER binds
   zmq::socket_t socket{context, zmq::socket_type::router};
   std::string endpoint;
-  bool curve = false;
-  std::set<std::string> authorized;  // raw 32-byte worker public keys
-  std::int64_t refused_handshakes = 0;
 
   std::shared_ptr<spdlog::logger> log = logger();
   const std::string blas_kernels = sim::blas_kernels_description();  // a worker's other than these is warned about
   bool terminal_progress = false;
-  Clock::time_point start = Clock::now(), last_progress = Clock::now(), last_reject_log{}, last_refuse_log{};
+  Clock::time_point start = Clock::now(), last_progress = Clock::now(), last_reject_log{};
   std::int64_t done_at_start = 0;
 
   // ---------------------------------------------------------------------------------------------------------------
@@ -138,48 +130,12 @@ struct Coordinator::Impl {
       config.authorized_keys = options.authorized_keys;
     }
     if (config.server_secret_key.empty()) return {};
-    auto keys = read_secret_key(config.server_secret_key);
-    if (!keys) return keys.error();
-    auto allowed = read_authorized_keys(config.authorized_keys);
-    if (!allowed) return allowed.error();
-    authorized = std::move(allowed).value();
-    try {
-      zap.set(zmq::sockopt::linger, 0);
-      zap.bind("inproc://zeromq.zap.01");
-      socket.set(zmq::sockopt::curve_server, 1);
-      socket.set(zmq::sockopt::curve_secretkey, keys->secret_z85);
-      socket.set(zmq::sockopt::zap_domain, "drapegen");
-    } catch (const zmq::error_t& e) {
-      return sim::Error{fmt::format("cannot set up CurveZMQ: {}", e.what())};
-    }
-    curve = true;
-    log->info("CurveZMQ on: {} authorised worker key(s); server public key {}", authorized.size(), keys->public_z85);
+    auto attached = CurveServer::attach(context, socket, config.server_secret_key, config.authorized_keys);
+    if (!attached) return attached.error();
+    curve = std::move(attached).value();
+    log->info("CurveZMQ on: {} authorised worker key(s); server public key {}", curve->authorized(),
+              curve->public_key());
     return {};
-  }
-
-  /// One ZAP request (RFC 27): admit the CURVE client if its public key is authorised.
-  void answer_zap() {
-    std::vector<zmq::message_t> request;
-    if (!zmq::recv_multipart(zap, std::back_inserter(request), zmq::recv_flags::dontwait)) return;
-    std::string status = "400", text = "unauthorised key";
-    if (request.size() >= 7 && request[5].to_string() == "CURVE" && authorized.count(request[6].to_string())) {
-      status = "200";
-      text = "OK";
-    } else {
-      ++refused_handshakes;
-      const auto now = Clock::now();
-      if (now - last_refuse_log > std::chrono::seconds(1)) {  // one line a second at most
-        log->warn("refused a connection from {} ({}; {} refused so far)",
-                  request.size() > 3 ? request[3].to_string() : "?",
-                  request.size() > 5 ? request[5].to_string() : "no mechanism", refused_handshakes);
-        last_refuse_log = now;
-      }
-    }
-    const std::string version = "1.0";
-    const std::string id = request.size() > 1 ? request[1].to_string() : "";
-    std::array<zmq::const_buffer, 6> reply = {zmq::buffer(version), zmq::buffer(id),   zmq::buffer(status),
-                                              zmq::buffer(text),    zmq::buffer("", 0), zmq::buffer("", 0)};
-    zmq::send_multipart(zap, reply);
   }
 
   sim::Status bind(const std::string& preferred, const std::string& fallback) {
@@ -724,13 +680,14 @@ struct Coordinator::Impl {
     // Answer late or reconnecting workers with Shutdown for a moment too.
     const auto until = Clock::now() + std::chrono::milliseconds(options.shutdown_linger_ms);
     while (Clock::now() < until) {
-      zmq::pollitem_t items[2] = {{socket.handle(), 0, ZMQ_POLLIN, 0}, {zap.handle(), 0, ZMQ_POLLIN, 0}};
+      zmq::pollitem_t items[2] = {{socket.handle(), 0, ZMQ_POLLIN, 0},
+                                  {curve ? curve->socket().handle() : nullptr, 0, ZMQ_POLLIN, 0}};
       try {
         zmq::poll(items, curve ? 2 : 1, std::chrono::milliseconds(50));
       } catch (const zmq::error_t&) {
         break;
       }
-      if (curve && (items[1].revents & ZMQ_POLLIN)) answer_zap();
+      if (curve && (items[1].revents & ZMQ_POLLIN)) curve->answer();
       if (!(items[0].revents & ZMQ_POLLIN)) continue;
       std::vector<zmq::message_t> frames;
       if (!zmq::recv_multipart(socket, std::back_inserter(frames), zmq::recv_flags::dontwait)) continue;
@@ -765,7 +722,8 @@ struct Coordinator::Impl {
       if (stop.load()) break;
       dispatch();
       if (!storage_error.empty()) break;
-      zmq::pollitem_t items[2] = {{socket.handle(), 0, ZMQ_POLLIN, 0}, {zap.handle(), 0, ZMQ_POLLIN, 0}};
+      zmq::pollitem_t items[2] = {{socket.handle(), 0, ZMQ_POLLIN, 0},
+                                  {curve ? curve->socket().handle() : nullptr, 0, ZMQ_POLLIN, 0}};
       zmq::pollitem_t& item = items[0];
       try {
         zmq::poll(items, curve ? 2 : 1, std::chrono::milliseconds(std::min(config.heartbeat_ms, 100)));
@@ -773,7 +731,7 @@ struct Coordinator::Impl {
         if (e.num() != EINTR) throw;
         continue;  // a signal: the loop condition sees the stop flag
       }
-      if (curve && (items[1].revents & ZMQ_POLLIN)) answer_zap();
+      if (curve && (items[1].revents & ZMQ_POLLIN)) curve->answer();
       if (item.revents & ZMQ_POLLIN) {
         // Drain what has arrived (up to a bound), then commit once: group commit.
         for (int n = 0; n < 1024 && storage_error.empty(); ++n) {

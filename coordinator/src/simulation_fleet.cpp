@@ -1,5 +1,7 @@
 #include "drapegen/coordinator/simulation_fleet.hpp"
 
+#include "curve_server.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <condition_variable>
@@ -51,6 +53,7 @@ struct SimulationFleet::Impl {
 
   FleetOptions options;
   zmq::context_t context{1};
+  std::unique_ptr<CurveServer> curve;  // CurveZMQ only: set up before the ROUTER binds
   zmq::socket_t socket{context, zmq::socket_type::router};
   std::string endpoint;
   std::shared_ptr<spdlog::logger> log = logger();
@@ -265,10 +268,12 @@ struct SimulationFleet::Impl {
 
   void serve() {
     while (!stop.load()) {
-      zmq::pollitem_t item{socket.handle(), 0, ZMQ_POLLIN, 0};
+      zmq::pollitem_t items[2] = {{socket.handle(), 0, ZMQ_POLLIN, 0},
+                                  {curve ? curve->socket().handle() : nullptr, 0, ZMQ_POLLIN, 0}};
       try {
-        zmq::poll(&item, 1, std::chrono::milliseconds(5));
-        if (item.revents & ZMQ_POLLIN) {
+        zmq::poll(items, curve ? 2 : 1, std::chrono::milliseconds(5));
+        if (curve && (items[1].revents & ZMQ_POLLIN)) curve->answer();
+        if (items[0].revents & ZMQ_POLLIN) {
           zmq::multipart_t message;
           while (message.recv(socket, static_cast<int>(zmq::recv_flags::dontwait))) {
             if (message.size() != 2) {
@@ -311,8 +316,25 @@ sim::Expected<std::unique_ptr<SimulationFleet>> SimulationFleet::start(const Fle
   if (options.heartbeat_ms < 1 || options.liveness < 1 || options.max_attempts < 1 || !(options.wait_s > 0)) {
     return sim::Error{"fleet: heartbeat, liveness, attempts and wait must be positive"};
   }
+  if (options.server_secret_key.empty() != options.authorized_keys.empty()) {
+    return sim::Error{"fleet: a server key and authorised keys go together (CurveZMQ)"};
+  }
+  const bool curve = !options.server_secret_key.empty();
+  if (!curve && !is_loopback(options.bind)) {
+    return sim::Error{fmt::format("fleet: refusing to bind {} without authentication: an address other machines can "
+                                  "reach needs a server key and authorised worker keys (CurveZMQ; drapegen keygen "
+                                  "makes keys)",
+                                  options.bind)};
+  }
   auto impl = std::make_unique<Impl>();
   impl->options = options;
+  if (curve) {
+    auto attached = CurveServer::attach(impl->context, impl->socket, options.server_secret_key, options.authorized_keys);
+    if (!attached) return sim::Error{"fleet: " + attached.error().message};
+    impl->curve = std::move(attached).value();
+    impl->log->info("fleet: CurveZMQ on: {} authorised worker key(s); server public key {}", impl->curve->authorized(),
+                    impl->curve->public_key());
+  }
   impl->socket.set(zmq::sockopt::linger, 500);  // the Shutdowns leave before the socket closes
   impl->socket.set(zmq::sockopt::maxmsgsize, static_cast<int64_t>(proto::kMaxFrameBytes));
   try {

@@ -1,10 +1,14 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <filesystem>
+#include <fstream>
+#include <unistd.h>
 #include <thread>
 #include <vector>
 #include <zmq.hpp>
 
+#include "drapegen/coordinator/curve_keys.hpp"
 #include "drapegen/coordinator/simulation_fleet.hpp"
 #include "drapegen/proto/codec.hpp"
 #include "drapegen/worker/worker.hpp"
@@ -26,13 +30,16 @@ sim::DrapeConfig small_drape(std::uint64_t seed) {
 /// `drapegen worker` loops on threads of this process, stopped (and joined) on destruction.
 class Workers {
  public:
-  Workers(const std::string& endpoint, int count) {
+  /// `keys`: CurveZMQ's server public key and the worker's secret key file (empty: plain).
+  Workers(const std::string& endpoint, int count, std::pair<std::string, std::string> keys = {}) {
     for (int i = 0; i < count; ++i) {
-      threads_.emplace_back([this, endpoint, i] {
+      threads_.emplace_back([this, endpoint, i, keys] {
         worker::WorkerOptions o;
         o.endpoint = endpoint;
         o.name = "test-" + std::to_string(i);
         o.heartbeat_ms = 100;
+        o.server_key = keys.first;
+        o.key_file = keys.second;
         (void)worker::run_worker(o, stop_);
       });
     }
@@ -155,6 +162,40 @@ TEST(SimulationFleet, GivesALostWorkersDrapeToTheNextAndFailsItAfterMaxAttempts)
   vanishing_again.join();
   ASSERT_FALSE(lost);
   EXPECT_NE(lost.error().message.find("lost with 1 workers"), std::string::npos) << lost.error().message;
+}
+
+TEST(SimulationFleet, AdmitsOnlyAuthorisedWorkersAndNeedsCurveBeyondLoopback) {
+  FleetOptions open = fast_options();
+  open.bind = "tcp://0.0.0.0:*";
+  auto refused = SimulationFleet::start(open);
+  ASSERT_FALSE(refused);
+  EXPECT_NE(refused.error().message.find("without authentication"), std::string::npos) << refused.error().message;
+
+  const auto dir = std::filesystem::temp_directory_path() / ("drapegen-fleet-keys-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  for (const char* name : {"server", "good", "stranger"}) {
+    auto pair = make_curve_keypair();
+    ASSERT_TRUE(pair) << pair.error().message;
+    ASSERT_TRUE(write_curve_keypair(*pair, (dir / name).string()));
+  }
+  std::filesystem::copy_file(dir / "good.pub", dir / "authorized");
+  FleetOptions curve = fast_options();
+  curve.bind = "tcp://0.0.0.0:*";
+  curve.server_secret_key = (dir / "server.key").string();
+  curve.authorized_keys = (dir / "authorized").string();
+  auto fleet = SimulationFleet::start(curve);
+  ASSERT_TRUE(fleet) << fleet.error().message;
+  const std::string port = (*fleet)->endpoint().substr((*fleet)->endpoint().rfind(':'));
+  const std::string endpoint = "tcp://127.0.0.1" + port;
+  {
+    Workers stranger(endpoint, 1, {(dir / "server.pub").string(), (dir / "stranger.key").string()});
+    EXPECT_EQ((*fleet)->wait_for_workers(1, 1.0), 0);  // its handshake is refused
+  }
+  Workers good(endpoint, 1, {(dir / "server.pub").string(), (dir / "good.key").string()});
+  auto drape = (*fleet)->simulate(small_drape(2));
+  ASSERT_TRUE(drape) << drape.error().message;
+  EXPECT_EQ(drape->mesh.positions, sim::simulate_drape(small_drape(2))->mesh.positions);
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

@@ -4,7 +4,8 @@
 // coordinator's side of the worker protocol (docs/SERVICE.md): `drapegen worker --connect ENDPOINT` processes, on this
 // machine or others, register, take one JOB_MODE_SIMULATE job at a time, heartbeat while they compute, and send the
 // drape back. A worker that goes silent beyond its liveness (or registers again) loses its drape to the next free
-// worker; nothing is written to disk and there is no manifest: a caller that stops loses only drapes in flight.
+// worker; nothing is written to disk and there is no manifest: a caller that stops loses only drapes in flight. As the
+// coordinator, it binds an address other machines can reach only with CurveZMQ on.
 
 #include <atomic>
 #include <cstdint>
@@ -17,7 +18,12 @@
 namespace drapegen::coordinator {
 
 struct FleetOptions {
-  std::string bind = "tcp://127.0.0.1:*";  // "*" as the port: any free one (endpoint() tells which)
+  /// "*" as the port: any free one (endpoint() tells which). An address other machines can reach needs CurveZMQ.
+  std::string bind = "tcp://127.0.0.1:*";
+  /// CurveZMQ (both or neither): this side's secret key file and the workers' public keys it admits (drapegen keygen
+  /// makes them; the workers connect with --server-key and --key), as `drapegen run` takes them.
+  std::string server_secret_key;
+  std::string authorized_keys;
   int heartbeat_ms = 1000;                 // this side's heartbeat interval
   int liveness = 5;                        // a worker silent for liveness x its interval is lost
   int max_attempts = 3;                    // a drape whose worker is lost this many times fails
@@ -27,7 +33,8 @@ struct FleetOptions {
 
 class SimulationFleet {
  public:
-  /// Binds and starts serving (on a thread of its own). Errors: the endpoint cannot be bound, invalid options.
+  /// Binds and starts serving (on a thread of its own). Errors: the endpoint cannot be bound, or is not a loopback
+  /// one and CurveZMQ is off; unreadable keys; invalid options.
   [[nodiscard]] static sim::Expected<std::unique_ptr<SimulationFleet>> start(const FleetOptions& options);
   /// Tells the connected workers to shut down and stops serving; drapes still waiting fail.
   ~SimulationFleet();
