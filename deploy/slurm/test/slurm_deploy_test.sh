@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Deploy test (label "deploy"): Debian's slurm-wlm on this machine (slurmctld + slurmd on localhost, a private
-# configuration and private ports), deploy/slurm/drapegen.sbatch submitted with sbatch, the manifest checked.
+# configuration and private ports), deploy/slurm/drapegen.sbatch submitted with sbatch, the manifest checked; then a
+# gap diagnosis on the job's workers, its report checked against a local run's.
 # Needs root (installs slurm-wlm and munge if missing, starts munged if it is not running).
 # Usage: slurm_deploy_test.sh DRAPEGEN_BINARY WORK_DIR
 set -euo pipefail
@@ -99,4 +100,22 @@ grep -q "run complete: 6 done, 0 failed of 6 jobs" job.out || { cat job.out >&2;
 grep -q '"done": 6' stats.json || fail "stats: $(cat stats.json)"
 grep -q '"state": "complete"' stats.json || fail "run state not complete"
 workers=$(sqlite3 "$WORK/run/out/manifest.sqlite" "SELECT count(DISTINCT worker) FROM jobs" 2> /dev/null || echo "?")
-echo "slurm_deploy_test: ok (sbatch --ntasks=$cpus; 6 jobs done by $workers worker(s))"
+
+# A gap diagnosis whose drapes the job's workers compute (`diagnose`): its report is the local one but its seconds.
+mkdir -p "$WORK/diagnose"
+cd "$WORK/diagnose"
+"$DRAPEGEN" reality --alpha 13923,11455,8821 --beta=-35390,-29660,-22042 --density 300 --effect bias=12 \
+  --resolution 14 --seed 4 --out capture > /dev/null
+small=(--capture "$WORK/diagnose/capture" --quick --resolution 10 --states 2 --evaluations 8 --refit-evaluations 4
+       --candidates shear,sensor --jobs 2)
+"$DRAPEGEN" diagnose "${small[@]}" --json -q > local.json
+DRAPEGEN=$DRAPEGEN DRAPEGEN_BIND=127.0.0.1 DRAPEGEN_HOST=127.0.0.1 DRAPEGEN_GIVE_UP=60 \
+  sbatch --wait --ntasks="$cpus" --cpus-per-task=1 --time=10 --output="$WORK/diagnose/job.out" \
+  --export=ALL "$SCRIPT" diagnose "${small[@]}" --report "$WORK/diagnose/report" \
+  || { cat "$WORK/diagnose/job.out" >&2; fail "sbatch diagnose job failed"; }
+grep -q "coordinator exit 0" job.out || { cat job.out >&2; fail "the diagnosis did not complete"; }
+grep -q "fleet: [0-9]* drapes on $cpus worker(s)" job.out || { cat job.out >&2; fail "not every worker joined"; }
+varying='seconds"|simulations_main_thread'
+diff <(grep -Ev "$varying" local.json) <(grep -Ev "$varying" report/report.json) > /dev/null \
+  || fail "the report on the fleet differs from the local one ($WORK/diagnose)"
+echo "slurm_deploy_test: ok (sbatch --ntasks=$cpus; 6 jobs done by $workers worker(s); a diagnosis on $cpus workers)"
