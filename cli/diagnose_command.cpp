@@ -13,6 +13,7 @@
 
 #include "commands.hpp"
 #include "failure.hpp"
+#include "drapegen/coordinator/logging.hpp"
 #include "drapegen/coordinator/simulation_fleet.hpp"
 #include "drapegen/diagnosis/capture.hpp"
 #include "drapegen/diagnosis/diagnosis.hpp"
@@ -122,7 +123,9 @@ int run_diagnose(const DiagnoseOptions& o) {
     candidates.push_back(*effect);
   }
   // Each stage's end by default (a diagnosis takes minutes); every evaluation with --verbose; warnings with --quiet.
-  sim::logger()->set_level(o.verbose ? spdlog::level::debug : o.quiet ? spdlog::level::warn : spdlog::level::info);
+  const auto level = o.verbose ? spdlog::level::debug : o.quiet ? spdlog::level::warn : spdlog::level::info;
+  sim::logger()->set_level(level);
+  coordinator::logger()->set_level(level);  // the fleet's
   auto capture = diagnosis::read_capture(o.capture);
   if (!capture) return fail(capture.error().message);
   std::optional<diagnosis::Capture> held_out, second;
