@@ -38,6 +38,7 @@ printf '%-22s %8.1f %7.2f  %s\n' "here, --jobs 1" "$base" 1 "$verdict"
 for n in "${counts[@]}"; do
   endpoint="ipc://$work/fleet-$n.ipc"
   pids=()
+  trap 'kill "${pids[@]}" 2> /dev/null; rm -rf "$work"' EXIT
   for _ in $(seq 1 "$n"); do
     "$DRAPEGEN" worker --connect "$endpoint" --give-up 120 --log-level warn &
     pids+=($!)

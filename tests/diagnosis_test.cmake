@@ -539,7 +539,7 @@ endif()
 expect_failure(1 "need --fleet" diagnose --capture ${WORK}/capture --fleet-endpoint-file x)
 expect_failure(1 "need --fleet" diagnose --capture ${WORK}/capture --fleet-server-key x)
 expect_failure(1 "without authentication" diagnose --capture ${WORK}/capture --fleet tcp://0.0.0.0:*)
-expect_failure(1 "cannot bind" diagnose --capture ${WORK}/capture --fleet bogus://nowhere)
+expect_failure(1 "cannot bind" diagnose --capture ${WORK}/capture --fleet ipc://${WORK}/no/such/dir/fleet.ipc)
 expect_failure(1 "fewer than 1 worker(s) connected" diagnose --capture ${WORK}/capture --fleet ${fleet}
                --fleet-wait 0.5 -q)
 expect_failure(1 "--yield-trade must be 0" diagnose --capture ${WORK}/capture --yield-trade 1)

@@ -24,6 +24,7 @@
 
 #include "drapegen/build_id.hpp"
 #include "curve_server.hpp"
+#include "worker_peers.hpp"
 #include "drapegen/coordinator/curve_keys.hpp"
 #include "drapegen/coordinator/job_message.hpp"
 #include "drapegen/coordinator/logging.hpp"
@@ -59,13 +60,6 @@ std::string format_duration(double seconds) {
   if (s >= 3600) return fmt::format("{}h{:02d}m", s / 3600, (s % 3600) / 60);
   if (s >= 60) return fmt::format("{}m{:02d}s", s / 60, s % 60);
   return fmt::format("{}s", s);
-}
-
-/// True for endpoints only this machine can reach.
-std::string printable(const std::string& identity) {
-  std::string out;
-  for (unsigned char c : identity) out += fmt::format("{:02x}", c);
-  return out;
 }
 
 }  // namespace
@@ -315,15 +309,7 @@ struct Coordinator::Impl {
       w.last_seen = w.last_sent = Clock::now();
       if (e.ready().interval_ms() > 0) w.interval_ms = static_cast<int>(e.ready().interval_ms());
       log->info("worker {} joined ({} connected)", w.name, workers.size() + 1);
-      if (const std::string& version = e.ready().code_version(); !version.empty() && version != DRAPEGEN_BUILD_ID) {
-        log->warn("worker {} runs drapegen {}, this coordinator {}: its drapes may differ from the others'", w.name,
-                  version, DRAPEGEN_BUILD_ID);
-      }
-      if (const std::string& kernels = e.ready().blas_kernels(); !kernels.empty() && kernels != blas_kernels) {
-        log->warn("worker {} factorises with {}, this coordinator with {}: its drapes may differ from the others' "
-                  "(OPENBLAS_CORETYPE chooses the kernels; docs/SERVICE.md, \"Determinism\")",
-                  w.name, kernels, blas_kernels);
-      }
+      warn_if_unlike(*log, w.name, e.ready(), "this coordinator", blas_kernels, "the others'");
       workers.emplace(identity, std::move(w));
       send_heartbeat(workers.at(identity));
       return;
@@ -332,11 +318,7 @@ struct Coordinator::Impl {
       if (e.body_case() == v1::Envelope::kResult || e.body_case() == v1::Envelope::kFailure) {
         reject(identity, fmt::format("{} from an unregistered worker", proto::body_name(e)));
       }
-      if (e.body_case() != v1::Envelope::kDisconnect && e.body_case() != v1::Envelope::kShutdown) {
-        v1::Envelope d;
-        d.mutable_disconnect()->set_reason("unknown worker: send ready");
-        send(identity, std::move(d));
-      }
+      if (auto answer = answer_to_stranger(e)) send(identity, std::move(*answer));
       return;
     }
     Worker& w = it->second;

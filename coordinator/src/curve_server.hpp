@@ -2,6 +2,7 @@
 // The server side of CurveZMQ, shared by the generation coordinator and the diagnosis's fleet: the server key on a
 // ROUTER socket and a ZAP handler (RFC 27) that admits only the authorised client keys; and which endpoints need it.
 
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <set>

@@ -1,6 +1,7 @@
 #include "drapegen/coordinator/simulation_fleet.hpp"
 
 #include "curve_server.hpp"
+#include "worker_peers.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -9,12 +10,12 @@
 #include <fmt/format.h>
 #include <future>
 #include <map>
+#include <set>
 #include <mutex>
 #include <thread>
 #include <zmq.hpp>
 #include <zmq_addon.hpp>
 
-#include "drapegen/build_id.hpp"
 #include "drapegen/coordinator/logging.hpp"
 #include "drapegen/proto/codec.hpp"
 #include "drapegen/proto/simulation.hpp"
@@ -35,12 +36,6 @@ struct Task {
   std::promise<sim::Expected<sim::DrapeResult>> answer;
 };
 
-std::string hex(const std::string& identity) {
-  std::string out;
-  for (unsigned char c : identity) out += fmt::format("{:02x}", c);
-  return out;
-}
-
 }  // namespace
 
 struct SimulationFleet::Impl {
@@ -49,6 +44,8 @@ struct SimulationFleet::Impl {
     Clock::time_point last_seen, last_sent;
     int interval_ms = 1000;
     std::shared_ptr<Task> task;  // the drape it computes (null: idle)
+    Clock::time_point dispatched;  // when it was sent
+    bool unfit = false;            // it did not compute a drape it was sent: it gets no more
   };
 
   FleetOptions options;
@@ -69,6 +66,7 @@ struct SimulationFleet::Impl {
 
   // The serving thread's alone.
   std::map<std::string, Worker> workers;
+  std::set<std::string> names;  // of every worker registered so far
   Clock::time_point last_worker = Clock::now();  // when a worker was last registered
   Clock::time_point last_reject_log{};
   std::atomic<bool> stop{false};
@@ -80,7 +78,7 @@ struct SimulationFleet::Impl {
       socket.send(zmq::buffer(identity), zmq::send_flags::sndmore);
       socket.send(zmq::buffer(frame), zmq::send_flags::none);
     } catch (const zmq::error_t& e) {
-      log->warn("fleet: cannot send to worker {}: {}", hex(identity), e.what());
+      log->warn("fleet: cannot send to worker {}: {}", printable(identity), e.what());
     }
     if (auto it = workers.find(identity); it != workers.end()) it->second.last_sent = Clock::now();
   }
@@ -97,7 +95,7 @@ struct SimulationFleet::Impl {
     ++counters.rejected;
     const auto now = Clock::now();
     if (now - last_reject_log > std::chrono::seconds(1)) {
-      log->warn("fleet: dropped a message from {}: {} ({} dropped so far)", hex(identity), why, counters.rejected);
+      log->warn("fleet: dropped a message from {}: {} ({} dropped so far)", printable(identity), why, counters.rejected);
       last_reject_log = now;
     }
   }
@@ -131,24 +129,17 @@ struct SimulationFleet::Impl {
     }
     Worker w;
     w.identity = identity;
-    w.name = ready.worker_name().empty() ? hex(identity) : ready.worker_name();
+    w.name = ready.worker_name().empty() ? printable(identity) : ready.worker_name();
     w.last_seen = w.last_sent = Clock::now();
     if (ready.interval_ms() > 0) w.interval_ms = static_cast<int>(ready.interval_ms());
     log->info("fleet: worker {} joined ({} connected)", w.name, workers.size() + 1);
-    if (!ready.code_version().empty() && ready.code_version() != DRAPEGEN_BUILD_ID) {
-      log->warn("fleet: worker {} runs drapegen {}, this process {}: its drapes may differ from local ones", w.name,
-                ready.code_version(), DRAPEGEN_BUILD_ID);
-    }
-    if (!ready.blas_kernels().empty() && ready.blas_kernels() != blas_kernels) {
-      log->warn("fleet: worker {} factorises with {}, this process with {}: its drapes may differ from local ones "
-                "(docs/SERVICE.md, \"Determinism\")",
-                w.name, ready.blas_kernels(), blas_kernels);
-    }
+    warn_if_unlike(*log, w.name, ready, "this diagnosis", blas_kernels, "this process's own");
+    names.insert(w.name);
     workers.emplace(identity, std::move(w));
     last_worker = Clock::now();
     {
       std::lock_guard lock(mutex);
-      ++counters.workers_seen;
+      counters.workers_seen = static_cast<int>(names.size());
     }
     update_worker_count();
     heartbeat(identity);
@@ -173,11 +164,7 @@ struct SimulationFleet::Impl {
       if (e.body_case() == v1::Envelope::kResult || e.body_case() == v1::Envelope::kFailure) {
         reject(identity, fmt::format("{} from an unregistered worker", proto::body_name(e)));
       }
-      if (e.body_case() != v1::Envelope::kDisconnect && e.body_case() != v1::Envelope::kShutdown) {
-        v1::Envelope d;
-        d.mutable_disconnect()->set_reason("unknown worker: send ready");
-        send(identity, std::move(d));
-      }
+      if (auto answer = answer_to_stranger(e)) send(identity, std::move(*answer));
       return;
     }
     Worker& w = it->second;
@@ -185,6 +172,16 @@ struct SimulationFleet::Impl {
     switch (e.body_case()) {
       case v1::Envelope::kHeartbeat:
         if (e.heartbeat().interval_ms() > 0) w.interval_ms = static_cast<int>(e.heartbeat().interval_ms());
+        // A worker names the job it computes. One that still names another two intervals after its drape was sent
+        // does not have it (it could not read the job, e.g. a build that does not know JOB_MODE_SIMULATE): the drape
+        // goes to the next worker, as a lost one's does, and this one gets no more.
+        if (w.task && e.heartbeat().job_id() != w.task->id &&
+            Clock::now() - w.dispatched > std::chrono::milliseconds(2L * w.interval_ms)) {
+          log->warn("fleet: worker {} does not compute the drape it was sent (another build?); it gets no more",
+                    w.name);
+          lose(w, "it does not compute it");
+          w.unfit = true;
+        }
         return;
       case v1::Envelope::kResult: {
         auto task = held(w, e.result().job_id(), e.result().attempt(), "result");
@@ -213,7 +210,7 @@ struct SimulationFleet::Impl {
 
   void dispatch() {
     for (auto& [identity, w] : workers) {
-      if (w.task) continue;
+      if (w.task || w.unfit) continue;
       {
         std::lock_guard lock(mutex);
         if (queue.empty()) return;
@@ -221,6 +218,7 @@ struct SimulationFleet::Impl {
         queue.pop_front();
         ++w.task->attempts;
       }
+      w.dispatched = Clock::now();
       v1::Envelope e;
       auto* job = e.mutable_job();
       job->set_job_id(w.task->id);
@@ -353,6 +351,8 @@ const std::string& SimulationFleet::endpoint() const { return impl_->endpoint; }
 sim::Expected<sim::DrapeResult> SimulationFleet::simulate(const sim::DrapeConfig& config) {
   auto wire = proto::to_proto(config);
   if (!wire) return wire.error();
+  // What a worker would refuse to read is refused here (a worker that cannot read its job answers nothing).
+  if (auto readable = proto::from_proto(*wire); !readable) return readable.error();
   auto task = std::make_shared<Task>();
   task->simulation = std::move(wire).value();
   task->queued = Clock::now();

@@ -164,6 +164,65 @@ TEST(SimulationFleet, GivesALostWorkersDrapeToTheNextAndFailsItAfterMaxAttempts)
   EXPECT_NE(lost.error().message.find("lost with 1 workers"), std::string::npos) << lost.error().message;
 }
 
+/// A worker that registers, takes one job, and heartbeats on as if it had none (a build that cannot read the job).
+void take_a_job_and_ignore_it(const std::string& endpoint, std::atomic<bool>& took, const std::atomic<bool>& stop) {
+  zmq::context_t context{1};
+  zmq::socket_t socket(context, zmq::socket_type::dealer);
+  socket.set(zmq::sockopt::linger, 0);
+  socket.connect(endpoint);
+  auto send = [&](v1::Envelope e) {
+    const std::string frame = proto::encode(std::move(e));
+    socket.send(zmq::buffer(frame));
+  };
+  v1::Envelope ready;
+  ready.mutable_ready()->set_worker_name("ignoring");
+  ready.mutable_ready()->set_interval_ms(50);
+  send(ready);
+  while (!stop) {
+    zmq::pollitem_t item{socket.handle(), 0, ZMQ_POLLIN, 0};
+    zmq::poll(&item, 1, std::chrono::milliseconds(50));
+    zmq::message_t message;
+    while (socket.recv(message, zmq::recv_flags::dontwait)) {
+      auto e = proto::decode(message.data(), message.size());
+      if (e && e->body_case() == v1::Envelope::kJob) took = true;
+    }
+    v1::Envelope beat;
+    beat.mutable_heartbeat()->set_interval_ms(50);
+    beat.mutable_heartbeat()->set_job_id(0);
+    send(beat);
+  }
+}
+
+TEST(SimulationFleet, GivesADrapeAWorkerDoesNotComputeToTheNext) {
+  auto fleet = SimulationFleet::start(fast_options());
+  ASSERT_TRUE(fleet);
+  const std::string endpoint = (*fleet)->endpoint();
+  std::atomic<bool> took{false}, stop{false};
+  std::thread ignoring([&] { take_a_job_and_ignore_it(endpoint, took, stop); });
+  struct Join {
+    std::atomic<bool>& stop;
+    std::thread& thread;
+    ~Join() {
+      stop = true;
+      thread.join();
+    }
+  } join{stop, ignoring};
+  ASSERT_EQ((*fleet)->wait_for_workers(1, 20.0), 1);
+  std::optional<Workers> real;
+  std::thread starter([&] {
+    while (!took) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    real.emplace(endpoint, 1);
+  });
+  auto drape = (*fleet)->simulate(small_drape(4));
+  starter.join();
+  ASSERT_TRUE(drape) << drape.error().message;
+  EXPECT_EQ(drape->mesh.positions, sim::simulate_drape(small_drape(4))->mesh.positions);
+  EXPECT_EQ((*fleet)->counters().lost_attempts, 1);
+  EXPECT_EQ((*fleet)->counters().workers, 2);  // the ignoring worker is still registered, and gets no drape
+  EXPECT_TRUE((*fleet)->simulate(small_drape(5)));
+  EXPECT_EQ((*fleet)->counters().lost_attempts, 1);
+}
+
 TEST(SimulationFleet, AdmitsOnlyAuthorisedWorkersAndNeedsCurveBeyondLoopback) {
   FleetOptions open = fast_options();
   open.bind = "tcp://0.0.0.0:*";

@@ -16,16 +16,12 @@ v1::Simulation::Directional directional(const sim::DirectionalValues& d) {
 
 sim::DirectionalValues directional(const v1::Simulation::Directional& d) { return {d.warp(), d.bias(), d.weft()}; }
 
-/// The solver options the wire form does not carry are DrapeConfig's defaults.
-bool default_solver_beyond_limits(const sim::SolverOptions& s) {
-  sim::SolverOptions d = sim::DrapeConfig{}.solver;
-  d.max_iterations = s.max_iterations;
-  d.tolerance = s.tolerance;
-  return s.armijo == d.armijo && s.max_line_search == d.max_line_search && s.max_step == d.max_step &&
-         s.max_regularization == d.max_regularization && s.exact_hessian_below == d.exact_hessian_below &&
-         s.gauss_newton_above == d.gauss_newton_above && s.lagged_every_above == d.lagged_every_above &&
-         s.lagged_every_iterations == d.lagged_every_iterations && s.lagged_outer_below == d.lagged_outer_below &&
-         s.lagged_tolerance == d.lagged_tolerance && s.max_pcg_iterations == d.max_pcg_iterations;
+/// The solver options the wire form does not carry (all but max_iterations and tolerance) are DrapeConfig's defaults.
+bool default_solver_beyond_limits(sim::SolverOptions s) {
+  const sim::SolverOptions d = sim::DrapeConfig{}.solver;
+  s.max_iterations = d.max_iterations;
+  s.tolerance = d.tolerance;
+  return s == d;
 }
 
 template <typename Enum>
@@ -98,7 +94,7 @@ sim::Expected<sim::DrapeConfig> from_proto(const v1::Simulation& s) {
   if (!model) return model.error();
   auto anisotropy = enum_value(s.anisotropy(), sim::AnisotropyRule::kEdge, "anisotropy rule");
   if (!anisotropy) return anisotropy.error();
-  auto triangulation = enum_value(s.specimen_triangulation(), sim::Triangulation::kEquilateral, "triangulation");
+  auto triangulation = enum_value(s.specimen_triangulation(), sim::Triangulation::kUniform, "triangulation");
   if (!triangulation) return triangulation.error();
   auto shape = enum_value(s.initial_shape(), sim::InitialShape::kFold, "initial shape");
   if (!shape) return shape.error();

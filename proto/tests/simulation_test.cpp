@@ -92,6 +92,17 @@ TEST(Simulation, CarriesEveryFieldOfTheConfigExactly) {
   EXPECT_EQ(*plain_back->effects.bending_yield_curvature, 0.0);
 }
 
+TEST(Simulation, CarriesEveryTriangulation) {
+  for (auto t : {sim::Triangulation::kAlternating, sim::Triangulation::kRandom, sim::Triangulation::kEquilateral,
+                 sim::Triangulation::kUniform}) {
+    sim::DrapeConfig c;
+    c.specimen.triangulation = t;
+    auto back = from_proto(*to_proto(c));
+    ASSERT_TRUE(back) << back.error().message;
+    EXPECT_EQ(back->specimen.triangulation, t);
+  }
+}
+
 TEST(Simulation, RefusesWhatItCannotCarry) {
   sim::DrapeConfig mesh;
   mesh.initial.shape = sim::InitialShape::kMesh;
@@ -99,6 +110,9 @@ TEST(Simulation, RefusesWhatItCannotCarry) {
   EXPECT_FALSE(to_proto(mesh));
   sim::DrapeConfig solver;
   solver.solver.max_step = 0.02;
+  EXPECT_FALSE(to_proto(solver));
+  solver = {};
+  solver.solver.pcg_tolerance = 0.05;  // every option, not a list of them
   EXPECT_FALSE(to_proto(solver));
   v1::Simulation s = *to_proto(sim::DrapeConfig{});
   s.set_initial_shape(3);  // kMesh

@@ -4,10 +4,10 @@
 // coordinator's side of the worker protocol (docs/SERVICE.md): `drapegen worker --connect ENDPOINT` processes, on this
 // machine or others, register, take one JOB_MODE_SIMULATE job at a time, heartbeat while they compute, and send the
 // drape back. A worker that goes silent beyond its liveness (or registers again) loses its drape to the next free
-// worker; nothing is written to disk and there is no manifest: a caller that stops loses only drapes in flight. As the
+// worker, and so does a drape that a worker does not name in its heartbeats two intervals after it was sent (it
+// could not read the job: that worker gets no more); nothing is written to disk and there is no manifest: a caller that stops loses only drapes in flight. As the
 // coordinator, it binds an address other machines can reach only with CurveZMQ on.
 
-#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -56,7 +56,7 @@ class SimulationFleet {
     std::int64_t lost_attempts = 0;  // attempts lost with their worker (re-queued or failed)
     std::int64_t rejected = 0;       // messages dropped (undecodable, stale, unknown)
     int workers = 0;                 // registered now
-    int workers_seen = 0;            // registered since the start
+    int workers_seen = 0;            // distinct workers (by name) registered since the start
   };
   [[nodiscard]] Counters counters() const;
 

@@ -30,8 +30,9 @@ struct FitSettings {
   std::vector<int> fit_views{0, 1, 2}; // the rest are held out
   MetricWeights weights;
   /// Computes a drape: sim::simulate_drape where unset, else e.g. a fleet of workers (coordinator::SimulationFleet;
-  /// docs/DIAGNOSIS.md, "Refits on workers"). It must give the drape simulate_drape would (the same build on the
-  /// same BLAS kernels does), or the diagnosis is another one. Called from several threads at once.
+  /// docs/DIAGNOSIS.md, "Refits on workers"). Its mesh, solve outcome and rest angles (all the forward model reads)
+  /// must be simulate_drape's (the same build on the same BLAS kernels gives them), or the diagnosis is another one.
+  /// Called from several threads at once.
   std::function<sim::Expected<sim::DrapeResult>(const sim::DrapeConfig&)> simulator;
 };
 

@@ -64,6 +64,8 @@ struct SolverOptions {
   double max_extrapolation = 8.0;
   /// Outer updates after which the parameters are fixed anyway (directions in nearly flat regions can cycle).
   int max_lagged_outer_updates = 6;
+
+  [[nodiscard]] bool operator==(const SolverOptions&) const = default;
 };
 
 struct SolveReport {
