@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # How a diagnosis's time drops when its drapes run on N workers (issue 6, acceptance 3; docs/BENCHMARKS.md):
 # the same diagnosis of one capture (with its second and held-out placements when CAPTURE.p1 and CAPTURE.p2 exist)
-# in this process with --jobs 1, then on a fleet of N local `drapegen worker` processes with --jobs N for each N
-# given. Prints the wall time of each (report.json runtime), its ratio to --jobs 1, the verdict, and whether the
+# in this process with --jobs 1, then for each N given on N threads of this process (N > 1) and on a fleet of N local
+# `drapegen worker` processes, with --jobs N. Prints the wall time of each (report.json runtime), its ratio to --jobs 1, the verdict, and whether the
 # report is --jobs 1's but for its seconds. Workers on this machine share its cores with the diagnosing process:
 # more workers than cores measure contention, not the fleet.
 #
@@ -36,6 +36,11 @@ read -r base verdict < <(summary "$work/local.json")
 printf '%-22s %8s %7s  %s\n' "run" "seconds" "ratio" "verdict"
 printf '%-22s %8.1f %7.2f  %s\n' "here, --jobs 1" "$base" 1 "$verdict"
 for n in "${counts[@]}"; do
+  if [ "$n" -gt 1 ]; then  # the same N on threads of this process, for comparison
+    "$DRAPEGEN" diagnose "${args[@]}" --jobs "$n" > "$work/here-$n.json"
+    read -r seconds verdict < <(summary "$work/here-$n.json")
+    printf '%-22s %8.1f %7.2f  %s\n' "here, --jobs $n" "$seconds" "$(python3 -c "print($seconds / $base)")" "$verdict"
+  fi
   endpoint="ipc://$work/fleet-$n.ipc"
   pids=()
   trap 'kill "${pids[@]}" 2> /dev/null; rm -rf "$work"' EXIT
