@@ -363,12 +363,13 @@ Runner add_diagnose_command(CLI::App& app) {
                  "result as --jobs 1)")
       ->capture_default_str();
   app.add_option("--fleet", o->fleet,
-                 "Compute the drapes on worker processes instead of here: bind this endpoint (e.g. tcp://*:5600; "
-                 "tcp://127.0.0.1:* picks a free port, logged and written by --fleet-endpoint-file) and serve every drape to `drapegen worker --connect "
-                 "ENDPOINT` processes, on this machine or others, as they come and go; the renders, scores and "
-                 "searches stay here. --jobs then counts refits in flight, and each refit simulates its initial states "
-                 "on --jobs threads too. The same result as without, where the workers run this build on the same "
-                 "BLAS kernels (docs/DIAGNOSIS.md, \"Refits on workers\"). An address other machines can reach needs "
+                 "Compute the drapes on worker processes instead of here: bind this endpoint (e.g. "
+                 "tcp://127.0.0.1:5600; tcp://127.0.0.1:* picks a free port, logged and written by "
+                 "--fleet-endpoint-file) and serve every drape to `drapegen worker --connect ENDPOINT` processes, on "
+                 "this machine or others, as they come and go; the renders, scores and searches stay here. --jobs then "
+                 "counts refits in flight, and each refit simulates its initial states on --jobs threads too. The same "
+                 "result as without, where the workers run this build on the same BLAS kernels (docs/DIAGNOSIS.md, "
+                 "\"Refits on workers\"). An address other machines can reach (e.g. tcp://*:5600) needs "
                  "--fleet-server-key and --fleet-authorized-keys");
   app.add_option("--fleet-workers", o->fleet_workers,
                  "With --fleet: wait for this many workers before starting (more may join later)")

@@ -67,7 +67,7 @@ struct SimulationFleet::Impl {
   // The serving thread's alone.
   std::map<std::string, Worker> workers;
   std::set<std::string> names;  // of every worker registered so far
-  Clock::time_point last_worker = Clock::now();  // when a worker was last registered
+  Clock::time_point last_worker = Clock::now();  // when a worker that takes drapes was last connected
   Clock::time_point last_reject_log{};
   std::atomic<bool> stop{false};
   std::thread thread;
@@ -95,7 +95,8 @@ struct SimulationFleet::Impl {
     ++counters.rejected;
     const auto now = Clock::now();
     if (now - last_reject_log > std::chrono::seconds(1)) {
-      log->warn("fleet: dropped a message from {}: {} ({} dropped so far)", printable(identity), why, counters.rejected);
+      log->warn("fleet: dropped a message from {}: {} ({} dropped so far)", printable(identity), why,
+                counters.rejected);
       last_reject_log = now;
     }
   }
@@ -246,7 +247,8 @@ struct SimulationFleet::Impl {
       ++it;
     }
     if (changed) update_worker_count();
-    if (!workers.empty()) {
+    // A worker that gets no more drapes (unfit) counts as none.
+    if (std::any_of(workers.begin(), workers.end(), [](const auto& entry) { return !entry.second.unfit; })) {
       last_worker = now;
       return;
     }
@@ -254,9 +256,9 @@ struct SimulationFleet::Impl {
     const auto limit = std::chrono::duration<double>(options.wait_s);
     for (auto it = queue.begin(); it != queue.end();) {
       if (now - std::max((*it)->queued, last_worker) > limit) {
-        (*it)->answer.set_value(sim::Error{fmt::format("no worker connected to {} for {} s (start some with: drapegen "
-                                                       "worker --connect {})",
-                                                       endpoint, options.wait_s, endpoint)});
+        (*it)->answer.set_value(sim::Error{fmt::format(
+            "no worker that computes drapes connected to {} for {} s (start some with: drapegen worker --connect {})",
+            endpoint, options.wait_s, endpoint)});
         it = queue.erase(it);
       } else {
         ++it;
@@ -327,7 +329,8 @@ sim::Expected<std::unique_ptr<SimulationFleet>> SimulationFleet::start(const Fle
   auto impl = std::make_unique<Impl>();
   impl->options = options;
   if (curve) {
-    auto attached = CurveServer::attach(impl->context, impl->socket, options.server_secret_key, options.authorized_keys);
+    auto attached =
+        CurveServer::attach(impl->context, impl->socket, options.server_secret_key, options.authorized_keys);
     if (!attached) return sim::Error{"fleet: " + attached.error().message};
     impl->curve = std::move(attached).value();
     impl->log->info("fleet: CurveZMQ on: {} authorised worker key(s); server public key {}", impl->curve->authorized(),

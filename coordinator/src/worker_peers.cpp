@@ -13,8 +13,8 @@ std::string printable(const std::string& identity) {
   return out;
 }
 
-void warn_if_unlike(spdlog::logger& log, const std::string& worker, const v1::Ready& ready, std::string_view self,
-                    const std::string& own_kernels, std::string_view others) {
+void warn_if_unlike(spdlog::logger& log, const std::string& worker, const v1::Ready& ready,
+                    std::string_view self, const std::string& own_kernels, std::string_view others) {
   if (const std::string& version = ready.code_version(); !version.empty() && version != DRAPEGEN_BUILD_ID) {
     log.warn("worker {} runs drapegen {}, {} {}: its drapes may differ from {}", worker, version, self,
              DRAPEGEN_BUILD_ID, others);

@@ -15,8 +15,8 @@ namespace drapegen::coordinator {
 
 /// Warns when a registering worker runs another build or factorises with other BLAS kernels than `self` (e.g. "this
 /// coordinator"; `own_kernels` its kernels): its drapes may then differ from `others` (e.g. "the others'").
-void warn_if_unlike(spdlog::logger& log, const std::string& worker, const proto::v1::Ready& ready, std::string_view self,
-                    const std::string& own_kernels, std::string_view others);
+void warn_if_unlike(spdlog::logger& log, const std::string& worker, const proto::v1::Ready& ready,
+                    std::string_view self, const std::string& own_kernels, std::string_view others);
 
 /// The answer to a message from a peer that has not registered: Disconnect ("send ready"), except to a Disconnect or
 /// a Shutdown (none).

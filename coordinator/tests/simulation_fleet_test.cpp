@@ -110,7 +110,8 @@ TEST(SimulationFleet, FailsADrapeThatNoWorkerComesFor) {
   ASSERT_TRUE(fleet);
   auto drape = (*fleet)->simulate(small_drape(1));
   ASSERT_FALSE(drape);
-  EXPECT_NE(drape.error().message.find("no worker connected"), std::string::npos) << drape.error().message;
+  EXPECT_NE(drape.error().message.find("no worker that computes drapes connected"), std::string::npos)
+      << drape.error().message;
 }
 
 /// A worker that registers, takes one job and then falls silent.
@@ -221,6 +222,28 @@ TEST(SimulationFleet, GivesADrapeAWorkerDoesNotComputeToTheNext) {
   EXPECT_EQ((*fleet)->counters().workers, 2);  // the ignoring worker is still registered, and gets no drape
   EXPECT_TRUE((*fleet)->simulate(small_drape(5)));
   EXPECT_EQ((*fleet)->counters().lost_attempts, 1);
+}
+
+TEST(SimulationFleet, FailsADrapeWhenOnlyWorkersThatDoNotComputeAreLeft) {
+  FleetOptions o = fast_options();
+  o.wait_s = 0.5;
+  auto fleet = SimulationFleet::start(o);
+  ASSERT_TRUE(fleet);
+  std::atomic<bool> took{false}, stop{false};
+  std::thread ignoring([&] { take_a_job_and_ignore_it((*fleet)->endpoint(), took, stop); });
+  struct Join {
+    std::atomic<bool>& stop;
+    std::thread& thread;
+    ~Join() {
+      stop = true;
+      thread.join();
+    }
+  } join{stop, ignoring};
+  ASSERT_EQ((*fleet)->wait_for_workers(1, 20.0), 1);
+  auto drape = (*fleet)->simulate(small_drape(6));
+  ASSERT_FALSE(drape);
+  EXPECT_NE(drape.error().message.find("no worker that computes drapes connected"), std::string::npos)
+      << drape.error().message;
 }
 
 TEST(SimulationFleet, AdmitsOnlyAuthorisedWorkersAndNeedsCurveBeyondLoopback) {

@@ -26,7 +26,9 @@ bool default_solver_beyond_limits(sim::SolverOptions s) {
 
 template <typename Enum>
 sim::Expected<Enum> enum_value(int value, Enum last, const char* what) {
-  if (value < 0 || value > static_cast<int>(last)) return sim::Error{fmt::format("simulation: unknown {} {}", what, value)};
+  if (value < 0 || value > static_cast<int>(last)) {
+    return sim::Error{fmt::format("simulation: unknown {} {}", what, value)};
+  }
   return static_cast<Enum>(value);
 }
 

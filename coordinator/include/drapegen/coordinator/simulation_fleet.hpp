@@ -4,9 +4,9 @@
 // coordinator's side of the worker protocol (docs/SERVICE.md): `drapegen worker --connect ENDPOINT` processes, on this
 // machine or others, register, take one JOB_MODE_SIMULATE job at a time, heartbeat while they compute, and send the
 // drape back. A worker that goes silent beyond its liveness (or registers again) loses its drape to the next free
-// worker, and so does a drape that a worker does not name in its heartbeats two intervals after it was sent (it
-// could not read the job: that worker gets no more); nothing is written to disk and there is no manifest: a caller that stops loses only drapes in flight. As the
-// coordinator, it binds an address other machines can reach only with CurveZMQ on.
+// worker, and so does one that does not name its drape in its heartbeats two intervals after it was sent (it could
+// not read the job; it gets no more). Nothing is written to disk and there is no manifest: a caller that stops loses
+// only drapes in flight. As the coordinator, it binds an address other machines can reach only with CurveZMQ on.
 
 #include <cstdint>
 #include <memory>
@@ -27,7 +27,8 @@ struct FleetOptions {
   int heartbeat_ms = 1000;                 // this side's heartbeat interval
   int liveness = 5;                        // a worker silent for liveness x its interval is lost
   int max_attempts = 3;                    // a drape whose worker is lost this many times fails
-  /// A drape fails when no worker has been connected for this long while it waited (none came, or all left).
+  /// A drape fails when no worker that takes drapes has been connected for this long while it waited (none came,
+  /// all left, or those left do not compute what they are sent).
   double wait_s = 600.0;
 };
 
