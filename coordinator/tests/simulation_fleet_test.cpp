@@ -194,20 +194,24 @@ void take_a_job_and_ignore_it(const std::string& endpoint, std::atomic<bool>& to
   }
 }
 
+/// take_a_job_and_ignore_it on a thread of its own, stopped (and joined) on destruction.
+struct IgnoringWorker {
+  explicit IgnoringWorker(const std::string& endpoint)
+      : thread([this, endpoint] { take_a_job_and_ignore_it(endpoint, took, stop); }) {}
+  ~IgnoringWorker() {
+    stop = true;
+    thread.join();
+  }
+  std::atomic<bool> took{false}, stop{false};
+  std::thread thread;
+};
+
 TEST(SimulationFleet, GivesADrapeAWorkerDoesNotComputeToTheNext) {
   auto fleet = SimulationFleet::start(fast_options());
   ASSERT_TRUE(fleet);
   const std::string endpoint = (*fleet)->endpoint();
-  std::atomic<bool> took{false}, stop{false};
-  std::thread ignoring([&] { take_a_job_and_ignore_it(endpoint, took, stop); });
-  struct Join {
-    std::atomic<bool>& stop;
-    std::thread& thread;
-    ~Join() {
-      stop = true;
-      thread.join();
-    }
-  } join{stop, ignoring};
+  IgnoringWorker ignoring(endpoint);
+  std::atomic<bool>& took = ignoring.took;
   ASSERT_EQ((*fleet)->wait_for_workers(1, 20.0), 1);
   std::optional<Workers> real;
   std::thread starter([&] {
@@ -229,16 +233,7 @@ TEST(SimulationFleet, FailsADrapeWhenOnlyWorkersThatDoNotComputeAreLeft) {
   o.wait_s = 0.5;
   auto fleet = SimulationFleet::start(o);
   ASSERT_TRUE(fleet);
-  std::atomic<bool> took{false}, stop{false};
-  std::thread ignoring([&] { take_a_job_and_ignore_it((*fleet)->endpoint(), took, stop); });
-  struct Join {
-    std::atomic<bool>& stop;
-    std::thread& thread;
-    ~Join() {
-      stop = true;
-      thread.join();
-    }
-  } join{stop, ignoring};
+  IgnoringWorker ignoring((*fleet)->endpoint());
   ASSERT_EQ((*fleet)->wait_for_workers(1, 20.0), 1);
   auto drape = (*fleet)->simulate(small_drape(6));
   ASSERT_FALSE(drape);
