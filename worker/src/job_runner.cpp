@@ -51,6 +51,18 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+// What every drape reports about its solve, whichever mode ran it.
+v1::Metrics solve_metrics(const sim::DrapeResult& drape, std::chrono::steady_clock::time_point start) {
+  v1::Metrics metrics;
+  metrics.set_outcome(std::string(sim::to_string(drape.report.outcome)));
+  metrics.set_iterations(drape.report.iterations);
+  metrics.set_coarse_iterations(drape.coarse_report.iterations);
+  metrics.set_residual(drape.report.residual);
+  metrics.set_energy(drape.report.energy);
+  metrics.set_sim_seconds(seconds_since(start));
+  return metrics;
+}
+
 }  // namespace
 
 sim::Expected<sim::DrapeConfig> drape_config(const v1::JobSpec& spec, const std::string& source_mesh_path) {
@@ -91,13 +103,7 @@ v1::Envelope JobRunner::simulate(const v1::Job& job) {
   auto* result = e.mutable_result();
   result->set_job_id(job.job_id());
   result->set_attempt(job.attempt());
-  auto* metrics = result->mutable_metrics();
-  metrics->set_outcome(std::string(sim::to_string(drape->report.outcome)));
-  metrics->set_iterations(drape->report.iterations);
-  metrics->set_coarse_iterations(drape->coarse_report.iterations);
-  metrics->set_residual(drape->report.residual);
-  metrics->set_energy(drape->report.energy);
-  metrics->set_sim_seconds(seconds_since(start));
+  *result->mutable_metrics() = solve_metrics(*drape, start);
   *result->mutable_drape() = proto::to_proto(*drape);
   return e;
 }
@@ -150,16 +156,10 @@ v1::Envelope JobRunner::compute(const v1::Job& job) {
   const auto sim_start = std::chrono::steady_clock::now();
   auto drape = sim::simulate_drape(*config);
   if (!drape) return failure(job, v1::FAILURE_REASON_INVALID_JOB, drape.error().message);
-  v1::Metrics metrics;
-  metrics.set_outcome(std::string(sim::to_string(drape->report.outcome)));
-  metrics.set_iterations(drape->report.iterations);
-  metrics.set_coarse_iterations(drape->coarse_report.iterations);
-  metrics.set_residual(drape->report.residual);
-  metrics.set_energy(drape->report.energy);
+  v1::Metrics metrics = solve_metrics(*drape, sim_start);
   metrics.set_drape_coefficient(drape->measures.drape_coefficient);
   metrics.set_folds(drape->measures.folds);
   metrics.set_self_intersections(drape->measures.self_intersections);
-  metrics.set_sim_seconds(seconds_since(sim_start));
   metrics.set_bending_model(config->bending_model == sim::BendingModel::kNonlinearTriangle ? "triangle" : "dihedral");
   // A solve that ends with a non-finite residual or energy diverged, whatever the solver called its stop.
   const bool non_finite = !std::isfinite(drape->report.residual) || !std::isfinite(drape->report.energy);
