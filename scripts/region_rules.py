@@ -18,7 +18,10 @@
 - place_gap_27b: place_gap_27, and a platform top at least lifted_scale times its own floor placing the gap
   everywhere (pre-registered in session 27 before seed 20 was diagnosed);
 - pixel_region, floor_region: the report's other two localisers (the most enriched region; the region furthest
-  above its own floor, in reports since session 22).
+  above its own floor, in reports since session 22);
+- split_enrichment, split_floor_ratio (session 44): where the report placed the gap at the hem or the skirt, whichever
+  of the two has the denser pixel residual (enrichment) or the residual further above its own floor (floor_ratio);
+  any other region as run.
 
 Per rule: the effect captures whose region is one of the effect's regions (the truth file's `regions`), per family.
 
@@ -43,7 +46,7 @@ from diagnosis_rules import THRESHOLD, confirmation_rule  # noqa: E402  (the tol
 
 OUTLINE = {"harmonics", "off_centre", "sorted_radii", "hem_height"}
 RULES = ["as_run", "largest", "place_gap_24", "place_gap", "place_gap_27", "place_gap_27b", "pixel_region",
-         "floor_region"]
+         "floor_region", "split_enrichment", "split_floor_ratio"]
 # Where each effect acts (candidate_effect.cpp, effect_regions).
 EFFECT_REGIONS = {"yield": {"skirt"}, "shear": {"skirt"}, "curl": {"hem"}, "misalignment": {"hem"},
                   "friction": {"top", "rim"}, "sensor": {"global"}}
@@ -96,6 +99,14 @@ def place_gap(loc, sensor_scale, skirt_denser, lifted_scale=None):
         return "hem"
     enrichment = {r["region"]: r["enrichment"] for r in loc["regions"]}
     return "skirt" if enrichment.get("skirt", 0.0) > skirt_denser * enrichment.get("hem", 0.0) else "hem"
+
+
+def split(loc, key):
+    """The hem or the skirt as run, re-split by the two regions' `key` (enrichment, floor_ratio); else as run."""
+    if loc["region"] not in ("hem", "skirt"):
+        return loc["region"]
+    share = {r["region"]: r.get(key, 0.0) for r in loc["regions"]}
+    return "hem" if share.get("hem", 0.0) > share.get("skirt", 0.0) else "skirt"
 
 
 def place_gap_27(loc, sensor_scale, skirt_denser, lifted_scale):
@@ -204,15 +215,16 @@ def main():
                       "place_gap": place_gap(loc, args.sensor_scale, args.skirt_denser, args.lifted_scale),
                       "place_gap_27": place_gap_27(loc, args.sensor_scale, args.skirt_denser, args.lifted_scale),
                       "place_gap_27b": place_gap_27b(loc, args.sensor_scale, args.skirt_denser, args.lifted_scale),
-                      "pixel_region": loc["pixel_region"], "floor_region": loc.get("floor_region")}
+                      "pixel_region": loc["pixel_region"], "floor_region": loc.get("floor_region"),
+                      "split_enrichment": split(loc, "enrichment"), "split_floor_ratio": split(loc, "floor_ratio")}
             totals[family] += 1
             for rule in RULES:
                 hits[rule][family] += region[rule] in regions
     families = sorted(totals)
-    print("%-13s %7s  " % ("rule", "all") + " ".join("%12s" % f for f in families))
+    print("%-17s %7s  " % ("rule", "all") + " ".join("%12s" % f for f in families))
     for rule in RULES:
         n = sum(hits[rule].values())
-        print("%-13s %3d/%-3d  " % (rule, n, sum(totals.values())) +
+        print("%-17s %3d/%-3d  " % (rule, n, sum(totals.values())) +
               " ".join("%12s" % ("%d/%d" % (hits[rule][f], totals[f])) for f in families))
 
 
