@@ -18,7 +18,6 @@
 #include <cmath>
 #include <filesystem>
 #include <fmt/format.h>
-#include <fstream>
 #include <iostream>
 #include <limits>
 #include <memory>
@@ -30,6 +29,7 @@
 #include "drapegen/diagnosis/diagnosis.hpp"
 #include "drapegen/diagnosis/forward_model.hpp"
 #include "drapegen/sim/blas_kernels.hpp"
+#include "json_file.hpp"
 
 namespace fs = std::filesystem;
 using namespace drapegen;
@@ -37,13 +37,7 @@ using nlohmann::json;
 
 namespace {
 
-sim::Expected<json> read_json(const fs::path& path) {
-  std::ifstream in(path);
-  if (!in) return sim::Error{"cannot read " + path.string()};
-  json j = json::parse(in, nullptr, false);
-  if (j.is_discarded()) return sim::Error{"not JSON: " + path.string()};
-  return j;
-}
+using bench::read_json;
 
 /// The truth file's (first) effect: its name and strength; none for a control.
 std::optional<std::pair<std::string, double>> first_effect(const json& truth) {

@@ -12,7 +12,6 @@
 #include <cmath>
 #include <filesystem>
 #include <fmt/format.h>
-#include <fstream>
 #include <iostream>
 #include <limits>
 #include <nlohmann/json.hpp>
@@ -23,6 +22,7 @@
 #include "drapegen/diagnosis/hem_profile.hpp"
 #include "drapegen/diagnosis/localisation.hpp"
 #include "drapegen/sim/blas_kernels.hpp"
+#include "json_file.hpp"
 
 namespace fs = std::filesystem;
 using namespace drapegen;
@@ -30,13 +30,7 @@ using nlohmann::json;
 
 namespace {
 
-sim::Expected<json> read_json(const fs::path& path) {
-  std::ifstream in(path);
-  if (!in) return sim::Error{"cannot read " + path.string()};
-  json j = json::parse(in, nullptr, false);
-  if (j.is_discarded()) return sim::Error{"not JSON: " + path.string()};
-  return j;
-}
+using bench::read_json;
 
 /// Residual energy and pixels per band of material distance from the free edge, over the hanging cloth's pixels.
 struct Bands {
@@ -68,34 +62,23 @@ Bands bands_of(const diagnosis::ForwardModel& model, const diagnosis::ScoredDrap
   B.edges = edges;
   B.energy.assign(edges.size() + 1, 0.0);
   B.pixels.assign(edges.size() + 1, 0.0);
-  const auto& capture = model.capture();
-  const double R = 0.5 * capture.specimen.cylinder_diameter;
+  const double R = 0.5 * model.capture().specimen.cylinder_diameter;
   const diagnosis::HemProfile outline = diagnosis::rotate(diagnosis::hem_profile_from_mesh(drape.mesh), drape.angle);
   // The drape as rendered: turned by its angle about +z (ForwardModel's render).
   const Eigen::Matrix3Xd turned =
       Eigen::AngleAxisd(drape.angle, Eigen::Vector3d::UnitZ()).toRotationMatrix() * drape.mesh.positions;
   const std::vector<double> from_edge = edge_distance(drape.mesh);
-  for (std::size_t v = 0; v < drape.views.size(); ++v) {
-    const auto& cmp = drape.views[v];
-    const auto& view = capture.views[v];
-    const Eigen::Isometry3d to_specimen = view.camera.world_to_camera.inverse();
-    const int W = view.depth.width;
-    for (std::size_t i = 0; i < cmp.residual.size(); ++i) {
-      const float res = cmp.residual[i];
-      if (!std::isfinite(res) || cmp.depth[i] <= 0.0f) continue;
-      const int u = static_cast<int>(i % W), row = static_cast<int>(i / W);
-      const Eigen::Vector3d p = to_specimen * (static_cast<double>(cmp.depth[i]) * view.camera.ray(u, row));
-      const diagnosis::Region r = diagnosis::classify_point(p, outline, R);
-      if (r != diagnosis::Region::kSkirt && r != diagnosis::Region::kHem) continue;
-      Eigen::Index nearest = 0;
-      const double d2 = (turned.colwise() - p).colwise().squaredNorm().minCoeff(&nearest);
-      B.to_vertex.push_back(std::sqrt(d2));
-      const double m = from_edge[static_cast<std::size_t>(nearest)];
-      const std::size_t band = static_cast<std::size_t>(std::upper_bound(edges.begin(), edges.end(), m) - edges.begin());
-      B.energy[band] += static_cast<double>(res) * res;
-      B.pixels[band] += 1.0;
-    }
-  }
+  diagnosis::for_each_residual_point(model, drape, [&](std::size_t, const Eigen::Vector3d& p, double res) {
+    const diagnosis::Region r = diagnosis::classify_point(p, outline, R);
+    if (r != diagnosis::Region::kSkirt && r != diagnosis::Region::kHem) return;
+    Eigen::Index nearest = 0;
+    const double d2 = (turned.colwise() - p).colwise().squaredNorm().minCoeff(&nearest);
+    B.to_vertex.push_back(std::sqrt(d2));
+    const double m = from_edge[static_cast<std::size_t>(nearest)];
+    const auto band = static_cast<std::size_t>(std::upper_bound(edges.begin(), edges.end(), m) - edges.begin());
+    B.energy[band] += res * res;
+    B.pixels[band] += 1.0;
+  });
   return B;
 }
 

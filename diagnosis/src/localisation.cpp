@@ -134,16 +134,10 @@ double RegionEnergy::view_mean(std::size_t view, Region region) const {
   return view_sum[view][k] / view_pixels[view][k];
 }
 
-namespace {
-
-/// region_energy with the drape's outline (turned as rendered) given.
-RegionEnergy region_energy(const ForwardModel& model, const ScoredDrape& drape, const HemProfile& model_outline) {
-  RegionEnergy E;
+void for_each_residual_point(
+    const ForwardModel& model, const ScoredDrape& drape,
+    const std::function<void(std::size_t view, const Eigen::Vector3d& point, double residual)>& visit) {
   const Capture& capture = model.capture();
-  const double R = 0.5 * capture.specimen.cylinder_diameter;
-  E.view_energy.assign(drape.views.size(), 0.0);
-  E.view_sum.assign(drape.views.size(), {});
-  E.view_pixels.assign(drape.views.size(), {});
   for (std::size_t v = 0; v < drape.views.size(); ++v) {
     const auto& cmp = drape.views[v];
     const auto& view = capture.views[v];
@@ -153,16 +147,29 @@ RegionEnergy region_energy(const ForwardModel& model, const ScoredDrape& drape, 
       const float res = cmp.residual[i];
       if (!std::isfinite(res) || cmp.depth[i] <= 0.0f) continue;
       const int u = static_cast<int>(i % W), row = static_cast<int>(i / W);
-      const Eigen::Vector3d p = to_specimen * (static_cast<double>(cmp.depth[i]) * view.camera.ray(u, row));
-      const int k = static_cast<int>(classify_point(p, model_outline, R));
-      const double e = static_cast<double>(res) * res;
-      E.energy[k] += e;
-      E.pixels[k] += 1.0;
-      E.view_energy[v] += e;
-      E.view_sum[v][k] += res;
-      E.view_pixels[v][k] += 1.0;
+      visit(v, to_specimen * (static_cast<double>(cmp.depth[i]) * view.camera.ray(u, row)), static_cast<double>(res));
     }
   }
+}
+
+namespace {
+
+/// region_energy with the drape's outline (turned as rendered) given.
+RegionEnergy region_energy(const ForwardModel& model, const ScoredDrape& drape, const HemProfile& model_outline) {
+  RegionEnergy E;
+  const double R = 0.5 * model.capture().specimen.cylinder_diameter;
+  E.view_energy.assign(drape.views.size(), 0.0);
+  E.view_sum.assign(drape.views.size(), {});
+  E.view_pixels.assign(drape.views.size(), {});
+  for_each_residual_point(model, drape, [&](std::size_t v, const Eigen::Vector3d& p, double res) {
+    const int k = static_cast<int>(classify_point(p, model_outline, R));
+    const double e = res * res;
+    E.energy[k] += e;
+    E.pixels[k] += 1.0;
+    E.view_energy[v] += e;
+    E.view_sum[v][k] += res;
+    E.view_pixels[v][k] += 1.0;
+  });
   return E;
 }
 

@@ -3,6 +3,7 @@
 // cylinder), per view, and in the hem's angular harmonics, fold count and phase.
 
 #include <array>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -75,6 +76,13 @@ struct Localisation {
 
 /// Region of a specimen-frame point given the fitted drape's outline (the hem: within 25 mm of the outline).
 [[nodiscard]] Region classify_point(const Eigen::Vector3d& p, const HemProfile& model_outline, double cylinder_radius);
+
+/// Calls visit(view, point, residual) for every pixel of `drape`'s residual maps that has one (a finite residual and a
+/// depth to place it): the point in the specimen frame where the residual sits (placed at the captured depth where the
+/// capture returned, else the model's; ViewComparison::depth), views and pixels in order.
+void for_each_residual_point(
+    const ForwardModel& model, const ScoredDrape& drape,
+    const std::function<void(std::size_t view, const Eigen::Vector3d& point, double residual)>& visit);
 
 /// `drape` scored against the capture (or a floor sample, with the capture's cameras): its residuals per region.
 [[nodiscard]] RegionEnergy region_energy(const ForwardModel& model, const ScoredDrape& drape);
