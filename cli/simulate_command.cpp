@@ -219,8 +219,8 @@ Runner add_simulate_command(CLI::App& app) {
   app.add_flag("-v,--verbose", o->verbose, "Print every Newton iteration on stderr");
   app.add_option("--effect", o->effects,
                  "Physical effect beyond the paper's model (repeatable): curl=K[,W] (edge rest curvature K 1/m over "
-                 "W mm), yield=K (bending yields at curvature K 1/m), shear=G (woven membrane, shear stiffness G "
-                 "kg/s^2), friction=MU (Coulomb friction on the top instead of adhesion)");
+                 "W mm, default 10), yield=K (bending yields at curvature K 1/m), shear=G (woven membrane, shear "
+                 "stiffness G kg/s^2), friction=MU (Coulomb friction on the top instead of adhesion)");
   return [o] { return run_simulate(*o); };
 }
 

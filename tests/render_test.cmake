@@ -74,7 +74,7 @@ foreach(k 00 01 02)
   endif()
 endforeach()
 
-# The OpenGL renderer instead of the default software rasteriser.
+# The default renderer, OpenGL through OSMesa, names its Mesa driver.
 run(${DRAPEGEN} render --mesh ${WORK}/drape.ply --out ${WORK}/gl.exr --orientations 1 --renderer osmesa --json)
 string(JSON renderer GET "${out}" renderer)
 if(NOT renderer MATCHES "llvmpipe|softpipe")
@@ -83,8 +83,12 @@ endif()
 
 # One data point: exactly the --out path; clean depth.
 run(${DRAPEGEN} render --mesh ${WORK}/drape.ply --out ${WORK}/clean.exr --orientations 1 --noise none)
-if(NOT EXISTS ${WORK}/clean.exr)
+if(NOT EXISTS ${WORK}/clean.exr OR EXISTS ${WORK}/clean_00.exr)
   message(FATAL_ERROR "--orientations 1 did not write --out itself")
+endif()
+run(${EXRHEADER} ${WORK}/clean.exr)
+if(NOT out MATCHES "drapegen.noise \\(type string\\): \"none\"")
+  message(FATAL_ERROR "--noise none: clean.exr does not record a clean depth: ${out}")
 endif()
 
 # Bad meshes: missing, empty, non-finite, out of view (millimetres); unwritable outputs.

@@ -247,7 +247,7 @@ TEST(Exr, SameSeedGivesByteIdenticalFilesDifferentSeedsDiffer) {
       cloth.triangles.push_back({a, a + n + 2, a + n + 1});
     }
   }
-  SoftwareRenderer renderer;  // what drapegen render and the workers use
+  SoftwareRenderer renderer;  // --renderer software; the default (OSMesa) is checked the same way in cli.render
   auto encode_all = [&](std::uint64_t seed) {
     RenderRequest request;
     request.seed = seed;

@@ -103,6 +103,18 @@ TEST(ParameterSampler, EverySampleIsInsideTheWidenedRangeAndDistinct) {
   auto all = sample_parameters(model, o);
   ASSERT_TRUE(all);
   EXPECT_EQ(all->candidates, 500);
+  ASSERT_EQ(all->features.size(), 500u);
+  EXPECT_EQ(all->rejected_range + all->rejected_duplicate, 0);
+  int outside = 0;
+  for (const Features& f : all->features) {
+    for (int i = 0; i < kFeatureCount; ++i) {
+      if (f[i] < low[i] || f[i] > high[i]) {
+        ++outside;
+        break;
+      }
+    }
+  }
+  EXPECT_GT(outside, 0);
 }
 
 TEST(ParameterSampler, VectorsAreTheDecodedLatents) {

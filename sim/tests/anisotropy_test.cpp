@@ -3,7 +3,6 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
@@ -418,41 +417,6 @@ TEST(HingeBendingAngles, RejectsMismatchedTopology) {
   Eigen::VectorXd phi;
   EXPECT_THROW(hinge_bending_angles(large, build_topology(small), AnisotropyRule::kCurvature, phi),
                std::invalid_argument);
-}
-
-/// Median and minimum wall time of `call` in milliseconds over `runs` calls.
-template <class Call>
-std::pair<double, double> time_ms(int runs, Call&& call) {
-  std::vector<double> times;
-  for (int i = 0; i < runs; ++i) {
-    const auto start = std::chrono::steady_clock::now();
-    call();
-    times.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
-  }
-  return {quantile(times, 0.5), *std::min_element(times.begin(), times.end())};
-}
-
-TEST(Anisotropy, TimingOn100x100) {
-  ClothMesh mesh = specimen(true);
-  wrap_on_cylinder(mesh, 0.08, 0.4);
-  const Topology topo = build_topology(mesh);
-  CurvatureWorkspace curvature_workspace;
-  CurvatureField field;
-  AnisotropyWorkspace workspace;
-  Eigen::VectorXd phi;
-  constexpr int kRuns = 40;
-  const auto curvature = time_ms(kRuns, [&] { principal_curvatures(mesh, topo, curvature_workspace, field); });
-  const auto by_curvature = time_ms(kRuns, [&] {
-    hinge_bending_angles(mesh, topo, AnisotropyRule::kCurvature, AnisotropyOptions{}, workspace, phi);
-  });
-  const auto by_edge = time_ms(kRuns, [&] {
-    hinge_bending_angles(mesh, topo, AnisotropyRule::kEdge, AnisotropyOptions{}, workspace, phi);
-  });
-  std::printf("[ timing   ] %d vertices, %zu hinges (median / min ms): principal_curvatures %.3f / %.3f, "
-              "hinge_bending_angles kCurvature %.3f / %.3f, kEdge %.3f / %.3f\n",
-              mesh.vertex_count(), topo.hinges.size(), curvature.first, curvature.second, by_curvature.first,
-              by_curvature.second, by_edge.first, by_edge.second);
-  SUCCEED();
 }
 
 }  // namespace

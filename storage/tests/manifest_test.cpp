@@ -62,7 +62,7 @@ TEST_F(ManifestTest, CreatesThePlanAtomicallyAndReadsItBack) {
   ASSERT_EQ(reader->jobs()->size(), 4u);
   EXPECT_EQ((*reader->jobs())[3].render_seed, 1003u);
   EXPECT_EQ(*reader->integrity_check(), "ok");
-  // WAL and full sync on the writer's connection.
+  // The file is in WAL mode (stored in the database itself), and stays so once a writer opens it again.
   auto writer = Manifest::open(path_);
   ASSERT_TRUE(writer);
   sqlite3* db = nullptr;

@@ -10,10 +10,10 @@ WORK=$2
 SCRIPT=$(readlink -f "$(dirname "$0")/../drapegen.sbatch")
 fail() { echo "slurm_deploy_test: FAILED: $*" >&2; exit 1; }
 
-if ! command -v slurmctld > /dev/null || ! command -v munged > /dev/null; then
+if ! command -v slurmctld > /dev/null || ! command -v munged > /dev/null || ! command -v sqlite3 > /dev/null; then
   [ "$(id -u)" -eq 0 ] || fail "slurm-wlm is not installed and this is not root"
   apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends slurm-wlm munge > /dev/null
+  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends slurm-wlm munge sqlite3 > /dev/null
 fi
 
 rm -rf "$WORK"
@@ -99,7 +99,13 @@ grep -q "run complete: 6 done, 0 failed of 6 jobs" job.out || { cat job.out >&2;
 "$DRAPEGEN" stats "$WORK/run/out/manifest.sqlite" --json > stats.json
 grep -q '"done": 6' stats.json || fail "stats: $(cat stats.json)"
 grep -q '"state": "complete"' stats.json || fail "run state not complete"
-workers=$(sqlite3 "$WORK/run/out/manifest.sqlite" "SELECT count(DISTINCT worker) FROM jobs" 2> /dev/null || echo "?")
+# Every job done names the worker that did it (the manifest's own record, read with SQLite's shell).
+command -v sqlite3 > /dev/null || fail "sqlite3 (Debian's sqlite3) is needed to read the manifest"
+manifest="$WORK/run/out/manifest.sqlite"
+unnamed=$(sqlite3 "$manifest" "SELECT count(*) FROM jobs WHERE state = 'done' AND coalesce(worker, '') = ''")
+[ "$unnamed" -eq 0 ] || fail "the manifest has $unnamed done jobs with no worker"
+workers=$(sqlite3 "$manifest" "SELECT count(DISTINCT worker) FROM jobs WHERE state = 'done'")
+{ [ "$workers" -ge 1 ] && [ "$workers" -le "$cpus" ]; } || fail "the manifest names $workers workers ($cpus started)"
 
 # A gap diagnosis whose drapes the job's workers compute (`diagnose`): its report is the local one but its seconds.
 mkdir -p "$WORK/diagnose"
