@@ -8,13 +8,13 @@
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <optional>
 #include <algorithm>
 #include <nlohmann/json.hpp>
 
 #include <fmt/core.h>
 
+#include "json_file.hpp"
 #include "drapegen/diagnosis/bending_json.hpp"
 #include "drapegen/diagnosis/capture.hpp"
 #include "drapegen/diagnosis/diagnosis.hpp"
@@ -86,23 +86,32 @@ int main(int argc, char** argv) {
       bool ok = true;
       for (const std::string suffix : {"", ".p1", ".p2"}) {
         auto capture = dg::read_capture(run + "/captures/" + name + suffix);
-        std::ifstream in(run + "/truth/" + name + suffix + ".json");
-        if (!capture || !in) {
+        const auto truth_file = drapegen::bench::read_json(run + "/truth/" + name + suffix + ".json");
+        if (!capture || !truth_file) {
+          fmt::print(stderr, "memory_probe: {}/{}{} skipped: {}\n", run, name, suffix,
+                     !capture ? capture.error().message : truth_file.error().message);
           ok = false;
           break;
         }
-        const nlohmann::json truth = nlohmann::json::parse(in);
+        const nlohmann::json& truth = *truth_file;
         const double rotation = truth["initial_state"]["rotation_rad"].get<double>();
         if (!first) {
           first = *capture;
           if (setup == "truth") {
             auto b = dg::bending_from_json(truth, "truth");
-            if (b) bending = *b;
+            if (b)
+              bending = *b;
+            else
+              fmt::print(stderr, "memory_probe: {}/{}: no true model: {}\n", run, name, b.error().message);
           }
-          std::ifstream report(run + "/diagnoses/" + name + ".json");
-          if (setup == "fitted" && report) {
-            auto fitted = dg::bending_from_json(nlohmann::json::parse(report)["baseline"]["fitted"], "fitted");
-            if (fitted) bending = *fitted;
+          if (setup == "fitted") {
+            const auto report = drapegen::bench::read_json(run + "/diagnoses/" + name + ".json");
+            if (!report)
+              fmt::print(stderr, "memory_probe: {}/{}: no fitted model: {}\n", run, name, report.error().message);
+            else if (auto fitted = dg::bending_from_json(report->value("baseline", nlohmann::json::object())
+                                                             .value("fitted", nlohmann::json::object()),
+                                                         "fitted"))
+              bending = *fitted;
           }
         }
         if (truth.contains("plastic_set")) set = truth["plastic_set"]["largest_rest_angle_rad"].get<double>();
