@@ -19,6 +19,9 @@ score. Hypotheses for the next evaluation, not the diagnosis's rule (docs/DIAGNO
   shrinkage (physical effects before the sensor error) the smallest score on the capture's held-out view, which no
   refit sees, instead of the smallest refit objective (3 more right on seeds 17-32; pre-registered on fresh seed 33,
   it named one fewer: negative, not the diagnosis's rule);
+- common4 (session 46): the verdict with `--common-bending 4` (the common bending decides only where four or more
+  effects are each within the floors), from reports made with the default 3; pre-registered on fresh seed 41
+  (out/s48_prereg.txt);
 - min_objective: the candidate whose refit objective (in-sample: the capture and the second capture) is the smallest;
   it ignores the held-out data, which the issue's attribution must use: a diagnostic of the refits, not a rule.
 
@@ -76,7 +79,7 @@ THRESHOLD = 0.25  # AttributionSettings::significant_shrinkage
 TOLERANCE = 0.1  # AttributionSettings::held_out_tolerance (since session 23); --tolerance sets the rule's
 RULES = ["current", "strict", "tolerance", "objective_ties", "parsimony", "tie_objective", "no_bar", "no_bar_unconfirmed",
          "mean3", "held_out_excess", "held_out_rank", "min_objective", "without_ablation", "reach", "reach_objective",
-         "tie_held_out_view"]
+         "tie_held_out_view", "common4"]
 PARAMETERS = {"sensor": 9, "misalignment": 2}  # effect_space's dimension; the others have 1
 # How each rule orders candidates of equal shrinkage before their objectives (confirmation_rule).
 TIES = {"physical_first": lambda effect: effect == "sensor",  # attribute() since session 25 (needs_simulation)
@@ -173,6 +176,19 @@ def confirmation_rule(j, tolerance, ties="physical_first"):
     return top["effect"] if ok else "unexplained"
 
 
+def common_at_least(j, k):
+    """The verdict with `--common-bending K` from a report made with a smaller count (the default 3): the candidates
+    do not depend on the count, only the verdict does (none where the bar or the common bending is within the
+    floors, else the first candidate if confirmed and significant, else unexplained)."""
+    a = j["attribution"]
+    cb = a.get("common_bending")
+    bar_within = a["bending_refit_bar"]["validated"]["excess_above_floors"] == 0.0
+    if not cb or not cb["within_floors"] or len(cb["effects"]) >= k or bar_within:
+        return j["verdict"]
+    top = a["candidates"][0]
+    return top["effect"] if top["confirmed"] and top["shrinkage"] >= a["significant_shrinkage"] else "unexplained"
+
+
 def verdicts(j):
     g = j["gap_tests"]
     a = j["attribution"]
@@ -224,6 +240,7 @@ def verdicts(j):
     v["held_out_rank"] = "none" if within else (
         max(ok, key=lambda c: c["held_out_shrinkage"])["effect"] if ok else "unexplained")
     v["min_objective"] = min(cands, key=lambda c: c["objective_mm"])["effect"]
+    v["common4"] = common_at_least(j, 4)
     for rule in ("without_ablation", "reach", "reach_objective"):
         v[rule] = reference_rule(j, rule)
     return v
