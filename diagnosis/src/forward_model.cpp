@@ -102,6 +102,22 @@ PlasticSet set_left(const ModelSetup& setup, const sim::InitialStateSpec& state,
   const bool had = setup.plastic_set.rest_angles.size() > 0;
   return {had ? setup.plastic_set.specimen_seed : state.seed, std::move(rest_angles)};
 }
+
+/// Every state's scored drape, in the states' order, and the first with the smallest fit score as the best. An error
+/// if no state scored finitely (the best would be an empty drape with a score of 0, a perfect fit).
+sim::Expected<Evaluation> evaluation_of(std::vector<ScoredDrape> states) {
+  Evaluation e;
+  double best = std::numeric_limits<double>::infinity();
+  for (const ScoredDrape& d : states) {
+    if (d.fit_score < best) {
+      best = d.fit_score;
+      e.best = d;
+    }
+  }
+  if (!std::isfinite(best)) return sim::Error{"no initial state's drape has a finite score"};
+  e.states = std::move(states);
+  return e;
+}
 }  // namespace
 
 sim::Expected<ModelSetup> ForwardModel::laid_again(const ModelSetup& setup, const sim::InitialStateSpec& state) {
@@ -233,8 +249,6 @@ sim::Expected<Evaluation> ForwardModel::evaluate(const ModelSetup& setup) { retu
 sim::Expected<Evaluation> ForwardModel::evaluate(const ModelSetup& setup,
                                                  const std::vector<sim::InitialStateSpec>& states,
                                                  const Simulated* simulated) {
-  Evaluation e;
-  double best = std::numeric_limits<double>::infinity();
   const bool yields = setup.effects.bending_yield_curvature.has_value();
   if (yields && simulated) return sim::Error{"evaluate: a yielding setup's drapes are always simulated"};
   // Every drape first (on threads_ threads, each taking the next state), then scored in the states' order.
@@ -256,6 +270,7 @@ sim::Expected<Evaluation> ForwardModel::evaluate(const ModelSetup& setup,
       }
     }
   });
+  std::vector<ScoredDrape> scored_states;
   for (std::size_t k = 0; k < states.size(); ++k) {
     auto& [mesh, converged, rest_angles] = drapes[k];
     if (!mesh) return mesh.error();
@@ -264,33 +279,20 @@ sim::Expected<Evaluation> ForwardModel::evaluate(const ModelSetup& setup,
     scored->state = static_cast<int>(k);
     scored->converged = converged;
     if (yields) scored->left = set_left(setup, states[k], std::move(rest_angles));
-    if (scored->fit_score < best) {
-      best = scored->fit_score;
-      e.best = *scored;
-    }
-    e.states.push_back(std::move(*scored));
+    scored_states.push_back(std::move(*scored));
   }
-  // No state scored finitely: e.best would be an empty drape with a score of 0, a perfect fit.
-  if (!std::isfinite(best)) return sim::Error{"no initial state's drape has a finite score"};
-  return e;
+  return evaluation_of(std::move(scored_states));
 }
 
 sim::Expected<Evaluation> ForwardModel::rescore(const std::vector<sim::ClothMesh>& meshes, const ModelSetup& setup) {
-  Evaluation e;
-  double best = std::numeric_limits<double>::infinity();
+  std::vector<ScoredDrape> scored_states;
   for (std::size_t k = 0; k < meshes.size(); ++k) {
     auto scored = score(meshes[k], setup);
     if (!scored) return scored.error();
     scored->state = static_cast<int>(k);
-    if (scored->fit_score < best) {
-      best = scored->fit_score;
-      e.best = *scored;
-    }
-    e.states.push_back(std::move(*scored));
+    scored_states.push_back(std::move(*scored));
   }
-  // No state scored finitely: e.best would be an empty drape with a score of 0, a perfect fit.
-  if (!std::isfinite(best)) return sim::Error{"no initial state's drape has a finite score"};
-  return e;
+  return evaluation_of(std::move(scored_states));
 }
 
 }  // namespace drapegen::diagnosis
