@@ -432,7 +432,7 @@ int main(int argc, char** argv) {
   // Detection and attribution apart: effect captures reported within the floors at the gate, within them once the
   // bending alone is refitted (verdict "none" either way), and the rest (detected) with their correct verdicts.
   int within_at_gate = 0, within_after_bending = 0, detected_correct = 0;
-  std::vector<double> shrinkages, named_shrinkages, seconds;
+  std::vector<double> shrinkages, named_shrinkages, seconds, cpu_seconds;
   std::map<std::string, int> starts;
   nlohmann::json per_case = nlohmann::json::array();
   for (const auto& c : cases) {
@@ -472,6 +472,7 @@ int main(int argc, char** argv) {
     starts[started]++;
     confusion[family][verdict]++;
     seconds.push_back(d["runtime"].value("seconds", 0.0));
+    if (d["runtime"].contains("cpu_seconds")) cpu_seconds.push_back(d["runtime"]["cpu_seconds"].get<double>());
     double shrink = std::numeric_limits<double>::quiet_NaN();
     bool region_ok = false;
     if (family == "none") {
@@ -579,8 +580,14 @@ int main(int argc, char** argv) {
     md += fmt::format("- the region furthest above its own floor (floor_region) matches it: {}/{}\n",
                       floor_region_match, floor_region_total);
   }
-  md += fmt::format("- runtime per capture: median {:.0f} s, max {:.0f} s\n", median(seconds),
+  md += fmt::format("- runtime per capture: median {:.0f} s, max {:.0f} s", median(seconds),
                     seconds.empty() ? 0.0 : *std::max_element(seconds.begin(), seconds.end()));
+  // CPU time leaves out waiting for a core and time a run was stopped; reports older than session 46 lack it.
+  if (!cpu_seconds.empty()) {
+    md += fmt::format("; CPU median {:.0f} s, max {:.0f} s ({} of {} reports)", median(cpu_seconds),
+                      *std::max_element(cpu_seconds.begin(), cpu_seconds.end()), cpu_seconds.size(), seconds.size());
+  }
+  md += "\n";
   md += "\n| case | effect | strength | verdict | stable / floor (mm) | shape / floor | region | region ok | "
         "shrinkage | s |\n|---|---|---|---|---|---|---|---|---|---|\n";
   for (const auto& c : per_case) {

@@ -85,6 +85,15 @@ endif()
 if(gap LESS_EQUAL 0 OR floor LESS_EQUAL 0)
   message(FATAL_ERROR "gap ${gap} and floor ${floor} must be positive")
 endif()
+# One thread (--jobs 1): the diagnosis's CPU time is positive and at most its wall time (it leaves out time spent
+# waiting for a core; one thread cannot use more), with a second for the clocks' grain.
+string(JSON wall GET "${out}" runtime seconds)
+string(JSON cpu GET "${out}" runtime cpu_seconds)
+string(REGEX REPLACE "\\..*" "" wall_whole "${wall}")
+math(EXPR wall_bound "${wall_whole} + 1")
+if(cpu LESS_EQUAL 0 OR cpu GREATER wall_bound)
+  message(FATAL_ERROR "runtime: CPU ${cpu} s against wall ${wall} s on one thread")
+endif()
 # A 12 mm depth bias is far above the floors on any fit: the stable-region test (platform top, bare cylinder) must
 # flag it, and the attribution must run and rank all six candidates.
 string(JSON stable GET "${out}" gap_tests stable_mm)

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <filesystem>
 #include <cmath>
 #include <limits>
@@ -18,6 +19,9 @@ namespace {
 double since(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
+
+/// CPU seconds this process has used so far, all threads.
+double process_cpu_seconds() { return static_cast<double>(std::clock()) / CLOCKS_PER_SEC; }
 
 ModelSetup baseline_setup(const ReducedBending& x) {
   ModelSetup s;
@@ -225,6 +229,7 @@ sim::Status check_same_specimen(const Capture& capture, const Capture& other, st
 sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisSettings& settings,
                                         const OtherPlacements& others) {
   const auto start = std::chrono::steady_clock::now();
+  const double cpu_start = process_cpu_seconds();
   if (others.second) {
     if (sim::Status s = check_same_specimen(capture, *others.second, "second capture"); !s) return s.error();
   }
@@ -476,6 +481,7 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
   for (const auto& m : {second_model.get(), held_out_model.get()})
     if (m) r.simulations += m->simulations();
   r.seconds = since(start);
+  r.cpu_seconds = process_cpu_seconds() - cpu_start;
   sim::logger()->info("diagnosis: verdict {} in {:.1f} s", r.verdict, r.seconds);
   return r;
 }
@@ -669,6 +675,7 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                       {"candidates", candidates}};
   j["shrinkage"] = r.attribution.candidates.empty() ? 0.0 : r.attribution.candidates[0].shrinkage;
   j["runtime"] = {{"seconds", r.seconds},
+                  {"cpu_seconds", r.cpu_seconds},
                   {"fit_seconds", r.seconds_fit},
                   {"floors_seconds", r.seconds_floors},
                   {"attribution_seconds", r.seconds_attribution},

@@ -131,6 +131,10 @@ struct DiagnosisResult {
   int simulations = 0;
   double seconds = 0.0;
   double seconds_fit = 0.0, seconds_floors = 0.0, seconds_attribution = 0.0;
+  /// CPU time of this process over the diagnosis, all its threads (a fleet's workers not counted). Unlike `seconds`
+  /// it leaves out waiting for a core another process holds and time the process was stopped (SIGSTOP), so it is
+  /// the figure to compare runtimes measured on a shared machine by.
+  double cpu_seconds = 0.0;
 };
 
 /// Other placements of the capture's specimen on the tester (attribution.hpp, OtherCaptures); either may be null.
