@@ -94,7 +94,14 @@ int main(int argc, char** argv) {
           break;
         }
         const nlohmann::json& truth = *truth_file;
-        const double rotation = truth["initial_state"]["rotation_rad"].get<double>();
+        const nlohmann::json* turn = truth.contains("initial_state") ? &truth["initial_state"] : nullptr;
+        if (!turn || !turn->contains("rotation_rad") || !(*turn)["rotation_rad"].is_number()) {
+          fmt::print(stderr, "memory_probe: {}/{}{} skipped: its truth file has no initial_state.rotation_rad\n", run,
+                     name, suffix);
+          ok = false;
+          break;
+        }
+        const double rotation = (*turn)["rotation_rad"].get<double>();
         if (!first) {
           first = *capture;
           if (setup == "truth") {
@@ -114,7 +121,7 @@ int main(int argc, char** argv) {
               bending = *fitted;
           }
         }
-        if (truth.contains("plastic_set")) set = truth["plastic_set"]["largest_rest_angle_rad"].get<double>();
+        if (truth.contains("plastic_set")) set = truth["plastic_set"].value("largest_rest_angle_rad", NAN);
         const dg::HemProfile f = dg::hem_profile_from_capture(*capture);
         world.push_back(f);
         cloth.push_back(dg::fold_content(dg::rotate(f, -rotation)));

@@ -177,10 +177,14 @@ def confirmation_rule(j, tolerance, ties="physical_first"):
 
 
 def common_at_least(j, k):
-    """The verdict with `--common-bending K` from a report made with a smaller count (the default 3): the candidates
-    do not depend on the count, only the verdict does (none where the bar or the common bending is within the
-    floors, else the first candidate if confirmed and significant, else unexplained)."""
+    """The verdict with `--common-bending K` from a report made with a count of at most K (the default 3): the
+    candidates do not depend on the count, only the verdict does (none where the bar or the common bending is within
+    the floors, else the first candidate if confirmed and significant, else unexplained). "undetermined" for a report
+    made without the rule or with a larger count (its common bending would need a simulation)."""
     a = j["attribution"]
+    ran_with = a.get("common_bending_effects", 3)  # recorded since session 46; the default 3 before
+    if "common_bending" not in a or ran_with == 0 or ran_with > k:
+        return "undetermined"  # made before session 29's rule, without it, or with a larger count
     cb = a.get("common_bending")
     bar_within = a["bending_refit_bar"]["validated"]["excess_above_floors"] == 0.0
     if not cb or not cb["within_floors"] or len(cb["effects"]) >= k or bar_within:

@@ -623,6 +623,7 @@ sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& base
   }
   std::stable_sort(a.candidates.begin(), a.candidates.end(), ranks_before);
   a.tie_margin = settings.tie_margin;
+  a.common_bending_effects = settings.common_bending_effects;
   a.sensor_held = settings.sensor_held && settings.sensor_start.has_value() &&
                   std::find(settings.candidates.begin(), settings.candidates.end(), Effect::kSensor) !=
                       settings.candidates.end();

@@ -670,6 +670,7 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                         {"validated", ran ? validated_json(r.attribution.bar, r.floors) : nlohmann::json(nullptr)},
                         {"shrinkage", r.attribution.bar.shrinkage}}},
                       {"common_bending", common_bending_json(r.attribution, r.floors)},
+                      {"common_bending_effects", ran ? nlohmann::json(r.attribution.common_bending_effects) : nullptr},
                       {"named", r.attribution.named},
                       {"confidence", r.attribution.confidence},
                       {"candidates", candidates}};

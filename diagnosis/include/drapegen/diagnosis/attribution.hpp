@@ -255,6 +255,7 @@ struct Attribution {
   /// The effects of the confirmed candidates that each brought the gate within the floors, where there were
   /// AttributionSettings::common_bending_effects or more (and the bar was not within the floors itself); else empty.
   std::vector<Effect> common_effects;
+  int common_bending_effects = 0;  // the count it ran with (AttributionSettings::common_bending_effects; 0: off)
   /// Then: the baseline's bending at the median of those candidates' scales, validated as the bar is (its shrinkage
   /// against the baseline's excess).
   std::optional<CandidateResult> common_bending;
