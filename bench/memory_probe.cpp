@@ -94,14 +94,14 @@ int main(int argc, char** argv) {
           break;
         }
         const nlohmann::json& truth = *truth_file;
-        const nlohmann::json* turn = truth.contains("initial_state") ? &truth["initial_state"] : nullptr;
-        if (!turn || !turn->contains("rotation_rad") || !(*turn)["rotation_rad"].is_number()) {
+        const nlohmann::json::json_pointer turn("/initial_state/rotation_rad");
+        if (!truth.contains(turn) || !truth[turn].is_number()) {
           fmt::print(stderr, "memory_probe: {}/{}{} skipped: its truth file has no initial_state.rotation_rad\n", run,
                      name, suffix);
           ok = false;
           break;
         }
-        const double rotation = (*turn)["rotation_rad"].get<double>();
+        const double rotation = truth[turn].get<double>();
         if (!first) {
           first = *capture;
           if (setup == "truth") {
@@ -115,9 +115,9 @@ int main(int argc, char** argv) {
             const auto report = drapegen::bench::read_json(run + "/diagnoses/" + name + ".json");
             if (!report)
               fmt::print(stderr, "memory_probe: {}/{}: no fitted model: {}\n", run, name, report.error().message);
-            else if (auto fitted = dg::bending_from_json(report->value("baseline", nlohmann::json::object())
-                                                             .value("fitted", nlohmann::json::object()),
-                                                         "fitted"))
+            else if (auto fitted = dg::bending_from_json(
+                         report->value(nlohmann::json::json_pointer("/baseline/fitted"), nlohmann::json::object()),
+                         "fitted"))
               bending = *fitted;
           }
         }

@@ -185,9 +185,8 @@ def common_at_least(j, k):
     ran_with = a.get("common_bending_effects", 3)  # recorded since session 46; the default 3 before
     if "common_bending" not in a or ran_with == 0 or ran_with > k:
         return "undetermined"  # made before session 29's rule, without it, or with a larger count
-    cb = a.get("common_bending")
-    bar_within = a["bending_refit_bar"]["validated"]["excess_above_floors"] == 0.0
-    if not cb or not cb["within_floors"] or len(cb["effects"]) >= k or bar_within:
+    cb = a["common_bending"]  # null where fewer effects were within the floors, or the bar was itself
+    if not cb or not cb["within_floors"] or len(cb["effects"]) >= k:
         return j["verdict"]
     top = a["candidates"][0]
     return top["effect"] if top["confirmed"] and top["shrinkage"] >= a["significant_shrinkage"] else "unexplained"

@@ -106,15 +106,17 @@ PlasticSet set_left(const ModelSetup& setup, const sim::InitialStateSpec& state,
 /// Every state's scored drape, in the states' order, and the first with the smallest fit score as the best. An error
 /// if no state scored finitely (the best would be an empty drape with a score of 0, a perfect fit).
 sim::Expected<Evaluation> evaluation_of(std::vector<ScoredDrape> states) {
-  Evaluation e;
-  double best = std::numeric_limits<double>::infinity();
-  for (const ScoredDrape& d : states) {
-    if (d.fit_score < best) {
-      best = d.fit_score;
-      e.best = d;
+  double best_score = std::numeric_limits<double>::infinity();
+  std::size_t best = states.size();
+  for (std::size_t k = 0; k < states.size(); ++k) {
+    if (states[k].fit_score < best_score) {
+      best_score = states[k].fit_score;
+      best = k;
     }
   }
-  if (!std::isfinite(best)) return sim::Error{"no initial state's drape has a finite score"};
+  if (!std::isfinite(best_score)) return sim::Error{"no initial state's drape has a finite score"};
+  Evaluation e;
+  e.best = states[best];
   e.states = std::move(states);
   return e;
 }
