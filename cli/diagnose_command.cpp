@@ -21,6 +21,7 @@
 #include "drapegen/sim/logging.hpp"
 #include "drapegen/storage/atomic_file.hpp"
 #include "parse.hpp"
+#include "usable_cpus.hpp"
 
 namespace drapegen::cli {
 namespace {
@@ -48,7 +49,7 @@ struct DiagnoseOptions {
   std::string start_alpha, start_beta;  // empty: the drape-coefficient guess
   std::optional<double> start_box;      // unset: the whole box
   bool ignore_measured_bending = false;
-  int jobs = 1;
+  std::optional<int> jobs;  // unset: one per CPU this process may run on (at most kMaxJobs)
   std::optional<double> shape_floor;
   bool gap_only = false;
   bool ablation = false;
@@ -67,9 +68,11 @@ struct DiagnoseOptions {
 };
 
 const Failure fail{"diagnose"};
+constexpr int kMaxJobs = 64;
 
 int run_diagnose(const DiagnoseOptions& o) {
-  if (o.jobs < 1 || o.jobs > 64) return fail("--jobs must be 1 .. 64");
+  if (o.jobs && (*o.jobs < 1 || *o.jobs > kMaxJobs)) return fail(fmt::format("--jobs must be 1 .. {}", kMaxJobs));
+  const int jobs = o.jobs.value_or(std::min(usable_cpus(), kMaxJobs));
   if (o.fleet.empty() && !(o.fleet_endpoint_file.empty() && o.fleet_server_key.empty() &&
                            o.fleet_authorized_keys.empty())) {
     return fail("--fleet-endpoint-file, --fleet-server-key and --fleet-authorized-keys need --fleet");
@@ -169,7 +172,7 @@ int run_diagnose(const DiagnoseOptions& o) {
                               settings.attribution.optimiser.max_evaluations));
     }
   }
-  settings.attribution.jobs = o.jobs;
+  settings.attribution.jobs = jobs;
   settings.attribute = !o.gap_only;
   settings.attribution.ablation = o.ablation;
   settings.attribution.held_out_tolerance = o.held_out_tolerance;
@@ -197,7 +200,7 @@ int run_diagnose(const DiagnoseOptions& o) {
     }
     coordinator::SimulationFleet* f = fleet.get();
     settings.fit.simulator = [f](const sim::DrapeConfig& config) { return f->simulate(config); };
-    settings.refit_state_threads = o.jobs;
+    settings.refit_state_threads = jobs;
   }
   auto result = diagnosis::diagnose(*capture, settings,
                                     {.second = second ? &*second : nullptr, .held_out = held_out ? &*held_out : nullptr});
@@ -359,9 +362,10 @@ Runner add_diagnose_command(CLI::App& app) {
                  "misalignment, sensor)")
       ->delimiter(',');
   app.add_option("--jobs", o->jobs,
-                 "Threads: the fit's and the floors' initial states, then the candidate refits, in parallel (same "
-                 "result as --jobs 1)")
-      ->capture_default_str();
+                 fmt::format("Threads: the fit's and the floors' initial states, then the candidate refits, in "
+                             "parallel (same result as --jobs 1; report.json: runtime.jobs). Default: one per CPU "
+                             "this process may run on (taskset, a Slurm or container CPU set), at most {}",
+                             kMaxJobs));
   app.add_option("--fleet", o->fleet,
                  "Compute the drapes on worker processes instead of here: bind this endpoint (e.g. "
                  "tcp://127.0.0.1:5600; tcp://127.0.0.1:* picks a free port, logged and written by "

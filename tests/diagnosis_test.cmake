@@ -71,7 +71,7 @@ endif()
 file(RENAME ${WORK}/capture/truth.json ${WORK}/truth.json)
 
 run_ok(out diagnose --capture ${WORK}/capture --quick --resolution 10 --states 2 --evaluations 8 --refit-evaluations 4
-       --json --report ${WORK}/report)
+       --json --report ${WORK}/report --jobs 1)
 set(out_first "${out}")
 string(JSON verdict GET "${out}" verdict)
 string(JSON gap GET "${out}" gap_mm all_views)
@@ -90,6 +90,10 @@ endif()
 # BLAS that an environment variable makes threaded).
 string(JSON wall GET "${out}" runtime seconds)
 string(JSON cpu GET "${out}" runtime cpu_seconds)
+string(JSON jobs GET "${out}" runtime jobs)
+if(NOT jobs EQUAL 1)
+  message(FATAL_ERROR "--jobs 1: report.json's runtime.jobs is ${jobs}")
+endif()
 string(REGEX REPLACE "\\..*" "" wall_whole "${wall}")
 math(EXPR wall_bound "${wall_whole} * 11 / 10 + 2")
 if(cpu LESS_EQUAL 0 OR cpu GREATER wall_bound)
@@ -220,6 +224,30 @@ run_ok(quiet diagnose --capture ${WORK}/capture --quick --resolution 10 --states
 if(NOT quiet_log STREQUAL "")
   message(FATAL_ERROR "diagnose --quiet logs: ${quiet_log}")
 endif()
+
+# By default a diagnosis runs on one thread per CPU it may use: under taskset on one CPU, one (report.json's
+# runtime.jobs and report.md); --jobs 2 overrides the default.
+find_program(TASKSET taskset)
+if(TASKSET)
+  execute_process(COMMAND ${TASKSET} -c 0 ${DRAPEGEN} diagnose --capture ${WORK}/capture --quick --resolution 10
+                          --states 2 --evaluations 4 --gap-only --json -q --report ${WORK}/one_cpu
+                  RESULT_VARIABLE code OUTPUT_VARIABLE one_cpu ERROR_VARIABLE err)
+  string(JSON jobs ERROR_VARIABLE no_jobs GET "${one_cpu}" runtime jobs)
+  file(READ ${WORK}/one_cpu/report.md one_cpu_md)
+  if(NOT code EQUAL 0 OR NOT jobs EQUAL 1 OR NOT one_cpu_md MATCHES "CPU [0-9]+ s; 1 thread\\.")
+    message(FATAL_ERROR "diagnose on one CPU (taskset): exit ${code}, runtime.jobs '${jobs}' (expected 1): ${err}")
+  endif()
+  execute_process(COMMAND ${TASKSET} -c 0 ${DRAPEGEN} diagnose --capture ${WORK}/capture --quick --resolution 10
+                          --states 2 --evaluations 4 --gap-only --json -q --jobs 2
+                  RESULT_VARIABLE code OUTPUT_VARIABLE two ERROR_VARIABLE err)
+  string(JSON jobs ERROR_VARIABLE no_jobs GET "${two}" runtime jobs)
+  if(NOT code EQUAL 0 OR NOT jobs EQUAL 2)
+    message(FATAL_ERROR "diagnose --jobs 2 on one CPU: exit ${code}, runtime.jobs '${jobs}' (expected 2): ${err}")
+  endif()
+else()
+  message(STATUS "taskset not found: the default --jobs is not checked")
+endif()
+expect_failure(1 "--jobs must be 1 .. 64" diagnose --capture ${WORK}/capture --jobs 0)
 
 # --starts 1: after the guess's simplex, the guess's alpha and one level, each at both softening ratios (4 starts),
 # are scored. If the best of them beats the first simplex's end (the run above, same budgets), a second simplex from
@@ -483,7 +511,7 @@ endforeach()
 # --ablation: each simulated candidate is validated with its effect switched off at its refitted bending scale as
 # well (report.json "ablated"); the sensor candidate re-renders the baseline's drapes and has none.
 run_ok(out diagnose --capture ${WORK}/capture --quick --resolution 10 --states 2 --evaluations 8 --refit-evaluations 4
-       --candidates shear,sensor --ablation --json)
+       --candidates shear,sensor --ablation --json --jobs 1)
 foreach(i 0 1)
   string(JSON effect GET "${out}" attribution candidates ${i} effect)
   string(JSON ablated_type TYPE "${out}" attribution candidates ${i} ablated)
@@ -534,8 +562,8 @@ execute_process(
 if(NOT codes STREQUAL "0;0;0")
   message(FATAL_ERROR "--fleet: exit codes ${codes} (worker, worker, diagnose): ${err}")
 endif()
-# Lines of time and of the main thread's share of the simulations (which --jobs sets) aside.
-set(varying "\n[^\n]*(seconds\"|simulations_main_thread)[^\n]*")
+# Lines of time, of the threads and of the main thread's share of the simulations (which --jobs sets) aside.
+set(varying "\n[^\n]*(seconds\"|simulations_main_thread|\"jobs\")[^\n]*")
 string(REGEX REPLACE "${varying}" "" local_lines "${one_thread}")
 string(REGEX REPLACE "${varying}" "" fleet_lines "${fleet_json}")
 string(REGEX MATCHALL "\n" newlines "${local_lines}")

@@ -482,6 +482,7 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
     if (m) r.simulations += m->simulations();
   r.seconds = since(start);
   r.cpu_seconds = process_cpu_seconds() - cpu_start;
+  r.jobs = settings.attribution.jobs;
   sim::logger()->info("diagnosis: verdict {} in {:.1f} s", r.verdict, r.seconds);
   return r;
 }
@@ -677,6 +678,7 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
   j["shrinkage"] = r.attribution.candidates.empty() ? 0.0 : r.attribution.candidates[0].shrinkage;
   j["runtime"] = {{"seconds", r.seconds},
                   {"cpu_seconds", r.cpu_seconds},
+                  {"jobs", r.jobs},
                   {"fit_seconds", r.seconds_fit},
                   {"floors_seconds", r.seconds_floors},
                   {"attribution_seconds", r.seconds_attribution},

@@ -135,6 +135,8 @@ struct DiagnosisResult {
   /// it leaves out waiting for a core another process holds and time the process was stopped (SIGSTOP), so it is
   /// the figure to compare runtimes measured on a shared machine by.
   double cpu_seconds = 0.0;
+  /// The threads it ran on (AttributionSettings::jobs; with a fleet, the refits in flight).
+  int jobs = 1;
 };
 
 /// Other placements of the capture's specimen on the tester (attribution.hpp, OtherCaptures); either may be null.
