@@ -72,7 +72,8 @@ constexpr int kMaxJobs = 64;
 
 int run_diagnose(const DiagnoseOptions& o) {
   if (o.jobs && (*o.jobs < 1 || *o.jobs > kMaxJobs)) return fail(fmt::format("--jobs must be 1 .. {}", kMaxJobs));
-  const int jobs = o.jobs.value_or(std::min(usable_cpus(), kMaxJobs));
+  // By default one thread per CPU here; with a fleet, as many refits in flight as workers are asked for.
+  const int jobs = o.jobs.value_or(std::clamp(o.fleet.empty() ? usable_cpus() : o.fleet_workers, 1, kMaxJobs));
   if (o.fleet.empty() && !(o.fleet_endpoint_file.empty() && o.fleet_server_key.empty() &&
                            o.fleet_authorized_keys.empty())) {
     return fail("--fleet-endpoint-file, --fleet-server-key and --fleet-authorized-keys need --fleet");
@@ -363,15 +364,17 @@ Runner add_diagnose_command(CLI::App& app) {
       ->delimiter(',');
   app.add_option("--jobs", o->jobs,
                  fmt::format("Threads: the fit's and the floors' initial states, then the candidate refits, in "
-                             "parallel (same result as --jobs 1; report.json: runtime.jobs). Default: one per CPU "
-                             "this process may run on (taskset, a Slurm or container CPU set), at most {}",
+                             "parallel, fewer where there are fewer to share out (same result as --jobs 1; report.json: "
+                             "runtime.jobs). Default: one per CPU this process may run on (taskset, a Slurm or "
+                             "container CPU set; not a CPU quota), at most {}; with --fleet, --fleet-workers",
                              kMaxJobs));
   app.add_option("--fleet", o->fleet,
                  "Compute the drapes on worker processes instead of here: bind this endpoint (e.g. "
                  "tcp://127.0.0.1:5600; tcp://127.0.0.1:* picks a free port, logged and written by "
                  "--fleet-endpoint-file) and serve every drape to `drapegen worker --connect ENDPOINT` processes, on "
                  "this machine or others, as they come and go; the renders, scores and searches stay here. --jobs then "
-                 "counts refits in flight, and each refit simulates its initial states on --jobs threads too. The same "
+                 "counts refits in flight (default: --fleet-workers), and each refit simulates its initial states on "
+                 "--jobs threads too. The same "
                  "result as without, where the workers run this build on the same BLAS kernels (docs/DIAGNOSIS.md, "
                  "\"Refits on workers\"). An address other machines can reach (e.g. tcp://*:5600) needs "
                  "--fleet-server-key and --fleet-authorized-keys");

@@ -299,8 +299,8 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
                       held_out ? "capture" : "view", 100 * r.attribution.held_out_tolerance);
     if (after) md += "\n![after](residual_after.png)\n\nResidual after adding the named effect.\n";
   }
-  md += fmt::format("\nRuntime {:.0f} s (fit {:.0f} s, floors {:.0f} s, attribution {:.0f} s); CPU {:.0f} s; {} "
-                    "thread{}.\n",
+  md += fmt::format("\nRuntime {:.0f} s (fit {:.0f} s, floors {:.0f} s, attribution {:.0f} s); CPU {:.0f} s; up to "
+                    "{} thread{}.\n",
                     r.seconds, r.seconds_fit, r.seconds_floors, r.seconds_attribution, r.cpu_seconds, r.jobs,
                     r.jobs == 1 ? "" : "s");
   std::ofstream out(dir / "report.md");

@@ -135,7 +135,8 @@ struct DiagnosisResult {
   /// it leaves out waiting for a core another process holds and time the process was stopped (SIGSTOP), so it is
   /// the figure to compare runtimes measured on a shared machine by.
   double cpu_seconds = 0.0;
-  /// The threads it ran on (AttributionSettings::jobs; with a fleet, the refits in flight).
+  /// The threads it was allowed (AttributionSettings::jobs; with a fleet, the refits in flight); fewer run at once
+  /// where there are fewer refits or initial states to share out.
   int jobs = 1;
 };
 
