@@ -49,7 +49,7 @@ struct DiagnoseOptions {
   std::string start_alpha, start_beta;  // empty: the drape-coefficient guess
   std::optional<double> start_box;      // unset: the whole box
   bool ignore_measured_bending = false;
-  std::optional<int> jobs;  // unset: one per CPU this process may run on (at most kMaxJobs)
+  std::optional<int> jobs;  // unset: one per CPU this process may run on, with a fleet --fleet-workers (run_diagnose)
   std::optional<double> shape_floor;
   bool gap_only = false;
   bool ablation = false;
@@ -374,8 +374,7 @@ Runner add_diagnose_command(CLI::App& app) {
                  "--fleet-endpoint-file) and serve every drape to `drapegen worker --connect ENDPOINT` processes, on "
                  "this machine or others, as they come and go; the renders, scores and searches stay here. --jobs then "
                  "counts refits in flight (default: --fleet-workers), and each refit simulates its initial states on "
-                 "--jobs threads too. The same "
-                 "result as without, where the workers run this build on the same BLAS kernels (docs/DIAGNOSIS.md, "
+                 "--jobs threads too. The same result as without, where the workers run this build on the same BLAS kernels (docs/DIAGNOSIS.md, "
                  "\"Refits on workers\"). An address other machines can reach (e.g. tcp://*:5600) needs "
                  "--fleet-server-key and --fleet-authorized-keys");
   app.add_option("--fleet-workers", o->fleet_workers,
