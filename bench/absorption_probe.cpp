@@ -29,6 +29,7 @@
 #include "drapegen/diagnosis/diagnosis.hpp"
 #include "drapegen/diagnosis/forward_model.hpp"
 #include "drapegen/sim/blas_kernels.hpp"
+#include "drapegen/sim/median.hpp"
 #include "json_file.hpp"
 
 namespace fs = std::filesystem;
@@ -120,7 +121,7 @@ sim::Expected<Scores> score(diagnosis::ForwardModel& model, const diagnosis::Mod
   const auto model_mean = mean_features(drapes);
   const auto scales = diagnosis::default_feature_scales();
   const auto& first = model.target().shape.all;
-  Scores r{e->best.shape_all, e->best.stable_all * 1e3, shapes[shapes.size() / 2]};
+  Scores r{e->best.shape_all, e->best.stable_all * 1e3, sim::median(shapes)};
   r.best_state = e->best.state;
   r.mean_shape_p0 = diagnosis::feature_distance(first, model_mean, scales);
   r.mean_shape = second_capture ? diagnosis::feature_distance(mean_features({&first, second_capture}), model_mean, scales)

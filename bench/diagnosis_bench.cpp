@@ -26,6 +26,7 @@
 #include "drapegen/renderer/random.hpp"
 #include "drapegen/sampler/fabric_data.hpp"
 #include "drapegen/sim/blas_kernels.hpp"
+#include "drapegen/sim/median.hpp"
 #include "visibility_screen.hpp"
 
 namespace fs = std::filesystem;
@@ -522,11 +523,7 @@ int main(int argc, char** argv) {
                         {"visible", screened}, {"fit_started_from", started},
                         {"seconds", d["runtime"]["seconds"]}});
   }
-  auto median = [](std::vector<double> v) {
-    if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
-    std::sort(v.begin(), v.end());
-    return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
-  };
+  using sim::median;
   const std::string options = fmt::format("{}{}{}", quick ? "--quick" : "", quick && !diagnose_args.empty() ? " " : "",
                                           diagnose_args);
   std::string md = fmt::format("Cases scored: {} effect captures, {} controls (diagnose {}{}).\n\n", effect_total,

@@ -15,9 +15,12 @@
 
 #include "drapegen/sim/blas_kernels.hpp"
 #include "drapegen/sim/drape.hpp"
+#include "drapegen/sim/median.hpp"
 #include "drapegen/sim/ply.hpp"
 
 namespace {
+
+using drapegen::sim::median;
 
 struct Fabric {
   double density;  // kg/m^2
@@ -39,12 +42,6 @@ std::vector<Fabric> read_fabrics(const std::string& path) {
     out.push_back({v[0], {v[1] * s, v[3] * s, v[2] * s}, {v[4] * s, v[6] * s, v[5] * s}});
   }
   return out;
-}
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
 }  // namespace

@@ -13,19 +13,10 @@
 #include "drapegen/diagnosis/shape_features.hpp"
 #include "drapegen/sampler/fabric_data.hpp"
 #include "drapegen/sim/blas_kernels.hpp"
+#include "drapegen/sim/median.hpp"
 
 namespace fs = std::filesystem;
 using namespace drapegen;
-
-namespace {
-
-double median(std::vector<double> v) {
-  if (v.empty()) return -1.0;
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
-
-}  // namespace
 
 int main(int argc, char** argv) {
   drapegen::sim::relaunch_with_blas_kernels(argv);  // the kernels drapegen runs on (blas_kernels.hpp)
@@ -98,7 +89,7 @@ int main(int argc, char** argv) {
         std::vector<double> v;
         for (const auto& d : diffs)
           if (d[g] >= 0.0) v.push_back(d[g]);
-        const double m = median(v);
+        const double m = sim::median(v);
         const double unit = g == static_cast<int>(diagnosis::FeatureGroup::kFolds) ? diagnosis::kFoldScale : 1e-3;
         std::cout << fmt::format(" {:>12.2f}", m / unit);
       }

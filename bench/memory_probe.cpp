@@ -21,6 +21,7 @@
 #include "drapegen/diagnosis/fold_repeatability.hpp"
 #include "drapegen/diagnosis/forward_model.hpp"
 #include "drapegen/diagnosis/hem_profile.hpp"
+#include "drapegen/sim/median.hpp"
 
 namespace dg = drapegen::diagnosis;
 
@@ -55,7 +56,7 @@ std::pair<double, double> model_repeatability(const dg::Capture& capture, const 
   }
   std::vector<double> c = dg::fold_repeatability({}, drapes).model;
   std::sort(c.begin(), c.end());
-  return {c.front(), c[c.size() / 2]};
+  return {c.front(), drapegen::sim::median(c)};
 }
 
 }  // namespace

@@ -22,6 +22,7 @@
 #include "drapegen/diagnosis/hem_profile.hpp"
 #include "drapegen/diagnosis/localisation.hpp"
 #include "drapegen/sim/blas_kernels.hpp"
+#include "drapegen/sim/median.hpp"
 #include "json_file.hpp"
 
 namespace fs = std::filesystem;
@@ -82,12 +83,6 @@ Bands bands_of(const diagnosis::ForwardModel& model, const diagnosis::ScoredDrap
   return B;
 }
 
-double median(std::vector<double> x) {
-  if (x.empty()) return std::numeric_limits<double>::quiet_NaN();
-  std::nth_element(x.begin(), x.begin() + static_cast<std::ptrdiff_t>(x.size() / 2), x.end());
-  return x[x.size() / 2];
-}
-
 /// What the summary needs of a case: its true region, the outer band's enrichment, the report's hem over skirt.
 struct Row {
   std::string truth;
@@ -139,7 +134,7 @@ sim::Status probe_case(const fs::path& run, const std::string& name, const diagn
   for (std::size_t b = 0; b < B.energy.size(); ++b) cells += fmt::format(" {:>6.2f}", B.enrichment(b));
   std::cout << fmt::format("{:<16} {:<12} {:<8} {:<12} {:>5.2f} {:>5.2f} |{} | {:>5.1f} {:>5.2f} {:>5.2f}\n", name,
                            truth_regions, loc.at("region").get<std::string>(), report->at("verdict").get<std::string>(),
-                           hem, skirt, cells, 1e3 * median(B.to_vertex), e->best.shape_all,
+                           hem, skirt, cells, 1e3 * sim::median(B.to_vertex), e->best.shape_all,
                            report->at("gap_tests").at("capture").at("shape").get<double>())
             << std::flush;
   rows.push_back({truth_regions, B.enrichment(0), skirt > 0.0 ? hem / skirt : 0.0});

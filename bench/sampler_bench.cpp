@@ -10,6 +10,7 @@
 
 #include "drapegen/sampler/parameter_sampler.hpp"
 #include "drapegen/sampler/recipe_generator.hpp"
+#include "drapegen/sim/median.hpp"
 
 int main(int argc, char** argv) {
   using namespace drapegen::sampler;
@@ -61,10 +62,7 @@ int main(int argc, char** argv) {
     text.push_back(ms(t3 - t2));
     total.push_back(ms(t2 - t0));
   }
-  auto median = [](std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    return v[v.size() / 2];
-  };
+  using drapegen::sim::median;
   fmt::print("{} vectors + {} recipes, {} repeats (median / min): total {:.1f} / {:.1f} ms = sampling {:.1f} ms + "
              "recipes {:.1f} ms; recipe text form {:.1f} ms extra (checksum {})\n",
              n, static_cast<long>(n) * states, repeats, median(total), *std::min_element(total.begin(), total.end()),

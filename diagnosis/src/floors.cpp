@@ -6,6 +6,7 @@
 
 #include "drapegen/renderer/noise.hpp"
 #include "drapegen/renderer/random.hpp"
+#include "drapegen/sim/median.hpp"
 
 namespace drapegen::diagnosis {
 namespace {
@@ -54,11 +55,7 @@ std::vector<double> pooled(const Floors& floors, std::vector<double> FloorSample
 
 double largest(const std::vector<double>& v) { return v.empty() ? 0.0 : *std::max_element(v.begin(), v.end()); }
 
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
-}
+double median_or_zero(std::vector<double> v) { return v.empty() ? 0.0 : sim::median(std::move(v)); }
 
 }  // namespace
 
@@ -123,8 +120,8 @@ sim::Expected<Floors> measure_floors(ForwardModel& model, const ModelSetup& fitt
   floors.shape_margin = settings.shape_margin;
   floors.shape = settings.shape_threshold > 0.0 ? settings.shape_threshold
                                                 : settings.shape_margin * largest(pooled(floors, &FloorSamples::shape));
-  floors.typical_all = median(pooled(floors, &FloorSamples::all));
-  floors.typical_held_out = median(pooled(floors, &FloorSamples::held_out));
+  floors.typical_all = median_or_zero(pooled(floors, &FloorSamples::all));
+  floors.typical_held_out = median_or_zero(pooled(floors, &FloorSamples::held_out));
   return floors;
 }
 

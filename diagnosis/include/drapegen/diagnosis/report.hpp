@@ -13,6 +13,10 @@ namespace drapegen::diagnosis {
 [[nodiscard]] sim::Status write_residual_png(const std::string& path, const std::vector<std::vector<float>>& residuals,
                                              int width, int height, double range);
 
+/// report.md's verdict: the verdict line, why a named effect was put ahead of another where that happened, and
+/// under a verdict within the floors ("none") what it does not rule out.
+[[nodiscard]] std::string verdict_markdown(const DiagnosisResult& result);
+
 /// Writes DIR/report.json, DIR/report.md, DIR/residual.png (capture - fitted baseline per view), DIR/views.png
 /// (capture over fitted drape) and DIR/residual_after.png (after adding the named effect, if any).
 [[nodiscard]] sim::Status write_report(const std::string& directory, const DiagnosisResult& result,
