@@ -117,7 +117,6 @@ sim::Expected<Scores> score(diagnosis::ForwardModel& model, const diagnosis::Mod
     shapes.push_back(s.shape_all);
     drapes.push_back(&s.shape.all);
   }
-  std::sort(shapes.begin(), shapes.end());
   const auto model_mean = mean_features(drapes);
   const auto scales = diagnosis::default_feature_scales();
   const auto& first = model.target().shape.all;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <limits>
 #include <optional>
+#include <utility>
 
 #include "drapegen/renderer/noise.hpp"
 #include "drapegen/renderer/random.hpp"

@@ -148,11 +148,11 @@ std::string verdict_markdown(const DiagnosisResult& r) {
   }
   if (r.verdict == "none") {
     // What the verdict does not say (docs/DIAGNOSIS.md, "What keeps top-1 down").
-    md += "Within the floors, the baseline explains this capture as closely as the floors let anything; that rules "
-          "out no effect whose drape an elastic fabric of another bending can match (a fabric yielding in one drape "
-          "drapes like a softer one). Many of the benchmark's effect captures end here, yield's most often "
-          "(docs/DIAGNOSIS.md). The fitted bending below then carries the effect; a measured bending in the "
-          "capture bounds it (docs/CAPTURE.md).\n\n";
+    md += "A verdict within the floors rules out no effect whose drape an elastic fabric of another bending can "
+          "match (a fabric yielding in one drape drapes like a softer one); many of the benchmark's effect captures "
+          "end here, yield's most often (docs/DIAGNOSIS.md). The bending that matched the capture (the baseline "
+          "fit's, or the refit named in the verdict) then carries the effect; a measured bending in the capture "
+          "limits how far that bending can stray from the specimen's (docs/CAPTURE.md).\n\n";
   }
   return md;
 }

@@ -7,7 +7,7 @@
 namespace drapegen::diagnosis {
 namespace {
 
-constexpr const char* kCaveat = "that rules out no effect whose drape an elastic fabric of another bending can match";
+constexpr const char* kCaveat = "rules out no effect whose drape an elastic fabric of another bending can match";
 
 bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
