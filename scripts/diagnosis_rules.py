@@ -73,6 +73,7 @@ near_ties_first names by since then):
 import glob
 import json
 import os
+import statistics
 import sys
 
 THRESHOLD = 0.25  # AttributionSettings::significant_shrinkage
@@ -308,8 +309,8 @@ def gate_terms(roots):
         if not v:
             continue
         two, three, stable = (sorted(x[k] for x in v) for k in range(3))
-        print(f"{key} ({len(v)}): shape / floor, two placements: median {two[len(v) // 2]:.2f}, max {two[-1]:.2f}; "
-              f"three: median {three[len(v) // 2]:.2f}, max {three[-1]:.2f}; stable / floor, three: "
+        print(f"{key} ({len(v)}): shape / floor, two placements: median {statistics.median(two):.2f}, max {two[-1]:.2f}; "
+              f"three: median {statistics.median(three):.2f}, max {three[-1]:.2f}; stable / floor, three: "
               f"{stable[0]:.2f} .. {stable[-1]:.2f}")
     controls = sorted(x[1] for x in classes["controls"])
     within = [x[1] for x in classes["effects within the floors at the gate"]]
@@ -389,8 +390,8 @@ def draw_noise(roots):
     shares.sort()
     n = len(shares)
     if n:
-        print(f"{n} captures above the floors: the share changes by {shares[n // 4]:.3f} / {shares[n // 2]:.3f} / "
-              f"{shares[3 * n // 4]:.3f} (quartiles)")
+        print(f"{n} captures above the floors: the share changes by {shares[n // 4]:.3f} / {statistics.median(shares):.3f} / "
+              f"{shares[3 * n // 4]:.3f} (quartiles; the middle one the median)")
 
 
 def substitute(effect, new_root, old_root):
