@@ -374,7 +374,8 @@ Runner add_diagnose_command(CLI::App& app) {
                  "--fleet-endpoint-file) and serve every drape to `drapegen worker --connect ENDPOINT` processes, on "
                  "this machine or others, as they come and go; the renders, scores and searches stay here. --jobs then "
                  "counts refits in flight (default: --fleet-workers), and each refit simulates its initial states on "
-                 "--jobs threads too. The same result as without, where the workers run this build on the same BLAS kernels (docs/DIAGNOSIS.md, "
+                 "--jobs threads too. The same result as without, where the workers run this build on the same BLAS "
+                 "kernels (docs/DIAGNOSIS.md, "
                  "\"Refits on workers\"). An address other machines can reach (e.g. tcp://*:5600) needs "
                  "--fleet-server-key and --fleet-authorized-keys");
   app.add_option("--fleet-workers", o->fleet_workers,
