@@ -123,8 +123,9 @@ sim::Expected<Scores> score(diagnosis::ForwardModel& model, const diagnosis::Mod
   Scores r{e->best.shape_all, e->best.stable_all * 1e3, sim::median(shapes)};
   r.best_state = e->best.state;
   r.mean_shape_p0 = diagnosis::feature_distance(first, model_mean, scales);
-  r.mean_shape = second_capture ? diagnosis::feature_distance(mean_features({&first, second_capture}), model_mean, scales)
-                                : r.mean_shape_p0;
+  r.mean_shape = second_capture
+                     ? diagnosis::feature_distance(mean_features({&first, second_capture}), model_mean, scales)
+                     : r.mean_shape_p0;
   return r;
 }
 

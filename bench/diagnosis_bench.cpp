@@ -86,7 +86,8 @@ int main(int argc, char** argv) {
   std::uint64_t seed = 1;
   std::vector<std::string> families{"yield", "shear", "curl", "friction", "misalignment", "sensor"};
   std::vector<std::string> sensor_kinds{"pose", "bias", "multipath"};
-  app.add_option("--out", out, "Benchmark directory (diagnoses already in it are kept: a rerun resumes)")->capture_default_str();
+  app.add_option("--out", out, "Benchmark directory (diagnoses already in it are kept: a rerun resumes)")
+      ->capture_default_str();
   app.add_option("--fabrics", fabrics_path, "fabrics618.csv")->capture_default_str();
   app.add_option("--drapegen", drapegen, "The drapegen program (default: beside this program)");
   app.add_option("--per-family", per_family, "Captures per effect family")->capture_default_str();
@@ -150,7 +151,8 @@ int main(int argc, char** argv) {
   }
   for (const auto& k : sensor_kinds) {
     if (k != "pose" && k != "bias" && k != "multipath") {
-      std::cerr << "diagnosis_bench: error: --sensor-kinds: unknown sensor error '" << k << "' (pose, bias, multipath)\n";
+      std::cerr << "diagnosis_bench: error: --sensor-kinds: unknown sensor error '" << k
+                << "' (pose, bias, multipath)\n";
       return 1;
     }
   }
@@ -181,7 +183,8 @@ int main(int argc, char** argv) {
     std::cerr << "diagnosis_bench: error: no fabrics in " << fabrics_path << "\n";
     return 1;
   }
-  // A fabric of fabrics618 and an effect's strength, drawn from `r` (for the cases as drawn and for the screen's draws).
+  // A fabric of fabrics618 and an effect's strength, drawn from `r` (for the cases as drawn and for the screen's
+  // draws).
   const auto draw_fabric = [&](renderer::Rng& r) {
     return fabrics[static_cast<std::size_t>(r.uniform() * fabrics.size()) % fabrics.size()];
   };

@@ -72,7 +72,9 @@ int main(int argc, char** argv) {
   app.add_option("--pcg-refactor", refactor_fraction, "SolverOptions::pcg_refactor_fraction")->capture_default_str();
   double gn_above = drapegen::sim::DrapeConfig{}.solver.gauss_newton_above;
   app.add_option("--gn-above", gn_above, "SolverOptions::gauss_newton_above")->capture_default_str();
-  app.add_option("--outer-below", outer_below, "SolverOptions::lagged_outer_below (effects with lagged forces use at most 3)")->capture_default_str();
+  app.add_option("--outer-below", outer_below,
+                 "SolverOptions::lagged_outer_below (effects with lagged forces use at most 3)")
+      ->capture_default_str();
   double exact_below = drapegen::sim::SolverOptions{}.exact_hessian_below;
   int max_iterations = drapegen::sim::SolverOptions{}.max_iterations;
   app.add_option("--exact-below", exact_below, "SolverOptions::exact_hessian_below")->capture_default_str();
@@ -169,8 +171,8 @@ int main(int argc, char** argv) {
       } else {
         std::cout << fmt::format(
             "fabric {:3d} alpha {:7.0f},{:7.0f},{:7.0f} beta {:8.0f},{:8.0f},{:8.0f} {:5s}: {:15s} {:4d} it "
-            "(+{:3d} coarse) {:6.2f} s, CPU {:6.2f} s (coarse {:4.2f} s, factorisation {:4.1f}%, PCG {:4.1f}%, assembly {:4.1f}%, "
-            "{} of {} steps by PCG, {} CG it, {} failed PCG) DC {:.3f} folds {}\n",
+            "(+{:3d} coarse) {:6.2f} s, CPU {:6.2f} s (coarse {:4.2f} s, factorisation {:4.1f}%, PCG {:4.1f}%, "
+            "assembly {:4.1f}%, {} of {} steps by PCG, {} CG it, {} failed PCG) DC {:.3f} folds {}\n",
             index, fabric.alpha.warp, fabric.alpha.bias, fabric.alpha.weft, fabric.beta.warp, fabric.beta.bias,
             fabric.beta.weft, init, drapegen::sim::to_string(r.outcome), r.iterations, c.iterations, wall, cpu,
             c.seconds, 100 * factor_share.back(), 100 * (r.pcg_seconds + c.pcg_seconds) / wall,

@@ -95,7 +95,9 @@ Run run(const std::string& label, const DrapeConfig& config) {
   return out;
 }
 
-double max_distance(const Eigen::Matrix3Xd& a, const Eigen::Matrix3Xd& b) { return (a - b).colwise().norm().maxCoeff(); }
+double max_distance(const Eigen::Matrix3Xd& a, const Eigen::Matrix3Xd& b) {
+  return (a - b).colwise().norm().maxCoeff();
+}
 double mean_distance(const Eigen::Matrix3Xd& a, const Eigen::Matrix3Xd& b) { return (a - b).colwise().norm().mean(); }
 
 /// The output table. A row without a bound is informative.
@@ -159,9 +161,10 @@ void check_k_over_rho(Table& t, int n, const Options& o) {
     // Exact Newton steps: the inexact PCG steps amplify the last-bit differences of the normalised moduli.
     DrapeConfig exact_base = base, exact_scaled = c;
     exact_base.solver.max_pcg_iterations = exact_scaled.solver.max_pcg_iterations = 0;
-    const double d = max_distance(run("a: base, exact Newton", exact_base).result.mesh.positions,
-                                  run(fmt::format("a: k, rho x {}, exact Newton", s), exact_scaled).result.mesh.positions) *
-                     kMm;
+    const double d =
+        max_distance(run("a: base, exact Newton", exact_base).result.mesh.positions,
+                     run(fmt::format("a: k, rho x {}, exact Newton", s), exact_scaled).result.mesh.positions) *
+        kMm;
     t.row(n, "a", fmt::format("k, rho x {}: max vertex distance (exact Newton steps), mm", s), d, "< 0.1", d < 0.1);
     DrapeConfig absolute = restart;
     absolute.membrane.stiffness /= s;
@@ -193,7 +196,8 @@ double grid_rotation_defect(int n, const Eigen::Matrix3Xd& a, const Eigen::Matri
 double grid_transpose_defect(int n, const Eigen::Matrix3Xd& a, const Eigen::Matrix3Xd& b) {
   Eigen::Matrix3Xd image(3, a.cols());
   for (int j = 0; j < n; ++j) {
-    for (int i = 0; i < n; ++i) image.col(i * n + j) = Eigen::Vector3d(a(1, j * n + i), a(0, j * n + i), a(2, j * n + i));
+    for (int i = 0; i < n; ++i)
+      image.col(i * n + j) = Eigen::Vector3d(a(1, j * n + i), a(0, j * n + i), a(2, j * n + i));
   }
   return max_distance(image, b);
 }
@@ -448,7 +452,8 @@ void check_mesh_dependence(Table& t, int n, const Options& o) {
   const double b = o.beta_scale;
   const FabricParameters aniso =
       fabric_from_paper_units({20000, 12500, 5000}, {-50000 * b, -31250 * b, -12500 * b}, 300.0);
-  const FabricParameters iso = fabric_from_paper_units({11180, 11180, 11180}, {-27950 * b, -27950 * b, -27950 * b}, 300.0);
+  const FabricParameters iso =
+      fabric_from_paper_units({11180, 11180, 11180}, {-27950 * b, -27950 * b, -27950 * b}, 300.0);
   struct Start {
     InitialShape shape;
     unsigned seed;

@@ -28,7 +28,9 @@ int main(int argc, char** argv) {
   int seeds = 4, resolution = 30;
   app.add_option("--fabrics", fabrics_path)->capture_default_str();
   app.add_option("--rows", fabric_rows, "Fabric rows of the CSV")->capture_default_str();
-  app.add_option("--effects", effects, "NAME=STRENGTH, A+B for several in one capture (stiff=S: no effect, bending scaled by S)")->capture_default_str();
+  app.add_option("--effects", effects,
+                 "NAME=STRENGTH, A+B for several in one capture (stiff=S: no effect, bending scaled by S)")
+      ->capture_default_str();
   app.add_option("--seeds", seeds)->capture_default_str();
   app.add_option("--resolution", resolution)->capture_default_str();
   app.add_option("--work", work)->capture_default_str();

@@ -85,11 +85,12 @@ void timing(Renderer& renderer, const TriangleMesh& cloth, int data_points, cons
   fmt::print("timing: {} data points x {} views, {} triangles (cloth + cylinder), storage {} {} (zip level {})\n",
              data_points, request.rig.views, tester_scene(cloth, request.rig).triangle_count(),
              storage.pixel == ExrStorage::Pixel::kHalf ? "half" : "float", storage.compression, storage.zip_level);
-  fmt::print("  CPU time: render {:.3f} ms/view, noise {:.3f} ms/view, EXR encode {:.3f} ms/view\n", 1e3 * t_render / views,
-             1e3 * t_noise / views, 1e3 * t_encode / views);
+  fmt::print("  CPU time: render {:.3f} ms/view, noise {:.3f} ms/view, EXR encode {:.3f} ms/view\n",
+             1e3 * t_render / views, 1e3 * t_noise / views, 1e3 * t_encode / views);
   // Per core = per CPU-second of this (single-threaded) process; wall time also counts waiting for a shared core.
-  fmt::print("  total {:.3f} ms/view CPU ({:.3f} ms/view wall) -> {:.0f} views per CPU-second ({:.0f} per wall-second)\n",
-             1e3 * cpu / views, 1e3 * wall / views, views / cpu, views / wall);
+  fmt::print(
+      "  total {:.3f} ms/view CPU ({:.3f} ms/view wall) -> {:.0f} views per CPU-second ({:.0f} per wall-second)\n",
+      1e3 * cpu / views, 1e3 * wall / views, views / cpu, views / wall);
   fmt::print("  {:.0f} bytes per view\n", static_cast<double>(bytes) / views);
 }
 
@@ -226,7 +227,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--pixel", pixel, "EXR pixel type for the timing: half or float")->capture_default_str();
   app.add_option("--compression", compression, "EXR compression for the timing")->capture_default_str();
-  app.add_option("--zip-level", zip_level, "deflate level of zip/zips for the timing (libdeflate)")->capture_default_str();
+  app.add_option("--zip-level", zip_level, "deflate level of zip/zips for the timing (libdeflate)")
+      ->capture_default_str();
   app.add_flag("--all-triangles", all_triangles,
                "osmesa: draw every triangle (RendererOptions::skip_empty_triangles off)");
   app.add_flag("--storage", storage, "Also measure bytes and storage error of every EXR option");

@@ -64,11 +64,14 @@ int run_cantilever(const CantileverOptions& o) {
   if (o.json) {
     std::cout << out.dump(2) << "\n";
   } else {
-    std::cout << fmt::format("cantilever: {} ({} iterations), Gamma = {:.4g}, H/W = {:.4f}", out["outcome"].get<std::string>(),
-                             result->report.iterations, result->gamma, result->height_over_width);
+    std::cout << fmt::format("cantilever: {} ({} iterations), Gamma = {:.4g}, H/W = {:.4f}",
+                             out["outcome"].get<std::string>(), result->report.iterations, result->gamma,
+                             result->height_over_width);
     if (reference) std::cout << fmt::format(" (elastica {:.4f})", reference->height_over_width);
     std::cout << "\n";
-    if (fit) std::cout << fmt::format("  regression: alpha {:.6g} g*mm^2/s^2, beta {:.6g} g*mm^3/s^2\n", fit->alpha * 1e9, fit->beta * 1e12);
+    if (fit)
+      std::cout << fmt::format("  regression: alpha {:.6g} g*mm^2/s^2, beta {:.6g} g*mm^3/s^2\n", fit->alpha * 1e9,
+                               fit->beta * 1e12);
   }
   return result->report.outcome == sim::SolveOutcome::kConverged ? kExitOk : kExitNotConverged;
 }

@@ -168,7 +168,8 @@ int run_diagnose(const DiagnoseOptions& o) {
   constexpr int kKeep = diagnosis::AttributionSettings::kSimplexAfterScan;
   for (auto [levels, option] : {std::pair{o.refit_scan, "--refit-scan"}, std::pair{o.yield_trade, "--yield-trade"},
                                  std::pair{o.shear_trade, "--shear-trade"}, std::pair{o.drift_scan, "--drift-scan"}}) {
-    if (levels && *levels > 0 && *levels > settings.attribution.optimiser.max_evaluations - kKeep) {  // 0: off, nothing to fit
+    if (levels && *levels > 0 &&
+        *levels > settings.attribution.optimiser.max_evaluations - kKeep) {  // 0: off, nothing to fit
       return fail(fmt::format("{} ({}) must leave the refit's simplex {} of its {} evaluations", option, *levels, kKeep,
                               settings.attribution.optimiser.max_evaluations));
     }
@@ -203,8 +204,8 @@ int run_diagnose(const DiagnoseOptions& o) {
     settings.fit.simulator = [f](const sim::DrapeConfig& config) { return f->simulate(config); };
     settings.refit_state_threads = jobs;
   }
-  auto result = diagnosis::diagnose(*capture, settings,
-                                    {.second = second ? &*second : nullptr, .held_out = held_out ? &*held_out : nullptr});
+  auto result = diagnosis::diagnose(
+      *capture, settings, {.second = second ? &*second : nullptr, .held_out = held_out ? &*held_out : nullptr});
   if (!result) return fail(result.error().message);
   if (fleet) {
     const auto c = fleet->counters();
@@ -265,8 +266,9 @@ Runner add_diagnose_command(CLI::App& app) {
                fmt::format("--quick's budgets on a {0}x{0} fitting mesh, with the shape floor calibrated for it",
                            diagnosis::DiagnosisSettings::kFineResolution))
       ->excludes(quick);
-  app.add_option("--resolution", o->resolution, "Fitting mesh vertices per side (default 20; quick 16; fine " +
-                                                    std::to_string(diagnosis::DiagnosisSettings::kFineResolution) + ")");
+  app.add_option("--resolution", o->resolution,
+                 "Fitting mesh vertices per side (default 20; quick 16; fine " +
+                     std::to_string(diagnosis::DiagnosisSettings::kFineResolution) + ")");
   app.add_option("--states", o->states, "Initial states per evaluation (default 3; quick and fine 2)");
   app.add_option("--evaluations", o->evaluations,
                  "Baseline fit evaluations per simplex (default 40; quick and fine 20; a second one with --starts)");
@@ -296,9 +298,10 @@ Runner add_diagnose_command(CLI::App& app) {
   app.add_option("--refit-evaluations", o->refit_evaluations,
                  "Evaluations per candidate refit and of the bar, the bending scale refitted alone (default 14, also "
                  "with --quick and --fine)");
-  app.add_option("--sensor-evaluations", o->sensor_evaluations,
-                 "Evaluations of the sensor candidate's refit, which re-renders the baseline's drapes (default 200, 100 "
-                 "with --quick and --fine)");
+  app.add_option(
+      "--sensor-evaluations", o->sensor_evaluations,
+      "Evaluations of the sensor candidate's refit, which re-renders the baseline's drapes (default 200, 100 "
+      "with --quick and --fine)");
   app.add_flag("--sensor-bending", o->sensor_bending,
                "The sensor candidate also refits the bending scale with a multipath gain under the camera it found, "
                "by simulation (a grid of 3 scales x 2 gains, a simplex within --refit-evaluations, the best without "
@@ -338,18 +341,18 @@ Runner add_diagnose_command(CLI::App& app) {
                              diagnosis::AttributionSettings::kYieldTradeCurvature,
                              diagnosis::AttributionSettings::kSimplexAfterScan,
                              diagnosis::AttributionSettings{}.yield_trade_levels));
-  app.add_option("--shear-trade", o->shear_trade,
-                 fmt::format("The shear refit starts with this many points along the trade of a stiffer bending (x1 "
-                             ".. the refits' upper bound, x{:.1f} unless a known bending's box sets it) against a more "
-                             "compliant membrane ({:.0f} kg/s^2 / the scale^{:.0f}), then refines from the best within "
-                             "--refit-evaluations, which must leave {} for that; replaces --refit-scan for shear (0: "
-                             "off; default {}, off where --refit-evaluations leaves it no room; docs/DIAGNOSIS_RESULTS.md, "
-                             "\"Session 42\")",
-                             std::exp(diagnosis::AttributionSettings{}.bending_scale_upper),
-                             diagnosis::AttributionSettings::kShearTradeStiffness,
-                             diagnosis::AttributionSettings::kShearTradePower,
-                             diagnosis::AttributionSettings::kSimplexAfterScan,
-                             diagnosis::AttributionSettings{}.shear_trade_levels));
+  app.add_option(
+      "--shear-trade", o->shear_trade,
+      fmt::format("The shear refit starts with this many points along the trade of a stiffer bending (x1 "
+                  ".. the refits' upper bound, x{:.1f} unless a known bending's box sets it) against a more "
+                  "compliant membrane ({:.0f} kg/s^2 / the scale^{:.0f}), then refines from the best within "
+                  "--refit-evaluations, which must leave {} for that; replaces --refit-scan for shear (0: "
+                  "off; default {}, off where --refit-evaluations leaves it no room; docs/DIAGNOSIS_RESULTS.md, "
+                  "\"Session 42\")",
+                  std::exp(diagnosis::AttributionSettings{}.bending_scale_upper),
+                  diagnosis::AttributionSettings::kShearTradeStiffness,
+                  diagnosis::AttributionSettings::kShearTradePower, diagnosis::AttributionSettings::kSimplexAfterScan,
+                  diagnosis::AttributionSettings{}.shear_trade_levels));
   app.add_option("--drift-scan", o->drift_scan,
                  fmt::format("The misalignment refit starts with this many drift sizes evenly spaced below its bound "
                              "(3: 10, 20 and 30 mm), bending as fitted, then refines from the best within "
@@ -362,12 +365,13 @@ Runner add_diagnose_command(CLI::App& app) {
                  "The candidate effects to refit, comma-separated (default: yield, shear, curl, friction, "
                  "misalignment, sensor)")
       ->delimiter(',');
-  app.add_option("--jobs", o->jobs,
-                 fmt::format("Threads: the fit's and the floors' initial states, then the candidate refits, in "
-                             "parallel, fewer where there are fewer to share out (same result as --jobs 1; report.json: "
-                             "runtime.jobs). Default: one per CPU this process may run on (taskset, a Slurm or "
-                             "container CPU set; not a CPU quota), at most {}; with --fleet, --fleet-workers",
-                             kMaxJobs));
+  app.add_option(
+      "--jobs", o->jobs,
+      fmt::format("Threads: the fit's and the floors' initial states, then the candidate refits, in "
+                  "parallel, fewer where there are fewer to share out (same result as --jobs 1; report.json: "
+                  "runtime.jobs). Default: one per CPU this process may run on (taskset, a Slurm or "
+                  "container CPU set; not a CPU quota), at most {}; with --fleet, --fleet-workers",
+                  kMaxJobs));
   app.add_option("--fleet", o->fleet,
                  "Compute the drapes on worker processes instead of here: bind this endpoint (e.g. "
                  "tcp://127.0.0.1:5600; tcp://127.0.0.1:* picks a free port, logged and written by "

@@ -9,6 +9,8 @@ int Failure::operator()(std::string_view message, int code) const {
   return code;
 }
 
-int Failure::operator()(const sim::Error& error) const { return (*this)(error.message, error.io ? kExitIo : kExitUsage); }
+int Failure::operator()(const sim::Error& error) const {
+  return (*this)(error.message, error.io ? kExitIo : kExitUsage);
+}
 
 }  // namespace drapegen::cli

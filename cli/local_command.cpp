@@ -146,7 +146,9 @@ class WorkerPool {
 
 Runner add_local_command(CLI::App& app) {
   auto o = std::make_shared<LocalOptions>();
-  app.add_option("--workers", o->workers, "Worker processes to start")->check(CLI::Range(1, 1024))->capture_default_str();
+  app.add_option("--workers", o->workers, "Worker processes to start")
+      ->check(CLI::Range(1, 1024))
+      ->capture_default_str();
   auto* config = app.add_option("--config", o->config, "Run configuration (TOML); default: the embedded small run");
   auto* resume = app.add_option("--resume", o->resume, "Continue the run of this manifest instead");
   config->excludes(resume);

@@ -84,9 +84,10 @@ int run_reality(const RealityOptions& o) {
 
 Runner add_reality_command(CLI::App& app) {
   auto o = std::make_shared<RealityOptions>();
-  app.add_option("--effect", o->effects,
-                 "NAME[=STRENGTH], repeatable: yield=K (1/m), shear=G (kg/s^2), curl=K[,W] (1/m over W mm, default 30), "
-                 "friction=MU, misalign=MM, pose=DEG, bias=MM, multipath=MM (without --effect: a control)");
+  app.add_option(
+      "--effect", o->effects,
+      "NAME[=STRENGTH], repeatable: yield=K (1/m), shear=G (kg/s^2), curl=K[,W] (1/m over W mm, default 30), "
+      "friction=MU, misalign=MM, pose=DEG, bias=MM, multipath=MM (without --effect: a control)");
   app.add_option("--alpha", o->alpha, "Linear bending moduli W,B,F, g*mm^2/s^2")->required();
   app.add_option("--beta", o->beta, "Quadratic bending moduli W,B,F, g*mm^3/s^2 (use --beta=-...)")
       ->capture_default_str();
@@ -97,9 +98,9 @@ Runner add_reality_command(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--placement", o->placement,
                  "Placement K of the specimen: K > 0 re-drapes the same specimen (same fabric, effects and camera "
-                 "calibration error) from another initial state, orientation, drift and noise: a second capture of it. A "
-                 "yielding specimen keeps its plastic set: placement K starts from the set placements 0..K-1 left "
-                 "(K + 1 drapes)")
+                 "calibration error) from another initial state, orientation, drift and noise: a second capture of "
+                 "it. A yielding specimen keeps its plastic set: placement K starts from the set placements 0..K-1 "
+                 "left (K + 1 drapes)")
       ->capture_default_str();
   app.add_option("--out", o->out, "Capture directory (capture.json, view0..3.exr, truth.json, preview.png)")
       ->required();

@@ -163,7 +163,8 @@ Runner add_render_command(CLI::App& app) {
   app.add_option("--pixel", o->pixel, "EXR pixel type: half or float")
       ->check(CLI::IsMember({"half", "float"}))
       ->capture_default_str();
-  app.add_option("--compression", o->compression, "EXR compression: none, rle, zips, zip, piz, pxr24, b44, b44a, dwaa, dwab")
+  app.add_option("--compression", o->compression,
+                 "EXR compression: none, rle, zips, zip, piz, pxr24, b44, b44a, dwaa, dwab")
       ->capture_default_str();
   app.add_option("--quantum", o->quantum, "Round stored depth to multiples of this, metres (0: off)")
       ->capture_default_str();

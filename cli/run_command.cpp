@@ -68,12 +68,15 @@ Runner add_run_command(CLI::App& app) {
   auto* config = app.add_option("--config", o->config, "Run configuration (TOML; keys in docs/SERVICE.md)");
   auto* resume = app.add_option("--resume", o->resume, "Continue the run of this manifest (OUTPUT/manifest.sqlite)");
   config->excludes(resume);
-  app.add_option("--bind", o->bind, "Bind this endpoint instead of the configured/recorded one, e.g. tcp://127.0.0.1:*");
-  app.add_option("--progress", o->progress, "Progress display: auto (terminal line if stderr is a TTY), terminal, log, off")
+  app.add_option("--bind", o->bind,
+                 "Bind this endpoint instead of the configured/recorded one, e.g. tcp://127.0.0.1:*");
+  app.add_option("--progress", o->progress,
+                 "Progress display: auto (terminal line if stderr is a TTY), terminal, log, off")
       ->check(CLI::IsMember({"auto", "terminal", "log", "off"}))
       ->capture_default_str();
   app.add_option("--server-key", o->server_key, "CurveZMQ secret key file (overrides [security] server_secret_key)");
-  app.add_option("--authorized-keys", o->authorized_keys, "Worker public keys file (overrides [security] authorized_keys)");
+  app.add_option("--authorized-keys", o->authorized_keys,
+                 "Worker public keys file (overrides [security] authorized_keys)");
   app.add_option("--endpoint-file", o->endpoint_file, "Also write the bound endpoint to this file");
   return [o] {
     if (o->config.empty() == o->resume.empty()) return fail("give --config RUN.toml or --resume MANIFEST");

@@ -199,7 +199,8 @@ Runner add_simulate_command(CLI::App& app) {
   app.add_option("--anisotropy", o->anisotropy, "Bending direction rule: curvature (paper) or edge (naive)")
       ->check(CLI::IsMember({"curvature", "edge"}))
       ->capture_default_str();
-  app.add_option("--sigma", o->sigma, "In-plane stiffness at the standard density (300 g/m^2), kg/s^2")->capture_default_str();
+  app.add_option("--sigma", o->sigma, "In-plane stiffness at the standard density (300 g/m^2), kg/s^2")
+      ->capture_default_str();
   app.add_option("--band", o->band, "Stretch band LOW,HIGH absorbed by the adaptive reference (1,1: none)")
       ->capture_default_str();
   std::vector<std::string> mesh_names{"perturbed"};

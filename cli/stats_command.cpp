@@ -40,7 +40,8 @@ Runner add_stats_command(CLI::App& app) {
       std::cout << stats->dump(2) << "\n";
     } else {
       std::cout << coordinator::format_stats(*stats);
-      if (stats->contains("plots")) std::cout << "  plots: " << (*stats)["plots"].size() << " SVG files in " << o->plots << "\n";
+      if (stats->contains("plots"))
+        std::cout << "  plots: " << (*stats)["plots"].size() << " SVG files in " << o->plots << "\n";
     }
     return kExitOk;
   };

@@ -25,7 +25,8 @@ Runner add_worker_command(CLI::App& app) {
   app.add_option("--backoff-max-ms", o->backoff_max_ms, "Longest reconnect delay, ms (exponential back-off)")
       ->check(CLI::Range(10, 3600000))
       ->capture_default_str();
-  app.add_option("--give-up", o->give_up_s, "Exit with an error after this many seconds without a coordinator (0: never)")
+  app.add_option("--give-up", o->give_up_s,
+                 "Exit with an error after this many seconds without a coordinator (0: never)")
       ->check(CLI::Range(0.0, 1e9))
       ->capture_default_str();
   app.add_option("--server-key", o->server_key, "CurveZMQ: the coordinator's public key (Z85, or a .pub file)");

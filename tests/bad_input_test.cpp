@@ -26,7 +26,8 @@ std::string dump(const fs::path& manifest) {
   }
   for (const auto& r : all(reader->results())) s << "result " << r.job_id << " " << r.outcome << "\n";
   for (const auto& f : all(reader->files())) s << "file " << f.path << " " << f.sha256 << "\n";
-  for (const auto& f : all(reader->failures())) s << "failure " << f.job_id << " " << f.attempt << " " << f.reason << "\n";
+  for (const auto& f : all(reader->failures()))
+    s << "failure " << f.job_id << " " << f.attempt << " " << f.reason << "\n";
   return s.str();
 }
 

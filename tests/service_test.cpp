@@ -274,7 +274,8 @@ TEST(Service, StopsOnAnUnwritableOutputAndResumes) {
 // mount (root); skipped otherwise.
 TEST(Service, StopsOnAFullDiskAndResumes) {
   // A mount left behind by an interrupted earlier run would keep test_dir from clearing the directory.
-  (void)!std::system(("umount " + (fs::path(SERVICE_TEST_WORK) / "disk_full" / "run").string() + " 2> /dev/null").c_str());
+  (void)!std::system(
+      ("umount " + (fs::path(SERVICE_TEST_WORK) / "disk_full" / "run").string() + " 2> /dev/null").c_str());
   const fs::path dir = test_dir("disk_full");
   const fs::path out = dir / "run";
   fs::create_directories(out);

@@ -55,7 +55,8 @@ class Reader {
     } else {
       return fail(name, "must be a number");
     }
-    if (!std::isfinite(v) || v < low || v > high) return fail(name, fmt::format("must be between {} and {}", low, high));
+    if (!std::isfinite(v) || v < low || v > high)
+      return fail(name, fmt::format("must be between {} and {}", low, high));
     out = v;
   }
 
@@ -103,9 +104,10 @@ sim::Expected<RunConfig> parse_run_config(const std::string& toml_text, const st
   }
   RunConfig c;
   Reader r(root, source_name);
-  r.only_keys(&root, "",
-              {"seed", "samples", "states_per_sample", "orientations", "resolution", "noise", "renderer", "density",
-               "bending_model", "output", "model", "recipes", "solver", "network", "security", "retry", "progress", "testing"});
+  r.only_keys(
+      &root, "",
+      {"seed", "samples", "states_per_sample", "orientations", "resolution", "noise", "renderer", "density",
+       "bending_model", "output", "model", "recipes", "solver", "network", "security", "retry", "progress", "testing"});
   if (const toml::node* seed = root.get("seed")) {
     if (!seed->is_integer() || seed->as_integer()->get() < 0) {
       r.fail("seed", "must be a non-negative integer");
@@ -203,7 +205,8 @@ sim::Expected<RunConfig> parse_run_config(const std::string& toml_text, const st
 }
 
 const std::string& default_config_toml() {
-  static const std::string text = R"toml(# drapegen local's embedded default: a small run with coarse meshes (docs/SERVICE.md lists every key).
+  static const std::string text =
+      R"toml(# drapegen local's embedded default: a small run with coarse meshes (docs/SERVICE.md lists every key).
 seed = 1
 samples = 30            # parameter vectors from the VAE sampler
 states_per_sample = 4   # initial states per vector (paper: 8)

@@ -77,7 +77,8 @@ TEST(RunConfig, NamesTheKeyOfEveryError) {
   EXPECT_EQ(error_of("[network]\nport = 1"), "run.toml: network.port: unknown key");
   EXPECT_EQ(error_of("[extra]\nx = 1"), "run.toml: extra: unknown section");
   EXPECT_EQ(error_of("seed = -1"), "run.toml: seed: must be a non-negative integer");
-  EXPECT_EQ(error_of("[testing]\npoison_samples = [\"a\"]"), "run.toml: testing.poison_samples: must hold non-negative integers");
+  EXPECT_EQ(error_of("[testing]\npoison_samples = [\"a\"]"),
+            "run.toml: testing.poison_samples: must hold non-negative integers");
   EXPECT_NE(error_of("seed = = 1").find("run.toml:1:"), std::string::npos);
 }
 

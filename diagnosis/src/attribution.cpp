@@ -200,7 +200,8 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
   auto scaled = [&](double ln_scale) { return scaled_bending(baseline, ln_scale); };
   auto setup_of = [&](const std::vector<double>& x) {
     ModelSetup setup = sim ? scaled(x[0]) : baseline;
-    if (!bar) apply_effect(*effect, std::vector<double>(x.begin() + static_cast<std::ptrdiff_t>(first), x.end()), setup);
+    if (!bar)
+      apply_effect(*effect, std::vector<double>(x.begin() + static_cast<std::ptrdiff_t>(first), x.end()), setup);
     return setup;
   };
   // The scan's best point, which the simplex evaluates first: its value is known (evaluations are deterministic).
@@ -520,7 +521,8 @@ double bootstrap_confidence(const ForwardModel& model, const ScoredDrape& a, con
   int wins = 0;
   for (int s = 0; s < samples; ++s) {
     double sum = 0.0;
-    for (std::size_t k = 0; k < d.size(); ++k) sum += d[std::min(d.size() - 1, static_cast<std::size_t>(rng.uniform() * d.size()))];
+    for (std::size_t k = 0; k < d.size(); ++k)
+      sum += d[std::min(d.size() - 1, static_cast<std::size_t>(rng.uniform() * d.size()))];
     wins += sum > 0.0;
   }
   return static_cast<double>(wins) / samples;

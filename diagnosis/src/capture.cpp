@@ -89,8 +89,8 @@ sim::Status check_view(const CaptureView& view) {
       return sim::Error{fmt::format("{}: negative depth {} at pixel ({}, {})", view.file, z, i % d.width, i / d.width)};
     }
     if (z > kFarthestDepth) {
-      return sim::Error{fmt::format("{}: depth {} m at pixel ({}, {}) is beyond {} m; use 0 for no return", view.file, z,
-                                    i % d.width, i / d.width, kFarthestDepth)};
+      return sim::Error{fmt::format("{}: depth {} m at pixel ({}, {}) is beyond {} m; use 0 for no return", view.file,
+                                    z, i % d.width, i / d.width, kFarthestDepth)};
     }
     returns += z > 0.0f;
   }
@@ -126,7 +126,8 @@ sim::Expected<Capture> read_capture(const std::string& directory) {
     }
     const auto& s = j["specimen"];
     const auto size = s.at("size_mm");
-    if (!size.is_array() || size.size() != 2) return sim::Error{fmt::format("{}: specimen.size_mm must be [X, Y]", where)};
+    if (!size.is_array() || size.size() != 2)
+      return sim::Error{fmt::format("{}: specimen.size_mm must be [X, Y]", where)};
     c.specimen.size_x = size[0].get<double>() * 1e-3;
     c.specimen.size_y = size[1].get<double>() * 1e-3;
     c.specimen.density = s.at("density_g_per_m2").get<double>();
@@ -138,7 +139,8 @@ sim::Expected<Capture> read_capture(const std::string& directory) {
     if (!(c.specimen.density >= 1.0 && c.specimen.density <= 1e5)) {
       return sim::Error{fmt::format("{}: density must be 1 .. 100000 g/m^2", where)};
     }
-    if (!(c.specimen.cylinder_diameter >= 0.01 && c.specimen.cylinder_diameter < std::min(c.specimen.size_x, c.specimen.size_y))) {
+    if (!(c.specimen.cylinder_diameter >= 0.01 &&
+          c.specimen.cylinder_diameter < std::min(c.specimen.size_x, c.specimen.size_y))) {
       return sim::Error{fmt::format("{}: cylinder diameter must be 10 mm .. the specimen size", where)};
     }
     if (s.contains("measured_bending") && !s["measured_bending"].is_null()) {
@@ -164,7 +166,8 @@ sim::Expected<Capture> read_capture(const std::string& directory) {
       }
       auto K = matrix_from(jv.at("K"), 3, 3, what + ".K");
       if (!K) return K.error();
-      if ((*K)(2, 0) != 0.0 || (*K)(2, 1) != 0.0 || (*K)(2, 2) != 1.0) return sim::Error{what + ".K: last row must be 0 0 1"};
+      if ((*K)(2, 0) != 0.0 || (*K)(2, 1) != 0.0 || (*K)(2, 2) != 1.0)
+        return sim::Error{what + ".K: last row must be 0 0 1"};
       if (!((*K)(0, 0) > 0.0 && (*K)(1, 1) > 0.0)) {
         return sim::Error{what + ".K: the focal lengths K[0][0] and K[1][1] must be positive"};
       }

@@ -59,8 +59,8 @@ sim::Expected<renderer::DepthImage> read_depth_exr(const std::string& path) {
     if (W <= 0 || H <= 0 || W > 16384 || H > 16384) return sim::Error{fmt::format("{}: bad image size", path)};
     std::vector<float> buffer(static_cast<std::size_t>(dw) * dh, 0.0f);
     Imf::FrameBuffer fb;
-    char* base = reinterpret_cast<char*>(buffer.data()) -
-                 (static_cast<std::ptrdiff_t>(data.min.y) * dw + data.min.x) * static_cast<std::ptrdiff_t>(sizeof(float));
+    char* base = reinterpret_cast<char*>(buffer.data()) - (static_cast<std::ptrdiff_t>(data.min.y) * dw + data.min.x) *
+                                                              static_cast<std::ptrdiff_t>(sizeof(float));
     fb.insert(channel, Imf::Slice(Imf::FLOAT, base, sizeof(float), sizeof(float) * dw));
     file.setFrameBuffer(fb);
     file.readPixels(data.min.y, data.max.y);

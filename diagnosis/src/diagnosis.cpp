@@ -245,7 +245,8 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
   if (!created) return created.error();
   ForwardModel& model = **created;
   std::unique_ptr<ForwardModel> second_model, held_out_model;
-  for (auto [placement, made] : {std::pair{others.second, &second_model}, std::pair{others.held_out, &held_out_model}}) {
+  for (auto [placement, made] :
+       {std::pair{others.second, &second_model}, std::pair{others.held_out, &held_out_model}}) {
     if (!placement) continue;
     auto m = ForwardModel::create(*placement, settings.fit);
     if (!m) return m.error();
@@ -495,7 +496,8 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
   j["confidence"] = r.attribution.confidence;
   j["within_floors"] = r.within_floors;
   j["within_floors_after_bending_refit"] = r.attribution.bending_within_floors();
-  j["gap_mm"] = {{"all_views", r.gap_all * 1e3}, {"fit_views", r.gap_fit * 1e3}, {"held_out_view", r.gap_held_out * 1e3}};
+  j["gap_mm"] = {
+      {"all_views", r.gap_all * 1e3}, {"fit_views", r.gap_fit * 1e3}, {"held_out_view", r.gap_held_out * 1e3}};
   nlohmann::json states = nlohmann::json::array();
   for (const auto& d : r.validated.states) {
     states.push_back({{"state", d.state}, {"stable_mm", d.stable_all * 1e3}, {"shape", d.shape_all},

@@ -80,7 +80,8 @@ double Floors::stable_floor() const { return largest(pooled(*this, &FloorSamples
 
 GapTerms gap_terms(const ScoredDrape& drape, const ScoredDrape* held_out_capture) {
   if (!held_out_capture) return {drape.stable_all, drape.shape_all};
-  return {0.5 * (drape.stable_all + held_out_capture->stable_all), 0.5 * (drape.shape_all + held_out_capture->shape_all)};
+  return {0.5 * (drape.stable_all + held_out_capture->stable_all),
+          0.5 * (drape.shape_all + held_out_capture->shape_all)};
 }
 
 double excess_above_floors(const GapTerms& gap, const Floors& floors) {

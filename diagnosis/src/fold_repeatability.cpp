@@ -70,7 +70,8 @@ std::vector<double> placement_fold_correlations(const ScoredDrape& capture, cons
   return drape_fold_correlations(chosen);
 }
 
-std::vector<sim::ClothMesh> sine_drapes(const Evaluation& evaluation, const std::vector<sim::InitialStateSpec>& states) {
+std::vector<sim::ClothMesh> sine_drapes(const Evaluation& evaluation,
+                                        const std::vector<sim::InitialStateSpec>& states) {
   std::vector<sim::ClothMesh> sine;
   for (std::size_t k = 0; k < evaluation.states.size() && k < states.size(); ++k)
     if (states[k].shape == sim::InitialShape::kSine) sine.push_back(evaluation.states[k].mesh);

@@ -209,7 +209,8 @@ Localisation localise(const ForwardModel& model, const ScoredDrape& drape) {
   const HemProfile capture_outline = hem_profile_from_capture(capture);
   HemProfile diff;
   diff.radius.resize(capture_outline.radius.size());
-  for (std::size_t k = 0; k < diff.radius.size(); ++k) diff.radius[k] = capture_outline.radius[k] - model_outline.radius[k];
+  for (std::size_t k = 0; k < diff.radius.size(); ++k)
+    diff.radius[k] = capture_outline.radius[k] - model_outline.radius[k];
   L.hem_difference = harmonics(diff, 12);
   L.capture_folds = fold_count(capture_outline);
   L.model_folds = fold_count(model_outline);

@@ -134,7 +134,8 @@ NelderMeadResult nelder_mead(const std::function<double(const std::vector<double
       } else {
         for (std::size_t k = 0; k <= n && result.evaluations < options.max_evaluations; ++k) {
           if (k == lo) continue;
-          for (std::size_t i = 0; i < n; ++i) simplex[k][i] = simplex[lo][i] + kShrink * (simplex[k][i] - simplex[lo][i]);
+          for (std::size_t i = 0; i < n; ++i)
+            simplex[k][i] = simplex[lo][i] + kShrink * (simplex[k][i] - simplex[lo][i]);
           values[k] = eval(simplex[k]);
         }
       }

@@ -68,8 +68,9 @@ std::string leading_feature_text(const Localisation& L) {
   const std::string& led = L.dominant_feature;
   if (led.empty()) return "nothing exceeds its floor";
   if (led == "camera") {
-    return fmt::format("the rigid surfaces put the camera {:.1f} mm from its calibration at the platform: a camera error",
-                       L.camera_moved * 1e3);
+    return fmt::format(
+        "the rigid surfaces put the camera {:.1f} mm from its calibration at the platform: a camera error",
+        L.camera_moved * 1e3);
   }
   if (led == "stable") {
     const RegionShare* top = region_share(L, Region::kTop);
@@ -114,7 +115,8 @@ std::string verdict_markdown(const DiagnosisResult& r) {
                       "no effect is named.\n\n",
                       r.attribution.common_effects.size(), effects, r.attribution.common_bending->alpha_scale);
   } else if (r.verdict == "none") {
-    md += "**Verdict: the gap is within the floors** (sensor noise and multiple stable drapes); no effect is named.\n\n";
+    md +=
+        "**Verdict: the gap is within the floors** (sensor noise and multiple stable drapes); no effect is named.\n\n";
   } else if (r.verdict == "not attributed") {
     md += "**Verdict: a gap above the floors; attribution was not run** (`--gap-only`).\n\n";
   } else if (r.verdict == "unexplained" && r.attribution.candidates.empty()) {
@@ -176,7 +178,8 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
     for (const auto& v : d.views) out.push_back(v.residual);
     return out;
   };
-  if (sim::Status s = write_residual_png((dir / "residual.png").string(), residuals(r.gap_drape()), W, H, range); !s) return s;
+  if (sim::Status s = write_residual_png((dir / "residual.png").string(), residuals(r.gap_drape()), W, H, range); !s)
+    return s;
   const bool after = r.attribution.named && !r.attribution.candidates.empty();
   if (after) {
     if (sim::Status s = write_residual_png((dir / "residual_after.png").string(),
@@ -201,22 +204,23 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
   md += fmt::format("| floor (x{:.2f} margin) | {:.2f} | {:.2f} |\n\n", r.floors.margin, r.floors.all * 1e3,
                     r.floors.held_out * 1e3);
   const GapTerms gap = r.gap();
-  md += fmt::format("Tests (all views{}): stable-region term {:.2f} mm against its floor {:.2f} mm; shape distance {:.2f} "
-                    "against its floor {:.2f}.\n\n",
-                    r.validated_second     ? ", mean of the capture and the second capture"
-                    : r.validated_held_out ? ", mean of the capture and the held-out capture"
-                                           : "",
-                    gap.stable * 1e3,
-                    r.floors.stable * 1e3, gap.shape, r.floors.shape);
+  md += fmt::format(
+      "Tests (all views{}): stable-region term {:.2f} mm against its floor {:.2f} mm; shape distance {:.2f} "
+      "against its floor {:.2f}.\n\n",
+      r.validated_second     ? ", mean of the capture and the second capture"
+      : r.validated_held_out ? ", mean of the capture and the held-out capture"
+                             : "",
+      gap.stable * 1e3, r.floors.stable * 1e3, gap.shape, r.floors.shape);
   if (r.rigid_pose) {
     const RigidPose& p = *r.rigid_pose;
-    md += fmt::format("Camera from the rigid surfaces (the cloth on the platform top, the bare side below the specimen's "
-                      "reach; {} and {} pixels): rotation ({:.1f}, {:.1f}, {:.1f}) mrad, translation ({:.1f}, {:.1f}, "
-                      "{:.1f}) mm in the camera frame; the pixels' RMS distance to the surfaces {:.2f} mm at the "
-                      "recorded camera, {:.2f} mm at this one. The sensor candidate starts from it.\n\n",
-                      p.top_pixels, p.side_pixels, p.pose.rotation.x() * 1e3, p.pose.rotation.y() * 1e3,
-                      p.pose.rotation.z() * 1e3, p.pose.translation.x() * 1e3, p.pose.translation.y() * 1e3,
-                      p.pose.translation.z() * 1e3, p.rms_recorded * 1e3, p.rms_estimated * 1e3);
+    md += fmt::format(
+        "Camera from the rigid surfaces (the cloth on the platform top, the bare side below the specimen's "
+        "reach; {} and {} pixels): rotation ({:.1f}, {:.1f}, {:.1f}) mrad, translation ({:.1f}, {:.1f}, "
+        "{:.1f}) mm in the camera frame; the pixels' RMS distance to the surfaces {:.2f} mm at the "
+        "recorded camera, {:.2f} mm at this one. The sensor candidate starts from it.\n\n",
+        p.top_pixels, p.side_pixels, p.pose.rotation.x() * 1e3, p.pose.rotation.y() * 1e3, p.pose.rotation.z() * 1e3,
+        p.pose.translation.x() * 1e3, p.pose.translation.y() * 1e3, p.pose.translation.z() * 1e3, p.rms_recorded * 1e3,
+        p.rms_estimated * 1e3);
     if (p.top_lift > 0.0) {
       md += fmt::format("The cloth on the platform top lies {:.1f} mm above its contact offset and the bare side shows "
                         "the camera where its calibration says: read as the specimen lifting off the top (one that "
@@ -224,26 +228,31 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
                         p.top_lift * 1e3);
     }
     if (r.attribution.sensor_held)
-      md += fmt::format("That camera is within {:.0f} mm of its calibration at the platform: the sensor candidate keeps "
-                        "it, with no depth bias or slope (either would move the rigid surfaces), and refits only the "
-                        "multipath gain, which they cannot see.\n\n",
-                        kCameraMovedAtPlatform * 1e3);
+      md += fmt::format(
+          "That camera is within {:.0f} mm of its calibration at the platform: the sensor candidate keeps "
+          "it, with no depth bias or slope (either would move the rigid surfaces), and refits only the "
+          "multipath gain, which they cannot see.\n\n",
+          kCameraMovedAtPlatform * 1e3);
   } else {
-    md += fmt::format("Camera from the rigid surfaces: not estimated ({}); the sensor candidate starts from the recorded "
-                      "camera.\n\n", r.rigid_pose_error);
+    md += fmt::format(
+        "Camera from the rigid surfaces: not estimated ({}); the sensor candidate starts from the recorded "
+        "camera.\n\n",
+        r.rigid_pose_error);
   }
-  md += fmt::format("Fitted baseline: alpha = {:.0f}, {:.0f}, {:.0f} g mm^2/s^2; beta = {:.0f}, {:.0f}, {:.0f} g mm^3/s^2 "
-                    "({} simplex evaluations from the {}{}{}).\n\n",
-                    r.fitted.alpha.warp, r.fitted.alpha.bias, r.fitted.alpha.weft, r.fitted.beta.warp,
-                    r.fitted.beta.bias, r.fitted.beta.weft, r.baseline_evaluations, r.initial_guess_from,
-                    r.search_within_factor > 1.0
-                        ? fmt::format(", searched within x{:.3g} of it", r.search_within_factor)
-                        : std::string(),
-                    r.start_evaluations == 0 ? std::string()
-                    : fmt::format(", {} starts{}", r.start_evaluations,
-                                  r.restarted ? "; the second simplex, from the best start, is the fit" : ""));
-  md += "## Where the gap sits\n\nShape features, capture against the fitted baseline, over the largest floor sample:\n\n"
-        "| feature group | region | ratio to floor |\n|---|---|---|\n";
+  md += fmt::format(
+      "Fitted baseline: alpha = {:.0f}, {:.0f}, {:.0f} g mm^2/s^2; beta = {:.0f}, {:.0f}, {:.0f} g mm^3/s^2 "
+      "({} simplex evaluations from the {}{}{}).\n\n",
+      r.fitted.alpha.warp, r.fitted.alpha.bias, r.fitted.alpha.weft, r.fitted.beta.warp, r.fitted.beta.bias,
+      r.fitted.beta.weft, r.baseline_evaluations, r.initial_guess_from,
+      r.search_within_factor > 1.0 ? fmt::format(", searched within x{:.3g} of it", r.search_within_factor)
+                                   : std::string(),
+      r.start_evaluations == 0
+          ? std::string()
+          : fmt::format(", {} starts{}", r.start_evaluations,
+                        r.restarted ? "; the second simplex, from the best start, is the fit" : ""));
+  md +=
+      "## Where the gap sits\n\nShape features, capture against the fitted baseline, over the largest floor sample:\n\n"
+      "| feature group | region | ratio to floor |\n|---|---|---|\n";
   for (std::size_t k = 0; k < r.localisation.group_ratio.size(); ++k) {
     const FeatureGroup g = kFeatureGroups[k];
     md += fmt::format("| {} | {}{} | {:.2f} |\n", feature_group_name(g), region_name(feature_region(g)),
@@ -285,20 +294,23 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
   std::sort(h.begin(), h.end(), [](const Harmonic& a, const Harmonic& b) { return a.amplitude > b.amplitude; });
   for (std::size_t k = 0; k < std::min<std::size_t>(3, h.size()); ++k)
     md += fmt::format(" order {} {:.1f} mm;", h[k].order, h[k].amplitude * 1e3);
-  md += "\n\n![residual maps](residual.png)\n\nResidual capture - fitted baseline per view (red: the capture is farther "
-        "from the camera, blue: nearer; saturated at +-" + fmt::format("{:.0f}", range * 1e3) + " mm; black: no return).\n\n"
-        "![views](views.png)\n\nTop: the capture; bottom: the fitted baseline.\n\n";
+  md +=
+      "\n\n![residual maps](residual.png)\n\nResidual capture - fitted baseline per view (red: the capture is farther "
+      "from the camera, blue: nearer; saturated at +-" +
+      fmt::format("{:.0f}", range * 1e3) +
+      " mm; black: no return).\n\n"
+      "![views](views.png)\n\nTop: the capture; bottom: the fitted baseline.\n\n";
   if (!r.attribution.candidates.empty()) {
     const bool held_out = r.validated_held_out.has_value();
-    md += fmt::format("## Candidate effects (refitted on the fit views{}, confirmed on the held-out {})\n\n"
-                      "| effect | all-view score (mm) | shrinkage of the excess above the floors{} | held-out {}'s score "
-                      "(mm) | its shrinkage | confirmed | parameters |\n",
-                      r.validated_second ? " of the capture and the second capture" : "",
-                      held_out ? "capture" : "view",
-                      r.validated_second     ? " (mean of the capture and the second capture)"
-                      : r.validated_held_out ? " (mean of the capture and the held-out capture)"
-                                             : "",
-                      held_out ? "capture" : "view");
+    md += fmt::format(
+        "## Candidate effects (refitted on the fit views{}, confirmed on the held-out {})\n\n"
+        "| effect | all-view score (mm) | shrinkage of the excess above the floors{} | held-out {}'s score "
+        "(mm) | its shrinkage | confirmed | parameters |\n",
+        r.validated_second ? " of the capture and the second capture" : "", held_out ? "capture" : "view",
+        r.validated_second     ? " (mean of the capture and the second capture)"
+        : r.validated_held_out ? " (mean of the capture and the held-out capture)"
+                               : "",
+        held_out ? "capture" : "view");
     md += "|---|---|---|---|---|---|---|\n";
     for (const auto& c : r.attribution.candidates) {
       std::string params;

@@ -157,8 +157,9 @@ TEST(SensorBendingGrid, IsTheScalesTimesTheGainsInOrderWithinTheBoundsAndTheBudg
 }
 
 TEST(CurlFirst, MovesAConfirmedSignificantCurlToTheFrontKeepingTheOthersOrder) {
-  std::vector<CandidateResult> order{ranked(Effect::kYield, true, 0.9, 5e-3, 0.0), ranked(Effect::kShear, true, 0.5, 5e-3, 0.0),
-                                      ranked(Effect::kCurl, true, 0.76, 5e-3, 0.0), ranked(Effect::kSensor, false, 0.3, 5e-3, 0.0)};
+  std::vector<CandidateResult> order{
+      ranked(Effect::kYield, true, 0.9, 5e-3, 0.0), ranked(Effect::kShear, true, 0.5, 5e-3, 0.0),
+      ranked(Effect::kCurl, true, 0.76, 5e-3, 0.0), ranked(Effect::kSensor, false, 0.3, 5e-3, 0.0)};
   ASSERT_TRUE(curl_first(order, 0.25));
   EXPECT_EQ(order[0].effect, Effect::kCurl);
   EXPECT_EQ(order[1].effect, Effect::kYield);
@@ -166,7 +167,8 @@ TEST(CurlFirst, MovesAConfirmedSignificantCurlToTheFrontKeepingTheOthersOrder) {
   EXPECT_EQ(order[3].effect, Effect::kSensor);
   EXPECT_FALSE(curl_first(order, 0.25));  // already first
   // Unconfirmed, or below the significant shrinkage: nothing moves.
-  std::vector<CandidateResult> weak{ranked(Effect::kYield, true, 0.9, 5e-3, 0.0), ranked(Effect::kCurl, false, 0.8, 5e-3, 0.0)};
+  std::vector<CandidateResult> weak{ranked(Effect::kYield, true, 0.9, 5e-3, 0.0),
+                                    ranked(Effect::kCurl, false, 0.8, 5e-3, 0.0)};
   EXPECT_FALSE(curl_first(weak, 0.25));
   EXPECT_EQ(weak[0].effect, Effect::kYield);
   weak = {ranked(Effect::kYield, true, 0.9, 5e-3, 0.0), ranked(Effect::kCurl, true, 0.2, 5e-3, 0.0)};
@@ -197,7 +199,8 @@ TEST(NearTiesFirst, NamesTheSmallestObjectiveOfTheSignificantConfirmedCandidates
   EXPECT_FALSE(near_ties_first(outside, 0.09, 0.25));
   ASSERT_TRUE(near_ties_first(physical, 0.1, 0.25));
   EXPECT_EQ(physical[0].effect, Effect::kCurl);
-  std::vector<CandidateResult> larger{ranked(Effect::kYield, true, 0.674, 7e-3, 0.0), ranked(Effect::kCurl, true, 0.6, 8e-3, 0.0)};
+  std::vector<CandidateResult> larger{ranked(Effect::kYield, true, 0.674, 7e-3, 0.0),
+                                      ranked(Effect::kCurl, true, 0.6, 8e-3, 0.0)};
   EXPECT_FALSE(near_ties_first(larger, 0.1, 0.25));
   // A first tied exactly keeps ranks_before's order (friction before the sensor error at 1.0 on seeds 22-28), even
   // with a third within the margin that fits better.
@@ -207,11 +210,14 @@ TEST(NearTiesFirst, NamesTheSmallestObjectiveOfTheSignificantConfirmedCandidates
   EXPECT_FALSE(near_ties_first(tied, 0.1, 0.25));
   EXPECT_EQ(tied[0].effect, Effect::kFriction);
   // Only a confirmed candidate that is significant itself, and only behind a confirmed first.
-  std::vector<CandidateResult> unconfirmed{ranked(Effect::kSensor, true, 0.9, 8e-3, 0.0), ranked(Effect::kCurl, false, 0.88, 7e-3, 0.0)};
+  std::vector<CandidateResult> unconfirmed{ranked(Effect::kSensor, true, 0.9, 8e-3, 0.0),
+                                           ranked(Effect::kCurl, false, 0.88, 7e-3, 0.0)};
   EXPECT_FALSE(near_ties_first(unconfirmed, 0.1, 0.25));
-  std::vector<CandidateResult> weak{ranked(Effect::kYield, true, 0.3, 8e-3, 0.0), ranked(Effect::kCurl, true, 0.22, 7e-3, 0.0)};
+  std::vector<CandidateResult> weak{ranked(Effect::kYield, true, 0.3, 8e-3, 0.0),
+                                    ranked(Effect::kCurl, true, 0.22, 7e-3, 0.0)};
   EXPECT_FALSE(near_ties_first(weak, 0.1, 0.25));
-  std::vector<CandidateResult> none_confirmed{ranked(Effect::kSensor, false, 0.9, 8e-3, 0.0), ranked(Effect::kCurl, false, 0.88, 7e-3, 0.0)};
+  std::vector<CandidateResult> none_confirmed{ranked(Effect::kSensor, false, 0.9, 8e-3, 0.0),
+                                              ranked(Effect::kCurl, false, 0.88, 7e-3, 0.0)};
   EXPECT_FALSE(near_ties_first(none_confirmed, 0.1, 0.25));
   std::vector<CandidateResult> empty;
   EXPECT_FALSE(near_ties_first(empty, 0.1, 0.25));
@@ -227,9 +233,10 @@ TEST(CommonBending, TheMedianScaleOfConfirmedCandidatesWithinTheFloors) {
     c.validated = drape_of(2e-3, shape);
     return c;
   };
-  std::vector<CandidateResult> cs{candidate(Effect::kShear, true, 2.72, 1.0), candidate(Effect::kYield, true, 2.25, 1.1),
-                                  candidate(Effect::kCurl, true, 2.12, 0.9), candidate(Effect::kFriction, true, 1.80, 1.15),
-                                  candidate(Effect::kSensor, true, 1.0, 1.3), candidate(Effect::kMisalignment, false, 1.0, 0.5)};
+  std::vector<CandidateResult> cs{
+      candidate(Effect::kShear, true, 2.72, 1.0), candidate(Effect::kYield, true, 2.25, 1.1),
+      candidate(Effect::kCurl, true, 2.12, 0.9),  candidate(Effect::kFriction, true, 1.80, 1.15),
+      candidate(Effect::kSensor, true, 1.0, 1.3), candidate(Effect::kMisalignment, false, 1.0, 0.5)};
   const auto shared = common_bending(cs, f, 3);
   ASSERT_TRUE(shared);
   EXPECT_EQ(shared->effects, (std::vector<Effect>{Effect::kShear, Effect::kYield, Effect::kCurl, Effect::kFriction}));

@@ -17,7 +17,8 @@ sim::Status check_in_view(const TriangleMesh& cloth, const RigSpec& rig, const s
           return sim::Error{fmt::format(
               "mesh is out of the camera's view: vertex {} at ({:.3g}, {:.3g}, {:.3g}) m leaves the {}x{} image at "
               "table angle {:.1f} deg (is the drape in metres, centred on the platform at z = 0?)",
-              i, x.x(), x.y(), x.z(), rig.width, rig.height, (p.orientation + view * 2 * M_PI / rig.views) * 180 / M_PI)};
+              i, x.x(), x.y(), x.z(), rig.width, rig.height,
+              (p.orientation + view * 2 * M_PI / rig.views) * 180 / M_PI)};
         }
       }
     }

@@ -251,7 +251,8 @@ sim::Expected<DepthImage> DepthRenderer::render(const Camera& camera, const Eige
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, impl_->chosen_ebo);  // recorded in the VAO
     glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(chosen.size() * sizeof(chosen[0])), chosen.data(),
                  GL_STREAM_DRAW);
-    if (!chosen.empty()) glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(3 * chosen.size()), GL_UNSIGNED_INT, nullptr);
+    if (!chosen.empty())
+      glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(3 * chosen.size()), GL_UNSIGNED_INT, nullptr);
   } else {
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, impl_->ebo);
     glDrawElements(GL_TRIANGLES, impl_->index_count, GL_UNSIGNED_INT, nullptr);

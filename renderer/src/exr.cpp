@@ -124,8 +124,9 @@ sim::Expected<DataPointRecord> decode(Imf::IStream& stream) {
     if (h.channels().findChannel(channel_name(v)) == nullptr) {
       return sim::Error{fmt::format("missing channel {}", channel_name(v))};
     }
-    char* base = reinterpret_cast<char*>(buffers[v].data()) -
-                 (static_cast<std::ptrdiff_t>(data.min.y) * dw + data.min.x) * static_cast<std::ptrdiff_t>(sizeof(float));
+    char* base =
+        reinterpret_cast<char*>(buffers[v].data()) -
+        (static_cast<std::ptrdiff_t>(data.min.y) * dw + data.min.x) * static_cast<std::ptrdiff_t>(sizeof(float));
     fb.insert(channel_name(v), Imf::Slice(Imf::FLOAT, base, sizeof(float), sizeof(float) * dw));
   }
   file.setFrameBuffer(fb);
@@ -270,7 +271,8 @@ sim::Expected<std::vector<char>> ExrWriter::encode(const DataPointRecord& point,
     Imf::Header header(Imath::Box2i({0, 0}, {W - 1, H - 1}), Imath::Box2i({x0, y0}, {x1, y1}));
     header.compression() = compressions().at(storage_.compression);
     header.zipCompressionLevel() = storage_.zip_level;
-    for (int v = 0; v < views; ++v) header.channels().insert(channel_name(v), Imf::Channel(half ? Imf::HALF : Imf::FLOAT));
+    for (int v = 0; v < views; ++v)
+      header.channels().insert(channel_name(v), Imf::Channel(half ? Imf::HALF : Imf::FLOAT));
     header.insert("drapegen.units", Imf::StringAttribute(kUnits));
     header.insert("drapegen.views", Imf::IntAttribute(views));
     header.insert("drapegen.index", Imf::IntAttribute(point.index));

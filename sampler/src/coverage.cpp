@@ -75,7 +75,8 @@ double mean_log_likelihood(const VaeModel& model, const std::vector<Features>& d
         z.col(k) = eps.col(k);
       }
     }
-    const Eigen::ArrayXd a = log_normal(z, centre, sd), b = log_normal(z, centre, wide), prior = log_normal(z, zero, one);
+    const Eigen::ArrayXd a = log_normal(z, centre, sd), b = log_normal(z, centre, wide),
+                         prior = log_normal(z, zero, one);
     const Eigen::ArrayXd top = a.max(b).max(prior);
     const Eigen::ArrayXd log_q = top + ((a - top).exp() + (b - top).exp() + (prior - top).exp()).log() - std::log(3.0);
     const Eigen::MatrixXd mean = model.decode_standardised(z);

@@ -38,7 +38,8 @@ const char* to_string(RecipeKind kind) {
 
 sim::Status validate(const InitialStateRecipe& r) {
   if (r.sample < 0 || r.slot < 0) return sim::Error{"recipe sample and slot must be non-negative"};
-  if (!(r.rotation >= 0.0 && r.rotation < 2.0 * std::numbers::pi)) return sim::Error{"recipe rotation must be in [0, 2 pi)"};
+  if (!(r.rotation >= 0.0 && r.rotation < 2.0 * std::numbers::pi))
+    return sim::Error{"recipe rotation must be in [0, 2 pi)"};
   if (!std::isfinite(r.drift_x_mm) || !std::isfinite(r.drift_y_mm)) return sim::Error{"recipe drift must be finite"};
   if (r.kind == RecipeKind::kDrape) {
     if (r.source.sample < 0 || r.source.slot < 0) return sim::Error{"a drape recipe needs a source sample/slot"};
@@ -52,9 +53,9 @@ sim::Status validate(const InitialStateRecipe& r) {
 std::string to_text(const InitialStateRecipe& r) {
   const std::string source =
       r.kind == RecipeKind::kDrape ? fmt::format("{}/{}", r.source.sample, r.source.slot) : std::string("-");
-  return fmt::format("sample={} slot={} kind={} shape_seed={} triangulation_seed={} rotation={} drift_mm={},{} source={}",
-                     r.sample, r.slot, to_string(r.kind), r.shape_seed, r.triangulation_seed, r.rotation, r.drift_x_mm,
-                     r.drift_y_mm, source);
+  return fmt::format(
+      "sample={} slot={} kind={} shape_seed={} triangulation_seed={} rotation={} drift_mm={},{} source={}", r.sample,
+      r.slot, to_string(r.kind), r.shape_seed, r.triangulation_seed, r.rotation, r.drift_x_mm, r.drift_y_mm, source);
 }
 
 sim::Expected<InitialStateRecipe> parse_recipe_text(const std::string& text) {
@@ -72,7 +73,8 @@ sim::Expected<InitialStateRecipe> parse_recipe_text(const std::string& text) {
     }
     fields[kKeys[index++]] = token.substr(eq + 1);
   }
-  if (index != std::size(kKeys)) return sim::Error{"recipe text: missing fields after '" + std::string(kKeys[index > 0 ? index - 1 : 0]) + "'"};
+  if (index != std::size(kKeys))
+    return sim::Error{"recipe text: missing fields after '" + std::string(kKeys[index > 0 ? index - 1 : 0]) + "'"};
   InitialStateRecipe r;
   const auto kind = parse_kind(fields["kind"]);
   if (!kind) return kind.error();
@@ -158,6 +160,8 @@ sim::Expected<sim::InitialStateSpec> to_initial_state(const InitialStateRecipe& 
   return spec;
 }
 
-void apply_triangulation(const InitialStateRecipe& r, sim::SpecimenSpec& specimen) { specimen.seed = r.triangulation_seed; }
+void apply_triangulation(const InitialStateRecipe& r, sim::SpecimenSpec& specimen) {
+  specimen.seed = r.triangulation_seed;
+}
 
 }  // namespace drapegen::sampler

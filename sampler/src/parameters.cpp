@@ -21,7 +21,8 @@ Features to_features(const ParameterVector& p) {
 }
 
 ParameterVector from_features(const Features& f) {
-  return {{signed_exp(f[0]), signed_exp(f[1]), signed_exp(f[2])}, {signed_exp(f[3]), signed_exp(f[4]), signed_exp(f[5])}};
+  return {{signed_exp(f[0]), signed_exp(f[1]), signed_exp(f[2])},
+          {signed_exp(f[3]), signed_exp(f[4]), signed_exp(f[5])}};
 }
 
 ParameterVector at_density(const ParameterVector& normalised, double density_g_per_m2) {

@@ -16,7 +16,8 @@ bool weight_ok(double w) { return w >= 0.0 && std::isfinite(w); }
 /// Draws one recipe; `pick_source(rng)` returns a source drape or nothing (then sine or fold).
 template <class PickSource>
 InitialStateRecipe draw(const RecipeOptions& o, std::int64_t sample, int slot, PickSource pick_source) {
-  Random rng(derive_seed(o.seed, {kRecipeStream, static_cast<std::uint64_t>(sample), static_cast<std::uint64_t>(slot)}));
+  Random rng(
+      derive_seed(o.seed, {kRecipeStream, static_cast<std::uint64_t>(sample), static_cast<std::uint64_t>(slot)}));
   InitialStateRecipe r;
   r.sample = sample;
   r.slot = slot;

@@ -31,12 +31,14 @@ Image read_png(const std::string& path) {
 
 int count_colour(const Image& img, unsigned char r, unsigned char g, unsigned char b) {
   int n = 0;
-  for (std::size_t i = 0; i + 2 < img.rgb.size(); i += 3) n += img.rgb[i] == r && img.rgb[i + 1] == g && img.rgb[i + 2] == b;
+  for (std::size_t i = 0; i + 2 < img.rgb.size(); i += 3)
+    n += img.rgb[i] == r && img.rgb[i + 1] == g && img.rgb[i + 2] == b;
   return n;
 }
 
 TEST(ScatterPlot, DrawsBothSetsIntoAPng) {
-  const std::string path = (fs::temp_directory_path() / ("drapegen_plot_" + std::to_string(::getpid()) + ".png")).string();
+  const std::string path =
+      (fs::temp_directory_path() / ("drapegen_plot_" + std::to_string(::getpid()) + ".png")).string();
   std::vector<Features> generated, measured;
   for (int i = 0; i < 50; ++i) generated.push_back({8.0 + 0.05 * i, 9, 9, -10.0 - 0.02 * i, -10, -10});
   measured.push_back({9.0, 9, 9, -11.5, -10, -10});  // inside the frame

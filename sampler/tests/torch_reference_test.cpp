@@ -89,8 +89,8 @@ TEST(TorchReference, FreshlyTrainedDecoderMatchesPyTorch) {
   ASSERT_TRUE(model) << model.error().message;
   EXPECT_EQ(model->observation, Observation::student_t);
   std::string reference;
-  ASSERT_TRUE(run(kPython + " " + kSource + "/training/vae/reference_decode.py --checkpoint " + (dir / "m.pt").string() +
-                      " --count 64 --seed 3",
+  ASSERT_TRUE(run(kPython + " " + kSource + "/training/vae/reference_decode.py --checkpoint " +
+                      (dir / "m.pt").string() + " --count 64 --seed 3",
                   reference));
   const double worst = max_difference(*model, reference, 64);
   std::cout << "freshly trained VAE-4: largest |C++ - PyTorch| over 64 latents x 6 features = " << worst << "\n";

@@ -319,7 +319,8 @@ std::vector<double> smooth_circular(const std::vector<double>& values, double si
 double circular_prominence(const std::vector<double>& v, int first, int last) {
   const int n = static_cast<int>(v.size());
   const double height = v[first];
-  // Walk away on each side until a strictly higher value or all the way round; the lowest value seen is that side's col.
+  // Walk away on each side until a strictly higher value or all the way round; the lowest value seen is that side's
+  // col.
   auto col = [&](int start, int step) {
     double lowest = height;
     for (int i = 1; i < n; ++i) {
@@ -361,7 +362,8 @@ double projected_area(const ClothMesh& mesh, double pixel) {
     if (std::abs(e1.x() * e2.y() - e1.y() * e2.x()) <= 1e-14 * e1.squaredNorm() + 1e-14 * e2.squaredNorm()) continue;
     const double y_min = std::min({span.corners[0].y(), span.corners[1].y(), span.corners[2].y()});
     const double y_max = std::max({span.corners[0].y(), span.corners[1].y(), span.corners[2].y()});
-    span.first_row = std::max<std::int64_t>(0, static_cast<std::int64_t>(std::ceil((y_min - lower.y()) / pixel - 0.5 - 1e-7)));
+    span.first_row =
+        std::max<std::int64_t>(0, static_cast<std::int64_t>(std::ceil((y_min - lower.y()) / pixel - 0.5 - 1e-7)));
     span.last_row = std::min(rows - 1, static_cast<std::int64_t>(std::floor((y_max - lower.y()) / pixel - 0.5 + 1e-7)));
     if (span.first_row <= span.last_row) spans.push_back(span);
   }

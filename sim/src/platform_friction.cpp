@@ -27,7 +27,8 @@ double PlatformFriction::update_lagged(const Eigen::Matrix3Xd& x) {
   Eigen::Matrix3Xd force = Eigen::Matrix3Xd::Zero(3, x.cols());
   contact_->evaluate(x, &force, nullptr);
   Eigen::VectorXd updated(normal_.size());
-  for (std::size_t i = 0; i < vertices_.size(); ++i) updated[static_cast<Eigen::Index>(i)] = force.col(vertices_[i]).norm();
+  for (std::size_t i = 0; i < vertices_.size(); ++i)
+    updated[static_cast<Eigen::Index>(i)] = force.col(vertices_[i]).norm();
   const double scale = std::max(updated.maxCoeff(), normal_.size() > 0 ? normal_.maxCoeff() : 0.0);
   const double change = scale > 0.0 ? (updated - normal_).cwiseAbs().maxCoeff() / scale : 0.0;
   normal_ = updated;

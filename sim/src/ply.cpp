@@ -491,7 +491,8 @@ Status write_file_atomically(const std::string& path, const std::string& bytes) 
   const bool written = std::fwrite(bytes.data(), 1, bytes.size(), file) == bytes.size() && std::fflush(file) == 0 &&
                        fsync(fileno(file)) == 0;
   const int write_errno = errno;
-  if (std::fclose(file) != 0 || !written) return fail("cannot write '" + temporary + "'", written ? errno : write_errno);
+  if (std::fclose(file) != 0 || !written)
+    return fail("cannot write '" + temporary + "'", written ? errno : write_errno);
   if (std::rename(temporary.c_str(), path.c_str()) != 0) return fail("cannot rename '" + temporary + "'", errno);
   return {};
 }

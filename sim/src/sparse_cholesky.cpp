@@ -89,8 +89,8 @@ struct SparseCholesky::Impl {
   Eigen::VectorXd permuted_rhs;
   bool analysed = false;
   // The preconditioner's compact copy of a supernodal factor, made on first use after each factorisation (empty
-  // until then): per supernode, its diagonal block packed in single precision (packed_triangle.hpp) and the rows below it in single precision or,
-  // for a factor of at least kBfloat16MinEntries values, in bfloat16.
+  // until then): per supernode, its diagonal block packed in single precision (packed_triangle.hpp) and the rows below
+  // it in single precision or, for a factor of at least kBfloat16MinEntries values, in bfloat16.
   std::vector<float> diagonal;
   std::vector<float> below_single;
   std::vector<std::uint16_t> below_bfloat16;

@@ -21,7 +21,8 @@ TEST(Bfloat16, RoundsToNearestWithTiesToEven) {
   // 1 + 3 * 2^-8 lies halfway between 1 + 2^-7 and 1 + 2^-6: to the even one, 1 + 2^-6.
   EXPECT_EQ(from_bfloat16(to_bfloat16(1.0f + 3.0f * std::ldexp(1.0f, -8))), 1.0f + std::ldexp(1.0f, -6));
   EXPECT_EQ(from_bfloat16(to_bfloat16(1.0f + 1.5f * std::ldexp(1.0f, -8))), 1.0f + std::ldexp(1.0f, -7));
-  // Relative error at most 2^-8 (half the spacing of 8 significant bits) over a wide range of magnitudes (the factor's entries span many decades).
+  // Relative error at most 2^-8 (half the spacing of 8 significant bits) over a wide range of magnitudes (the factor's
+  // entries span many decades).
   std::mt19937 rng(3);
   std::uniform_real_distribution<float> mantissa(-1.0f, 1.0f);
   std::uniform_int_distribution<int> exponent(-60, 60);

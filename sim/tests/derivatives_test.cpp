@@ -24,7 +24,8 @@ TEST(Derivatives, MembraneStretchBandIsC2) {
     const auto g = membrane.stretch_energy(s);
     EXPECT_NEAR(g.first, (membrane.stretch_energy(s + h).value - membrane.stretch_energy(s - h).value) / (2 * h), 1e-7);
     // g is C2; its third derivative jumps at the band edges, which limits central differences to ~1e-5 there.
-    EXPECT_NEAR(g.second, (membrane.stretch_energy(s + h).first - membrane.stretch_energy(s - h).first) / (2 * h), 1e-4);
+    EXPECT_NEAR(g.second, (membrane.stretch_energy(s + h).first - membrane.stretch_energy(s - h).first) / (2 * h),
+                1e-4);
   }
   EXPECT_DOUBLE_EQ(membrane.stretch_energy(1.0).value, 0.0);
   EXPECT_DOUBLE_EQ(membrane.stretch_energy(1.005).second, 0.02);  // eps * 2 inside the band

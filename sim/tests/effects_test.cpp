@@ -191,8 +191,9 @@ DrapeResult drape(const DrapeConfig& c, const char* label) {
   Expected<DrapeResult> r = simulate_drape(c);
   EXPECT_TRUE(r.has_value()) << (r ? "" : r.error().message);
   if (!r) return {};
-  std::printf("[ drape    ] %-34s %s %3d it  DC %.4f  folds %d\n", label, std::string(to_string(r->report.outcome)).c_str(),
-              r->report.iterations, r->measures.drape_coefficient, r->measures.folds);
+  std::printf("[ drape    ] %-34s %s %3d it  DC %.4f  folds %d\n", label,
+              std::string(to_string(r->report.outcome)).c_str(), r->report.iterations, r->measures.drape_coefficient,
+              r->measures.folds);
   EXPECT_EQ(r->report.outcome, SolveOutcome::kConverged) << label << ": " << r->report.message;
   if (r->report.outcome != SolveOutcome::kConverged) std::printf("  %s\n", r->report.message.c_str());
   return std::move(r).value();

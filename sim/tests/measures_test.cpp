@@ -18,8 +18,14 @@ namespace {
 constexpr double kPi = std::numbers::pi;
 
 ClothMesh square_specimen(int vertices, double jitter = 0.0, bool random_diagonals = false) {
-  return make_specimen(SpecimenSpec{.size_x = 0.3, .size_y = 0.3, .vertices_x = vertices, .vertices_y = vertices,
-                                    .jitter = jitter, .triangulation = random_diagonals ? Triangulation::kRandom : Triangulation::kAlternating, .seed = 3});
+  return make_specimen(
+      SpecimenSpec{.size_x = 0.3,
+                   .size_y = 0.3,
+                   .vertices_x = vertices,
+                   .vertices_y = vertices,
+                   .jitter = jitter,
+                   .triangulation = random_diagonals ? Triangulation::kRandom : Triangulation::kAlternating,
+                   .seed = 3});
 }
 
 /// The specimen draped analytically: flat on the platform for r <= R, then straight down a cone whose generators
@@ -123,7 +129,8 @@ TEST(DrapeCoefficient, ConeMatchesCusickFormula) {
     // the integral of r_max over a square's boundary, 8 h ln(1 + sqrt 2), and of r_max^2 / 2, the square's area.
     const double s = std::sin(half_angle);
     const double shadow = kPi * platform * platform * (1 - s) * (1 - s) +
-                          8.0 * half_side * platform * (1 - s) * s * std::log(1.0 + std::sqrt(2.0)) + s * s * side * side;
+                          8.0 * half_side * platform * (1 - s) * s * std::log(1.0 + std::sqrt(2.0)) +
+                          s * s * side * side;
     const double platform_area = kPi * platform * platform;
     const double expected = (shadow - platform_area) / (side * side - platform_area);
     EXPECT_NEAR(projected_area(mesh), shadow, 0.005 * shadow) << half_angle;
@@ -208,7 +215,8 @@ TEST(CountFolds, UnequalFoldsAndPlateaus) {
   bump(0, 20, 0.03);
   bump(90, 20, 0.03);
   bump(180, 15, 0.004);
-  for (int b = 250; b <= 290; ++b) profile[b] = b < 260 || b > 280 ? 0.15 + 0.002 * (b < 260 ? b - 249 : 291 - b) : 0.17;
+  for (int b = 250; b <= 290; ++b)
+    profile[b] = b < 260 || b > 280 ? 0.15 + 0.002 * (b < 260 ? b - 249 : 291 - b) : 0.17;
   EXPECT_EQ(count_folds(profile), 4);
   EXPECT_EQ(count_folds(profile, 0.01), 3);
 }
@@ -291,7 +299,8 @@ TEST(SelfIntersections, TwoLooseTriangles) {
 }
 
 TEST(SelfIntersections, TrianglesSharingAVertexAreNotCounted) {
-  ClothMesh mesh = triangle_pair({Eigen::Vector3d(0, 0, 0), {1, 0, 0}, {0, 1, 0}, {0, 0, 0}, {0.5, 0.5, 1}, {0.5, 0.5, -1}});
+  ClothMesh mesh =
+      triangle_pair({Eigen::Vector3d(0, 0, 0), {1, 0, 0}, {0, 1, 0}, {0, 0, 0}, {0.5, 0.5, 1}, {0.5, 0.5, -1}});
   EXPECT_EQ(count_self_intersections(mesh), 1);  // vertex 3 coincides with vertex 0 but is a different vertex
   mesh.triangles(0, 1) = 0;
   EXPECT_EQ(count_self_intersections(mesh), 0);

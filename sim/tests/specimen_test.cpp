@@ -54,8 +54,8 @@ TEST(Specimen, DiagonalPatterns) {
   const auto pattern = [&](Triangulation t) {
     return main_diagonals(make_specimen(SpecimenSpec{0.1, 0.1, n, n, 0.0, t, 1, 0.0}), n);
   };
-  const std::vector<bool> uniform = pattern(Triangulation::kUniform), alternating = pattern(Triangulation::kAlternating),
-                          random = pattern(Triangulation::kRandom);
+  const std::vector<bool> uniform = pattern(Triangulation::kUniform),
+                          alternating = pattern(Triangulation::kAlternating), random = pattern(Triangulation::kRandom);
   ASSERT_EQ(uniform.size(), static_cast<std::size_t>((n - 1) * (n - 1)));
   int random_main = 0;
   for (std::size_t q = 0; q < uniform.size(); ++q) {
@@ -69,7 +69,8 @@ TEST(Specimen, DiagonalPatterns) {
 }
 
 TEST(Specimen, RejectsBadSpecs) {
-  EXPECT_THROW(make_specimen(SpecimenSpec{0.1, 0.1, 1, 5, 0.0, Triangulation::kUniform, 0, 0.0}), std::invalid_argument);
+  EXPECT_THROW(make_specimen(SpecimenSpec{0.1, 0.1, 1, 5, 0.0, Triangulation::kUniform, 0, 0.0}),
+               std::invalid_argument);
   EXPECT_THROW(make_specimen(SpecimenSpec{0.1, 0.1, 5, 5, 0.5, Triangulation::kRandom, 0, 0.0}), std::invalid_argument);
   EXPECT_THROW(make_specimen(SpecimenSpec{-0.1, 0.1, 5, 5, 0.0, Triangulation::kRandom, 0, 0.0}),
                std::invalid_argument);

@@ -29,7 +29,8 @@ TEST(TriangleCurvatureBending, DerivativesAnisotropicSofteningAndStiffening) {
   const Topology topology = build_topology(mesh);
   // Soft enough that some directions sit on the torque plateau (kappa > alpha / 2|beta|).
   for (double beta : {-3e-7, 3e-9}) {
-    TriangleCurvatureBending bending(mesh, topology, DihedralModuli{{1e-5, 1.5e-5, 2e-5}, {beta, 0.5 * beta, 0.8 * beta}},
+    TriangleCurvatureBending bending(mesh, topology,
+                                     DihedralModuli{{1e-5, 1.5e-5, 2e-5}, {beta, 0.5 * beta, 0.8 * beta}},
                                      AnisotropyRule::kCurvature);
     EXPECT_GE(bending.update_lagged(mesh.positions), 0.0);
     check_derivatives(bending, mesh.positions, 1e-8, 1e-5);
@@ -54,7 +55,8 @@ TEST(TriangleCurvatureBending, EveryTriangleIsAnElementBorderWingsAbsent) {
       const int a = vertices[(i + 1) % 3], b = vertices[(i + 2) % 3];
       hinges += hinge_edges.count({std::min(a, b), std::max(a, b)}) > 0 ? 1 : 0;
     }
-    const int wings = static_cast<int>(std::count_if(vertices.begin() + 3, vertices.end(), [](int v) { return v >= 0; }));
+    const int wings =
+        static_cast<int>(std::count_if(vertices.begin() + 3, vertices.end(), [](int v) { return v >= 0; }));
     EXPECT_EQ(wings, hinges) << t;
     absent += 3 - wings;
   }
@@ -93,7 +95,8 @@ double energy_ratio(Triangulation triangulation, double jitter, double axis_degr
     x.col(v) << p, amplitude * 0.5 * p.dot(k * p);
   }
   std::set<std::pair<int, int>> free_edges;
-  for (const Eigen::Vector2i& e : topology.boundary_edges) free_edges.insert({std::min(e.x(), e.y()), std::max(e.x(), e.y())});
+  for (const Eigen::Vector2i& e : topology.boundary_edges)
+    free_edges.insert({std::min(e.x(), e.y()), std::max(e.x(), e.y())});
   double continuum = 0.0;
   for (int t = 0; t < mesh.triangle_count(); ++t) {
     const Eigen::Vector2d p[3] = {mesh.rest.col(mesh.triangles(0, t)), mesh.rest.col(mesh.triangles(1, t)),

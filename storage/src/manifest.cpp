@@ -60,7 +60,8 @@ sim::Status configure(sqlite3* db, bool writer) {
 sim::Status check_schema(sqlite3* db, const std::string& path) {
   Statement st(db, "SELECT value FROM meta WHERE key = 'schema_version'");
   if (!st.ok()) return sim::Error{fmt::format("{} is not a drapegen manifest ({})", path, st.prepare_error())};
-  if (st.step() != SQLITE_ROW) return sim::Error{fmt::format("{} is not a drapegen manifest (no schema version)", path)};
+  if (st.step() != SQLITE_ROW)
+    return sim::Error{fmt::format("{} is not a drapegen manifest (no schema version)", path)};
   const std::string version = st.text(0);
   if (version != std::to_string(kSchemaVersion)) {
     return sim::Error{fmt::format("{} has manifest schema version {}; this build reads version {}", path, version,

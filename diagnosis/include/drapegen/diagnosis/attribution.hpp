@@ -280,7 +280,8 @@ struct Attribution {
 [[nodiscard]] sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& baseline,
                                                    const Evaluation& fit, const Evaluation& validated,
                                                    const Floors& floors, const AttributionSettings& settings,
-                                                   const ModelFactory& make_model = {}, const OtherCaptures& others = {});
+                                                   const ModelFactory& make_model = {},
+                                                   const OtherCaptures& others = {});
 
 /// Unlike effects each within the floors (AttributionSettings::common_bending_effects): the confirmed candidates whose
 /// validated excess is 0, and the median of their ln bending scales; unset where fewer than `at_least` (or 0) are.

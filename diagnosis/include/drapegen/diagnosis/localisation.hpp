@@ -92,7 +92,8 @@ void for_each_residual_point(
 
 /// Sets each region's floor_ratio and floor_region: the region's residual RMS over the largest floor sample's there
 /// (`floor_mean_square`, m^2 per region, Floors::region_floor).
-void localise_against_floors(Localisation& localisation, const std::array<double, RegionEnergy::kCount>& floor_mean_square);
+void localise_against_floors(Localisation& localisation,
+                             const std::array<double, RegionEnergy::kCount>& floor_mean_square);
 
 /// The region a feature group describes: the outline groups the hem, the skirt groups the skirt.
 [[nodiscard]] Region feature_region(FeatureGroup group);
@@ -128,9 +129,9 @@ void localise_features(Localisation& localisation, const ScoredDrape& drape, con
 /// it everywhere (kGlobal, "camera"). Else the largest ratio above 1 leads, but the stable term leads whatever else
 /// exceeds its floor when it is above its floor with stable_region kTop (a lifted platform top), when the top is above
 /// its own floor and seen farther than the fitted cloth, or when it is at least kLiftedTopSensorRatio times its floor
-/// (a camera's error; session 27). The stable term: stable_region. A skirt group: kSkirt. The hem's centre offset: kHem.
-/// The other hem groups (harmonics, sorted radii, hem height): kSkirt if the skirt's pixel residual is denser than the
-/// hem's (the outline carries a change of the skirt above it), else kHem. Nothing above 1: kGlobal.
+/// (a camera's error; session 27). The stable term: stable_region. A skirt group: kSkirt. The hem's centre offset:
+/// kHem. The other hem groups (harmonics, sorted radii, hem height): kSkirt if the skirt's pixel residual is denser
+/// than the hem's (the outline carries a change of the skirt above it), else kHem. Nothing above 1: kGlobal.
 void place_gap(Localisation& localisation);
 
 }  // namespace drapegen::diagnosis

@@ -35,7 +35,8 @@ struct SensorError {
   /// Bias and multipath applied to a clean depth image (keeps the incidence channel for the noise model).
   [[nodiscard]] DepthImage apply(const DepthImage& clean, const Intrinsics& intrinsics) const;
   /// The multipath concavity S(p) of every pixel (0 without a return).
-  [[nodiscard]] static std::vector<float> concavity(const DepthImage& depth, const Intrinsics& intrinsics, int radius_px);
+  [[nodiscard]] static std::vector<float> concavity(const DepthImage& depth, const Intrinsics& intrinsics,
+                                                    int radius_px);
 };
 
 }  // namespace drapegen::renderer

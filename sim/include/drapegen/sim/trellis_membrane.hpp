@@ -24,9 +24,9 @@ struct TrellisParameters {
 /// with a = F d_warp and b = F d_weft the deformed yarn vectors (F the 3x2 deformation gradient of a rest triangle,
 /// d_warp and d_weft the yarn directions in rest coordinates from the mesh's material angle) and g the band energy of
 /// CorotationalMembrane: a shear gamma stretches the cloth by 1 +- sin(gamma)/2 along the diagonals, charged with the
-/// same anti-locking dead zone as the isotropic model (without it, the trellis locks). The Hessian is formed in the 6-D space of
-/// the two deformed yarn vectors (exact, by forward-mode differentiation of the closed-form gradient) and mapped to
-/// the triangle's 9 coordinates; the projected mode clamps the 6x6 eigenvalues at zero.
+/// same anti-locking dead zone as the isotropic model (without it, the trellis locks). The Hessian is formed in the 6-D
+/// space of the two deformed yarn vectors (exact, by forward-mode differentiation of the closed-form gradient) and
+/// mapped to the triangle's 9 coordinates; the projected mode clamps the 6x6 eigenvalues at zero.
 class TrellisMembrane final : public EnergyTerm {
  public:
   TrellisMembrane(const ClothMesh& mesh, const TrellisParameters& params);
