@@ -42,8 +42,8 @@ namespace drapegen::sim {
 /// below 45 bins), then its circular local maxima (a plateau counts once) with a topographic prominence of at least
 /// `min_prominence` metres are counted. The prominence of a peak is its height above the higher of the two lowest
 /// points met walking round the circle in each direction until a strictly higher value; the highest peak's is its
-/// height above the profile's minimum. A constant profile has no folds; a flat square specimen has 4 (its corners); r0
-/// + a cos(k psi) has k when 2a (times the smoothing's attenuation, 0.92 for k = 12) reaches `min_prominence`.
+/// height above the profile's minimum. A constant profile has no folds; a flat square specimen has 4 (its corners);
+/// r0 + a cos(k psi) has k when 2a (times the smoothing's attenuation, 0.92 for k = 12) reaches `min_prominence`.
 [[nodiscard]] int count_folds(const std::vector<double>& profile, double min_prominence = 2e-3);
 
 /// The number of unordered pairs of triangles that share no vertex index and intersect, as closed sets: touching
