@@ -319,8 +319,8 @@ std::vector<double> smooth_circular(const std::vector<double>& values, double si
 double circular_prominence(const std::vector<double>& v, int first, int last) {
   const int n = static_cast<int>(v.size());
   const double height = v[first];
-  // Walk away on each side until a strictly higher value or all the way round; the lowest value seen is that side's
-  // col.
+  // Walk away on each side until a strictly higher value or all the way round; the lowest value seen is
+  // that side's col.
   auto col = [&](int start, int step) {
     double lowest = height;
     for (int i = 1; i < n; ++i) {

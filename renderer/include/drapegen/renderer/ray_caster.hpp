@@ -32,8 +32,8 @@ class RayCaster {
  private:
   struct Node {
     Eigen::Vector3d lo, hi;
-    int first = 0,
-        count = 0;  // leaf: triangles order_[first, first + count); inner: count == 0, children first, first+1
+    // Leaf: triangles order_[first, first + count); inner: count == 0, children first, first+1.
+    int first = 0, count = 0;
   };
   std::vector<Eigen::Vector3d> a_, b_, c_;  // triangle corners
   std::vector<int> order_;
