@@ -269,6 +269,36 @@ TEST(Service, StopsOnAnUnwritableOutputAndResumes) {
   EXPECT_EQ(reader->run()->state, "complete");
 }
 
+// One result's file cannot be written (its temporary name taken by a directory: EISDIR) while the rest of data/ can:
+// the coordinator stops naming that path; what it recorded before stays; once the directory is gone, resume completes.
+TEST(Service, StopsOnOneUnwritableResultAndResumes) {
+  const fs::path dir = test_dir("one_file_fault");
+  const fs::path out = dir / "run";
+  const fs::path blocker = out / "data" / "s000003_k01_o01.exr.tmp";
+  fs::create_directories(blocker);
+  write_text(dir / "run.toml", small_config(out, 8, 2));
+  const fs::path manifest = out / "manifest.sqlite";
+  auto [coordinator, endpoint] = start_coordinator({"--config", (dir / "run.toml").string()}, out, dir / "coordinator");
+  ASSERT_FALSE(endpoint.empty()) << coordinator.err();
+  Process worker = start_worker(endpoint, dir, 1);
+  ASSERT_EQ(coordinator.wait(60s), 3) << coordinator.err();
+  const std::string err = coordinator.err();
+  const auto last_line = err.substr(err.rfind('\n', err.size() - 2) + 1);
+  EXPECT_NE(last_line.find("cannot create " + blocker.string() + ": Is a directory"), std::string::npos) << err;
+  EXPECT_NE(last_line.find("drapegen run --resume"), std::string::npos) << err;
+  const long recorded = recorded_jobs(manifest);
+  EXPECT_GE(recorded, 0);
+  EXPECT_LT(recorded, 16);
+  EXPECT_EQ(worker.wait(10s), 0) << worker.err();
+  fs::remove(blocker);
+  ASSERT_TRUE(resume_to_completion(manifest, out, dir, 2));
+  check_manifest(manifest, 2);
+  auto reader = storage::ManifestReader::open(manifest.string());
+  ASSERT_TRUE(reader);
+  EXPECT_EQ(reader->results()->size(), 16u);
+  EXPECT_EQ(reader->run()->state, "complete");
+}
+
 // Acceptance 6, the disk-full half: the output directory is a small tmpfs that fills up during the run; the
 // coordinator stops with a clear error; after the filesystem grows, --resume completes the run. Needs the right to
 // mount (root); skipped otherwise.

@@ -97,8 +97,13 @@ struct Coordinator::Impl {
   std::map<std::string, Worker> workers;
   std::int64_t done = 0, failed = 0;
   std::int64_t recorded = 0, rejected = 0;
-  std::string storage_error;
+  std::string storage_error;  // the first storage fault of this session; the run stops on it
   bool files_written = false;
+
+  /// Keeps the first fault: what follows it (a commit on the same failing disk) would only hide its path and cause.
+  void storage_fault(const sim::Error& error) {
+    if (storage_error.empty()) storage_error = error.message;
+  }
 
   zmq::context_t context{1};
   std::unique_ptr<CurveServer> curve;  // CurveZMQ only: set up before the ROUTER binds
@@ -406,7 +411,7 @@ struct Coordinator::Impl {
     std::int64_t bytes = 0;
     auto write = [&](const std::string& name, const std::string& data, const char* kind, int index) {
       if (sim::Status s = storage::write_file_atomic(data_dir + "/" + name, data); !s) {
-        storage_error = s.error().message;
+        storage_fault(s.error());
         return false;
       }
       files.push_back({slot->rec.id, kind, index, "data/" + name, storage::sha256_hex(data),
@@ -441,11 +446,11 @@ struct Coordinator::Impl {
     rec.started_at = slot->lease_started;
     rec.finished_at = unix_now();
     if (sim::Status s = manifest->begin(); !s) {
-      storage_error = s.error().message;
+      storage_fault(s.error());
       return;
     }
     if (sim::Status s = manifest->record_result(rec, result, files); !s) {
-      storage_error = s.error().message;
+      storage_fault(s.error());
       return;
     }
     rec.state = storage::JobState::kDone;
@@ -480,11 +485,11 @@ struct Coordinator::Impl {
     storage::FailureRecord failure{rec.id, slot.attempts, proto::reason_name(reason), message, worker_name,
                                    rec.finished_at};
     if (sim::Status s = manifest->begin(); !s) {
-      storage_error = s.error().message;
+      storage_fault(s.error());
       return;
     }
     if (sim::Status s = manifest->record_failure(rec, failure, final); !s) {
-      storage_error = s.error().message;
+      storage_fault(s.error());
       return;
     }
     ++recorded;
@@ -520,7 +525,7 @@ struct Coordinator::Impl {
       slot.waiting_on = 0;
       if (!source_done) {
         if (sim::Status s = fall_back(slot); !s) {
-          storage_error = s.error().message;
+          storage_fault(s.error());
           return;
         }
       }
@@ -577,7 +582,7 @@ struct Coordinator::Impl {
       ++slot.attempts;
       auto job = make_job(slot);
       if (!job) {
-        storage_error = job.error().message;
+        storage_fault(job.error());
         return;
       }
       slot.leased = true;
@@ -644,13 +649,13 @@ struct Coordinator::Impl {
     if (!manifest->in_transaction()) return;
     if (files_written) {
       if (sim::Status s = storage::sync_directory(data_dir); !s) {
-        storage_error = s.error().message;
+        storage_fault(s.error());
         manifest->rollback();
         return;
       }
       files_written = false;
     }
-    if (sim::Status s = manifest->commit(); !s) storage_error = s.error().message;
+    if (sim::Status s = manifest->commit(); !s) storage_fault(s.error());
   }
 
   void shutdown_workers(const std::string& reason) {
@@ -740,7 +745,8 @@ struct Coordinator::Impl {
           send_due_heartbeats();
         }
       }
-      timers();
+      // After a fault, no new lease times out or worker is lost; what this pass recorded before it commits.
+      if (storage_error.empty()) timers();
       commit();
       progress(false);
     }

@@ -49,27 +49,19 @@ std::string default_fabrics() { return sampler::default_fabric_data_path(); }
 sim::Expected<Data> gather(const std::string& manifest_path, const StatsOptions& options) {
   auto reader = storage::ManifestReader::open(manifest_path);
   if (!reader) return reader.error();
-  auto run = reader->run();
-  if (!run) return run.error();
-  auto jobs = reader->jobs();
-  if (!jobs) return jobs.error();
-  auto results = reader->results();
-  if (!results) return results.error();
-  auto files = reader->files();
-  if (!files) return files.error();
-  auto failures = reader->failures();
-  if (!failures) return failures.error();
-  auto samples = reader->samples();
-  if (!samples) return samples.error();
+  // One read transaction: a run in progress commits meanwhile, and the figures must all be of one commit.
+  auto snapshot = reader->snapshot();
+  if (!snapshot) return snapshot.error();
+  const auto& [run, samples, jobs, results, files, failures] = *snapshot;
 
   Data d;
   nlohmann::json& s = d.stats;
   s["manifest"] = manifest_path;
-  s["run"] = {{"seed", run->seed}, {"state", run->state}, {"code_version", run->code_version},
-              {"total_jobs", run->total_jobs}, {"samples", samples->size()}};
+  s["run"] = {{"seed", run.seed}, {"state", run.state}, {"code_version", run.code_version},
+              {"total_jobs", run.total_jobs}, {"samples", samples.size()}};
   // The stored configuration was validated when the run was planned; one that no longer parses (a manifest of
   // another version) leaves the model unnamed rather than guessed.
-  const auto config = parse_run_config(run->config_toml, manifest_path);
+  const auto config = parse_run_config(run.config_toml, manifest_path);
   s["run"]["bending_model"] = config ? config->bending_model : std::string("unknown");
 
   std::map<std::string, std::int64_t> by_state, by_reason, attempts_by_reason;
@@ -80,7 +72,7 @@ sim::Expected<Data> gather(const std::string& manifest_path, const StatsOptions&
   };
   std::map<std::string, WorkerStats> workers;
   double first_start = 1e300, last_finish = 0.0;
-  for (const auto& j : *jobs) {
+  for (const auto& j : jobs) {
     ++by_state[std::string(storage::to_string(j.state))];
     if (j.state == storage::JobState::kFailed) ++by_reason[j.failure_reason];
     if (j.state == storage::JobState::kDone) {
@@ -93,9 +85,9 @@ sim::Expected<Data> gather(const std::string& manifest_path, const StatsOptions&
       last_finish = std::max(last_finish, j.finished_at);
     }
   }
-  for (const auto& f : *failures) ++attempts_by_reason[f.reason];
+  for (const auto& f : failures) ++attempts_by_reason[f.reason];
   s["jobs"] = {{"by_state", by_state}, {"failed_by_reason", by_reason},
-               {"failed_attempts_by_reason", attempts_by_reason}, {"failed_attempts", failures->size()}};
+               {"failed_attempts_by_reason", attempts_by_reason}, {"failed_attempts", failures.size()}};
 
   const double wall = last_finish > first_start ? last_finish - first_start : 0.0;
   nlohmann::json per_worker = nlohmann::json::object();
@@ -110,7 +102,7 @@ sim::Expected<Data> gather(const std::string& manifest_path, const StatsOptions&
                      {"per_worker", per_worker}};
   s["seconds_per_job"] = summary(d.seconds);
 
-  for (const auto& r : *results) {
+  for (const auto& r : results) {
     if (r.outcome == "noop") continue;
     d.dc.push_back(r.drape_coefficient);
     d.folds.push_back(r.folds);
@@ -118,13 +110,13 @@ sim::Expected<Data> gather(const std::string& manifest_path, const StatsOptions&
   s["drape_coefficient"] = summary(d.dc);
   s["folds"] = summary(d.folds);
   std::vector<double> iterations;
-  for (const auto& r : *results) {
+  for (const auto& r : results) {
     if (r.outcome != "noop") iterations.push_back(r.iterations);
   }
   s["newton_iterations"] = summary(iterations);
 
   std::int64_t bytes = 0, mesh_bytes = 0, exr_bytes = 0;
-  for (const auto& f : *files) {
+  for (const auto& f : files) {
     bytes += f.bytes;
     (f.kind == "mesh" ? mesh_bytes : exr_bytes) += f.bytes;
   }
@@ -134,12 +126,12 @@ sim::Expected<Data> gather(const std::string& manifest_path, const StatsOptions&
     const auto size = std::filesystem::file_size(manifest_path + suffix, ec);
     if (!ec) manifest_bytes += static_cast<std::int64_t>(size);
   }
-  s["storage"] = {{"files", files->size()}, {"bytes", bytes}, {"mesh_bytes", mesh_bytes},
+  s["storage"] = {{"files", files.size()}, {"bytes", bytes}, {"mesh_bytes", mesh_bytes},
                   {"exr_bytes", exr_bytes}, {"manifest_bytes", manifest_bytes}};
 
   // Parameters in the sampler's feature space (sign(k) ln|k| at 300 g/m^2) against the measured fabrics.
   d.run_features.assign(sampler::kFeatureCount, {});
-  for (const auto& smp : *samples) {
+  for (const auto& smp : samples) {
     sampler::ParameterVector v{{smp.alpha[0], smp.alpha[1], smp.alpha[2]}, {smp.beta[0], smp.beta[1], smp.beta[2]}};
     const auto f = sampler::to_features(sampler::normalise_density(v, smp.density_g_per_m2));
     for (int i = 0; i < sampler::kFeatureCount; ++i) d.run_features[i].push_back(f[i]);

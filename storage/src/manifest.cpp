@@ -248,6 +248,35 @@ sim::Expected<std::vector<FailureRecord>> ManifestReader::failures() const {
   return out;
 }
 
+sim::Expected<ManifestSnapshot> ManifestReader::snapshot() const {
+  // A reader on its own connection reads in one transaction; the writer's view (Manifest::reader) shares the
+  // writer's connection, which sees its own state whole.
+  const bool transaction = impl_->owns;
+  if (transaction) {
+    if (sim::Status s = exec(impl_->db, "BEGIN"); !s) return s.error();
+  }
+  auto read = [&]() -> sim::Expected<ManifestSnapshot> {
+    ManifestSnapshot snap;
+    auto run_record = run();
+    if (!run_record) return run_record.error();
+    snap.run = std::move(run_record).value();
+    auto take = [](auto got, auto& into) -> sim::Status {
+      if (!got) return got.error();
+      into = std::move(got).value();
+      return {};
+    };
+    if (sim::Status s = take(samples(), snap.samples); !s) return s.error();
+    if (sim::Status s = take(jobs(), snap.jobs); !s) return s.error();
+    if (sim::Status s = take(results(), snap.results); !s) return s.error();
+    if (sim::Status s = take(files(), snap.files); !s) return s.error();
+    if (sim::Status s = take(failures(), snap.failures); !s) return s.error();
+    return snap;
+  };
+  auto snap = read();
+  if (transaction) (void)exec(impl_->db, "COMMIT");  // a read transaction: nothing to keep or lose
+  return snap;
+}
+
 sim::Expected<std::string> ManifestReader::integrity_check() const {
   Statement st(impl_->db, "PRAGMA integrity_check");
   if (!st.ok()) return sim::Error{"manifest: " + st.prepare_error()};
@@ -355,6 +384,15 @@ sim::Expected<Manifest> Manifest::create(const std::string& path, const RunRecor
                                          const std::vector<JobRecord>& jobs) {
   if (std::filesystem::exists(path)) {
     return sim::Error{fmt::format("{} exists already (use --resume to continue that run)", path)};
+  }
+  // A log or journal left by a manifest that is gone (deleted after a crash) would be replayed into the new one:
+  // SQLite ties neither to its database. It is the user's to remove, not ours. (A -shm alone is rebuilt, harmless.)
+  for (const char* suffix : {"-wal", "-journal"}) {
+    if (std::filesystem::exists(path + suffix)) {
+      return sim::Error{fmt::format("{}{} is left from a manifest that is no longer there; SQLite would replay it "
+                                    "into a new one: remove it before starting a new run here",
+                                    path, suffix)};
+    }
   }
   const std::string tmp = path + ".tmp";
   for (const char* suffix : {"", "-wal", "-shm", "-journal"}) std::filesystem::remove(tmp + suffix);

@@ -123,6 +123,36 @@ TEST_F(ManifestTest, RecordsEachJobExactlyOnce) {
   EXPECT_EQ(*m.reader().integrity_check(), "ok");
 }
 
+TEST_F(ManifestTest, SnapshotsReadOneCommitAndLetTheNextOneIn) {
+  auto m = make();
+  auto reader = ManifestReader::open(path_);
+  ASSERT_TRUE(reader);
+  JobRecord job;
+  job.id = 1;
+  job.attempts = 1;
+  ASSERT_TRUE(m.begin());
+  ASSERT_TRUE(m.record_result(job, ResultRecord{}, {{0, "mesh", 0, "data/a.ply", "00", 10}}));
+  // The writer sees its own pass whole (no second transaction on its connection); another reader, the last commit.
+  auto own = m.reader().snapshot();
+  ASSERT_TRUE(own) << own.error().message;
+  EXPECT_EQ(own->results.size(), 1u);
+  EXPECT_EQ(own->jobs[0].state, JobState::kDone);
+  auto before = reader->snapshot();
+  ASSERT_TRUE(before) << before.error().message;
+  EXPECT_EQ(before->results.size(), 0u);
+  EXPECT_EQ(before->jobs[0].state, JobState::kPending);
+  EXPECT_EQ(before->run.total_jobs, 4);
+  EXPECT_EQ(before->samples.size(), 2u);
+  ASSERT_TRUE(m.commit());
+  // The reader's transaction ended with its snapshot: the next one sees the commit.
+  auto after = reader->snapshot();
+  ASSERT_TRUE(after) << after.error().message;
+  EXPECT_EQ(after->results.size(), 1u);
+  EXPECT_EQ(after->files.size(), 1u);
+  EXPECT_EQ(after->jobs[0].state, JobState::kDone);
+  EXPECT_TRUE(after->failures.empty());
+}
+
 TEST_F(ManifestTest, UncommittedGroupsVanish) {
   {
     auto m = make();
@@ -136,6 +166,34 @@ TEST_F(ManifestTest, UncommittedGroupsVanish) {
   ASSERT_TRUE(reader);
   EXPECT_EQ(reader->results()->size(), 0u);
   EXPECT_EQ((*reader->jobs())[0].state, JobState::kPending);
+}
+
+TEST_F(ManifestTest, RefusesToStartOverALogLeftByAManifestThatIsGone) {
+  // A run killed with committed pages still in its log, whose manifest the user then deletes to start over.
+  { auto m = make(); }
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open(path_.c_str(), &db), SQLITE_OK);
+  ASSERT_EQ(sqlite3_exec(db, "PRAGMA wal_autocheckpoint = 0; UPDATE runs SET state = 'stopped'", nullptr, nullptr,
+                         nullptr),
+            SQLITE_OK);
+  const std::string wal = path_ + "-wal";
+  ASSERT_GT(std::filesystem::file_size(wal), 0u);
+  const auto saved = dir_ / "saved-wal";
+  std::filesystem::copy_file(wal, saved);  // what a kill leaves; closing would check it into the database
+  sqlite3_close(db);
+  std::filesystem::remove(path_);
+  std::filesystem::copy_file(saved, wal);
+  const auto again = Manifest::create(path_, RunRecord{}, {}, {});
+  ASSERT_FALSE(again);
+  EXPECT_NE(again.error().message.find(wal + " is left from a manifest"), std::string::npos)
+      << again.error().message;
+  EXPECT_TRUE(std::filesystem::exists(wal));  // not ours to delete
+  EXPECT_FALSE(std::filesystem::exists(path_));
+  std::filesystem::remove(wal);
+  { auto m = make(); }  // once it is removed, the run starts
+  auto reader = ManifestReader::open(path_);
+  ASSERT_TRUE(reader) << reader.error().message;
+  EXPECT_EQ(reader->run()->state, "running");
 }
 
 TEST_F(ManifestTest, RefusesForeignFilesAndOtherSchemaVersions) {

@@ -1,6 +1,7 @@
 #pragma once
 // The stable read interface of a manifest, for statistics and the training stage. Opens the database read-only
-// (any number of readers may run while the coordinator writes; WAL gives each query a consistent snapshot).
+// (any number of readers may run while the coordinator writes; WAL gives each query, and each snapshot(), a consistent
+// view of one commit).
 
 #include <memory>
 #include <string>
@@ -10,6 +11,16 @@
 #include "drapegen/storage/records.hpp"
 
 namespace drapegen::storage {
+
+/// Every table of a manifest as of one commit.
+struct ManifestSnapshot {
+  RunRecord run;
+  std::vector<SampleRecord> samples;
+  std::vector<JobRecord> jobs;
+  std::vector<ResultRecord> results;
+  std::vector<FileRecord> files;
+  std::vector<FailureRecord> failures;
+};
 
 class ManifestReader {
  public:
@@ -26,6 +37,9 @@ class ManifestReader {
   [[nodiscard]] sim::Expected<std::vector<ResultRecord>> results() const;
   [[nodiscard]] sim::Expected<std::vector<FileRecord>> files() const;
   [[nodiscard]] sim::Expected<std::vector<FailureRecord>> failures() const;
+  /// All of the above in one read transaction: while a coordinator commits, the separate calls can each see another
+  /// commit (more jobs done than results read), the snapshot cannot.
+  [[nodiscard]] sim::Expected<ManifestSnapshot> snapshot() const;
   /// `PRAGMA integrity_check`: "ok" or SQLite's findings.
   [[nodiscard]] sim::Expected<std::string> integrity_check() const;
   /// The directory holding the manifest (file paths are relative to it).
