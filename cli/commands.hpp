@@ -18,6 +18,14 @@ enum ExitCode : int {
   kExitStopped = 4,      // a run stopped by SIGINT/SIGTERM before it completed (continue with --resume)
 };
 
+/// A ZeroMQ endpoint option: tcp:// or ipc://, as the configuration's network.bind.
+inline const CLI::Validator kEndpoint(
+    [](const std::string& value) -> std::string {
+      if (value.rfind("tcp://", 0) == 0 || value.rfind("ipc://", 0) == 0) return {};
+      return "'" + value + "' is not a tcp:// or ipc:// endpoint, e.g. tcp://127.0.0.1:5555";
+    },
+    "ENDPOINT");
+
 Runner add_simulate_command(CLI::App& app);
 Runner add_cantilever_command(CLI::App& app);
 Runner add_render_command(CLI::App& app);

@@ -141,7 +141,7 @@ int run_diagnose(const DiagnoseOptions& o) {
     *into = std::move(*read);
   }
   if (!o.report.empty()) {
-    if (sim::Status s = check_writable(o.report + ".probe"); !s) return fail(s.error().message, kExitIo);
+    if (sim::Status s = prepare_output_directory(o.report, "report.json"); !s) return fail(s.error().message, kExitIo);
   }
   diagnosis::DiagnosisSettings settings = o.fine    ? diagnosis::DiagnosisSettings::fine()
                                           : o.quick ? diagnosis::DiagnosisSettings::quick()
@@ -372,23 +372,25 @@ Runner add_diagnose_command(CLI::App& app) {
                   "runtime.jobs). Default: one per CPU this process may run on (taskset, a Slurm or "
                   "container CPU set; not a CPU quota), at most {}; with --fleet, --fleet-workers",
                   kMaxJobs));
-  app.add_option("--fleet", o->fleet,
-                 "Compute the drapes on worker processes instead of here: bind this endpoint (e.g. "
-                 "tcp://127.0.0.1:5600; tcp://127.0.0.1:* picks a free port, logged and written by "
-                 "--fleet-endpoint-file) and serve every drape to `drapegen worker --connect ENDPOINT` processes, on "
-                 "this machine or others, as they come and go; the renders, scores and searches stay here. --jobs then "
-                 "counts refits in flight (default: --fleet-workers), and each refit simulates its initial states on "
-                 "--jobs threads too. The same result as without, where the workers run this build on the same BLAS "
-                 "kernels (docs/DIAGNOSIS.md, "
-                 "\"Refits on workers\"). An address other machines can reach (e.g. tcp://*:5600) needs "
-                 "--fleet-server-key and --fleet-authorized-keys");
+  CLI::Option* fleet = app.add_option(
+      "--fleet", o->fleet,
+      "Compute the drapes on worker processes instead of here: bind this endpoint (e.g. tcp://127.0.0.1:5600; "
+      "tcp://127.0.0.1:* picks a free port, logged and written by --fleet-endpoint-file) and serve every drape to "
+      "`drapegen worker --connect ENDPOINT` processes, on this machine or others, as they come and go; the renders, "
+      "scores and searches stay here. --jobs then counts refits in flight (default: --fleet-workers), and each refit "
+      "simulates its initial states on --jobs threads too. The same result as without, where the workers run this "
+      "build on the same BLAS kernels (docs/DIAGNOSIS.md, \"Refits on workers\"). An address other machines can reach "
+      "(e.g. tcp://*:5600) needs --fleet-server-key and --fleet-authorized-keys");
+  fleet->check(kEndpoint);
   app.add_option("--fleet-workers", o->fleet_workers,
                  "With --fleet: wait for this many workers before starting (more may join later)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->needs(fleet);
   app.add_option("--fleet-wait", o->fleet_wait,
                  "With --fleet: fail when the workers asked for have not all come within this many seconds, or a drape "
                  "has waited this long with no worker connected")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->needs(fleet);
   app.add_option("--fleet-server-key", o->fleet_server_key,
                  "With --fleet: CurveZMQ, this side's secret key file (drapegen keygen; the workers connect with "
                  "--server-key and --key)");

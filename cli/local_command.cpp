@@ -152,7 +152,8 @@ Runner add_local_command(CLI::App& app) {
   auto* config = app.add_option("--config", o->config, "Run configuration (TOML); default: the embedded small run");
   auto* resume = app.add_option("--resume", o->resume, "Continue the run of this manifest instead");
   config->excludes(resume);
-  app.add_option("--output", o->output, "Override the configuration's output directory");
+  app.add_option("--output", o->output, "Override the configuration's output directory (a new run only)")
+      ->excludes(resume);
   app.add_flag("--print-config", o->print_config, "Print the embedded default configuration and exit");
   return [o]() -> int {
     if (o->print_config) {
@@ -175,15 +176,10 @@ Runner add_local_command(CLI::App& app) {
         name = o->config;
       }
       if (!o->output.empty()) {
-        // The override becomes the first line; the file's own top-level output line is removed.
-        auto parsed = coordinator::parse_run_config(text, name);
-        if (!parsed) return fail(parsed.error().message);
-        text = fmt::format("output = \"{}\"\n", o->output) + text;
-        const auto pos = text.find("\noutput =");
-        if (pos != std::string::npos) {
-          const auto end = text.find('\n', pos + 1);
-          text.erase(pos, end - pos);
-        }
+        auto overridden = coordinator::with_output(text, name, o->output);
+        if (!overridden) return fail(overridden.error().message);
+        text = std::move(overridden).value();
+        name += " with --output";
       }
       c = coordinator::Coordinator::create(text, name, options);
     }

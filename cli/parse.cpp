@@ -1,11 +1,13 @@
 #include "parse.hpp"
 
+#include <unistd.h>
+
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <cstdlib>
-#include <unistd.h>
+#include <cstring>
+#include <filesystem>
 #include <sstream>
 #include <vector>
 
@@ -83,6 +85,8 @@ sim::Expected<sim::PhysicalEffects> parse_effects(const std::vector<std::string>
 }
 
 sim::Status check_writable(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) return sim::Error{"cannot write '" + path + "': it is a directory"};
   // A unique probe beside the target (never touches an existing file), removed again.
   std::string probe = path + ".probe-XXXXXX";
   const int fd = ::mkstemp(probe.data());
@@ -90,6 +94,13 @@ sim::Status check_writable(const std::string& path) {
   ::close(fd);
   std::remove(probe.c_str());
   return {};
+}
+
+sim::Status prepare_output_directory(const std::string& directory, const std::string& file) {
+  std::error_code ec;
+  std::filesystem::create_directories(directory, ec);
+  if (ec) return sim::Error{directory + ": cannot create directory: " + ec.message()};
+  return check_writable((std::filesystem::path(directory) / file).string());
 }
 
 }  // namespace drapegen::cli

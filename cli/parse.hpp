@@ -18,7 +18,12 @@ namespace drapegen::cli {
 /// the platform top instead of adhesion). Each name at most once.
 [[nodiscard]] sim::Expected<sim::PhysicalEffects> parse_effects(const std::vector<std::string>& items);
 
-/// Whether a file can be created at `path` (probes with a temporary file beside it, then removes it).
+/// Whether a file can be created at `path` (probes with a temporary file beside it, then removes it); a directory
+/// there is an error, not a file that can be replaced.
 [[nodiscard]] sim::Status check_writable(const std::string& path);
+
+/// Creates `directory` (and its parents) for an output written later, and checks that `file` can be created in it:
+/// an error now rather than after the work.
+[[nodiscard]] sim::Status prepare_output_directory(const std::string& directory, const std::string& file);
 
 }  // namespace drapegen::cli

@@ -60,12 +60,7 @@ int run_reality(const RealityOptions& o) {
       if (other.name == e->name) return fail(fmt::format("--effect {} given twice", e->name));
     spec.effects.push_back(*e);
   }
-  std::error_code ec;
-  std::filesystem::create_directories(o.out, ec);
-  if (ec) return fail(fmt::format("{}: cannot create directory: {}", o.out, ec.message()), kExitIo);
-  if (sim::Status s = check_writable((std::filesystem::path(o.out) / "capture.json").string()); !s) {
-    return fail(s.error().message, kExitIo);
-  }
+  if (sim::Status s = prepare_output_directory(o.out, "capture.json"); !s) return fail(s.error().message, kExitIo);
   auto r = diagnosis::generate_reality(spec, o.out);
   if (!r) return fail(r.error().message);
   if (o.json) {

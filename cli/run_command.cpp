@@ -1,13 +1,17 @@
 // drapegen run: the coordinator of a generation run (docs/SERVICE.md).
 #include <fmt/format.h>
+
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <memory>
 #include <sstream>
 
 #include "commands.hpp"
-#include "failure.hpp"
 #include "drapegen/coordinator/coordinator.hpp"
+#include "failure.hpp"
 #include "signals.hpp"
 
 namespace drapegen::cli {
@@ -36,10 +40,14 @@ coordinator::CoordinatorOptions::Progress parse_progress(const std::string& p) {
 }  // namespace
 
 sim::Expected<std::string> read_text_file(const std::string& path) {
+  // A directory opens as a stream that reads nothing: an empty configuration, i.e. the whole default run.
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) return sim::Error{"cannot read " + path + ": it is a directory"};
   std::ifstream in(path, std::ios::binary);
-  if (!in) return sim::Error{"cannot read " + path};
+  if (!in) return sim::Error{"cannot read " + path + ": " + std::strerror(errno)};
   std::ostringstream text;
   text << in.rdbuf();
+  if (in.bad()) return sim::Error{"cannot read " + path};
   return text.str();
 }
 
@@ -68,8 +76,8 @@ Runner add_run_command(CLI::App& app) {
   auto* config = app.add_option("--config", o->config, "Run configuration (TOML; keys in docs/SERVICE.md)");
   auto* resume = app.add_option("--resume", o->resume, "Continue the run of this manifest (OUTPUT/manifest.sqlite)");
   config->excludes(resume);
-  app.add_option("--bind", o->bind,
-                 "Bind this endpoint instead of the configured/recorded one, e.g. tcp://127.0.0.1:*");
+  app.add_option("--bind", o->bind, "Bind this endpoint instead of the configured/recorded one, e.g. tcp://127.0.0.1:*")
+      ->check(kEndpoint);
   app.add_option("--progress", o->progress,
                  "Progress display: auto (terminal line if stderr is a TTY), terminal, log, off")
       ->check(CLI::IsMember({"auto", "terminal", "log", "off"}))

@@ -1,13 +1,14 @@
 // drapegen worker: computes jobs for a coordinator (docs/SERVICE.md, "Worker").
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
 #include <memory>
 
 #include "commands.hpp"
-#include "failure.hpp"
 #include "drapegen/coordinator/logging.hpp"
 #include "drapegen/worker/worker.hpp"
+#include "failure.hpp"
 #include "signals.hpp"
 
 namespace drapegen::cli {
@@ -26,7 +27,8 @@ Runner add_worker_command(CLI::App& app) {
       ->check(CLI::Range(10, 3600000))
       ->capture_default_str();
   app.add_option("--give-up", o->give_up_s,
-                 "Exit with an error after this many seconds without a coordinator (0: never)")
+                 "Exit with an error after this many seconds without a coordinator (0: never); checked when a silent "
+                 "connection is dropped, so up to --heartbeat-ms x --liveness later")
       ->check(CLI::Range(0.0, 1e9))
       ->capture_default_str();
   app.add_option("--server-key", o->server_key, "CurveZMQ: the coordinator's public key (Z85, or a .pub file)");
@@ -36,6 +38,8 @@ Runner add_worker_command(CLI::App& app) {
       ->check(CLI::IsMember({"debug", "info", "warn", "error"}))
       ->capture_default_str();
   return [o, level]() -> int {
+    // CLI::Range lets NaN through (no comparison with it is true): a worker that never gives up.
+    if (!std::isfinite(o->give_up_s)) return Failure{"worker"}("--give-up: must be a number of seconds");
     coordinator::logger()->set_level(spdlog::level::from_str(*level));
     const auto& stop = install_stop_signals();
     const sim::Status s = worker::run_worker(*o, stop);

@@ -13,6 +13,9 @@ namespace v1 = proto::v1;
 std::string keygen(const fs::path& prefix, const fs::path& dir) {
   Process p({"keygen", "--out", prefix.string()}, (dir / ("keygen_" + prefix.filename().string())).string());
   EXPECT_EQ(p.wait(10s), 0) << p.err();
+  // The secret is never readable by others, not even while it is written (created with that mode).
+  EXPECT_EQ(fs::status(prefix.string() + ".key").permissions() & fs::perms::all,
+            fs::perms::owner_read | fs::perms::owner_write);
   std::string pub = Process::slurp(prefix.string() + ".pub");
   if (!pub.empty() && pub.back() == '\n') pub.pop_back();
   return pub;

@@ -40,6 +40,11 @@ TEST(Service, EndToEndWithTwoWorkers) {
   ASSERT_EQ(stats.wait(30s), 0) << stats.err();
   EXPECT_NE(stats.out().find("\"done\": 8"), std::string::npos) << stats.out();
   EXPECT_NE(stats.out().find("\"bending_model\": \"dihedral\""), std::string::npos) << stats.out();
+  // A fabrics file named on the command line that cannot be read is an error, not a comparison quietly dropped.
+  Process no_fabrics({"stats", (out / "manifest.sqlite").string(), "--fabrics", (dir / "missing.csv").string()},
+                     (dir / "stats_no_fabrics").string());
+  EXPECT_EQ(no_fabrics.wait(30s), 1) << no_fabrics.err();
+  EXPECT_NE(no_fabrics.err().find("missing.csv"), std::string::npos) << no_fabrics.err();
   // The run records the build that planned it, as `drapegen --version` names it (version, commit, local changes).
   Process version({"--version"}, (dir / "version").string());
   ASSERT_EQ(version.wait(10s), 0) << version.err();

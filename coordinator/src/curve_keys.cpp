@@ -50,11 +50,10 @@ sim::Expected<CurveKeyPair> make_curve_keypair() {
 sim::Status write_curve_keypair(const CurveKeyPair& pair, const std::string& prefix) {
   const std::string secret = prefix + ".key", pub = prefix + ".pub";
   if (sim::Status s = storage::write_file_atomic(
-          secret, "# drapegen CurveZMQ secret key (keep private)\n" + pair.secret_z85 + "\n");
+          secret, "# drapegen CurveZMQ secret key (keep private)\n" + pair.secret_z85 + "\n", 0600);
       !s) {
     return s;
   }
-  ::chmod(secret.c_str(), 0600);
   return storage::write_file_atomic(pub, pair.public_z85 + "\n");
 }
 

@@ -1,9 +1,11 @@
 #include "drapegen/coordinator/run_config.hpp"
 
-#include <cmath>
 #include <fmt/format.h>
-#include <set>
 #include <toml++/toml.h>
+
+#include <cmath>
+#include <set>
+#include <sstream>
 
 namespace drapegen::coordinator {
 namespace {
@@ -92,16 +94,33 @@ class Reader {
   std::string error_;
 };
 
-}  // namespace
-
-sim::Expected<RunConfig> parse_run_config(const std::string& toml_text, const std::string& source_name) {
-  toml::table root;
+/// The TOML text as a table, or its first syntax error with line and column.
+sim::Expected<toml::table> parse_toml(const std::string& toml_text, const std::string& source_name) {
   try {
-    root = toml::parse(toml_text, source_name);
+    return toml::parse(toml_text, source_name);
   } catch (const toml::parse_error& e) {
     const auto& where = e.source().begin;
     return sim::Error{fmt::format("{}:{}:{}: {}", source_name, where.line, where.column, e.description())};
   }
+}
+
+}  // namespace
+
+sim::Expected<std::string> with_output(const std::string& toml_text, const std::string& source_name,
+                                       const std::string& output) {
+  auto parsed = parse_toml(toml_text, source_name);
+  if (!parsed) return parsed.error();
+  toml::table& root = *parsed;
+  root.insert_or_assign("output", output);
+  std::ostringstream text;
+  text << root << '\n';
+  return text.str();
+}
+
+sim::Expected<RunConfig> parse_run_config(const std::string& toml_text, const std::string& source_name) {
+  auto parsed = parse_toml(toml_text, source_name);
+  if (!parsed) return parsed.error();
+  toml::table& root = *parsed;
   RunConfig c;
   Reader r(root, source_name);
   r.only_keys(

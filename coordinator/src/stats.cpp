@@ -140,6 +140,7 @@ sim::Expected<Data> gather(const std::string& manifest_path, const StatsOptions&
   nlohmann::json params = nlohmann::json::object();
   auto fabrics = csv.empty() ? sim::Expected<std::vector<sampler::MeasuredFabric>>(sim::Error{"no fabric data"})
                              : sampler::read_fabric_csv(csv);
+  if (!fabrics && !options.fabrics_csv.empty()) return sim::Error{"the measured fabrics: " + fabrics.error().message};
   if (fabrics) {
     d.measured_features.assign(sampler::kFeatureCount, {});
     for (const auto& f : sampler::distinct_features(*fabrics)) {

@@ -82,6 +82,28 @@ TEST(RunConfig, NamesTheKeyOfEveryError) {
   EXPECT_NE(error_of("seed = = 1").find("run.toml:1:"), std::string::npos);
 }
 
+TEST(RunConfig, TakesAnyOutputDirectoryAsAnOverride) {
+  // Quotes, backslashes and tabs are data, not TOML; a file's own output (however spaced) is replaced.
+  const std::string odd = "C:\\temp\t\"run\" #1";
+  for (const std::string& text :
+       {default_config_toml(), std::string("output=\"y\"\nsamples = 3\n[retry]\nmax_attempts = 5\n")}) {
+    auto overridden = with_output(text, "run.toml", odd);
+    ASSERT_TRUE(overridden) << overridden.error().message;
+    auto before = parse_run_config(text, "run.toml");
+    auto after = parse_run_config(*overridden, "run.toml");
+    ASSERT_TRUE(before && after) << *overridden;
+    EXPECT_EQ(after->output, odd);
+    EXPECT_EQ(after->seed, before->seed);
+    EXPECT_EQ(after->samples, before->samples);
+    EXPECT_EQ(after->states_per_sample, before->states_per_sample);
+    EXPECT_EQ(after->resolution, before->resolution);
+    EXPECT_EQ(after->noise, before->noise);
+    EXPECT_EQ(after->bind, before->bind);
+    EXPECT_EQ(after->max_attempts, before->max_attempts);
+  }
+  EXPECT_NE(with_output("seed = = 1", "run.toml", "x").error().message.find("run.toml:1:"), std::string::npos);
+}
+
 TEST(Planner, IsAPureFunctionOfTheConfiguration) {
   auto c = parse_run_config("seed = 3\nsamples = 5\nstates_per_sample = 4\n[testing]\npoison_samples = [2]", "t");
   ASSERT_TRUE(c);

@@ -46,15 +46,16 @@ sim::Status sqlite_error(sqlite3* db, const std::string& what) {
   return sim::Error{fmt::format("manifest: {}: {}", what, db ? sqlite3_errmsg(db) : "out of memory")};
 }
 
-/// Connection settings of every connection (writer and readers).
-sim::Status configure(sqlite3* db, bool writer) {
+/// Connection settings of every connection (writer and readers); they write nothing to the file.
+sim::Status configure(sqlite3* db) {
   sqlite3_busy_timeout(db, 10000);
-  if (sim::Status s = exec(db, "PRAGMA foreign_keys = ON"); !s) return s;
-  if (writer) {
-    if (sim::Status s = exec(db, "PRAGMA journal_mode = WAL"); !s) return s;
-    if (sim::Status s = exec(db, "PRAGMA synchronous = FULL"); !s) return s;
-  }
-  return {};
+  return exec(db, "PRAGMA foreign_keys = ON");
+}
+
+/// The writer's settings, applied once the file is known to be a manifest (WAL mode is written into the file).
+sim::Status configure_writer(sqlite3* db) {
+  if (sim::Status s = exec(db, "PRAGMA journal_mode = WAL"); !s) return s;
+  return exec(db, "PRAGMA synchronous = FULL");
 }
 
 sim::Status check_schema(sqlite3* db, const std::string& path) {
@@ -112,7 +113,7 @@ sim::Expected<ManifestReader> ManifestReader::open(const std::string& path) {
   auto impl = std::make_unique<Impl>();
   impl->db = *db;
   impl->owns = true;
-  if (sim::Status s = configure(impl->db, false); !s) return s.error();
+  if (sim::Status s = configure(impl->db); !s) return s.error();
   if (sim::Status s = check_schema(impl->db, path); !s) return s.error();
   return ManifestReader(std::move(impl), directory_of(path));
 }
@@ -480,8 +481,9 @@ sim::Expected<Manifest> Manifest::open(const std::string& path) {
   if (!db) return db.error();
   auto impl = std::make_unique<Impl>();
   impl->db = *db;
-  if (sim::Status s = configure(impl->db, true); !s) return s.error();
-  if (sim::Status s = check_schema(impl->db, path); !s) return s.error();
+  if (sim::Status s = configure(impl->db); !s) return s.error();
+  if (sim::Status s = check_schema(impl->db, path); !s) return s.error();  // before anything writes to the file
+  if (sim::Status s = configure_writer(impl->db); !s) return s.error();
   if (sim::Status s = impl->prepare(); !s) return s.error();
   auto reader_impl = std::make_unique<ManifestReader::Impl>();
   reader_impl->db = impl->db;

@@ -1,10 +1,11 @@
-#include <gtest/gtest.h>
+#include "drapegen/storage/manifest.hpp"
 
-#include <filesystem>
+#include <gtest/gtest.h>
 #include <sqlite3.h>
 #include <unistd.h>
 
-#include "drapegen/storage/manifest.hpp"
+#include <filesystem>
+#include <fstream>
 
 namespace drapegen::storage {
 namespace {
@@ -206,6 +207,15 @@ TEST_F(ManifestTest, RefusesForeignFilesAndOtherSchemaVersions) {
   auto foreign = ManifestReader::open(other);
   ASSERT_FALSE(foreign);
   EXPECT_NE(foreign.error().message.find("not a drapegen manifest"), std::string::npos);
+  // Refused for writing, a file is left as it was (no WAL mode written into someone else's database, no empty file
+  // turned into one).
+  const auto other_size = std::filesystem::file_size(other);
+  EXPECT_FALSE(Manifest::open(other));
+  EXPECT_EQ(std::filesystem::file_size(other), other_size);
+  const std::string empty = (dir_ / "empty.sqlite").string();
+  { std::ofstream touch(empty); }
+  EXPECT_FALSE(Manifest::open(empty));
+  EXPECT_EQ(std::filesystem::file_size(empty), 0u);
   { auto m = make(); }
   ASSERT_EQ(sqlite3_open(path_.c_str(), &db), SQLITE_OK);
   sqlite3_exec(db, "UPDATE meta SET value = '99' WHERE key = 'schema_version'", nullptr, nullptr, nullptr);

@@ -35,6 +35,15 @@ TEST(AtomicFile, WritesAndChecksums) {
   ASSERT_FALSE(bad);
   EXPECT_NE(bad.error().message.find("Not a directory"), std::string::npos) << bad.error().message;
   EXPECT_FALSE(sha256_file((dir / "missing").string()));
+  // A private file is private from its first byte, even where a stale temporary of a wider mode is left.
+  namespace fs = std::filesystem;
+  const std::string secret = (dir / "s.key").string();
+  std::ofstream(secret + ".tmp") << "stale";
+  fs::permissions(secret + ".tmp",
+                  fs::perms::owner_read | fs::perms::owner_write | fs::perms::group_read | fs::perms::others_read);
+  ASSERT_TRUE(write_file_atomic(secret, "key", 0600));
+  EXPECT_EQ(fs::status(secret).permissions() & fs::perms::all, fs::perms::owner_read | fs::perms::owner_write);
+  EXPECT_EQ(*sha256_file(secret), sha256_hex("key"));
   std::filesystem::remove_all(dir);
 }
 

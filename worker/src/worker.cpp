@@ -274,9 +274,11 @@ sim::Status run_worker(const WorkerOptions& o, const std::atomic<bool>& stop) {
       current_job = 0;
       (void)current_attempt;
     }
-    if (o.give_up_s > 0 &&
-        std::chrono::duration<double>(Clock::now() - last_contact).count() > o.give_up_s) {
-      return sim::Error{fmt::format("no coordinator at {} for {} s; giving up", o.endpoint, o.give_up_s)};
+    // Checked when a connection is given up (after liveness heartbeats of silence), so the wait can exceed it.
+    if (const double waited = std::chrono::duration<double>(Clock::now() - last_contact).count();
+        o.give_up_s > 0 && waited > o.give_up_s) {
+      return sim::Error{fmt::format("no coordinator at {} for {:.1f} s (--give-up {} s); giving up", o.endpoint, waited,
+                                    o.give_up_s)};
     }
     const auto until = Clock::now() + milliseconds(backoff_ms);
     while (Clock::now() < until && !stop.load()) std::this_thread::sleep_for(milliseconds(20));

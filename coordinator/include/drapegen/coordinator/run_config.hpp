@@ -52,6 +52,11 @@ struct RunConfig {
 /// name the key, e.g. "run.toml: samples: must be between 1 and 10000000".
 [[nodiscard]] sim::Expected<RunConfig> parse_run_config(const std::string& toml_text, const std::string& source_name);
 
+/// The configuration with its top-level `output` set to `output` (any characters; the file's own, if any, replaced),
+/// as TOML text again (comments and layout are not kept). Errors: the text does not parse.
+[[nodiscard]] sim::Expected<std::string> with_output(const std::string& toml_text, const std::string& source_name,
+                                                     const std::string& output);
+
 /// The embedded default configuration of `drapegen local`: a small run with coarse meshes (about a minute on two
 /// cores with two workers).
 [[nodiscard]] const std::string& default_config_toml();

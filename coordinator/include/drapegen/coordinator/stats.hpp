@@ -11,8 +11,9 @@
 namespace drapegen::coordinator {
 
 struct StatsOptions {
-  /// The measured fabrics (fabrics618.csv); empty: the copy committed with the source (sampler/data). A missing
-  /// file only drops the comparison.
+  /// The measured fabrics (fabrics618.csv); empty: the copy committed with the source (sampler/data), whose absence
+  /// (an installed binary without the source) only drops the comparison. A file named here that cannot be read is
+  /// an error.
   std::string fabrics_csv;
 };
 

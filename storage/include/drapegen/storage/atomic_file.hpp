@@ -10,9 +10,9 @@
 
 namespace drapegen::storage {
 
-/// Writes `bytes` to `path` atomically (tmp, fsync, rename). Errors name the path and the OS error (e.g. "No space
-/// left on device", "Permission denied").
-[[nodiscard]] sim::Status write_file_atomic(const std::string& path, std::string_view bytes);
+/// Writes `bytes` to `path` atomically (tmp, fsync, rename), the file created with `mode` (less the umask) from the
+/// start. Errors name the path and the OS error (e.g. "No space left on device", "Permission denied").
+[[nodiscard]] sim::Status write_file_atomic(const std::string& path, std::string_view bytes, unsigned mode = 0644);
 /// fsync of a directory, so that renames into it are durable.
 [[nodiscard]] sim::Status sync_directory(const std::string& directory);
 
