@@ -26,6 +26,16 @@ inline const CLI::Validator kEndpoint(
     },
     "ENDPOINT");
 
+/// A 64-bit seed option: digits only, at most 2^64 - 1 (CLI11 alone wraps "-1" round and clamps larger values).
+inline const CLI::Validator kSeed(
+    [](const std::string& value) -> std::string {
+      const std::string max = "18446744073709551615";
+      const bool digits = !value.empty() && value.find_first_not_of("0123456789") == std::string::npos;
+      if (digits && (value.size() < max.size() || (value.size() == max.size() && value <= max))) return {};
+      return "'" + value + "' is not a seed (an integer 0 .. " + max + ")";
+    },
+    "SEED");
+
 Runner add_simulate_command(CLI::App& app);
 Runner add_cantilever_command(CLI::App& app);
 Runner add_render_command(CLI::App& app);

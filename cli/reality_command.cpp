@@ -90,6 +90,7 @@ Runner add_reality_command(CLI::App& app) {
   app.add_option("--resolution", o->resolution, "Vertices per side of the simulated specimen")->capture_default_str();
   app.add_option("--seed", o->seed,
                  "Seed of initial state, orientation, drift, camera, noise and the measured bending's error")
+      ->check(kSeed)
       ->capture_default_str();
   app.add_option("--placement", o->placement,
                  "Placement K of the specimen: K > 0 re-drapes the same specimen (same fabric, effects and camera "

@@ -156,7 +156,9 @@ Runner add_render_command(CLI::App& app) {
                  "Depth renderer: osmesa (OpenGL through OSMesa) or software (the faster CPU rasteriser)")
       ->check(CLI::IsMember(renderer::kRendererNames))
       ->capture_default_str();
-  app.add_option("--seed", o->seed, "Seed of orientations, perturbations and noise")->capture_default_str();
+  app.add_option("--seed", o->seed, "Seed of orientations, perturbations and noise")
+      ->check(kSeed)
+      ->capture_default_str();
   app.add_option("--preview", o->preview, "Also write a PNG: one row per data point, its views side by side");
   app.add_flag("--json", o->json, "Print the summary as JSON");
   app.add_flag("!--no-augment", o->augment, "No camera or affine image perturbation (orientations only)");

@@ -249,6 +249,7 @@ Runner add_sample_command(CLI::App& app) {
   auto o = std::make_shared<SampleOptions>();
   app.add_option("--n", o->n, "Number of parameter vectors")->capture_default_str();
   app.add_option("--seed", o->seed, "Seed of the latents and the recipes (0 is a seed like any other)")
+      ->check(kSeed)
       ->capture_default_str();
   app.add_option("--out", o->out, "Write the parameter vectors to this CSV file (paper units at 300 g/m^2)");
   app.add_option("--model", o->model, "VAE model file (default: the committed sampler/models/vae3.dgvae)");

@@ -188,6 +188,7 @@ Runner add_simulate_command(CLI::App& app) {
   app.add_option("--drift", o->drift, "Specimen centre off the axis: MM (seeded direction) or DX,DY, millimetres")
       ->capture_default_str();
   app.add_option("--seed", o->seed, "Seed of the triangulation perturbation and the initial state")
+      ->check(kSeed)
       ->capture_default_str();
   app.add_option("--out", o->out, "Write the draped mesh to this PLY file");
   app.add_flag("--json", o->json, "Print the summary as JSON");

@@ -45,6 +45,11 @@ TEST(Service, EndToEndWithTwoWorkers) {
                      (dir / "stats_no_fabrics").string());
   EXPECT_EQ(no_fabrics.wait(30s), 1) << no_fabrics.err();
   EXPECT_NE(no_fabrics.err().find("missing.csv"), std::string::npos) << no_fabrics.err();
+  // The run's directory instead of its manifest: pointed to the file inside.
+  Process on_directory({"stats", out.string()}, (dir / "stats_on_directory").string());
+  EXPECT_EQ(on_directory.wait(30s), 1) << on_directory.err();
+  EXPECT_NE(on_directory.err().find("the run's manifest is " + (out / "manifest.sqlite").string()), std::string::npos)
+      << on_directory.err();
   // The run records the build that planned it, as `drapegen --version` names it (version, commit, local changes).
   Process version({"--version"}, (dir / "version").string());
   ASSERT_EQ(version.wait(10s), 0) << version.err();

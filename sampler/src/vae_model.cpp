@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <numbers>
@@ -215,6 +216,8 @@ void VaeModel::encode_standardised(const Eigen::MatrixXd& standardised, Eigen::M
 
 sim::Expected<VaeModel> load_vae_model(const std::string& path) {
   const std::string where = "model file '" + path + "'";
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) return sim::Error{where + " is a directory"};
   std::ifstream in(path, std::ios::binary);
   if (!in) return sim::Error{"cannot open " + where};
   std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

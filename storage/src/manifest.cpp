@@ -58,6 +58,16 @@ sim::Status configure_writer(sqlite3* db) {
   return exec(db, "PRAGMA synchronous = FULL");
 }
 
+/// The error for a path that is not a file: a run's output directory points to the manifest inside it.
+sim::Error no_manifest_at(const std::string& path) {
+  const auto inside = std::filesystem::path(path) / "manifest.sqlite";
+  std::error_code ec;
+  if (std::filesystem::is_regular_file(inside, ec)) {
+    return sim::Error{fmt::format("no manifest at {}: a directory; the run's manifest is {}", path, inside.string())};
+  }
+  return sim::Error{fmt::format("no manifest at {}", path)};
+}
+
 sim::Status check_schema(sqlite3* db, const std::string& path) {
   Statement st(db, "SELECT value FROM meta WHERE key = 'schema_version'");
   if (!st.ok()) return sim::Error{fmt::format("{} is not a drapegen manifest ({})", path, st.prepare_error())};
@@ -107,7 +117,7 @@ ManifestReader& ManifestReader::operator=(ManifestReader&&) noexcept = default;
 ManifestReader::~ManifestReader() = default;
 
 sim::Expected<ManifestReader> ManifestReader::open(const std::string& path) {
-  if (!std::filesystem::is_regular_file(path)) return sim::Error{fmt::format("no manifest at {}", path)};
+  if (!std::filesystem::is_regular_file(path)) return no_manifest_at(path);
   auto db = open_db(path, SQLITE_OPEN_READONLY);
   if (!db) return db.error();
   auto impl = std::make_unique<Impl>();
@@ -476,7 +486,7 @@ sim::Expected<Manifest> Manifest::create(const std::string& path, const RunRecor
 }
 
 sim::Expected<Manifest> Manifest::open(const std::string& path) {
-  if (!std::filesystem::is_regular_file(path)) return sim::Error{fmt::format("no manifest at {}", path)};
+  if (!std::filesystem::is_regular_file(path)) return no_manifest_at(path);
   auto db = open_db(path, SQLITE_OPEN_READWRITE);
   if (!db) return db.error();
   auto impl = std::make_unique<Impl>();
