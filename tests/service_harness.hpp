@@ -186,6 +186,9 @@ inline ::testing::AssertionResult resume_to_completion(const fs::path& manifest,
   return ::testing::AssertionSuccess();
 }
 
+/// The last line of a process's stderr (where a command's one-line error goes, after any log lines).
+inline std::string last_line(const std::string& err) { return err.substr(err.rfind('\n', err.size() - 2) + 1); }
+
 /// Jobs recorded (done or failed), read through the stable reader; -1 if the manifest cannot be read yet.
 inline long recorded_jobs(const fs::path& manifest) {
   auto reader = storage::ManifestReader::open(manifest.string());
