@@ -13,6 +13,8 @@ import hashlib
 import math
 import os
 import sqlite3
+import urllib.parse
+import warnings
 
 import numpy as np
 import OpenImageIO as oiio
@@ -52,6 +54,31 @@ def read_views(path):
     return np.ascontiguousarray(np.transpose(full[:, :, order], (2, 0, 1)))
 
 
+def open_manifest(manifest):
+    """A read-only connection to a run's manifest, with errors that name the path.
+
+    A WAL database is read through its shared-memory file, which SQLite creates beside it when no writer has: where
+    this process cannot write that directory (another user's run, a read-only mount), only a run that has ended can
+    be read, as an immutable file (the coordinator checkpoints its log into the file when it exits)."""
+    if os.path.isdir(manifest):
+        inside = os.path.join(manifest, "manifest.sqlite")
+        hint = f"; the run's manifest is {inside}" if os.path.isfile(inside) else ""
+        raise FileNotFoundError(f"{manifest}: a directory, not a manifest{hint}")
+    if not os.path.isfile(manifest):
+        raise FileNotFoundError(f"{manifest}: no such manifest")
+    uri = "file:" + urllib.parse.quote(manifest)
+    try:
+        db = sqlite3.connect(uri + "?mode=ro", uri=True)
+        db.execute("SELECT count(*) FROM sqlite_master").fetchone()
+        return db, False
+    except sqlite3.OperationalError as e:
+        if os.access(os.path.dirname(manifest), os.W_OK):
+            raise ValueError(f"{manifest}: cannot be read as a manifest ({e})") from None
+    except sqlite3.DatabaseError as e:
+        raise ValueError(f"{manifest}: not a drapegen manifest ({e})") from None
+    return sqlite3.connect(uri + "?immutable=1", uri=True), True
+
+
 class DrapeDataset(Dataset):
     """Data points of the done jobs of a run, in (job id, orientation) order."""
 
@@ -59,11 +86,22 @@ class DrapeDataset(Dataset):
         self.manifest = os.path.abspath(manifest)
         self.root = os.path.dirname(self.manifest)
         self.verify = verify_checksums
-        db = sqlite3.connect(f"file:{self.manifest}?mode=ro", uri=True)
+        db, immutable = open_manifest(self.manifest)
         try:
-            (version,) = db.execute("SELECT value FROM meta WHERE key = 'schema_version'").fetchone()
-            if version != "1":
-                raise ValueError(f"{manifest}: manifest schema version {version}, this reader reads 1")
+            try:
+                row = db.execute("SELECT value FROM meta WHERE key = 'schema_version'").fetchone()
+                state = db.execute("SELECT state FROM runs ORDER BY id LIMIT 1").fetchone()
+            except sqlite3.DatabaseError as e:
+                raise ValueError(f"{self.manifest}: not a drapegen manifest ({e})") from None
+            if row is None or state is None:
+                raise ValueError(f"{self.manifest}: not a drapegen manifest (no schema version or no run)")
+            if row[0] != "1":
+                raise ValueError(f"{self.manifest}: manifest schema version {row[0]}, this reader reads 1")
+            self.run_state = state[0]
+            if immutable and self.run_state == "running":
+                raise PermissionError(f"{self.manifest}: the run is still running (or its coordinator was killed) and "
+                                      "this process cannot write its directory, which reading a live run needs; "
+                                      "read it where it can, or once it has ended (or resume it to an end)")
             rows = db.execute(
                 "SELECT j.id, j.sample, j.slot, f.idx, f.path, f.sha256, s.alpha_warp, s.alpha_bias, s.alpha_weft, "
                 "s.beta_warp, s.beta_bias, s.beta_weft, s.density "
@@ -72,6 +110,9 @@ class DrapeDataset(Dataset):
                 "WHERE j.state = 'done' ORDER BY j.id, f.idx").fetchall()
         finally:
             db.close()
+        if self.run_state != "complete":
+            warnings.warn(f"{self.manifest}: the run is {self.run_state}: the dataset holds the jobs done so far "
+                          "(and, by default, their mean and std)", stacklevel=2)
         self.items = []
         for job, sample, slot, idx, path, sha, aw, ab, af, bw, bb, bf, density in rows:
             self.items.append({"job": job, "sample": sample, "slot": slot, "orientation": idx, "path": path,

@@ -8,6 +8,7 @@ import shutil
 import sqlite3
 import subprocess
 import sys
+import warnings
 
 import numpy as np
 import torch
@@ -68,4 +69,62 @@ assert torch.equal(a, ds[0][0])
 loader = torch.utils.data.DataLoader(ds, batch_size=4, shuffle=False)
 batch_views, batch_targets = next(iter(loader))
 assert tuple(batch_views.shape) == (4, 4, 180, 240) and tuple(batch_targets.shape) == (4, 6)
+assert ds.run_state == "complete", ds.run_state
+
+# Clear errors that name the path: the run's directory, a file that is no manifest.
+try:
+    DrapeDataset(os.path.dirname(manifest))
+    raise AssertionError("a directory was read as a manifest")
+except FileNotFoundError as e:
+    assert f"the run's manifest is {manifest}" in str(e), e
+other = os.path.join(work, "other.sqlite")
+with open(other, "w") as f:
+    f.write("not a database at all")
+try:
+    DrapeDataset(other)
+    raise AssertionError("a text file was read as a manifest")
+except ValueError as e:
+    assert "not a drapegen manifest" in str(e) and other in str(e), e
+
+# A run that has not ended is read with a warning: the dataset holds what is done so far.
+stopped = os.path.join(work, "stopped", "manifest.sqlite")
+os.makedirs(os.path.dirname(stopped))
+shutil.copy(manifest, stopped)
+sql = sqlite3.connect(stopped)
+sql.execute("UPDATE runs SET state = 'stopped'")
+sql.commit()
+sql.close()
+with warnings.catch_warnings(record=True) as caught:
+    warnings.simplefilter("always")
+    assert DrapeDataset(stopped).run_state == "stopped"
+assert any("the run is stopped" in str(w.message) for w in caught), [str(w.message) for w in caught]
+
+# Another user's finished run in a directory this process cannot write (no -shm can be made beside the WAL
+# database): read as an immutable file. Root writes anywhere, so the reader runs as nobody where root can arrange it.
+runuser = shutil.which("runuser")
+if os.geteuid() == 0 and runuser:
+    shared = os.path.join("/tmp", f"drapegen_dataset_ro_{os.getpid()}")
+    shutil.rmtree(shared, ignore_errors=True)
+    shutil.copytree(os.path.join(work, "run"), os.path.join(shared, "run"))
+    shutil.copy(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "drapegen_dataset.py"), shared)
+    for root, dirs, files in os.walk(shared):
+        for d in dirs:
+            os.chmod(os.path.join(root, d), 0o555)
+        for f in files:
+            os.chmod(os.path.join(root, f), 0o444)
+    os.chmod(shared, 0o555)
+    probe = ("import sys; sys.path.insert(0, sys.argv[1]); from drapegen_dataset import DrapeDataset; "
+             "ds = DrapeDataset(sys.argv[1] + '/run/manifest.sqlite', verify_checksums=True); "
+             "v, t = ds[0]; print(len(ds), ds.run_state, float(v.max()) > 0)")
+    out = subprocess.run([runuser, "-u", "nobody", "--", sys.executable, "-c", probe, shared],
+                         capture_output=True, text=True, env={"PATH": "/usr/bin:/bin", "HOME": "/tmp"})
+    os.chmod(shared, 0o755)
+    for root, dirs, files in os.walk(shared):
+        for d in dirs:
+            os.chmod(os.path.join(root, d), 0o755)
+    shutil.rmtree(shared)
+    assert out.returncode == 0 and out.stdout.split() == [str(len(ds)), "complete", "True"], (out.stdout,
+                                                                                                out.stderr[-2000:])
+    assert not os.path.exists(os.path.join(shared, "run", "manifest.sqlite-shm"))
+
 print(f"dataset_test: ok ({len(ds)} items of 4 views 180x240 from {done} drapes)")
