@@ -45,10 +45,11 @@ sim::Expected<std::string> read_text_file(const std::string& path) {
   if (std::filesystem::is_directory(path, ec)) return sim::Error{"cannot read " + path + ": it is a directory"};
   std::ifstream in(path, std::ios::binary);
   if (!in) return sim::Error{"cannot read " + path + ": " + std::strerror(errno)};
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) return sim::Error{"cannot read " + path};
-  return text.str();
+  std::string text;
+  char buffer[4096];
+  while (in.read(buffer, sizeof buffer) || in.gcount() > 0) text.append(buffer, static_cast<std::size_t>(in.gcount()));
+  if (in.bad()) return sim::Error{"cannot read " + path + ": " + std::strerror(errno)};  // not a shorter file
+  return text;
 }
 
 int report_run(const coordinator::RunSummary& s, const std::string& manifest, const char* sub) {

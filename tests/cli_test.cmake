@@ -15,6 +15,13 @@ function(expect_failure code_expected)
   if(NOT newline EQUAL -1)
     message(FATAL_ERROR "error of '${ARGN}' is more than one line: ${err}")
   endif()
+  # With expect_said set by the caller: the error must say that.
+  if(DEFINED expect_said)
+    string(FIND "${err}" "${expect_said}" said)
+    if(said EQUAL -1)
+      message(FATAL_ERROR "error of '${ARGN}' does not say '${expect_said}': ${err}")
+    endif()
+  endif()
 endfunction()
 
 execute_process(COMMAND ${DRAPEGEN} simulate --alpha 20000,15000,10000 --beta -40000,-30000,-20000 --resolution 25
@@ -57,9 +64,12 @@ expect_failure(1 simulate --alpha 1000 --resolution 30 --init mesh:${WORK}/drape
 expect_failure(3 simulate --alpha 1000 --resolution 5 --out /nonexistent-dir/drape.ply)
 # A directory where a file goes: refused before the work, not after it.
 file(MAKE_DIRECTORY ${WORK}/a-directory)
+set(expect_said "it is a directory")
 expect_failure(3 simulate --alpha 1000 --resolution 5 --out ${WORK}/a-directory)
 expect_failure(3 sample --n 10 --out ${WORK}/p.csv --recipes ${WORK}/a-directory)
+set(expect_said "is a directory")
 expect_failure(1 sample --n 10 --model ${WORK}/a-directory)
+unset(expect_said)
 expect_failure(1 simulate --alpha 1000 --resolution 5 --seed -1)
 expect_failure(1 simulate --alpha 1000 --resolution 5 --seed 18446744073709551616)
 expect_failure(1 simulate --alpha 1000 --tolerance 0)

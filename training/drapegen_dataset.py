@@ -67,16 +67,31 @@ def open_manifest(manifest):
     if not os.path.isfile(manifest):
         raise FileNotFoundError(f"{manifest}: no such manifest")
     uri = "file:" + urllib.parse.quote(manifest)
+    db = None
     try:
         db = sqlite3.connect(uri + "?mode=ro", uri=True)
         db.execute("SELECT count(*) FROM sqlite_master").fetchone()
         return db, False
     except sqlite3.OperationalError as e:
+        if db is not None:
+            db.close()
         if os.access(os.path.dirname(manifest), os.W_OK):
             raise ValueError(f"{manifest}: cannot be read as a manifest ({e})") from None
     except sqlite3.DatabaseError as e:
+        if db is not None:
+            db.close()
         raise ValueError(f"{manifest}: not a drapegen manifest ({e})") from None
-    return sqlite3.connect(uri + "?immutable=1", uri=True), True
+    # Immutable reads the file alone: commits still in a log beside it (a live run, or one whose coordinator was
+    # killed) would be missed.
+    wal = manifest + "-wal"
+    if os.path.exists(wal) and os.path.getsize(wal) > 0:
+        raise PermissionError(f"{manifest}: the run is live or was not closed (its log {wal} holds commits), and this "
+                              "process cannot write its directory, which reading it then needs; read it where it "
+                              "can, or once it has ended (or resume it to an end)")
+    try:
+        return sqlite3.connect(uri + "?immutable=1", uri=True), True
+    except sqlite3.Error as e:
+        raise ValueError(f"{manifest}: cannot be read as a manifest ({e})") from None
 
 
 class DrapeDataset(Dataset):
@@ -98,10 +113,7 @@ class DrapeDataset(Dataset):
             if row[0] != "1":
                 raise ValueError(f"{self.manifest}: manifest schema version {row[0]}, this reader reads 1")
             self.run_state = state[0]
-            if immutable and self.run_state == "running":
-                raise PermissionError(f"{self.manifest}: the run is still running (or its coordinator was killed) and "
-                                      "this process cannot write its directory, which reading a live run needs; "
-                                      "read it where it can, or once it has ended (or resume it to an end)")
+            self.read_immutable = immutable  # read as a finished file (its directory not writable here)
             rows = db.execute(
                 "SELECT j.id, j.sample, j.slot, f.idx, f.path, f.sha256, s.alpha_warp, s.alpha_bias, s.alpha_weft, "
                 "s.beta_warp, s.beta_bias, s.beta_weft, s.density "

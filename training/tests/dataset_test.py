@@ -59,6 +59,7 @@ assert np.allclose(targets.mean(axis=0), 0.0, atol=1e-5), targets.mean(axis=0)
 row = db.execute("SELECT alpha_warp, alpha_bias, alpha_weft, beta_warp, beta_bias, beta_weft, density "
                  "FROM samples WHERE sample = ?", (ds.items[0]["sample"],)).fetchone()
 assert np.allclose(ds.denormalise(target.numpy()), features(row[:6], row[6]), atol=1e-5)
+db.close()  # the last connection: no log or shared-memory file left beside the manifest, as after a finished run
 
 # Two orientations of one drape differ (other table angles), the same item read twice does not.
 a, _ = ds[0]
@@ -105,6 +106,7 @@ runuser = shutil.which("runuser")
 if os.geteuid() == 0 and runuser:
     shared = os.path.join("/tmp", f"drapegen_dataset_ro_{os.getpid()}")
     shutil.rmtree(shared, ignore_errors=True)
+    assert not os.path.exists(manifest + "-wal") and not os.path.exists(manifest + "-shm")
     shutil.copytree(os.path.join(work, "run"), os.path.join(shared, "run"))
     shutil.copy(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "drapegen_dataset.py"), shared)
     for root, dirs, files in os.walk(shared):
@@ -115,16 +117,48 @@ if os.geteuid() == 0 and runuser:
     os.chmod(shared, 0o555)
     probe = ("import sys; sys.path.insert(0, sys.argv[1]); from drapegen_dataset import DrapeDataset; "
              "ds = DrapeDataset(sys.argv[1] + '/run/manifest.sqlite', verify_checksums=True); "
-             "v, t = ds[0]; print(len(ds), ds.run_state, float(v.max()) > 0)")
+             "v, t = ds[0]; print(len(ds), ds.run_state, ds.read_immutable, float(v.max()) > 0)")
     out = subprocess.run([runuser, "-u", "nobody", "--", sys.executable, "-c", probe, shared],
                          capture_output=True, text=True, env={"PATH": "/usr/bin:/bin", "HOME": "/tmp"})
+    made_shm = os.path.exists(os.path.join(shared, "run", "manifest.sqlite-shm"))
     os.chmod(shared, 0o755)
     for root, dirs, files in os.walk(shared):
         for d in dirs:
             os.chmod(os.path.join(root, d), 0o755)
+    assert out.returncode == 0 and out.stdout.split() == [str(len(ds)), "complete", "True", "True"], (
+        out.stdout, out.stderr[-2000:])
+    assert not made_shm
+    # A run whose log still holds commits (live, or its coordinator killed): read through its shared-memory file where
+    # that is left beside it (the log's commit seen, not a stale file); refused where it is not.
+    live = os.path.join(work, "live")
+    os.makedirs(live)
+    shutil.copy(manifest, live)
+    writer = sqlite3.connect(os.path.join(live, "manifest.sqlite"))
+    writer.execute("PRAGMA wal_autocheckpoint = 0")
+    writer.execute("UPDATE runs SET state = 'running'")
+    writer.commit()
+    for name in ("with_shm", "without_shm"):
+        shutil.copytree(live, os.path.join(shared, name))  # as a kill leaves it
+    writer.close()
+    os.remove(os.path.join(shared, "without_shm", "manifest.sqlite-shm"))
+    assert os.path.getsize(os.path.join(shared, "without_shm", "manifest.sqlite-wal")) > 0
+    state = ("import sys, warnings; warnings.simplefilter('ignore'); sys.path.insert(0, sys.argv[1]); "
+             "from drapegen_dataset import DrapeDataset; ds = DrapeDataset(sys.argv[2]); "
+             "print(ds.run_state, ds.read_immutable)")
+    results = {}
+    for name in ("with_shm", "without_shm"):
+        os.chmod(os.path.join(shared, name), 0o555)
+        os.chmod(shared, 0o555)
+        results[name] = subprocess.run(
+            [runuser, "-u", "nobody", "--", sys.executable, "-c", state, shared,
+             os.path.join(shared, name, "manifest.sqlite")],
+            capture_output=True, text=True, env={"PATH": "/usr/bin:/bin", "HOME": "/tmp"})
+        os.chmod(shared, 0o755)
+        os.chmod(os.path.join(shared, name), 0o755)
     shutil.rmtree(shared)
-    assert out.returncode == 0 and out.stdout.split() == [str(len(ds)), "complete", "True"], (out.stdout,
-                                                                                                out.stderr[-2000:])
-    assert not os.path.exists(os.path.join(shared, "run", "manifest.sqlite-shm"))
+    seen = results["with_shm"]
+    assert seen.returncode == 0 and seen.stdout.split() == ["running", "False"], (seen.stdout, seen.stderr[-2000:])
+    refused = results["without_shm"]
+    assert refused.returncode != 0 and "holds commits" in refused.stderr, (refused.stdout, refused.stderr[-2000:])
 
 print(f"dataset_test: ok ({len(ds)} items of 4 views 180x240 from {done} drapes)")
