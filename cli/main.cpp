@@ -50,6 +50,11 @@ int main(int argc, char** argv) {
     for (const auto& [sub, run] : runners) {
       if (sub->parsed()) where += " " + sub->get_name();
     }
+    if (where == "drapegen" && argc > 1 && argv[1][0] != '-') {
+      // CLI11 calls a mistyped command a missing one ("A subcommand is required"): name it and the known ones.
+      message = "unknown command '" + std::string(argv[1]) + "'; the commands:";
+      for (const CLI::App* sub : app.get_subcommands({})) message += " " + sub->get_name();
+    }
     std::cerr << where << ": error: " << message << " (see --help)\n";
     return drapegen::cli::kExitUsage;
   }

@@ -4,20 +4,10 @@
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
 
+include(${CMAKE_CURRENT_LIST_DIR}/expect_error.cmake)
+# expect_failure(EXIT NEEDLE ARGS...): a one-line error that says NEEDLE.
 function(expect_failure code_expected needle)
-  execute_process(COMMAND ${DRAPEGEN} ${ARGN} RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
-  if(NOT code EQUAL ${code_expected})
-    message(FATAL_ERROR "expected exit ${code_expected} from '${ARGN}', got ${code}: ${out} ${err}")
-  endif()
-  string(STRIP "${err}" err)
-  string(FIND "${err}" "\n" newline)
-  if(NOT newline EQUAL -1)
-    message(FATAL_ERROR "error of '${ARGN}' is more than one line: ${err}")
-  endif()
-  string(FIND "${err}" "${needle}" found)
-  if(found EQUAL -1)
-    message(FATAL_ERROR "error of '${ARGN}' does not say '${needle}': ${err}")
-  endif()
+  expect_drapegen_error(CODE ${code_expected} SAYS "${needle}" ARGS ${ARGN})
 endfunction()
 
 # Runs drapegen with the arguments after `out_var`; stops the test unless it exits 0; its stdout goes to `out_var`.

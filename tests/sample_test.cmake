@@ -3,20 +3,10 @@
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
 
+include(${CMAKE_CURRENT_LIST_DIR}/expect_error.cmake)
+# expect_failure(EXIT NEEDLE ARGS...): `drapegen sample ARGS...` fails with a one-line error that mentions NEEDLE.
 function(expect_failure code_expected needle)
-  execute_process(COMMAND ${DRAPEGEN} sample ${ARGN} RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
-  if(NOT code EQUAL ${code_expected})
-    message(FATAL_ERROR "expected exit ${code_expected} from 'sample ${ARGN}', got ${code}: ${out} ${err}")
-  endif()
-  string(STRIP "${err}" err)
-  string(FIND "${err}" "\n" newline)
-  if(NOT newline EQUAL -1 OR NOT err MATCHES "^drapegen sample: error: ")
-    message(FATAL_ERROR "error of 'sample ${ARGN}' is not one 'drapegen sample: error:' line: ${err}")
-  endif()
-  string(FIND "${err}" "${needle}" found)
-  if(found EQUAL -1)
-    message(FATAL_ERROR "error of 'sample ${ARGN}' does not mention '${needle}': ${err}")
-  endif()
+  expect_drapegen_error(CODE ${code_expected} SUB sample SAYS "${needle}" ARGS sample ${ARGN})
 endfunction()
 
 function(sample)

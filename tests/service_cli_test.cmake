@@ -2,34 +2,15 @@
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
 
+include(${CMAKE_CURRENT_LIST_DIR}/expect_error.cmake)
+# expect_failure(EXIT ARGS...), run in WORK: log lines may come before the error; with expect_said set by the caller,
+# the error must say that.
 function(expect_failure code_expected)
-  execute_process(COMMAND ${DRAPEGEN} ${ARGN} RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err
-                  WORKING_DIRECTORY ${WORK} TIMEOUT 60)
-  if(NOT code EQUAL ${code_expected})
-    message(FATAL_ERROR "expected exit ${code_expected} from '${ARGN}', got ${code}: ${out} ${err}")
-  endif()
-  string(STRIP "${err}" err)
-  if(err STREQUAL "")
-    message(FATAL_ERROR "no error message from '${ARGN}'")
-  endif()
-  # Log lines (time-stamped) may come first; the error is the last line, one line, "drapegen SUB: error: ...".
-  string(FIND "${err}" "\n" newline REVERSE)
-  if(NOT newline EQUAL -1)
-    math(EXPR start "${newline} + 1")
-    string(SUBSTRING "${err}" ${start} -1 last)
-  else()
-    set(last "${err}")
-  endif()
-  if(NOT last MATCHES "^drapegen [a-z]+: error: ")
-    message(FATAL_ERROR "last line of '${ARGN}' is not 'drapegen SUB: error: ...': ${err}")
-  endif()
-  # With expect_said set by the caller: the error must say that.
+  set(says)
   if(DEFINED expect_said)
-    string(FIND "${last}" "${expect_said}" said)
-    if(said EQUAL -1)
-      message(FATAL_ERROR "error of '${ARGN}' does not say '${expect_said}': ${err}")
-    endif()
+    set(says SAYS "${expect_said}")
   endif()
+  expect_drapegen_error(CODE ${code_expected} ${says} AFTER_LOG IN ${WORK} TIMEOUT 60 ARGS ${ARGN})
 endfunction()
 
 file(WRITE ${WORK}/typo.toml "seed = 1\nsampels = 3\n")

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <random>
 
+#include "drapegen/sim/mesh_transfer.hpp"
 #include "drapegen/sim/ply.hpp"
 
 namespace drapegen::sim {
@@ -102,6 +103,11 @@ Status apply_initial_state(const InitialStateSpec& spec, ClothMesh& mesh) {
                    "rest coordinates (u, v) of the same area and counter-clockwise rest triangles"};
     }
     mesh = std::move(loaded).value();
+    // The drape sits where its own drift and rotation put it: bring its centre point back onto the axis, so that
+    // `drift` places the centre as it does for the other shapes instead of adding to the source's drift.
+    const Eigen::Vector2d rest_centre = 0.5 * (mesh.rest.rowwise().minCoeff() + mesh.rest.rowwise().maxCoeff());
+    const Eigen::Vector3d centre = transfer_positions(mesh, rest_centre).col(0);
+    mesh.positions.topRows<2>().colwise() -= centre.head<2>();
   } else {
     mesh.positions.topRows<2>() = mesh.rest;
     mesh.positions.row(2).setConstant(spec.lift);

@@ -30,7 +30,8 @@ struct InitialStateSpec {
 /// platform top stays flat on it, so it can be held by the adhesive boundary condition. For kMesh the file replaces
 /// the whole mesh (positions, rest coordinates, triangles): it must have the specimen's vertex and triangle counts
 /// and rest coordinates (u, v) of the same total area (within 1%) with counter-clockwise triangles, as the PLY
-/// files this library writes do.
+/// files this library writes do; it is first moved level so that its centre point (the middle of its rest
+/// coordinates' bounding box) lies on the axis, so that rotation and drift act on it as on the other shapes.
 [[nodiscard]] Status apply_initial_state(const InitialStateSpec& spec, ClothMesh& mesh);
 
 }  // namespace drapegen::sim

@@ -1,0 +1,84 @@
+// Initial states place the specimen's centre point where the drift says, whatever the shape: a mesh initial state
+// (another sample's drape) is brought back onto the axis first, so drifts do not add up along chains of drapes.
+#include "drapegen/sim/initial_state.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <numbers>
+#include <string>
+
+#include "drapegen/sim/mesh_transfer.hpp"
+#include "drapegen/sim/ply.hpp"
+#include "drapegen/sim/specimen.hpp"
+
+namespace drapegen::sim {
+namespace {
+
+ClothMesh small_specimen() {
+  SpecimenSpec spec;
+  spec.vertices_x = spec.vertices_y = 21;
+  return make_specimen(spec);
+}
+
+// Where the specimen's centre point (rest (0, 0)) is, in mm.
+Eigen::Vector2d centre_mm(const ClothMesh& mesh) {
+  return 1e3 * transfer_positions(mesh, Eigen::Vector2d::Zero().eval()).col(0).head<2>();
+}
+
+TEST(InitialState, EveryShapePutsTheCentreAtTheDrift) {
+  const Eigen::Vector2d drift(0.003, -0.001);
+  for (const InitialShape shape : {InitialShape::kFlat, InitialShape::kSine, InitialShape::kFold}) {
+    ClothMesh mesh = small_specimen();
+    InitialStateSpec spec;
+    spec.shape = shape;
+    spec.seed = 5;
+    spec.rotation = 0.7;
+    spec.drift = drift;
+    ASSERT_TRUE(apply_initial_state(spec, mesh));
+    const Eigen::Vector2d c = centre_mm(mesh);
+    EXPECT_NEAR(c.x(), 3.0, 1e-9) << static_cast<int>(shape);
+    EXPECT_NEAR(c.y(), -1.0, 1e-9) << static_cast<int>(shape);
+  }
+}
+
+TEST(InitialState, AMeshIsBroughtOntoTheAxisBeforeItsDrift) {
+  // A source state 4 mm off the axis, as a drape with a drift leaves it.
+  ClothMesh source = small_specimen();
+  InitialStateSpec sine;
+  sine.shape = InitialShape::kSine;
+  sine.seed = 9;
+  sine.drift = Eigen::Vector2d(0.004, 0.0);
+  ASSERT_TRUE(apply_initial_state(sine, source));
+  ASSERT_NEAR(centre_mm(source).x(), 4.0, 1e-9);
+  const std::string path = testing::TempDir() + "/initial_state_source.ply";
+  ASSERT_TRUE(write_ply(path, source));
+  const Expected<ClothMesh> stored = read_ply(path);  // as the file holds it (its precision)
+  ASSERT_TRUE(stored);
+
+  InitialStateSpec from_mesh;
+  from_mesh.shape = InitialShape::kMesh;
+  from_mesh.mesh_path = path;
+  from_mesh.rotation = std::numbers::pi / 2.0;
+  from_mesh.drift = Eigen::Vector2d(0.0, 0.002);
+  ClothMesh mesh = small_specimen();
+  ASSERT_TRUE(apply_initial_state(from_mesh, mesh));
+  const Eigen::Vector2d c = centre_mm(mesh);
+  EXPECT_NEAR(c.x(), 0.0, 1e-6);  // not 4 mm turned to (0, 4) and drifted to (0, 6)
+  EXPECT_NEAR(c.y(), 2.0, 1e-6);
+  EXPECT_NEAR(centre_mm(*stored).x(), 4.0, 1e-3);
+  // Moved and turned rigidly: every edge keeps its length, and the heights are the source's.
+  for (int t = 0; t < mesh.triangle_count(); ++t) {
+    for (int k = 0; k < 3; ++k) {
+      const int a = mesh.triangles(k, t), b = mesh.triangles((k + 1) % 3, t);
+      EXPECT_NEAR((mesh.positions.col(a) - mesh.positions.col(b)).norm(),
+                  (stored->positions.col(a) - stored->positions.col(b)).norm(), 1e-12);
+    }
+  }
+  EXPECT_TRUE(mesh.positions.row(2).isApprox(stored->positions.row(2)));
+  std::filesystem::remove(path);
+}
+
+}  // namespace
+}  // namespace drapegen::sim
