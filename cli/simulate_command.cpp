@@ -39,6 +39,7 @@ struct SimulateOptions {
   std::optional<sim::Triangulation> mesh;  // a structured grid (--mesh); none: the perturbed triangulation
   int max_iterations = sim::SolverOptions{}.max_iterations;
   double tolerance = 1e-3;
+  int coarse_start = sim::DrapeConfig{}.coarse_start_resolution;
   bool verbose = false;
   std::vector<std::string> effects;
 };
@@ -83,6 +84,7 @@ int run_simulate(const SimulateOptions& o) {
   if (!std::isfinite(o.rotation_deg)) return fail("--rotation must be finite");
   if (!(o.tolerance > 0.0) || !std::isfinite(o.tolerance)) return fail("--tolerance must be positive");
   if (o.max_iterations < 1) return fail("--max-iterations must be at least 1");
+  if (o.coarse_start != 0 && o.coarse_start < 3) return fail("--coarse-start must be 0 (off) or at least 3");
   const auto effects = parse_effects(o.effects);
   if (!effects) return fail(effects.error().message);
 
@@ -128,6 +130,7 @@ int run_simulate(const SimulateOptions& o) {
   config.initial = *initial;
   config.solver.max_iterations = o.max_iterations;
   config.solver.tolerance = o.tolerance;
+  config.coarse_start_resolution = o.coarse_start;
   if (sim::Status s = sim::validate(config.fabric, config.bending_model); !s) return fail(s.error().message);
 
   // Refuse an unwritable output before spending the simulation on it.
@@ -218,6 +221,10 @@ Runner add_simulate_command(CLI::App& app) {
   app.add_flag("--structured", o->structured, "Shorthand for --mesh union-jack")->excludes(mesh);
   app.add_option("--max-iterations", o->max_iterations, "Newton iteration limit")->capture_default_str();
   app.add_option("--tolerance", o->tolerance, "Residual force over the largest vertex weight")->capture_default_str();
+  app.add_option("--coarse-start", o->coarse_start,
+                 "Solve first at half the resolution, recursively down to this many vertices per side, and start "
+                 "from that drape (0: off; only where --resolution is at least twice it)")
+      ->capture_default_str();
   app.add_flag("-v,--verbose", o->verbose, "Print every Newton iteration on stderr");
   app.add_option("--effect", o->effects,
                  "Physical effect beyond the paper's model (repeatable): curl=K[,W] (edge rest curvature K 1/m over "

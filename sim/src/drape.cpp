@@ -109,8 +109,10 @@ Expected<DrapeResult> simulate_drape(const DrapeConfig& config,
     if (friction) terms.push_back(friction.get());
     Eigen::Matrix3Xd x = mesh.positions;
     const int coarse = config.coarse_start_resolution;
+    // No cascade for a yielding fabric: plastic flow would start from the coarse drape interpolated piecewise flat,
+    // whose fine hinges along the coarse edges carry about twice the curvature, and set that grid's pattern for good.
     if (coarse >= 3 && initial.shape != InitialShape::kMesh && config.rest_angles.size() == 0 &&
-        config.specimen.vertices_x >= 2 * coarse &&
+        !config.effects.bending_yield_curvature && config.specimen.vertices_x >= 2 * coarse &&
         config.specimen.vertices_y >= 2 * coarse) {
       // A cascade: each level starts from the drape of one at half its resolution, down to `coarse`.
       DrapeConfig coarse_config = config;

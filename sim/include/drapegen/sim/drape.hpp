@@ -50,7 +50,8 @@ struct DrapeConfig {
   /// edge curl's rest angles (the set includes them) and turns the coarse start off (the set lives on this mesh).
   Eigen::VectorXd rest_angles;
   /// Solve first on specimens of half the resolution, recursively down to this many vertices per side, from the same
-  /// initial state, and start each finer solve from the coarser drape (0: off; ignored for mesh initial states and
+  /// initial state, and start each finer solve from the coarser drape (0: off; ignored for mesh initial states,
+  /// given rest angles, bending plasticity, whose flow would set the interpolated start's coarse pattern, and
   /// specimens with fewer than twice this many vertices per side).
   int coarse_start_resolution = 25;
 };
