@@ -27,8 +27,9 @@ Runner add_worker_command(CLI::App& app) {
       ->check(CLI::Range(10, 3600000))
       ->capture_default_str();
   app.add_option("--give-up", o->give_up_s,
-                 "Exit with an error after this many seconds without a coordinator (0: never); checked when a silent "
-                 "connection is dropped, so up to --heartbeat-ms x --liveness later")
+                 "Exit with an error after this many seconds without a coordinator that accepts this worker (0: "
+                 "never); checked when a connection is dropped (after --liveness of the coordinator's heartbeat "
+                 "intervals of silence), so the exit can come that much later, plus up to --backoff-max-ms")
       ->check(CLI::Range(0.0, 1e9))
       ->capture_default_str();
   app.add_option("--server-key", o->server_key, "CurveZMQ: the coordinator's public key (Z85, or a .pub file)");

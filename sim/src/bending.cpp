@@ -162,11 +162,11 @@ double DihedralBending::update_lagged(const Eigen::Matrix3Xd& x) {
 namespace {
 
 /// Whether a hinge whose angle is `after` at the end of a step folded through the wrap at +-pi on the way from
-/// `from`. A hinge that crossed the wrap ends near +-pi (past pi/2) on the other side, wherever it lands relative to
-/// the barrier; steps of less than pi are assumed, so a hinge that swings by more than pi through flat (from -1.7 to
-/// 1.7, say) is ruled out as well: that only shortens the step.
+/// `from`: its angle jumped by more than pi, the short way round being through the wrap (2.5 to -1.4, say),
+/// wherever it lands relative to the barrier. Steps of less than pi are assumed, so a hinge that swings by more than
+/// pi through flat (from -1.7 to 1.7, say) is ruled out as well: that only shortens the step.
 bool wrapped(double after, const Eigen::Matrix3Xd& from, const Hinge& h) {
-  return std::abs(after) >= 0.5 * std::numbers::pi && std::abs(after - hinge_angle(from, h)) > std::numbers::pi;
+  return std::abs(after - hinge_angle(from, h)) > std::numbers::pi;
 }
 
 }  // namespace

@@ -4,12 +4,17 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <stdexcept>
 
 #include "drapegen/sim/dihedral.hpp"
+#include "drapegen/sim/fold_barrier.hpp"
 
 namespace drapegen::sim {
 namespace {
+
+/// The largest rest angle a hinge holds: where the fold barrier begins.
+constexpr double kHeldAngle = std::numbers::pi - FoldBarrier::kWidth;
 
 /// The rolled band's cross-section, by arc length s from where the band begins (s = width - d): the tangent turns
 /// by phi(s) = curvature s^2 / (2 width) (the integral of k), so a point at s lies at (inward, up) = (integral of
@@ -85,7 +90,13 @@ Eigen::VectorXd edge_curl_rest_angles(const ClothMesh& mesh, const Topology& top
       const Eigen::Vector2d rolled = roll.at(d);
       x[k] = Eigen::Vector3d(along.x() + rolled.x() * inward.x(), along.y() + rolled.x() * inward.y(), rolled.y());
     }
-    angles[static_cast<Eigen::Index>(i)] = dihedral_angle(x[0], x[1], x[2], x[3]);
+    // A roll tighter than the mesh resolves turns a hinge by pi or more, which the angle's range (-pi, pi] wraps to
+    // the other sign: unwrap it by the roll's sense, then hold it where the fold barrier begins (the barrier would
+    // push against a rest angle inside it, and set_rest_angles refuses one beyond pi).
+    double theta = dihedral_angle(x[0], x[1], x[2], x[3]);
+    const double sense = -std::copysign(1.0, curl.curvature);
+    if (theta * sense < -0.5 * std::numbers::pi) theta += sense * 2.0 * std::numbers::pi;
+    angles[static_cast<Eigen::Index>(i)] = std::clamp(theta, -kHeldAngle, kHeldAngle);
   }
   return angles;
 }

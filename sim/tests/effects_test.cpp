@@ -11,6 +11,7 @@
 #include "drapegen/sim/dihedral.hpp"
 #include "drapegen/sim/drape.hpp"
 #include "drapegen/sim/edge_curl.hpp"
+#include "drapegen/sim/fold_barrier.hpp"
 #include "drapegen/sim/membrane.hpp"
 #include "drapegen/sim/newton_solver.hpp"
 #include "drapegen/sim/platform.hpp"
@@ -148,6 +149,23 @@ TEST(Effects, EdgeCurlLiftsTheEdges) {
     EXPECT_GT(edge * sign, 0.5 * expected);
     EXPECT_LT(edge * sign, 1.5 * expected);
     EXPECT_LT(middle, 0.1 * expected);
+  }
+}
+
+// A roll tighter than the mesh: 450 /m over 30 mm turns a 12.5 mm hinge of a 25x25 specimen by more than pi. Its
+// rest angle keeps the roll's sign (it wrapped to the other before) and stops where the fold barrier begins; on a
+// mesh fine enough for the roll nothing is held.
+TEST(Effects, EdgeCurlTighterThanTheMeshIsHeldAtTheBarrier) {
+  const double held = std::numbers::pi - FoldBarrier::kWidth;
+  for (double sign : {1.0, -1.0}) {
+    const ClothMesh coarse = make_specimen(SpecimenSpec{0.3, 0.3, 25, 25, 0.0, Triangulation::kAlternating, 0, 0.0});
+    const Eigen::VectorXd a = edge_curl_rest_angles(coarse, build_topology(coarse), EdgeCurl{sign * 450.0, 0.03});
+    EXPECT_NEAR((-sign * a).maxCoeff(), held, 1e-12) << sign;  // curling up (+z) is a negative angle
+    EXPECT_LT((sign * a).maxCoeff(), 0.5) << sign;               // no hinge wrapped to the other sign
+    const ClothMesh fine = make_specimen(SpecimenSpec{0.3, 0.3, 60, 60, 0.0, Triangulation::kAlternating, 0, 0.0});
+    const Eigen::VectorXd b = edge_curl_rest_angles(fine, build_topology(fine), EdgeCurl{sign * 200.0, 0.03});
+    EXPECT_GT(b.cwiseAbs().maxCoeff(), 0.5) << sign;
+    EXPECT_LT(b.cwiseAbs().maxCoeff(), held - 0.1) << sign;
   }
 }
 

@@ -127,6 +127,8 @@ TEST(FoldBarrier, LineSearchMayNotFoldThroughTheWrap) {
   EXPECT_FALSE(s.bending.admissible_step(b, folded(s.mesh, h, -2.5)));
   // A swing of more than pi through flat is taken for a wrap (conservative: the line search only shortens it).
   EXPECT_FALSE(s.bending.admissible_step(folded(s.mesh, h, -1.7), folded(s.mesh, h, 1.7)));
+  // Through the wrap the short way (2.38 rad) yet landing within pi/2 of flat: still ruled out.
+  EXPECT_FALSE(s.bending.admissible_step(folded(s.mesh, h, 2.5), folded(s.mesh, h, -1.4)));
   // What the line search sees: the energy is finite at both ends, but the step between them is ruled out.
   EXPECT_TRUE(std::isfinite(s.bending.energy(c)) && std::isfinite(s.bending.energy(d)));
   EXPECT_EQ(s.bending.step_energy(c, d), std::numeric_limits<double>::infinity());

@@ -11,6 +11,7 @@
 #include "drapegen/proto/codec.hpp"
 #include "drapegen/proto/recipe.hpp"
 #include "drapegen/proto/simulation.hpp"
+#include "drapegen/proto/text.hpp"
 #include "drapegen/renderer/data_point.hpp"
 #include "drapegen/renderer/make_renderer.hpp"
 #include "drapegen/renderer/scene.hpp"
@@ -23,6 +24,8 @@ namespace v1 = proto::v1;
 
 namespace {
 
+constexpr std::size_t kMaxFailureMessage = 4096;  // bytes
+
 v1::Envelope failure(const v1::Job& job, v1::FailureReason reason, std::string message,
                      const v1::Metrics* metrics = nullptr) {
   v1::Envelope e;
@@ -30,11 +33,8 @@ v1::Envelope failure(const v1::Job& job, v1::FailureReason reason, std::string m
   f->set_job_id(job.job_id());
   f->set_attempt(job.attempt());
   f->set_reason(reason);
-  // One line, valid UTF-8 (protobuf strings).
-  for (char& c : message) {
-    if (c == '\n' || c == '\r') c = ' ';
-  }
-  f->set_message(std::move(message));
+  // One line of valid UTF-8: the receiver drops a frame whose string is not (a path in another encoding).
+  f->set_message(proto::one_line_utf8(message, kMaxFailureMessage));
   if (metrics) *f->mutable_metrics() = *metrics;
   return e;
 }

@@ -1,9 +1,11 @@
 #include "drapegen/worker/worker.hpp"
 
+#include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <filesystem>
 #include <fmt/format.h>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <thread>
@@ -17,7 +19,9 @@
 #include "drapegen/coordinator/curve_keys.hpp"
 #include "drapegen/coordinator/logging.hpp"
 #include "drapegen/proto/codec.hpp"
+#include "drapegen/proto/text.hpp"
 #include "drapegen/sim/blas_kernels.hpp"
+#include "drapegen/storage/atomic_file.hpp"
 #include "drapegen/worker/job_runner.hpp"
 
 namespace drapegen::worker {
@@ -27,63 +31,73 @@ using std::chrono::milliseconds;
 
 namespace {
 
-/// The computing thread: one job at a time, its answer picked up by the I/O loop.
+/// The computing thread: one job at a time, its answer picked up by the I/O loop. The thread shares the state (and
+/// the runner, whose OSMesa contexts belong to it) with the executor: a worker stopped mid-job detaches the thread,
+/// which finishes its job on state it still owns and releases it last.
 class Executor {
  public:
-  explicit Executor(std::string scratch) : runner_(std::move(scratch)), thread_([this] { loop(); }) {}
+  explicit Executor(std::string scratch)
+      : state_(std::make_shared<State>(std::move(scratch))), thread_([state = state_] { loop(*state); }) {}
   ~Executor() {
     {
-      std::lock_guard lock(mutex_);
-      quit_ = true;
+      std::lock_guard lock(state_->mutex);
+      state_->quit = true;
     }
-    cv_.notify_all();
-    if (busy_) {
+    state_->cv.notify_all();
+    if (state_->busy) {
       thread_.detach();  // a computation cannot be interrupted; the process exits without waiting for it
     } else {
       thread_.join();
     }
   }
+  Executor(const Executor&) = delete;
+  Executor& operator=(const Executor&) = delete;
   void submit(v1::Job job) {
     {
-      std::lock_guard lock(mutex_);
-      job_ = std::move(job);
-      busy_ = true;
+      std::lock_guard lock(state_->mutex);
+      state_->job = std::move(job);
+      state_->busy = true;
     }
-    cv_.notify_all();
+    state_->cv.notify_all();
   }
-  [[nodiscard]] bool busy() const { return busy_; }
+  [[nodiscard]] bool busy() const { return state_->busy; }
   std::optional<v1::Envelope> take() {
-    std::lock_guard lock(mutex_);
-    std::optional<v1::Envelope> out = std::move(answer_);
-    answer_.reset();
-    if (out) busy_ = false;
+    std::lock_guard lock(state_->mutex);
+    std::optional<v1::Envelope> out = std::move(state_->answer);
+    state_->answer.reset();
+    if (out) state_->busy = false;
     return out;
   }
 
  private:
-  void loop() {
+  struct State {
+    explicit State(std::string scratch) : runner(std::move(scratch)) {}
+    JobRunner runner;
+    std::mutex mutex;
+    std::condition_variable cv;
+    std::optional<v1::Job> job;
+    std::optional<v1::Envelope> answer;
+    std::atomic<bool> busy{false};
+    bool quit = false;
+  };
+
+  static void loop(State& state) {
     for (;;) {
       v1::Job job;
       {
-        std::unique_lock lock(mutex_);
-        cv_.wait(lock, [&] { return quit_ || job_.has_value(); });
-        if (quit_) return;
-        job = std::move(*job_);
-        job_.reset();
+        std::unique_lock lock(state.mutex);
+        state.cv.wait(lock, [&] { return state.quit || state.job.has_value(); });
+        if (state.quit) return;
+        job = std::move(*state.job);
+        state.job.reset();
       }
-      v1::Envelope answer = runner_.run(job);
-      std::lock_guard lock(mutex_);
-      answer_ = std::move(answer);
+      v1::Envelope answer = state.runner.run(job);
+      std::lock_guard lock(state.mutex);
+      state.answer = std::move(answer);
     }
   }
 
-  JobRunner runner_;
-  std::mutex mutex_;
-  std::condition_variable cv_;
-  std::optional<v1::Job> job_;
-  std::optional<v1::Envelope> answer_;
-  std::atomic<bool> busy_{false};
-  bool quit_ = false;
+  std::shared_ptr<State> state_;
   std::thread thread_;
 };
 
@@ -98,6 +112,10 @@ std::string default_name() {
 sim::Status run_worker(const WorkerOptions& o, const std::atomic<bool>& stop) {
   auto log = coordinator::logger();
   const std::string name = o.name.empty() ? default_name() : o.name;
+  // The coordinator drops a Ready whose name is too long or not UTF-8, and the worker would register for ever.
+  if (name.size() > proto::kMaxReadyText || !proto::is_utf8(name) || name.find_first_of("\r\n") != std::string::npos) {
+    return sim::Error{fmt::format("--name must be one line of UTF-8 of at most {} bytes", proto::kMaxReadyText)};
+  }
   std::string scratch = o.scratch_dir;
   if (scratch.empty()) {
     // Scratch directories of workers that died without cleaning up (SIGKILL): their process no longer exists.
@@ -119,6 +137,18 @@ sim::Status run_worker(const WorkerOptions& o, const std::atomic<bool>& stop) {
       std::filesystem::remove_all(dir, ec);
     }
   } remove_scratch{o.scratch_dir.empty() ? scratch : std::string()};
+  // A scratch directory the jobs cannot write to would fail every job it takes (as invalid), one after the other:
+  // refuse to start instead.
+  {
+    std::error_code ec;
+    std::filesystem::create_directories(scratch, ec);
+    const std::string probe = (std::filesystem::path(scratch) / "write_probe").string();
+    if (ec) return sim::Error{fmt::format("scratch directory {}: {}", scratch, ec.message())};
+    if (sim::Status s = storage::write_file_atomic(probe, "probe"); !s) {
+      return sim::Error{fmt::format("scratch directory {} is not writable: {}", scratch, s.error().message)};
+    }
+    std::filesystem::remove(probe, ec);
+  }
   std::optional<coordinator::CurveKeyPair> own_key;
   std::string server_key;
   if (!o.server_key.empty() || !o.key_file.empty()) {
@@ -189,7 +219,9 @@ sim::Status run_worker(const WorkerOptions& o, const std::atomic<bool>& stop) {
             log->warn("dropped a message from the coordinator: {}", decoded.error().message);
             continue;
           }
-          last_recv = last_contact = Clock::now();
+          last_recv = Clock::now();
+          // A coordinator that only says it does not know us is no coordinator for --give-up.
+          if (decoded->body_case() != v1::Envelope::kDisconnect) last_contact = last_recv;
           if (!connected) {
             connected = true;
             backoff_ms = o.backoff_initial_ms;
@@ -274,7 +306,8 @@ sim::Status run_worker(const WorkerOptions& o, const std::atomic<bool>& stop) {
       current_job = 0;
       (void)current_attempt;
     }
-    // Checked when a connection is given up (after liveness heartbeats of silence), so the wait can exceed it.
+    // Checked when a connection is given up (after liveness heartbeats of silence, or on a Disconnect), so the wait
+    // can exceed it by that and by the last reconnect delay.
     if (const double waited = std::chrono::duration<double>(Clock::now() - last_contact).count();
         o.give_up_s > 0 && waited > o.give_up_s) {
       return sim::Error{fmt::format("no coordinator at {} for {:.1f} s (--give-up {} s); giving up", o.endpoint, waited,

@@ -6,6 +6,7 @@
 
 #include "drapegen/proto/recipe.hpp"
 #include "drapegen/proto/simulation.hpp"
+#include "drapegen/proto/text.hpp"
 #include "drapegen/renderer/exr.hpp"
 #include "drapegen/sampler/recipe_generator.hpp"
 #include "drapegen/worker/job_runner.hpp"
@@ -164,6 +165,21 @@ TEST(JobRunner, RefusesADrapeRecipeWithoutItsMesh) {
   const auto answer = runner.run(job);
   ASSERT_EQ(answer.body_case(), v1::Envelope::kFailure);
   EXPECT_EQ(answer.failure().reason(), v1::FAILURE_REASON_INVALID_JOB);
+  EXPECT_EQ(answer.failure().message(), "drape recipe without mesh");
+}
+
+// A failure message naming a path in another encoding still reaches the coordinator: the receiver drops a frame
+// whose string field is not UTF-8, and the job would wait out its lease.
+TEST(JobRunner, FailureMessagesAreOneLineOfValidUtf8) {
+  JobRunner runner("/proc/1/latin1-\xE9t\xE9\nscratch");  // cannot be made: the error names it
+  const auto answer = runner.run(tiny_job(v1::JOB_MODE_DRAPE));
+  ASSERT_EQ(answer.body_case(), v1::Envelope::kFailure);
+  const std::string& message = answer.failure().message();
+  EXPECT_NE(message.find("latin1-?t?"), std::string::npos) << message;
+  EXPECT_TRUE(proto::is_utf8(message));
+  EXPECT_EQ(message.find('\n'), std::string::npos);
+  v1::Envelope back;
+  EXPECT_TRUE(back.ParseFromString(proto::encode(answer)));
 }
 
 TEST(JobRunner, NoopAnswersAtOnce) {
