@@ -108,7 +108,7 @@ expect_failure(1 "bad magic" --n 10 --out ${WORK}/x.csv --model ${WORK}/truncate
 expect_failure(1 "--out" --n 10)
 expect_failure(3 "cannot write" --n 10 --out /nonexistent-dir/params.csv)
 expect_failure(1 "cannot open fabric data" --report --data ${WORK}/missing.csv --no-plot)
-file(WRITE ${WORK}/bad.csv "density,a,b,c,d,e,f\n0.1,1,2,x,4,5,6\n")
+file(WRITE ${WORK}/bad.csv "density,linear warp,linear weft,linear diag,nonlinear warp,nonlinear weft,nonlinear diag\n0.1,1,2,x,4,5,6\n")
 expect_failure(1 "line 2" --report --data ${WORK}/bad.csv --no-plot)
 expect_failure(1 "--plot-x" --report --data ${DATA} --plot-x gamma)
 expect_failure(1 "at least" --report --data ${DATA} --n 100 --no-plot)

@@ -18,6 +18,22 @@ bool parse_double(std::string_view text, double& out) {
   return ec == std::errc() && end == text.data() + text.size() && std::isfinite(out);
 }
 
+/// Whether `line` is fabrics618.csv's header: seven fields, density first, then the directions in the order the
+/// reader maps them (warp, weft, diag; linear, then nonlinear). A file without it would lose its first fabric.
+bool is_header(std::string_view line) {
+  constexpr std::array<std::string_view, 7> kNames = {"density", "warp", "weft", "diag", "warp", "weft", "diag"};
+  std::size_t field = 0;
+  while (true) {
+    const std::size_t comma = line.find(',');
+    const std::string_view text = line.substr(0, comma);
+    if (field >= kNames.size() || text.find(kNames[field]) == std::string_view::npos) return false;
+    ++field;
+    if (comma == std::string_view::npos) break;
+    line.remove_prefix(comma + 1);
+  }
+  return field == kNames.size();
+}
+
 }  // namespace
 
 sim::Expected<std::vector<MeasuredFabric>> read_fabric_csv(const std::string& path) {
@@ -25,6 +41,10 @@ sim::Expected<std::vector<MeasuredFabric>> read_fabric_csv(const std::string& pa
   if (!in) return sim::Error{"cannot open fabric data '" + path + "'"};
   std::string line;
   if (!std::getline(in, line)) return sim::Error{"fabric data '" + path + "' is empty or unreadable"};
+  if (!is_header(line)) {
+    return sim::Error{"fabric data '" + path + "' line 1: expected the header (density, linear warp, linear weft, "
+                      "linear diag, nonlinear warp, nonlinear weft, nonlinear diag), which fixes the columns' order"};
+  }
   std::vector<MeasuredFabric> fabrics;
   int line_number = 1;
   while (std::getline(in, line)) {

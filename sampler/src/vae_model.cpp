@@ -158,16 +158,16 @@ sim::Status VaeModel::validate() const {
   }
   int in = kFeatureCount;
   for (int i = 0; i < h; ++i) {
-    if (!shaped(encoder[i], in, hidden[i])) return sim::Error{"encoder layer " + std::to_string(i) + " is malformed"};
+    if (!shaped(encoder[i], in, hidden[i])) return sim::Error{"encoder layer " + std::to_string(i) + " is malformed (wrong shape or non-finite values)"};
     in = hidden[i];
   }
   if (!shaped(encoder_mu, in, latent_dim) || !shaped(encoder_logvar, in, latent_dim)) {
-    return sim::Error{"encoder heads are malformed"};
+    return sim::Error{"encoder heads are malformed (wrong shape or non-finite values)"};
   }
   in = latent_dim;
   for (int i = 0; i <= h; ++i) {
     const int out = i < h ? hidden[h - 1 - i] : kFeatureCount;
-    if (!shaped(decoder[i], in, out)) return sim::Error{"decoder layer " + std::to_string(i) + " is malformed"};
+    if (!shaped(decoder[i], in, out)) return sim::Error{"decoder layer " + std::to_string(i) + " is malformed (wrong shape or non-finite values)"};
     in = out;
   }
   return {};
@@ -218,6 +218,15 @@ sim::Expected<VaeModel> load_vae_model(const std::string& path) {
   const std::string where = "model file '" + path + "'";
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) return sim::Error{where + " is a directory"};
+  // Read whole below: a device or a pipe (/dev/zero) would never end, a huge file would fill the memory first.
+  const auto status = std::filesystem::status(path, ec);
+  if (std::filesystem::exists(status) && !std::filesystem::is_regular_file(status)) {
+    return sim::Error{where + " is not a regular file"};
+  }
+  constexpr std::uintmax_t kMaxModelBytes = std::uintmax_t{1} << 30;  // VAE-1, the largest of Table 1: about 44 MB
+  if (const std::uintmax_t size = std::filesystem::file_size(path, ec); !ec && size > kMaxModelBytes) {
+    return sim::Error{where + " is " + std::to_string(size) + " bytes, larger than any model (1 GiB at most)"};
+  }
   std::ifstream in(path, std::ios::binary);
   if (!in) return sim::Error{"cannot open " + where};
   std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

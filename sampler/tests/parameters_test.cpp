@@ -98,8 +98,12 @@ class CsvErrors : public ::testing::Test {
 };
 
 TEST_F(CsvErrors, BadFilesSayWhatIsWrong) {
-  const std::string header = "density,a,b,c,d,e,f\n";
+  const std::string header = "density, linear warp, linear weft, linear diag, nonlinear warp, nonlinear weft, "
+                             "nonlinear diag\n";
   EXPECT_NE(error_of("").find("empty"), std::string::npos);
+  // No header (its first fabric would have been skipped), or columns in another order.
+  EXPECT_NE(error_of("0.1,1,2,3,4,5,6\n0.1,1,2,3,4,5,6\n").find("line 1: expected the header"), std::string::npos);
+  EXPECT_NE(error_of("density,warp,diag,weft,warp,diag,weft\n0.1,1,2,3,4,5,6\n").find("line 1"), std::string::npos);
   EXPECT_NE(error_of(header).find("no rows"), std::string::npos);
   EXPECT_NE(error_of(header + "0.1,1,2,3,4,5\n").find("line 2"), std::string::npos);
   EXPECT_NE(error_of(header + "0.1,1,2,3,4,5,6,7\n").find("7 finite"), std::string::npos);

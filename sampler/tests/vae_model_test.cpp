@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -119,6 +120,30 @@ TEST_F(ModelFileTest, NonFiniteWeightsAreRejectedOnSave) {
   m = model_;
   m.feature_std[2] = 0.0;
   EXPECT_FALSE(m.validate());
+}
+
+// A file with a valid checksum can still carry values no model has (another exporter, a bug): the loader checks
+// them itself.
+TEST_F(ModelFileTest, NonFiniteWeightsAreRejectedOnLoad) {
+  std::vector<char> bad = bytes_;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const std::size_t first_weight = 36 + 8 * 30;  // past the header and the 30 per-feature reals
+  std::memcpy(bad.data() + first_weight, &nan, sizeof nan);
+  std::uint64_t h = 0xcbf29ce484222325ULL;  // FNV-1a over the body, stored little-endian at the end
+  for (std::size_t i = 0; i + 8 < bad.size(); ++i) {
+    h ^= static_cast<unsigned char>(bad[i]);
+    h *= 0x100000001b3ULL;
+  }
+  for (int i = 0; i < 8; ++i) bad[bad.size() - 8 + i] = static_cast<char>(h >> (8 * i));
+  const std::string error = error_of(bad);
+  EXPECT_NE(error.find("non-finite"), std::string::npos) << error;
+  EXPECT_EQ(error.find("checksum"), std::string::npos) << error;
+}
+
+TEST_F(ModelFileTest, DevicesAreRefusedBeforeReading) {
+  auto loaded = load_vae_model("/dev/zero");  // read whole, it would never end
+  ASSERT_FALSE(loaded);
+  EXPECT_NE(loaded.error().message.find("not a regular file"), std::string::npos) << loaded.error().message;
 }
 
 TEST_F(ModelFileTest, StudentTModelRoundTripsAsVersion2) {

@@ -35,6 +35,8 @@ def model_bytes(model, range_low, range_high):
 
     def reals(values):
         arr = np.ascontiguousarray(np.asarray(values, dtype="<f8"))
+        if not np.all(np.isfinite(arr)):  # the C++ loader refuses such a model; say so here, not there
+            raise ValueError("the model has non-finite values (a diverged training?); not exported")
         return arr.tobytes()
 
     out += reals(model.feature_mean.numpy())
@@ -43,7 +45,10 @@ def model_bytes(model, range_low, range_high):
     out += reals(range_high)
     out += reals(model.log_sigma.detach().numpy())
     if not gaussian:
-        out += reals(model.degrees_of_freedom().detach().numpy())
+        dof = model.degrees_of_freedom().detach().numpy()
+        if not np.all(dof > 1.0):
+            raise ValueError("Student-t degrees of freedom must be > 1; not exported")
+        out += reals(dof)
     layers = _linear_layers(model.encoder) + [model.to_mu, model.to_logvar] + _linear_layers(model.decoder)
     for layer in layers:
         out += reals(layer.weight.detach().numpy())  # out x in, row-major

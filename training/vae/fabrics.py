@@ -16,8 +16,20 @@ class DataError(Exception):
     pass
 
 
+HEADER_NAMES = ["density", "warp", "weft", "diag", "warp", "weft", "diag"]
+
+
 def read_rows(path):
     """All 618 rows as (density kg/m^2, 6 moduli in feature order, paper units)."""
+    try:
+        with open(path, encoding="utf-8") as f:
+            header = f.readline().split(",")
+    except (OSError, UnicodeDecodeError) as e:
+        raise DataError(f"cannot read fabric data '{path}': {e}") from e
+    # The header fixes the columns' order (CSV_TO_FEATURE); a file without one would lose its first fabric.
+    if len(header) != 7 or any(name not in field for name, field in zip(HEADER_NAMES, header)):
+        raise DataError(f"'{path}' line 1: expected the header (density, linear warp, linear weft, linear diag, "
+                        "nonlinear warp, nonlinear weft, nonlinear diag)")
     try:
         raw = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
     except (OSError, ValueError) as e:
@@ -86,5 +98,5 @@ if __name__ == "__main__":
     import os
     import sys
     here = os.path.dirname(os.path.abspath(__file__))
-    print(summary(sys.argv[1] if len(sys.argv) > 1 else os.path.join(here, "..", "..", "..", "shared", "data",
+    print(summary(sys.argv[1] if len(sys.argv) > 1 else os.path.join(here, "..", "..", "sampler", "data",
                                                                         "fabrics618.csv")))

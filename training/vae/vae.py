@@ -1,6 +1,6 @@
-"""The VAE subspace model (paper Section 5.1.3, Table 1): fully connected encoder and mirrored decoder, Gaussian
-observation model with one learned standard deviation per feature, standard normal prior. Works in float64 on
-standardised features (feature - mean) / std with the training set's mean and std."""
+"""The VAE subspace model (paper Section 5.1.3, Table 1): fully connected encoder and mirrored decoder, a Gaussian
+or Student-t observation model (OBSERVATIONS) with one learned scale per feature, standard normal prior. Works in
+float64 on standardised features (feature - mean) / std with the training set's mean and std."""
 import math
 import os
 
@@ -16,7 +16,7 @@ ARCHITECTURES = {
     "VAE-4": ([32, 16, 8], 4),
 }
 OBSERVATIONS = ("gaussian", "student")
-ACTIVATION = "elu"  # the C++ decoder implements the same function (sampler/src/mlp.cpp)
+ACTIVATION = "elu"  # the C++ decoder implements the same function (sampler/src/vae_model.cpp)
 
 
 def mlp(widths):
