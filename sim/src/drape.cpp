@@ -62,6 +62,8 @@ std::unique_ptr<EnergyTerm> make_membrane(const ClothMesh& mesh, const DrapeConf
 Expected<DrapeResult> simulate_drape(const DrapeConfig& config,
                                      const std::function<void(const IterationInfo&)>& progress) {
   if (Status s = validate(config.fabric, config.bending_model); !s) return s.error();
+  // The residual test is relative to the heaviest vertex's weight: without weight every solve would end "diverged".
+  if (!(config.gravity > 0.0) || !std::isfinite(config.gravity)) return Error{"gravity must be positive and finite"};
   DrapeResult result;
   try {
     result.mesh = make_specimen(config.specimen);

@@ -202,6 +202,7 @@ SolveReport NewtonSolver::solve(const std::vector<EnergyTerm*>& terms, const std
     bool reuse = have_factor && lambda == 0.0 && options_.max_pcg_iterations > 0 &&
                  last_cg_iterations <= options_.pcg_refactor_fraction * options_.max_pcg_iterations;
     bool solved = false;
+    bool non_finite_step = false;  // the last solve gave a non-finite step
     while (!accepted) {
       FactorStatus status = FactorStatus::kOk;
       solved = false;
@@ -243,7 +244,11 @@ SolveReport NewtonSolver::solve(const std::vector<EnergyTerm*>& terms, const std
         report.seconds = since(start);
         return report;
       }
-      if (status == FactorStatus::kOk && (solved || cholesky.solve(-g, step))) {
+      // A non-finite step (a singular factor, or a Hessian with NaN in it) is retried with a stronger shift like a
+      // step without descent; if it is still non-finite at the strongest, the solve diverged.
+      if (status == FactorStatus::kOk && !solved) solved = cholesky.solve(-g, step);
+      non_finite_step = status == FactorStatus::kOk && !solved;
+      if (status == FactorStatus::kOk && solved) {
         // Limit the largest vertex displacement.
         double largest = 0.0;
         for (int f = 0; f < n / 3; ++f) largest = std::max(largest, step.segment<3>(3 * f).norm());
@@ -289,8 +294,11 @@ SolveReport NewtonSolver::solve(const std::vector<EnergyTerm*>& terms, const std
       if (!accepted) {
         lambda = lambda == 0.0 ? 1e-6 : lambda * 10.0;
         if (lambda > options_.max_regularization) {
-          report.outcome = SolveOutcome::kStalled;
-          report.message = fmt::format("no descent step at iteration {} (residual {:.3g})", it, report.residual);
+          report.outcome = non_finite_step ? SolveOutcome::kDiverged : SolveOutcome::kStalled;
+          report.message = non_finite_step
+                               ? fmt::format("non-finite Newton step at iteration {} (residual {:.3g})", it,
+                                             report.residual)
+                               : fmt::format("no descent step at iteration {} (residual {:.3g})", it, report.residual);
           report.seconds = since(start);
           return report;
         }

@@ -254,6 +254,9 @@ TEST(Cantilever, RejectsBadInput) {
   s.width = 0.0;
   EXPECT_TRUE(fails(s));
   s = good;
+  s.gravity = 0.0;  // no weight: nothing to solve (it ended "diverged")
+  EXPECT_TRUE(fails(s));
+  s = good;
   s.fabric.alpha = {0.0, 0.0, 0.0};
   EXPECT_TRUE(fails(s));
   s = good;

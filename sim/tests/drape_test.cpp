@@ -17,6 +17,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <filesystem>
 #include <cstdio>
 #include <numbers>
@@ -84,6 +85,17 @@ double mean_distance_mm(const Eigen::Matrix3Xd& a, const Eigen::Matrix3Xd& b) {
 // coarse mesh compresses beyond the 1% band in its folds, where sigma acts (bench/drape_physics.cpp, check a, at
 // finer meshes). (2) continues from the base drape: from a flat start, tiny differences can select another of the
 // drape's many local minima, which measures the path, not k/rho.
+TEST(DrapePhysics, AWeightlessDrapeIsAnInputError) {
+  for (const double g : {0.0, -9.81, std::numeric_limits<double>::quiet_NaN()}) {
+    DrapeConfig c;
+    c.specimen.vertices_x = c.specimen.vertices_y = 10;
+    c.gravity = g;
+    const Expected<DrapeResult> r = simulate_drape(c);
+    ASSERT_FALSE(r.has_value()) << g;
+    EXPECT_NE(r.error().message.find("gravity must be positive"), std::string::npos) << r.error().message;
+  }
+}
+
 TEST(DrapePhysics, DrapeDependsOnBendingOverDensity) {
   const DrapeConfig base = config(25, false);
   const DrapeResult r0 = drape(base, "k/rho: median fabric");

@@ -1,6 +1,9 @@
 // The Newton solver's step control on small synthetic energies with known minimisers.
 #include <gtest/gtest.h>
 
+#include <limits>
+#include <string>
+
 #include "drapegen/sim/newton_solver.hpp"
 
 namespace drapegen::sim {
@@ -58,6 +61,34 @@ TEST(NewtonSolver, ExtrapolatesAlongStepsFlatterThanTheModel) {
   EXPECT_LE(with.iterations, 2);
   // Without extrapolation the error shrinks by 3/4 per step: from 1.7 (relative residual) to 1e-3 takes ~26 steps.
   EXPECT_GE(without.iterations, 20);
+}
+
+// Every solve ends in an outcome that says why (docs/PHYSICS.md). A Hessian with NaN in it (energy and gradient
+// finite) gives non-finite steps at every shift: diverged, not stalled.
+TEST(NewtonSolver, ANonFiniteStepEndsDiverged) {
+  const Eigen::Matrix3Xd target = Eigen::Matrix3Xd::Constant(3, 4, 1e-3);
+  StiffModelSpring spring(target, 10.0, std::numeric_limits<double>::quiet_NaN());
+  SolverOptions options;
+  options.exact_hessian_below = 0.0;
+  Eigen::Matrix3Xd x = Eigen::Matrix3Xd::Zero(3, 4);
+  const SolveReport report = NewtonSolver(options).solve({&spring}, std::vector<bool>(4, false), 1e-6, x);
+  EXPECT_EQ(report.outcome, SolveOutcome::kDiverged) << report.message;
+  EXPECT_NE(report.message.find("non-finite"), std::string::npos) << report.message;
+  EXPECT_EQ(x, Eigen::Matrix3Xd::Zero(3, 4));  // no step was taken
+}
+
+TEST(NewtonSolver, TheIterationLimitIsAnOutcome) {
+  const Eigen::Matrix3Xd target = Eigen::Matrix3Xd::Constant(3, 4, 1e-3);
+  StiffModelSpring spring(target, 10.0, 4.0);  // a quarter of the way per step
+  SolverOptions options;
+  options.exact_hessian_below = 0.0;
+  options.extrapolate_above = 0.0;
+  options.max_iterations = 3;
+  Eigen::Matrix3Xd x = Eigen::Matrix3Xd::Zero(3, 4);
+  const SolveReport report = NewtonSolver(options).solve({&spring}, std::vector<bool>(4, false), 1e-6, x);
+  EXPECT_EQ(report.outcome, SolveOutcome::kIterationLimit) << report.message;
+  EXPECT_GT(report.residual, options.tolerance);
+  EXPECT_LT((x - target).norm(), (Eigen::Matrix3Xd::Zero(3, 4) - target).norm());  // it moved towards the minimum
 }
 
 }  // namespace
