@@ -5,6 +5,7 @@
 #include <condition_variable>
 #include <filesystem>
 #include <fmt/format.h>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -142,7 +143,10 @@ sim::Status run_worker(const WorkerOptions& o, const std::atomic<bool>& stop) {
   {
     std::error_code ec;
     std::filesystem::create_directories(scratch, ec);
-    const std::string probe = (std::filesystem::path(scratch) / "write_probe").string();
+    // Named per thread: workers in one process (tests, embedders) share the PID's scratch directory.
+    const std::string probe = (std::filesystem::path(scratch) /
+                               fmt::format("write_probe_{}", std::hash<std::thread::id>{}(std::this_thread::get_id())))
+                                  .string();
     if (ec) return sim::Error{fmt::format("scratch directory {}: {}", scratch, ec.message())};
     if (sim::Status s = storage::write_file_atomic(probe, "probe"); !s) {
       return sim::Error{fmt::format("scratch directory {} is not writable: {}", scratch, s.error().message)};
