@@ -13,14 +13,15 @@
 #include <ImfStringAttribute.h>
 #include <Imath/half.h>
 
-#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <fmt/format.h>
 #include <algorithm>
 #include <map>
+#include <string_view>
 
+#include "drapegen/storage/atomic_file.hpp"
 #include "exr_scanline.hpp"
 
 namespace drapegen::renderer {
@@ -316,21 +317,8 @@ sim::Expected<std::vector<char>> ExrWriter::encode(const DataPointRecord& point,
 sim::Status ExrWriter::write_file(const std::string& path, const DataPointRecord& point) const {
   auto bytes = encode(point);
   if (!bytes) return bytes.error();
-  const std::string tmp = path + ".tmp";
-  std::FILE* f = std::fopen(tmp.c_str(), "wb");
-  if (f == nullptr) return sim::Error{fmt::format("cannot write {}: {}", path, std::strerror(errno))};
-  const bool written = std::fwrite(bytes->data(), 1, bytes->size(), f) == bytes->size();
-  const bool closed = std::fclose(f) == 0;
-  if (!written || !closed) {
-    std::remove(tmp.c_str());
-    return sim::Error{fmt::format("cannot write {}: {}", path, std::strerror(errno))};
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    const int err = errno;
-    std::remove(tmp.c_str());
-    return sim::Error{fmt::format("cannot write {}: {}", path, std::strerror(err))};
-  }
-  return {};
+  // Through a synced temporary file: a reader (or a crash) never sees half an image.
+  return storage::write_file_atomic(path, std::string_view(bytes->data(), bytes->size()));
 }
 
 sim::Expected<DataPointRecord> read_exr(const std::vector<char>& bytes) {
