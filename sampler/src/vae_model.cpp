@@ -125,6 +125,11 @@ bool shaped(const DenseLayer& layer, int in, int out) {
          layer.weight.allFinite() && layer.bias.allFinite();
 }
 
+/// What validate() says of a layer (or the encoder's heads) that fails shaped().
+sim::Error malformed(const std::string& what) {
+  return sim::Error{what + " is malformed (wrong shape or non-finite values)"};
+}
+
 }  // namespace
 
 sim::Status VaeModel::validate() const {
@@ -158,16 +163,16 @@ sim::Status VaeModel::validate() const {
   }
   int in = kFeatureCount;
   for (int i = 0; i < h; ++i) {
-    if (!shaped(encoder[i], in, hidden[i])) return sim::Error{"encoder layer " + std::to_string(i) + " is malformed (wrong shape or non-finite values)"};
+    if (!shaped(encoder[i], in, hidden[i])) return malformed("encoder layer " + std::to_string(i));
     in = hidden[i];
   }
   if (!shaped(encoder_mu, in, latent_dim) || !shaped(encoder_logvar, in, latent_dim)) {
-    return sim::Error{"encoder heads are malformed (wrong shape or non-finite values)"};
+    return malformed("encoder heads");
   }
   in = latent_dim;
   for (int i = 0; i <= h; ++i) {
     const int out = i < h ? hidden[h - 1 - i] : kFeatureCount;
-    if (!shaped(decoder[i], in, out)) return sim::Error{"decoder layer " + std::to_string(i) + " is malformed (wrong shape or non-finite values)"};
+    if (!shaped(decoder[i], in, out)) return malformed("decoder layer " + std::to_string(i));
     in = out;
   }
   return {};

@@ -104,7 +104,9 @@ Expected<CantileverResult> simulate_cantilever(const CantileverSpec& spec) {
   }
   if (spec.segments < 2) return Error{"cantilever needs at least 2 segments"};
   // Without weight there is nothing to solve, and the residual test, relative to the weight, would call it diverged.
-  if (!(spec.gravity > 0.0) || !std::isfinite(spec.gravity)) return Error{"cantilever gravity must be positive and finite"};
+  if (!(spec.gravity > 0.0) || !std::isfinite(spec.gravity)) {
+    return Error{"cantilever gravity must be positive and finite"};
+  }
   if (!std::isfinite(spec.cut_angle)) return Error{"cantilever cut angle must be finite"};
 
   StripMesh strip;

@@ -295,10 +295,9 @@ SolveReport NewtonSolver::solve(const std::vector<EnergyTerm*>& terms, const std
         lambda = lambda == 0.0 ? 1e-6 : lambda * 10.0;
         if (lambda > options_.max_regularization) {
           report.outcome = non_finite_step ? SolveOutcome::kDiverged : SolveOutcome::kStalled;
-          report.message = non_finite_step
-                               ? fmt::format("non-finite Newton step at iteration {} (residual {:.3g})", it,
-                                             report.residual)
-                               : fmt::format("no descent step at iteration {} (residual {:.3g})", it, report.residual);
+          report.message = fmt::format("{} at iteration {} (residual {:.3g})",
+                                       non_finite_step ? "non-finite Newton step" : "no descent step", it,
+                                       report.residual);
           report.seconds = since(start);
           return report;
         }

@@ -74,17 +74,6 @@ double mean_distance_mm(const Eigen::Matrix3Xd& a, const Eigen::Matrix3Xd& b) {
   return a.cols() == b.cols() && a.cols() > 0 ? (a - b).colwise().norm().mean() * kMm : 1e9;
 }
 
-// (a) Section 5.1.2, Fig. 14. Scaling alpha, beta and rho by s scales bending and gravity by s; the paper argues that
-// the stretching force may be scaled arbitrarily "as long as it remains sufficiently large", so x depends on k/rho
-// only, and it normalises every fabric to the standard density. The simulator does the same (normalized()): sigma
-// and the contact penalty are stiffnesses at the standard density. So (1) a fabric with k and rho scaled together
-// must drape like the original from the same start (the normalised moduli differ in the last bit, so the inexact
-// solver path differs at round-off level); (2) the physical claim behind it: with sigma and the contact penalty
-// held in absolute units instead (equivalently, both divided by s at the standard density), the equilibrium moves
-// little. Observed at 25 x 25: max 8.2 / 4.6 mm, mean 1.45 / 0.67 mm, |dDC| 0.0007 / 0.0009 for s = 3 / 0.5: the
-// coarse mesh compresses beyond the 1% band in its folds, where sigma acts (bench/drape_physics.cpp, check a, at
-// finer meshes). (2) continues from the base drape: from a flat start, tiny differences can select another of the
-// drape's many local minima, which measures the path, not k/rho.
 TEST(DrapePhysics, AWeightlessDrapeIsAnInputError) {
   for (const double g : {0.0, -9.81, std::numeric_limits<double>::quiet_NaN()}) {
     DrapeConfig c;
@@ -96,6 +85,17 @@ TEST(DrapePhysics, AWeightlessDrapeIsAnInputError) {
   }
 }
 
+// (a) Section 5.1.2, Fig. 14. Scaling alpha, beta and rho by s scales bending and gravity by s; the paper argues that
+// the stretching force may be scaled arbitrarily "as long as it remains sufficiently large", so x depends on k/rho
+// only, and it normalises every fabric to the standard density. The simulator does the same (normalized()): sigma
+// and the contact penalty are stiffnesses at the standard density. So (1) a fabric with k and rho scaled together
+// must drape like the original from the same start (the normalised moduli differ in the last bit, so the inexact
+// solver path differs at round-off level); (2) the physical claim behind it: with sigma and the contact penalty
+// held in absolute units instead (equivalently, both divided by s at the standard density), the equilibrium moves
+// little. Observed at 25 x 25: max 8.2 / 4.6 mm, mean 1.45 / 0.67 mm, |dDC| 0.0007 / 0.0009 for s = 3 / 0.5: the
+// coarse mesh compresses beyond the 1% band in its folds, where sigma acts (bench/drape_physics.cpp, check a, at
+// finer meshes). (2) continues from the base drape: from a flat start, tiny differences can select another of the
+// drape's many local minima, which measures the path, not k/rho.
 TEST(DrapePhysics, DrapeDependsOnBendingOverDensity) {
   const DrapeConfig base = config(25, false);
   const DrapeResult r0 = drape(base, "k/rho: median fabric");

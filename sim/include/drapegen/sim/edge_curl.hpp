@@ -23,8 +23,8 @@ struct EdgeCurl {
 /// roll, so the rest angles are those of a realisable shape on any triangulation (a per-hinge normal curvature times
 /// (H0 + H1) / 2 is not: on right-triangle grids the diagonals of a cylindrically bent strip stay flat, and such
 /// rest angles fight each other). A roll tighter than the mesh resolves (a hinge turned by more than
-/// pi - FoldBarrier::kWidth, e.g. 450 /m over 30 mm at 12.5 mm spacing) is held at that angle, with the roll's sign. Throws
-/// std::invalid_argument on a non-finite curvature or a non-positive width.
+/// pi - FoldBarrier::kWidth, e.g. 450 /m over 30 mm at 12.5 mm spacing) is held at that angle, with the roll's sign.
+/// Throws std::invalid_argument on a non-finite curvature or a non-positive width.
 [[nodiscard]] Eigen::VectorXd edge_curl_rest_angles(const ClothMesh& mesh, const Topology& topology,
                                                     const EdgeCurl& curl);
 
