@@ -106,6 +106,8 @@ expect_failure(1 "bad magic" --n 10 --out ${WORK}/x.csv --model ${WORK}/empty.dg
 file(WRITE ${WORK}/truncated.dgvae "DGVAE")
 expect_failure(1 "bad magic" --n 10 --out ${WORK}/x.csv --model ${WORK}/truncated.dgvae)
 expect_failure(1 "--out" --n 10)
+expect_failure(1 "--states must be 1..1000" --n 10 --out ${WORK}/x.csv --states 0)
+expect_failure(1 "--max-drift must be 0..50" --n 10 --out ${WORK}/x.csv --max-drift -1)
 expect_failure(3 "cannot write" --n 10 --out /nonexistent-dir/params.csv)
 expect_failure(1 "cannot open fabric data" --report --data ${WORK}/missing.csv --no-plot)
 file(WRITE ${WORK}/bad.csv "density,linear warp,linear weft,linear diag,nonlinear warp,nonlinear weft,nonlinear diag\n0.1,1,2,x,4,5,6\n")

@@ -51,6 +51,8 @@ double mean_log_likelihood(const VaeModel& model, const std::vector<Features>& d
     return Eigen::ArrayXd(-0.5 * r2 - sd.array().log().sum() - 0.5 * latent * log_2pi);
   };
   const int third = samples / 3;
+  const double log_share_a = std::log(double(third) / samples), log_share_b = log_share_a,
+               log_share_prior = std::log(double(samples - 2 * third) / samples);
   double total = 0.0;
   Eigen::MatrixXd eps(latent, samples);
   for (std::size_t f = 0; f < data.size(); ++f) {
@@ -64,7 +66,8 @@ double mean_log_likelihood(const VaeModel& model, const std::vector<Features>& d
     for (int k = 0; k < samples; ++k) {
       for (int d = 0; d < latent; ++d) eps(d, k) = rng.normal();
     }
-    // Proposal: 1/3 q(z|x), 1/3 q(z|x) with 3x its standard deviation, 1/3 the prior (training/vae/vae.py).
+    // Proposal: K/3 draws from q(z|x), K/3 from q(z|x) with 3x its standard deviation, the rest from the prior
+    // (training/vae/vae.py).
     Eigen::MatrixXd z(latent, samples);
     for (int k = 0; k < samples; ++k) {
       if (k < third) {
@@ -77,8 +80,10 @@ double mean_log_likelihood(const VaeModel& model, const std::vector<Features>& d
     }
     const Eigen::ArrayXd a = log_normal(z, centre, sd), b = log_normal(z, centre, wide),
                          prior = log_normal(z, zero, one);
-    const Eigen::ArrayXd top = a.max(b).max(prior);
-    const Eigen::ArrayXd log_q = top + ((a - top).exp() + (b - top).exp() + (prior - top).exp()).log() - std::log(3.0);
+    // The mixture's weights are the shares of the draws each part got (a third each when 3 divides the count).
+    const Eigen::ArrayXd la = a + log_share_a, lb = b + log_share_b, lp = prior + log_share_prior;
+    const Eigen::ArrayXd top = la.max(lb).max(lp);
+    const Eigen::ArrayXd log_q = top + ((la - top).exp() + (lb - top).exp() + (lp - top).exp()).log();
     const Eigen::MatrixXd mean = model.decode_standardised(z);
     Eigen::ArrayXd w(samples);
     for (int k = 0; k < samples; ++k) w(k) = model.log_observation(s, mean.col(k)) + prior(k) - log_q(k);

@@ -107,8 +107,11 @@ class VAE(nn.Module):
             if defensive:
                 k = samples // 3
                 z = torch.cat([mu[i] + std[i] * eps[:k], mu[i] + 3 * std[i] * eps[k:2 * k], eps[2 * k:]])
-                log_q = torch.logsumexp(torch.stack([log_n(z, mu[i], std[i]), log_n(z, mu[i], 3 * std[i]),
-                                                     log_prior_of(z)]), 0) - math.log(3)
+                # the mixture's weights are the parts' shares of the draws (a third each when 3 divides samples)
+                log_share = [math.log(k / samples), math.log(k / samples), math.log((samples - 2 * k) / samples)]
+                log_q = torch.logsumexp(torch.stack([log_n(z, mu[i], std[i]) + log_share[0],
+                                                     log_n(z, mu[i], 3 * std[i]) + log_share[1],
+                                                     log_prior_of(z) + log_share[2]]), 0)
             else:
                 z = mu[i] + std[i] * eps
                 log_q = log_n(z, mu[i], std[i])
