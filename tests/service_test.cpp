@@ -279,13 +279,14 @@ TEST(Service, StopsOnAnUnwritableOutputAndResumes) {
   EXPECT_EQ(reader->run()->state, "complete");
 }
 
-// One result's file cannot be written (its temporary name taken by a directory: EISDIR) while the rest of data/ can:
-// the coordinator stops naming that path; what it recorded before stays; once the directory is gone, resume completes.
+// One result's file cannot be written (its name taken by a directory, so the rename fails: EISDIR) while the rest of
+// data/ can: the coordinator stops naming that path; what it recorded before stays; once the directory is gone, resume
+// completes.
 TEST(Service, StopsOnOneUnwritableResultAndResumes) {
   const fs::path dir = test_dir("one_file_fault");
   const fs::path out = dir / "run";
-  const fs::path blocker = out / "data" / "s000003_k01_o01.exr.tmp";
-  fs::create_directories(blocker);
+  const fs::path blocker = out / "data" / "s000003_k01_o01.exr";
+  fs::create_directories(blocker / "inside");
   write_text(dir / "run.toml", small_config(out, 8, 2));
   const fs::path manifest = out / "manifest.sqlite";
   auto [coordinator, endpoint] = start_coordinator({"--config", (dir / "run.toml").string()}, out, dir / "coordinator");
@@ -294,13 +295,13 @@ TEST(Service, StopsOnOneUnwritableResultAndResumes) {
   ASSERT_EQ(coordinator.wait(60s), 3) << coordinator.err();
   const std::string err = coordinator.err();
   const std::string last = last_line(err);
-  EXPECT_NE(last.find("cannot create " + blocker.string() + ": Is a directory"), std::string::npos) << err;
+  EXPECT_NE(last.find("cannot rename to " + blocker.string() + ": Is a directory"), std::string::npos) << err;
   EXPECT_NE(last.find("drapegen run --resume"), std::string::npos) << err;
   const long recorded = recorded_jobs(manifest);
   EXPECT_GE(recorded, 0);
   EXPECT_LT(recorded, 16);
   EXPECT_EQ(worker.wait(10s), 0) << worker.err();
-  fs::remove(blocker);
+  fs::remove_all(blocker);
   ASSERT_TRUE(resume_to_completion(manifest, out, dir, 2));
   check_manifest(manifest, 2);
   EXPECT_EQ(recorded_jobs(manifest), 16);

@@ -8,6 +8,7 @@
 
 #include "drapegen/diagnosis/bending_json.hpp"
 #include "drapegen/diagnosis/depth_exr.hpp"
+#include "drapegen/storage/atomic_file.hpp"
 
 namespace drapegen::diagnosis {
 namespace fs = std::filesystem;
@@ -218,7 +219,6 @@ sim::Status write_capture(const std::string& directory, const Capture& capture) 
 
 sim::Status write_capture_json(const std::string& directory, const Capture& capture) {
   const fs::path dir(directory);
-  std::error_code ec;
   nlohmann::json views = nlohmann::json::array();
   for (std::size_t v = 0; v < capture.views.size(); ++v) {
     const auto& view = capture.views[v];
@@ -243,17 +243,8 @@ sim::Status write_capture_json(const std::string& directory, const Capture& capt
     j["specimen"]["measured_bending"] = measured;
   }
   if (capture.scan_mesh) j["scan"] = *capture.scan_mesh;
-  // Through a temporary file: a reader (or a crash) never leaves half a capture.json.
-  const fs::path path = dir / "capture.json", tmp = dir / "capture.json.tmp";
-  {
-    std::ofstream out(tmp);
-    out << j.dump(2) << "\n";
-    out.close();
-    if (!out) return sim::Error{fmt::format("{}: cannot write", tmp.string())};
-  }
-  fs::rename(tmp, path, ec);
-  if (ec) return sim::Error{fmt::format("{}: cannot write: {}", path.string(), ec.message())};
-  return {};
+  // Atomically: a reader (or a crash) never sees half a capture.json.
+  return storage::write_file_atomic((dir / "capture.json").string(), j.dump(2) + "\n");
 }
 
 }  // namespace drapegen::diagnosis

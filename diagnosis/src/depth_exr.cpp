@@ -9,6 +9,10 @@
 
 #include <filesystem>
 #include <fmt/format.h>
+#include <string_view>
+
+#include "drapegen/renderer/exr_memory_stream.hpp"
+#include "drapegen/storage/atomic_file.hpp"
 
 namespace drapegen::diagnosis {
 
@@ -22,20 +26,19 @@ sim::Status write_depth_exr(const std::string& path, const renderer::DepthImage&
     header.channels().insert("Z", Imf::Channel(Imf::FLOAT));
     header.compression() = Imf::ZIP_COMPRESSION;
     header.insert("units", Imf::StringAttribute("metres, camera-space z, 0 = no return"));
-    const std::string tmp = path + ".tmp";
+    renderer::MemoryOStream stream;
     {
-      Imf::OutputFile file(tmp.c_str(), header);
+      Imf::OutputFile file(stream, header);
       Imf::FrameBuffer fb;
       fb.insert("Z", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(const_cast<float*>(depth.depth.data())),
                                 sizeof(float), sizeof(float) * depth.width));
       file.setFrameBuffer(fb);
       file.writePixels(depth.height);
     }
-    std::filesystem::rename(tmp, path);
+    return storage::write_file_atomic(path, std::string_view(stream.data.data(), stream.data.size()));
   } catch (const std::exception& e) {
     return sim::Error{fmt::format("{}: cannot write: {}", path, e.what())};
   }
-  return {};
 }
 
 sim::Expected<renderer::DepthImage> read_depth_exr(const std::string& path) {

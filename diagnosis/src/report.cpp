@@ -1,7 +1,5 @@
 #include "drapegen/diagnosis/report.hpp"
 
-#include <png.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -11,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "drapegen/renderer/preview.hpp"
+#include "drapegen/storage/png.hpp"
 
 namespace drapegen::diagnosis {
 namespace fs = std::filesystem;
@@ -41,24 +40,7 @@ sim::Status write_residual_png(const std::string& path, const std::vector<std::v
       }
     }
   }
-  FILE* f = std::fopen(path.c_str(), "wb");
-  if (f == nullptr) return sim::Error{path + ": cannot open for writing"};
-  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
-  png_infop info = png != nullptr ? png_create_info_struct(png) : nullptr;
-  if (png == nullptr || info == nullptr || setjmp(png_jmpbuf(png))) {
-    png_destroy_write_struct(&png, &info);
-    std::fclose(f);
-    return sim::Error{path + ": PNG encoding failed"};
-  }
-  png_init_io(png, f);
-  png_set_IHDR(png, info, static_cast<png_uint_32>(W), static_cast<png_uint_32>(H), 8, PNG_COLOR_TYPE_RGB,
-               PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
-  png_write_info(png, info);
-  for (int y = 0; y < H; ++y) png_write_row(png, &rgb[static_cast<std::size_t>(y) * W * 3]);
-  png_write_end(png, nullptr);
-  png_destroy_write_struct(&png, &info);
-  if (std::fclose(f) != 0) return sim::Error{path + ": write failed"};
-  return {};
+  return storage::write_png_rgb(path, W, H, rgb);
 }
 
 namespace {

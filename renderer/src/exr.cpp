@@ -21,6 +21,7 @@
 #include <map>
 #include <string_view>
 
+#include "drapegen/renderer/exr_memory_stream.hpp"
 #include "drapegen/storage/atomic_file.hpp"
 #include "exr_scanline.hpp"
 
@@ -43,39 +44,6 @@ const std::map<std::string, exr_scanline::Compression>& own_compressions() {
                                                                      {"zip", exr_scanline::Compression::kZip}};
   return m;
 }
-
-class MemoryOStream final : public Imf::OStream {
- public:
-  MemoryOStream() : Imf::OStream("<memory>") {}
-  void write(const char c[], int n) override {
-    if (position_ + n > data.size()) data.resize(position_ + n);
-    std::memcpy(data.data() + position_, c, static_cast<std::size_t>(n));
-    position_ += n;
-  }
-  std::uint64_t tellp() override { return position_; }
-  void seekp(std::uint64_t pos) override { position_ = pos; }
-  std::vector<char> data;
-
- private:
-  std::uint64_t position_ = 0;
-};
-
-class MemoryIStream final : public Imf::IStream {
- public:
-  explicit MemoryIStream(const std::vector<char>& bytes) : Imf::IStream("<memory>"), bytes_(bytes) {}
-  bool read(char c[], int n) override {
-    if (position_ + n > bytes_.size()) throw std::runtime_error("unexpected end of EXR data");
-    std::memcpy(c, bytes_.data() + position_, static_cast<std::size_t>(n));
-    position_ += n;
-    return position_ < bytes_.size();
-  }
-  std::uint64_t tellg() override { return position_; }
-  void seekg(std::uint64_t pos) override { position_ = pos; }
-
- private:
-  const std::vector<char>& bytes_;
-  std::uint64_t position_ = 0;
-};
 
 /// Short on purpose (every byte of the header is a quarter byte per view); docs/RENDERER.md spells it out.
 constexpr const char* kUnits = "Z: camera z, m, 0 = none; K: px, OpenCV; meshToCamera: m, x' = M x; angles: rad";

@@ -1,7 +1,5 @@
 #include "drapegen/renderer/preview.hpp"
 
-#include <png.h>
-
 #include <algorithm>
 #include <array>
 #include <cerrno>
@@ -9,6 +7,8 @@
 #include <cstdio>
 #include <cstring>
 #include <fmt/format.h>
+
+#include "drapegen/storage/png.hpp"
 
 namespace drapegen::renderer {
 namespace {
@@ -92,31 +92,7 @@ sim::Status write_preview_png(const std::string& path, const std::vector<std::ve
     }
   }
 
-  const std::string tmp = path + ".tmp";
-  std::FILE* f = std::fopen(tmp.c_str(), "wb");
-  if (f == nullptr) return sim::Error{fmt::format("cannot write {}: {}", path, std::strerror(errno))};
-  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
-  png_infop info = png != nullptr ? png_create_info_struct(png) : nullptr;
-  if (png == nullptr || info == nullptr || setjmp(png_jmpbuf(png))) {
-    png_destroy_write_struct(&png, &info);
-    std::fclose(f);
-    std::remove(tmp.c_str());
-    return sim::Error{fmt::format("cannot write {}: libpng failed", path)};
-  }
-  png_init_io(png, f);
-  png_set_IHDR(png, info, static_cast<png_uint_32>(width), static_cast<png_uint_32>(height), 8, PNG_COLOR_TYPE_RGB,
-               PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
-  png_write_info(png, info);
-  for (int y = 0; y < height; ++y) png_write_row(png, &rgb[static_cast<std::size_t>(y) * width * 3]);
-  png_write_end(png, nullptr);
-  png_destroy_write_struct(&png, &info);
-  const bool closed = std::fclose(f) == 0;
-  if (!closed || std::rename(tmp.c_str(), path.c_str()) != 0) {
-    const int err = errno;
-    std::remove(tmp.c_str());
-    return sim::Error{fmt::format("cannot write {}: {}", path, std::strerror(err))};
-  }
-  return {};
+  return storage::write_png_rgb(path, width, height, rgb);
 }
 
 }  // namespace drapegen::renderer

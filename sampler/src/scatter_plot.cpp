@@ -1,12 +1,12 @@
 #include "drapegen/sampler/scatter_plot.hpp"
 
-#include <png.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fmt/format.h>
 #include <map>
+
+#include "drapegen/storage/png.hpp"
 
 namespace drapegen::sampler {
 namespace {
@@ -86,33 +86,6 @@ class Canvas {
   std::vector<unsigned char> pixels_;
 };
 
-sim::Status save_png(const std::string& path, const Canvas& canvas) {
-  std::FILE* file = std::fopen(path.c_str(), "wb");
-  if (!file) return sim::Error{"cannot create plot file '" + path + "'"};
-  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
-  png_infop info = png ? png_create_info_struct(png) : nullptr;
-  if (!png || !info) {
-    png_destroy_write_struct(&png, &info);
-    std::fclose(file);
-    return sim::Error{"libpng could not start writing '" + path + "'"};
-  }
-  if (setjmp(png_jmpbuf(png))) {
-    png_destroy_write_struct(&png, &info);
-    std::fclose(file);
-    return sim::Error{"libpng failed writing '" + path + "'"};
-  }
-  png_init_io(png, file);
-  png_set_IHDR(png, info, canvas.width(), canvas.height(), 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
-               PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
-  png_write_info(png, info);
-  for (int y = 0; y < canvas.height(); ++y) {
-    png_write_row(png, const_cast<png_bytep>(&canvas.pixels()[static_cast<std::size_t>(y) * canvas.width() * 3]));
-  }
-  png_write_end(png, nullptr);
-  png_destroy_write_struct(&png, &info);
-  if (std::fclose(file) != 0) return sim::Error{"cannot write plot file '" + path + "'"};
-  return {};
-}
 
 }  // namespace
 
@@ -170,7 +143,7 @@ sim::Status write_scatter_png(const std::string& path, const ScatterPlotSpec& sp
   lx += 10 + c.text(lx + 10, 14, fmt::format("generated {}", generated.size()), kBlack);
   c.square(lx + 20, 21, 3, kOrange);
   c.text(lx + 30, 14, fmt::format("measured {}", measured.size()), kBlack);
-  return save_png(path, c);
+  return storage::write_png_rgb(path, c.width(), c.height(), c.pixels());
 }
 
 }  // namespace drapegen::sampler

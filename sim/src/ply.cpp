@@ -1,9 +1,10 @@
 #include "drapegen/sim/ply.hpp"
 
-#include <unistd.h>  // fsync
+#include <unistd.h>  // fsync, getpid
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <bit>
 #include <cerrno>
 #include <charconv>
@@ -478,9 +479,11 @@ Expected<std::string> read_file(const std::string& path) {
   return content;
 }
 
-/// Writes `bytes` to `path + ".tmp"`, syncs it and renames it over `path`.
+/// Writes `bytes` to a temporary file of its own beside `path` (`path.tmp.PID.N`: writers racing for one path never
+/// share it), syncs it and renames it over `path`.
 Status write_file_atomically(const std::string& path, const std::string& bytes) {
-  const std::string temporary = path + ".tmp";
+  static std::atomic<std::uint64_t> counter{0};
+  const std::string temporary = path + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(counter++);
   auto fail = [&](const std::string& what, int error_number) {
     std::remove(temporary.c_str());
     return Error{"write_ply: '" + path + "': " + what + ": " + system_reason(error_number)};

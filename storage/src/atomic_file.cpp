@@ -1,10 +1,13 @@
 #include "drapegen/storage/atomic_file.hpp"
 
 #include <fcntl.h>
-#include <sys/stat.h>
 #include <unistd.h>
 
+#include <fmt/format.h>
+
+#include <atomic>
 #include <cerrno>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 
@@ -17,18 +20,16 @@ sim::Error os_error(const std::string& what, const std::string& path) {
 
 }  // namespace
 
+std::string temporary_path(const std::string& path) {
+  static std::atomic<std::uint64_t> counter{0};
+  return fmt::format("{}.tmp.{}.{}", path, ::getpid(), counter.fetch_add(1));
+}
+
 sim::Status write_file_atomic(const std::string& path, std::string_view bytes, unsigned mode) {
-  const std::string tmp = path + ".tmp";
-  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, static_cast<mode_t>(mode));
+  const std::string tmp = temporary_path(path);
+  // O_EXCL: the name is this call's alone, so the file is new and has `mode` from its first byte.
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, static_cast<mode_t>(mode));
   if (fd < 0) return os_error("cannot create", tmp);
-  // O_CREAT applies the mode to a new file only: a stale tmp keeps its own, narrowed here before any byte is written.
-  struct stat st {};
-  if (::fstat(fd, &st) == 0 && (st.st_mode & 0777 & ~mode) != 0 && ::fchmod(fd, st.st_mode & 0777 & mode) != 0) {
-    sim::Error e = os_error("cannot set the mode of", tmp);
-    ::close(fd);
-    ::unlink(tmp.c_str());
-    return e;
-  }
   std::size_t done = 0;
   while (done < bytes.size()) {
     const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);

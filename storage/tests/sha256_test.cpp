@@ -1,7 +1,13 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <atomic>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <string>
+#include <thread>
+#include <vector>
 #include <unistd.h>
 
 #include "drapegen/storage/atomic_file.hpp"
@@ -21,30 +27,75 @@ TEST(Sha256, KnownVectors) {  // FIPS 180-4 examples
   EXPECT_EQ(million.hex_digest(), "cdc76e5c9914fb9281a1c7e284d73e67f1809a48a497200e046d39ccc7112cd0");
 }
 
+namespace fs = std::filesystem;
+
+fs::path fresh_dir(const std::string& name) {
+  const auto dir = fs::temp_directory_path() / (name + "_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+std::vector<std::string> names_in(const fs::path& dir) {
+  std::vector<std::string> out;
+  for (const auto& e : fs::directory_iterator(dir)) out.push_back(e.path().filename().string());
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
 TEST(AtomicFile, WritesAndChecksums) {
-  const auto dir = std::filesystem::temp_directory_path() / ("drapegen_atomic_test_" + std::to_string(::getpid()));
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
+  const auto dir = fresh_dir("drapegen_atomic_test");
   const std::string path = (dir / "a.bin").string();
   ASSERT_TRUE(write_file_atomic(path, "hello"));
   ASSERT_TRUE(sync_directory(dir.string()));
-  EXPECT_FALSE(std::filesystem::exists(path + ".tmp"));
+  EXPECT_EQ(names_in(dir), std::vector<std::string>{"a.bin"});  // no temporary left
   EXPECT_EQ(*sha256_file(path), sha256_hex("hello"));
   // A path under a regular file cannot be written: a clear error, no file.
   const auto bad = write_file_atomic(path + "/x.bin", "data");
   ASSERT_FALSE(bad);
   EXPECT_NE(bad.error().message.find("Not a directory"), std::string::npos) << bad.error().message;
   EXPECT_FALSE(sha256_file((dir / "missing").string()));
-  // A private file is private from its first byte, even where a stale temporary of a wider mode is left.
-  namespace fs = std::filesystem;
+  // A private file is private from its first byte.
   const std::string secret = (dir / "s.key").string();
-  std::ofstream(secret + ".tmp") << "stale";
-  fs::permissions(secret + ".tmp",
-                  fs::perms::owner_read | fs::perms::owner_write | fs::perms::group_read | fs::perms::others_read);
   ASSERT_TRUE(write_file_atomic(secret, "key", 0600));
   EXPECT_EQ(fs::status(secret).permissions() & fs::perms::all, fs::perms::owner_read | fs::perms::owner_write);
   EXPECT_EQ(*sha256_file(secret), sha256_hex("key"));
-  std::filesystem::remove_all(dir);
+  // A rename that fails (the path is a directory) says so and leaves no temporary behind.
+  fs::create_directories(dir / "d.bin" / "inside");
+  const auto blocked = write_file_atomic((dir / "d.bin").string(), "data");
+  ASSERT_FALSE(blocked);
+  EXPECT_NE(blocked.error().message.find("Is a directory"), std::string::npos) << blocked.error().message;
+  EXPECT_EQ(names_in(dir), (std::vector<std::string>{"a.bin", "d.bin", "s.key"}));
+  fs::remove_all(dir);
+}
+
+TEST(AtomicFile, TemporaryNamesAreDistinct) {
+  const std::string a = temporary_path("/x/y.exr"), b = temporary_path("/x/y.exr");
+  EXPECT_NE(a, b);
+  EXPECT_EQ(a.rfind("/x/y.exr.tmp.", 0), 0u) << a;
+}
+
+TEST(AtomicFile, WritersRacingForOnePathEachLeaveAWholeFile) {
+  // Four threads write one path 50 times each, each its own 256 KiB content: after every round the file is one of
+  // the contents in full (with one shared temporary name, a writer could rename another's half-written file).
+  const auto dir = fresh_dir("drapegen_atomic_race");
+  const std::string path = (dir / "r.bin").string();
+  std::vector<std::string> contents;
+  for (char c : {'a', 'b', 'c', 'd'}) contents.emplace_back(256 * 1024, c);
+  for (int round = 0; round < 50; ++round) {
+    std::vector<std::thread> writers;
+    std::atomic<int> failures{0};
+    for (const std::string& content : contents) {
+      writers.emplace_back([&] { failures += write_file_atomic(path, content) ? 0 : 1; });
+    }
+    for (auto& t : writers) t.join();
+    ASSERT_EQ(failures.load(), 0);
+    std::ifstream in(path, std::ios::binary);
+    const std::string got((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    ASSERT_NE(std::find(contents.begin(), contents.end(), got), contents.end()) << "round " << round;
+  }
+  EXPECT_EQ(names_in(dir), std::vector<std::string>{"r.bin"});
+  fs::remove_all(dir);
 }
 
 }  // namespace

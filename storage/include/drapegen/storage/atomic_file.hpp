@@ -1,7 +1,8 @@
 #pragma once
-// Crash-safe file writes: the bytes go to `path + ".tmp"`, are fsync'ed, and the file is renamed over `path`; the
-// directory is fsync'ed (sync_directory) before the manifest transaction that refers to the file commits. A crash
-// at any instant leaves either no file, a stray ".tmp" (removed on resume) or the complete file.
+// Crash-safe file writes: the bytes go to a temporary file beside `path` (temporary_path), are fsync'ed, and the file
+// is renamed over `path`; the directory is fsync'ed (sync_directory) before the manifest transaction that refers to
+// the file commits. A crash at any instant leaves either no file, a stray temporary (removed on resume) or the
+// complete file; writers racing for one path each rename a complete file, the last one wins.
 
 #include <string>
 #include <string_view>
@@ -10,6 +11,8 @@
 
 namespace drapegen::storage {
 
+/// A name beside `path` that no other call of this process or any other process uses: `path.tmp.PID.N`.
+[[nodiscard]] std::string temporary_path(const std::string& path);
 /// Writes `bytes` to `path` atomically (tmp, fsync, rename), the file created with `mode` (less the umask) from the
 /// start. Errors name the path and the OS error (e.g. "No space left on device", "Permission denied").
 [[nodiscard]] sim::Status write_file_atomic(const std::string& path, std::string_view bytes, unsigned mode = 0644);
