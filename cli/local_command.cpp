@@ -19,13 +19,13 @@
 #include "drapegen/coordinator/logging.hpp"
 #include "drapegen/coordinator/run_config.hpp"
 #include "drapegen/coordinator/stats.hpp"
+#include "drapegen/storage/read_file.hpp"
 #include "signals.hpp"
 
 extern char** environ;
 
 namespace drapegen::cli {
 
-sim::Expected<std::string> read_text_file(const std::string& path);
 int report_run(const coordinator::RunSummary& s, const std::string& manifest, const char* sub);
 
 namespace {
@@ -170,7 +170,7 @@ Runner add_local_command(CLI::App& app) {
       std::string text = coordinator::default_config_toml();
       std::string name = "the embedded default configuration";
       if (!o->config.empty()) {
-        auto file = read_text_file(o->config);
+        auto file = storage::read_file(o->config);
         if (!file) return fail(file.error().message);
         text = *file;
         name = o->config;

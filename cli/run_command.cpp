@@ -1,16 +1,12 @@
 // drapegen run: the coordinator of a generation run (docs/SERVICE.md).
 #include <fmt/format.h>
 
-#include <cerrno>
-#include <cstring>
-#include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <memory>
-#include <sstream>
 
 #include "commands.hpp"
 #include "drapegen/coordinator/coordinator.hpp"
+#include "drapegen/storage/read_file.hpp"
 #include "failure.hpp"
 #include "signals.hpp"
 
@@ -38,19 +34,6 @@ coordinator::CoordinatorOptions::Progress parse_progress(const std::string& p) {
 }
 
 }  // namespace
-
-sim::Expected<std::string> read_text_file(const std::string& path) {
-  // A directory opens as a stream that reads nothing: an empty configuration, i.e. the whole default run.
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) return sim::Error{"cannot read " + path + ": it is a directory"};
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return sim::Error{"cannot read " + path + ": " + std::strerror(errno)};
-  std::string text;
-  char buffer[4096];
-  while (in.read(buffer, sizeof buffer) || in.gcount() > 0) text.append(buffer, static_cast<std::size_t>(in.gcount()));
-  if (in.bad()) return sim::Error{"cannot read " + path + ": " + std::strerror(errno)};  // not a shorter file
-  return text;
-}
 
 int report_run(const coordinator::RunSummary& s, const std::string& manifest, const char* sub) {
   switch (s.outcome) {
@@ -98,7 +81,7 @@ Runner add_run_command(CLI::App& app) {
     options.endpoint_file = o->endpoint_file;
     sim::Expected<std::unique_ptr<coordinator::Coordinator>> c = sim::Error{""};
     if (!o->config.empty()) {
-      auto text = read_text_file(o->config);
+      auto text = storage::read_file(o->config);
       if (!text) return fail(text.error().message);
       c = coordinator::Coordinator::create(*text, o->config, options);
     } else {

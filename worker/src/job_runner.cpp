@@ -4,9 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fmt/format.h>
-#include <fstream>
 #include <limits>
-#include <sstream>
 
 #include "drapegen/proto/codec.hpp"
 #include "drapegen/proto/recipe.hpp"
@@ -18,6 +16,7 @@
 #include "drapegen/sampler/initial_state_recipe.hpp"
 #include "drapegen/sim/ply.hpp"
 #include "drapegen/storage/atomic_file.hpp"
+#include "drapegen/storage/read_file.hpp"
 
 namespace drapegen::worker {
 namespace v1 = proto::v1;
@@ -37,14 +36,6 @@ v1::Envelope failure(const v1::Job& job, v1::FailureReason reason, std::string m
   f->set_message(proto::one_line_utf8(message, kMaxFailureMessage));
   if (metrics) *f->mutable_metrics() = *metrics;
   return e;
-}
-
-sim::Expected<std::string> read_bytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return sim::Error{"cannot read " + path};
-  std::ostringstream out;
-  out << in.rdbuf();
-  return out.str();
 }
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
@@ -189,7 +180,7 @@ v1::Envelope JobRunner::compute(const v1::Job& job) {
   if (sim::Status s = sim::write_ply(mesh_path, drape->mesh); !s) {
     return failure(job, v1::FAILURE_REASON_INVALID_JOB, s.error().message, &metrics);
   }
-  auto mesh_bytes = read_bytes(mesh_path);
+  auto mesh_bytes = storage::read_file(mesh_path);
   if (!mesh_bytes) return failure(job, v1::FAILURE_REASON_INVALID_JOB, mesh_bytes.error().message, &metrics);
 
   const auto render_start = std::chrono::steady_clock::now();
