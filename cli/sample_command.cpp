@@ -237,8 +237,12 @@ int run(const SampleOptions& o) {
   if (o.n > 10'000'000) return fail("--n must be at most 10000000");
   if (!(o.range_margin >= 0.0 && o.range_margin <= 10.0)) return fail("--range-margin must be 0..10");
   if (!(o.duplicate_distance >= 0.0 && o.duplicate_distance <= 10.0)) return fail("--duplicate-distance must be 0..10");
-  if (o.states < 1 || o.states > 1000) return fail(fmt::format("--states must be 1..1000, got {}", o.states));
-  if (!(o.max_drift_mm >= 0.0 && o.max_drift_mm <= 50.0)) return fail("--max-drift must be 0..50 (mm)");
+  if (o.states < 1 || o.states > sampler::kMaxStatesPerSample) {
+    return fail(fmt::format("--states must be 1..{}, got {}", sampler::kMaxStatesPerSample, o.states));
+  }
+  if (!(o.max_drift_mm >= 0.0 && o.max_drift_mm <= sampler::kMaxDriftMm)) {
+    return fail(fmt::format("--max-drift must be 0..{} (mm)", sampler::kMaxDriftMm));
+  }
   const std::string model_path = o.model.empty() ? sampler::default_model_path() : o.model;
   auto model = sampler::load_vae_model(model_path);
   if (!model) return fail(model.error().message);

@@ -2,19 +2,15 @@
 
 #include <algorithm>
 #include <array>
-#include <cerrno>
 #include <chrono>
 #include <cmath>
-#include <cstring>
 #include <cstdio>
 #include <deque>
 #include <filesystem>
 #include <fmt/format.h>
-#include <fstream>
 #include <map>
 #include <optional>
 #include <set>
-#include <sstream>
 #include <unistd.h>
 #include <unordered_map>
 #include <unordered_set>
@@ -33,6 +29,7 @@
 #include "drapegen/proto/recipe.hpp"
 #include "drapegen/sim/blas_kernels.hpp"
 #include "drapegen/storage/atomic_file.hpp"
+#include "drapegen/storage/read_file.hpp"
 #include "drapegen/storage/manifest.hpp"
 #include "drapegen/storage/output_lock.hpp"
 #include "drapegen/storage/sha256.hpp"
@@ -553,15 +550,10 @@ struct Coordinator::Impl {
       const JobSlot& source = jobs[static_cast<std::size_t>(job_id(config, recipe->source.sample,
                                                                     recipe->source.slot) - 1)];
       const std::string path = data_dir + "/" + file_name(source, ".ply");
-      errno = 0;
-      std::ifstream in(path, std::ios::binary);
-      std::ostringstream bytes;
-      if (in) bytes << in.rdbuf();
-      if (!in || bytes.str().empty()) {
-        return sim::Error{fmt::format("cannot read the source drape {}: {}", path,
-                                      errno ? std::strerror(errno) : "empty file")};
-      }
-      source_mesh = bytes.str();
+      auto bytes = storage::read_file(path);
+      if (!bytes) return sim::Error{fmt::format("the source drape: {}", bytes.error().message)};
+      if (bytes->empty()) return sim::Error{fmt::format("cannot read the source drape {}: empty file", path)};
+      source_mesh = std::move(*bytes);
     }
     auto job = make_job_message(config, samples[static_cast<std::size_t>(slot.rec.sample)], slot.rec, slot.attempts,
                                 std::move(source_mesh));

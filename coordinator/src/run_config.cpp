@@ -7,6 +7,8 @@
 #include <set>
 #include <sstream>
 
+#include "drapegen/sampler/recipe_generator.hpp"
+
 namespace drapegen::coordinator {
 namespace {
 
@@ -151,7 +153,7 @@ sim::Expected<RunConfig> parse_run_config(const std::string& toml_text, const st
   r.real(recipes, "recipes", "weight_sine", c.weight_sine, 0.0, 1e6);
   r.real(recipes, "recipes", "weight_fold", c.weight_fold, 0.0, 1e6);
   r.real(recipes, "recipes", "weight_drape", c.weight_drape, 0.0, 1e6);
-  r.real(recipes, "recipes", "max_drift_mm", c.max_drift_mm, 0.0, 50.0);
+  r.real(recipes, "recipes", "max_drift_mm", c.max_drift_mm, 0.0, sampler::kMaxDriftMm);
   if (r.ok() && !(c.weight_sine + c.weight_fold > 0.0)) {
     r.fail("recipes", "weight_sine + weight_fold must be positive (a drape recipe needs a fallback)");
   }

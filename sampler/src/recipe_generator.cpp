@@ -1,6 +1,7 @@
 #include "drapegen/sampler/recipe_generator.hpp"
 
 #include <cmath>
+#include <fmt/format.h>
 #include <numbers>
 #include <optional>
 
@@ -49,12 +50,16 @@ InitialStateRecipe draw(const RecipeOptions& o, std::int64_t sample, int slot, P
 }  // namespace
 
 sim::Status validate(const RecipeOptions& o) {
-  if (o.states_per_sample < 1 || o.states_per_sample > 1000) return sim::Error{"states per sample must be 1..1000"};
+  if (o.states_per_sample < 1 || o.states_per_sample > kMaxStatesPerSample) {
+    return sim::Error{fmt::format("states per sample must be 1..{}", kMaxStatesPerSample)};
+  }
   if (!weight_ok(o.weight_sine) || !weight_ok(o.weight_fold) || !weight_ok(o.weight_drape) ||
       !(o.weight_sine + o.weight_fold > 0.0)) {
     return sim::Error{"initial-state weights must be >= 0 with sine + fold > 0"};
   }
-  if (!(o.max_drift_mm >= 0.0) || !(o.max_drift_mm <= 50.0)) return sim::Error{"max drift must be 0..50 mm"};
+  if (!(o.max_drift_mm >= 0.0) || !(o.max_drift_mm <= kMaxDriftMm)) {
+    return sim::Error{fmt::format("max drift must be 0..{} mm", kMaxDriftMm)};
+  }
   return {};
 }
 

@@ -1,6 +1,7 @@
 #include "drapegen/sim/ply.hpp"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdint>
@@ -71,8 +72,9 @@ TEST(Ply, BinaryRoundTripIsBitExact) {
   const ClothMesh mesh = sample_mesh();
   const std::string path = temp_path("round_trip.ply");
   ASSERT_TRUE(write_ply(path, mesh).ok());
-  for (const auto& entry : std::filesystem::directory_iterator(::testing::TempDir())) {  // no temporary left
-    EXPECT_NE(entry.path().string().rfind(path + ".tmp", 0), 0u) << entry.path();
+  const std::string own_temporaries = path + ".tmp." + std::to_string(::getpid()) + ".";
+  for (const auto& entry : std::filesystem::directory_iterator(::testing::TempDir())) {  // none of ours left
+    EXPECT_NE(entry.path().string().rfind(own_temporaries, 0), 0u) << entry.path();
   }
 
   const Expected<ClothMesh> read = read_ply(path);

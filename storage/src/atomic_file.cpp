@@ -26,9 +26,16 @@ std::string temporary_path(const std::string& path) {
 }
 
 sim::Status write_file_atomic(const std::string& path, std::string_view bytes, unsigned mode) {
-  const std::string tmp = temporary_path(path);
-  // O_EXCL: the name is this call's alone, so the file is new and has `mode` from its first byte.
-  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, static_cast<mode_t>(mode));
+  // O_EXCL: the file is new, this call's alone, and has `mode` from its first byte. A name can still exist: left by
+  // a crashed process that had this PID (a restarted container), or by one on another host sharing the directory;
+  // the next name is tried then.
+  std::string tmp;
+  int fd = -1;
+  for (int attempt = 0; attempt < 100 && fd < 0; ++attempt) {
+    tmp = temporary_path(path);
+    fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, static_cast<mode_t>(mode));
+    if (fd < 0 && errno != EEXIST) break;
+  }
   if (fd < 0) return os_error("cannot create", tmp);
   std::size_t done = 0;
   while (done < bytes.size()) {

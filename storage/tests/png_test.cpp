@@ -43,6 +43,12 @@ TEST(Png, RefusesSizesThatDoNotMatchAndNamesThePath) {
   ASSERT_FALSE(wrong);
   EXPECT_NE(wrong.error().message.find("not a 2x2 RGB image"), std::string::npos) << wrong.error().message;
   EXPECT_FALSE(encode_png_rgb(0, 1, {}));
+  // libpng's own refusal (wider than its 1000000-pixel limit) comes back with libpng's reason.
+  const std::vector<unsigned char> wide(3 * 1000001, 0);
+  const auto too_wide = encode_png_rgb(1000001, 1, wide);
+  ASSERT_FALSE(too_wide);
+  EXPECT_NE(too_wide.error().message.find("PNG: "), std::string::npos);
+  EXPECT_EQ(too_wide.error().message.find("libpng failed"), std::string::npos) << too_wide.error().message;
   const std::string path = (std::filesystem::temp_directory_path() /
                             ("drapegen_png_test_" + std::to_string(::getpid()) + ".png")).string();
   const auto failed = write_png_rgb(path, 2, 2, rgb);

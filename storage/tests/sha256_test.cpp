@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -69,10 +70,21 @@ TEST(AtomicFile, WritesAndChecksums) {
   fs::remove_all(dir);
 }
 
-TEST(AtomicFile, TemporaryNamesAreDistinct) {
+TEST(AtomicFile, TemporaryNamesAreDistinctAndLeftOnesAreSkipped) {
   const std::string a = temporary_path("/x/y.exr"), b = temporary_path("/x/y.exr");
   EXPECT_NE(a, b);
   EXPECT_EQ(a.rfind("/x/y.exr.tmp.", 0), 0u) << a;
+  // Temporaries a crashed process with this PID would have left under the next names: the write still succeeds.
+  const auto dir = fresh_dir("drapegen_atomic_left");
+  const std::string path = (dir / "e.txt").string();
+  const std::string next = temporary_path(path);
+  const std::string stem = next.substr(0, next.rfind('.') + 1);
+  const std::uint64_t n = std::stoull(next.substr(next.rfind('.') + 1));
+  for (std::uint64_t k = n + 1; k < n + 6; ++k) std::ofstream(stem + std::to_string(k)) << "left";
+  ASSERT_TRUE(write_file_atomic(path, "fresh"));
+  EXPECT_EQ(*sha256_file(path), sha256_hex("fresh"));
+  EXPECT_EQ(names_in(dir).size(), 6u);  // e.txt and the five left ones, untouched
+  fs::remove_all(dir);
 }
 
 TEST(AtomicFile, WritersRacingForOnePathEachLeaveAWholeFile) {

@@ -5,8 +5,9 @@ evaluates them, and exports the chosen VAE for the C++ sampler.
 Metrics (docs/SAMPLER.md):
 - log-likelihood: mean (and median) over distinct fabrics of log p(x), nats per fabric, in feature space
   x = sign(k) ln|k| of the six moduli normalised to 300 g/m^2. GMM: exact. VAE: importance sampling with K draws from
-  the defensive mixture 1/3 q(z|x) + 1/3 q(z|x) widened 3x + 1/3 N(0, I) (vae.VAE.log_likelihood); the plain IWAE
-  estimate (K draws from q(z|x)) of the validation set is recorded too.
+  the defensive mixture 1/3 q(z|x) + 1/3 q(z|x) widened 3x + 1/3 N(0, I), each part weighted by its share of the K
+  draws (vae.VAE.log_likelihood); the plain IWAE estimate (K draws from q(z|x)) of the validation set is recorded
+  too.
 - VAE training: early stopping by the median log-likelihood of a tenth of the training fabrics (the "stop" set),
   never on the validation set.
 - Wasserstein: exact W1 with Euclidean cost in the same feature space, between the distinct fabrics (train and

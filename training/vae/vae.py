@@ -90,7 +90,8 @@ class VAE(nn.Module):
     @torch.no_grad()
     def log_likelihood(self, s, samples, generator):
         """Importance-sampling estimate of log p(s) (standardised space) with `samples` draws from the defensive
-        mixture proposal 1/3 q(z|s) + 1/3 q(z|s) with 3x its standard deviation + 1/3 N(0, I). Unbiased for p(s),
+        mixture proposal 1/3 q(z|s) + 1/3 q(z|s) with 3x its standard deviation + 1/3 N(0, I) (for samples not a
+        multiple of 3 the prior takes the remaining draws, and each part is weighted by its share). Unbiased for p(s),
         so a stochastic lower bound of log p(s); unlike plain IWAE it stays tight for atypical fabrics. The C++
         report (sampler/src/coverage.cpp) computes the same estimator."""
         return self._importance_estimate(s, samples, generator, defensive=True)
@@ -105,6 +106,8 @@ class VAE(nn.Module):
             log_n = lambda z, c, sd: (-0.5 * ((z - c) / sd) ** 2 - torch.log(sd) - half_log_2pi).sum(-1)  # noqa: E731
             log_prior_of = lambda z: (-0.5 * z ** 2 - half_log_2pi).sum(-1)  # noqa: E731
             if defensive:
+                if samples < 3:
+                    raise ValueError(f"the defensive mixture needs at least 3 samples, got {samples}")
                 k = samples // 3
                 z = torch.cat([mu[i] + std[i] * eps[:k], mu[i] + 3 * std[i] * eps[k:2 * k], eps[2 * k:]])
                 # the mixture's weights are the parts' shares of the draws (a third each when 3 divides samples)

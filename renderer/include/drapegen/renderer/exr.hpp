@@ -55,7 +55,7 @@ class ExrWriter {
   [[nodiscard]] sim::Expected<std::vector<char>> encode(const DataPointRecord& point) const;
   /// The same file, always through OpenEXR's Imf::OutputFile (the reference for encode()).
   [[nodiscard]] sim::Expected<std::vector<char>> encode_with_openexr(const DataPointRecord& point) const;
-  /// Writes `path + ".tmp"`, then renames it over `path`.
+  /// Encodes, then writes atomically (storage::write_file_atomic: a temporary of its own, fsync, rename).
   [[nodiscard]] sim::Status write_file(const std::string& path, const DataPointRecord& point) const;
   [[nodiscard]] const ExrStorage& storage() const { return storage_; }
 

@@ -32,6 +32,7 @@ class MemoryOStream final : public Imf::OStream {
 class MemoryIStream final : public Imf::IStream {
  public:
   explicit MemoryIStream(const std::vector<char>& bytes) : Imf::IStream("<memory>"), bytes_(bytes) {}
+  explicit MemoryIStream(std::vector<char>&&) = delete;  // it would outlive the bytes
   bool read(char c[], int n) override {
     if (position_ + n > bytes_.size()) throw std::runtime_error("unexpected end of EXR data");
     std::memcpy(c, bytes_.data() + position_, static_cast<std::size_t>(n));

@@ -11,6 +11,10 @@
 
 namespace drapegen::sampler {
 
+/// validate()'s limits, for front ends that name their own options.
+inline constexpr int kMaxStatesPerSample = 1000;
+inline constexpr double kMaxDriftMm = 50.0;
+
 struct RecipeOptions {
   std::uint64_t seed = 0;
   int states_per_sample = 8;

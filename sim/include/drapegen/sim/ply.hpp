@@ -14,10 +14,11 @@ namespace drapegen::sim {
 ///   element vertex N: property double x y z (positions) and u v (rest coordinates)
 ///   element face T:   property list uchar int vertex_indices
 ///
-/// The file is written to `path + ".tmp"`, flushed to disk and then renamed over `path`, so a crash leaves either
-/// the old file or the complete new one (plus possibly a stale ".tmp"). Fails, naming the path and the system's
-/// reason, if the file cannot be written, and without touching the disk if the mesh is inconsistent (size mismatch,
-/// index out of range, non-finite value, no triangles): it never writes a file that read_ply would reject.
+/// The file is written to a temporary of its own (`path.tmp.PID.N`), flushed to disk and then renamed over `path`,
+/// so a crash leaves either the old file or the complete new one (plus possibly a stale temporary). Fails, naming
+/// the path and the system's reason, if the file cannot be written, and without touching the disk if the mesh is
+/// inconsistent (size mismatch, index out of range, non-finite value, no triangles): it never writes a file that
+/// read_ply would reject.
 [[nodiscard]] Status write_ply(const std::string& path, const ClothMesh& mesh);
 
 /// Reads a PLY file in ascii or binary_little_endian format.

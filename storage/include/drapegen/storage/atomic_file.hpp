@@ -11,7 +11,8 @@
 
 namespace drapegen::storage {
 
-/// A name beside `path` that no other call of this process or any other process uses: `path.tmp.PID.N`.
+/// A name beside `path` that no other call of this process returns: `path.tmp.PID.N`. (Another process with the same
+/// PID, earlier or on another host, may have used it: write_file_atomic creates it exclusively and moves on if so.)
 [[nodiscard]] std::string temporary_path(const std::string& path);
 /// Writes `bytes` to `path` atomically (tmp, fsync, rename), the file created with `mode` (less the umask) from the
 /// start. Errors name the path and the OS error (e.g. "No space left on device", "Permission denied").
