@@ -40,6 +40,7 @@ struct SimulateOptions {
   int max_iterations = sim::SolverOptions{}.max_iterations;
   double tolerance = 1e-3;
   int coarse_start = sim::DrapeConfig{}.coarse_start_resolution;
+  int lagged_updates = sim::SolverOptions{}.max_lagged_outer_updates;
   bool verbose = false;
   std::vector<std::string> effects;
 };
@@ -85,6 +86,7 @@ int run_simulate(const SimulateOptions& o) {
   if (!(o.tolerance > 0.0) || !std::isfinite(o.tolerance)) return fail("--tolerance must be positive");
   if (o.max_iterations < 1) return fail("--max-iterations must be at least 1");
   if (o.coarse_start != 0 && o.coarse_start < 3) return fail("--coarse-start must be 0 (off) or at least 3");
+  if (o.lagged_updates < 1 || o.lagged_updates > 1000) return fail("--lagged-updates must be 1..1000");
   const auto effects = parse_effects(o.effects);
   if (!effects) return fail(effects.error().message);
 
@@ -131,6 +133,7 @@ int run_simulate(const SimulateOptions& o) {
   config.solver.max_iterations = o.max_iterations;
   config.solver.tolerance = o.tolerance;
   config.coarse_start_resolution = o.coarse_start;
+  config.solver.max_lagged_outer_updates = o.lagged_updates;
   if (sim::Status s = sim::validate(config.fabric, config.bending_model); !s) return fail(s.error().message);
 
   // Refuse an unwritable output before spending the simulation on it.
@@ -224,6 +227,10 @@ Runner add_simulate_command(CLI::App& app) {
   app.add_option("--coarse-start", o->coarse_start,
                  "Solve first at half the resolution, recursively down to this many vertices per side, and start "
                  "from that drape (0: off; only where --resolution is at least twice it)")
+      ->capture_default_str();
+  app.add_option("--lagged-updates", o->lagged_updates,
+                 "Outer updates of the lagged state (curvature-rule directions, plastic flow, friction's normal "
+                 "forces) near equilibrium, at most; fewer once it changes by under 0.1%")
       ->capture_default_str();
   app.add_flag("-v,--verbose", o->verbose, "Print every Newton iteration on stderr");
   app.add_option("--effect", o->effects,
