@@ -41,6 +41,7 @@ struct SimulateOptions {
   double tolerance = 1e-3;
   int coarse_start = sim::DrapeConfig{}.coarse_start_resolution;
   int lagged_updates = sim::SolverOptions{}.max_lagged_outer_updates;
+  int load_steps = 1;
   bool verbose = false;
   std::vector<std::string> effects;
 };
@@ -87,6 +88,7 @@ int run_simulate(const SimulateOptions& o) {
   if (o.max_iterations < 1) return fail("--max-iterations must be at least 1");
   if (o.coarse_start != 0 && o.coarse_start < 3) return fail("--coarse-start must be 0 (off) or at least 3");
   if (o.lagged_updates < 1 || o.lagged_updates > 1000) return fail("--lagged-updates must be 1..1000");
+  if (o.load_steps < 1 || o.load_steps > 100) return fail("--load-steps must be 1..100");
   const auto effects = parse_effects(o.effects);
   if (!effects) return fail(effects.error().message);
 
@@ -134,6 +136,7 @@ int run_simulate(const SimulateOptions& o) {
   config.solver.tolerance = o.tolerance;
   config.coarse_start_resolution = o.coarse_start;
   config.solver.max_lagged_outer_updates = o.lagged_updates;
+  config.load_steps = o.load_steps;
   if (sim::Status s = sim::validate(config.fabric, config.bending_model); !s) return fail(s.error().message);
 
   // Refuse an unwritable output before spending the simulation on it.
@@ -231,6 +234,10 @@ Runner add_simulate_command(CLI::App& app) {
   app.add_option("--lagged-updates", o->lagged_updates,
                  "Outer updates of the lagged state (curvature-rule directions, plastic flow, friction's normal "
                  "forces) near equilibrium, at most; fewer once it changes by under 0.1%")
+      ->capture_default_str();
+  app.add_option("--load-steps", o->load_steps,
+                 "Ramp gravity in this many equal steps, each solved to equilibrium (a loading history for plastic "
+                 "flow; experimental; more than 1 turns the coarse start off)")
       ->capture_default_str();
   app.add_flag("-v,--verbose", o->verbose, "Print every Newton iteration on stderr");
   app.add_option("--effect", o->effects,

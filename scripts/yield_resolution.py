@@ -4,12 +4,13 @@ reality's (60x60), from each capture's own initial state (a benchmark tool: it r
 of the reality's yield effect the diagnosis's yield candidate can reproduce on its coarser mesh
 (docs/DIAGNOSIS_RESULTS.md, "Session 52").
 
-    scripts/yield_resolution.py DRAPEGEN RUN [--lagged-updates N]
+    scripts/yield_resolution.py DRAPEGEN RUN [--lagged-updates N] [--load-steps N]
 
 RUN is a benchmark run (truth/ as drapegen_diagnosis_bench writes it); every truth/yield_NN.json (placement 0) is
 solved four times with `drapegen simulate --coarse-start 0` (no cascade, as both the reality and the refits solve a
 yielding drape). Prints one JSON line per case: the drape coefficient, fold count and last relative lagged change of
 the elastic and the yielding drape at each resolution, and the yield's shift of the drape coefficient.
+--lagged-updates and --load-steps are passed to every solve (drapegen simulate's options).
 """
 import glob
 import json
@@ -19,7 +20,7 @@ import subprocess
 import sys
 
 
-def solve(drapegen, truth, resolution, yield_curvature, lagged_updates):
+def solve(drapegen, truth, resolution, yield_curvature, extra):
     state = truth["initial_state"]
     command = [drapegen, "simulate", "--json", "--coarse-start", "0", "--resolution", str(resolution),
                "--alpha", ",".join(repr(a) for a in truth["alpha"]),
@@ -29,8 +30,7 @@ def solve(drapegen, truth, resolution, yield_curvature, lagged_updates):
                "--drift", ",".join(repr(d) for d in truth["drift_mm"])]
     if yield_curvature is not None:
         command += ["--effect", f"yield={yield_curvature!r}"]
-    if lagged_updates is not None:
-        command += ["--lagged-updates", str(lagged_updates)]
+    command += extra
     done = subprocess.run(command, capture_output=True, text=True)
     if done.returncode != 0:
         sys.exit(f"{' '.join(command)} failed: {done.stderr.strip()}")
@@ -39,11 +39,12 @@ def solve(drapegen, truth, resolution, yield_curvature, lagged_updates):
 
 
 def main(args):
-    lagged_updates = None
-    if "--lagged-updates" in args:
-        i = args.index("--lagged-updates")
-        lagged_updates = int(args[i + 1])
-        del args[i:i + 2]
+    extra = []
+    for option in ("--lagged-updates", "--load-steps"):
+        if option in args:
+            i = args.index(option)
+            extra += [option, str(int(args[i + 1]))]
+            del args[i:i + 2]
     if len(args) != 2:
         sys.exit(__doc__)
     drapegen, run = args
@@ -55,8 +56,8 @@ def main(args):
         strength = next(e["strength"] for e in truth["effects"] if e["name"] == "yield")
         row = {"case": os.path.basename(path)[:-5], "yield_per_m": round(strength, 2)}
         for resolution in (32, 60):
-            elastic = solve(drapegen, truth, resolution, None, lagged_updates)
-            yielding = solve(drapegen, truth, resolution, strength, lagged_updates)
+            elastic = solve(drapegen, truth, resolution, None, extra)
+            yielding = solve(drapegen, truth, resolution, strength, extra)
             row[f"elastic_{resolution}"] = elastic
             row[f"yield_{resolution}"] = yielding
             row[f"shift_{resolution}"] = round(yielding["dc"] - elastic["dc"], 4)

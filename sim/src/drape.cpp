@@ -1,5 +1,6 @@
 #include "drapegen/sim/drape.hpp"
 
+#include <algorithm>
 #include <fmt/format.h>
 
 #include <memory>
@@ -64,6 +65,7 @@ Expected<DrapeResult> simulate_drape(const DrapeConfig& config,
   if (Status s = validate(config.fabric, config.bending_model); !s) return s.error();
   // The residual test is relative to the heaviest vertex's weight: without weight every solve would end "diverged".
   if (!(config.gravity > 0.0) || !std::isfinite(config.gravity)) return Error{"gravity must be positive and finite"};
+  if (config.load_steps < 1 || config.load_steps > 100) return Error{"load steps must be 1..100"};
   DrapeResult result;
   try {
     result.mesh = make_specimen(config.specimen);
@@ -114,7 +116,7 @@ Expected<DrapeResult> simulate_drape(const DrapeConfig& config,
     // No cascade for a yielding fabric: plastic flow would start from the coarse drape interpolated piecewise flat,
     // whose fine hinges along the coarse edges carry about twice the curvature, and set that grid's pattern for good.
     if (coarse >= 3 && initial.shape != InitialShape::kMesh && config.rest_angles.size() == 0 &&
-        !config.effects.bending_yield_curvature && config.specimen.vertices_x >= 2 * coarse &&
+        !config.effects.bending_yield_curvature && config.load_steps == 1 && config.specimen.vertices_x >= 2 * coarse &&
         config.specimen.vertices_y >= 2 * coarse) {
       // A cascade: each level starts from the drape of one at half its resolution, down to `coarse`.
       DrapeConfig coarse_config = config;
@@ -131,7 +133,19 @@ Expected<DrapeResult> simulate_drape(const DrapeConfig& config,
         }
       }
     }
+    // A ramped load: the steps before the last solve under a fraction of gravity, carrying the lagged state along.
+    SolveReport ramp;
+    for (int step = 1; step < config.load_steps; ++step) {
+      Gravity partial(mesh, fabric.density, config.gravity * step / config.load_steps);
+      std::vector<EnergyTerm*> step_terms = terms;
+      std::replace(step_terms.begin(), step_terms.end(), static_cast<EnergyTerm*>(&gravity),
+                   static_cast<EnergyTerm*>(&partial));
+      const SolveReport report = solver.solve(step_terms, fixed, partial.vertex_weights().maxCoeff(), x);
+      ramp.add_work(report);
+      if (report.outcome == SolveOutcome::kDiverged) return Error{"a load step diverged: " + report.message};
+    }
     result.report = solver.solve(terms, fixed, gravity.vertex_weights().maxCoeff(), x);
+    result.report.add_work(ramp);
     mesh.positions = x;
     if (const auto* hinges = dynamic_cast<const DihedralBending*>(bending.front().get())) {
       result.rest_angles = hinges->rest_angles();

@@ -328,6 +328,28 @@ TEST(Effects, AYieldingDrapeSkipsTheCoarseStart) {
   EXPECT_EQ(yielded.rest_angles, reference.rest_angles);
 }
 
+TEST(Effects, ARampedLoadEndsInAFullGravityEquilibriumAndGivesPlasticFlowAHistory) {
+  // Gravity in 3 steps, each solved: the last solve is under full gravity, so the drape is one of its equilibria
+  // (the outcome says converged at the full weight's tolerance), and it took the earlier steps' work too. A yielding
+  // fabric flows along the ramp instead of along one solve's Newton path: another plastic set.
+  DrapeConfig c = drape_config();
+  const DrapeResult once = drape(c, "elastic, gravity at once");
+  c.load_steps = 3;
+  const DrapeResult ramped = drape(c, "elastic, gravity in 3 steps");
+  EXPECT_GT(ramped.report.iterations, once.report.iterations);
+  EXPECT_NEAR(ramped.measures.drape_coefficient, once.measures.drape_coefficient, 0.05);
+  c.effects.bending_yield_curvature = 30.0;
+  const DrapeResult yield_ramped = drape(c, "yield 30 /m, 3 steps");
+  c.load_steps = 1;
+  const DrapeResult yield_once = drape(c, "yield 30 /m, at once");
+  ASSERT_EQ(yield_ramped.rest_angles.size(), yield_once.rest_angles.size());
+  EXPECT_GT((yield_ramped.rest_angles - yield_once.rest_angles).cwiseAbs().maxCoeff(), 0.01);
+  c.load_steps = 0;
+  const Expected<DrapeResult> refused = simulate_drape(c);
+  ASSERT_FALSE(refused);
+  EXPECT_EQ(refused.error().message, "load steps must be 1..100");
+}
+
 TEST(Effects, AYieldedSpecimenKeepsItsSetWhenReleased) {
   // Lifted off the tester, a specimen whose hinges yielded keeps the creases they took (its plastic set); an elastic
   // one springs back flat. "Released" here: the drape's mesh under a thousandth of gravity, the top still held.

@@ -54,6 +54,10 @@ struct DrapeConfig {
   /// given rest angles, bending plasticity, whose flow would set the interpolated start's coarse pattern, and
   /// specimens with fewer than twice this many vertices per side).
   int coarse_start_resolution = 25;
+  /// Gravity ramped in this many equal steps, each solved to equilibrium from the last (1: all at once). A loading
+  /// history for the lagged effects (plastic flow) that does not follow the Newton path of one solve; experimental
+  /// (docs/PHYSICS.md, "Bending plasticity"). More than 1 turns the coarse start off.
+  int load_steps = 1;
 };
 
 struct DrapeMeasures {
