@@ -39,6 +39,7 @@ sim::Expected<v1::Simulation> to_proto(const sim::DrapeConfig& c) {
   if (!default_solver_beyond_limits(c.solver)) {
     return sim::Error{"simulation: solver options other than max_iterations and tolerance are not sent"};
   }
+  if (c.load_steps != 1) return sim::Error{"simulation: a ramped load (load_steps) is not sent"};
   v1::Simulation s;
   *s.mutable_alpha() = directional(c.fabric.alpha);
   *s.mutable_beta() = directional(c.fabric.beta);

@@ -123,6 +123,11 @@ TEST(Simulation, RefusesWhatItCannotCarry) {
   mesh.initial.shape = sim::InitialShape::kMesh;
   mesh.initial.mesh_path = "drape.ply";
   EXPECT_FALSE(to_proto(mesh));
+  sim::DrapeConfig ramped;
+  ramped.load_steps = 4;
+  const auto refused = to_proto(ramped);
+  ASSERT_FALSE(refused);
+  EXPECT_NE(refused.error().message.find("load_steps"), std::string::npos) << refused.error().message;
   sim::DrapeConfig solver;
   solver.solver.max_step = 0.02;
   EXPECT_FALSE(to_proto(solver));
