@@ -51,7 +51,7 @@ double mean_log_likelihood(const VaeModel& model, const std::vector<Features>& d
     return Eigen::ArrayXd(-0.5 * r2 - sd.array().log().sum() - 0.5 * latent * log_2pi);
   };
   const int third = samples / 3;
-  const double log_share_a = std::log(double(third) / samples), log_share_b = log_share_a,
+  const double log_share_q = std::log(double(third) / samples),  // each of the two q parts
                log_share_prior = std::log(double(samples - 2 * third) / samples);
   double total = 0.0;
   Eigen::MatrixXd eps(latent, samples);
@@ -81,7 +81,7 @@ double mean_log_likelihood(const VaeModel& model, const std::vector<Features>& d
     const Eigen::ArrayXd a = log_normal(z, centre, sd), b = log_normal(z, centre, wide),
                          prior = log_normal(z, zero, one);
     // The mixture's weights are the shares of the draws each part got (a third each when 3 divides the count).
-    const Eigen::ArrayXd la = a + log_share_a, lb = b + log_share_b, lp = prior + log_share_prior;
+    const Eigen::ArrayXd la = a + log_share_q, lb = b + log_share_q, lp = prior + log_share_prior;
     const Eigen::ArrayXd top = la.max(lb).max(lp);
     const Eigen::ArrayXd log_q = top + ((la - top).exp() + (lb - top).exp() + (lp - top).exp()).log();
     const Eigen::MatrixXd mean = model.decode_standardised(z);

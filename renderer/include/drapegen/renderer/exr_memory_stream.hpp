@@ -1,6 +1,6 @@
 #pragma once
-// OpenEXR streams over memory: files are encoded to bytes (sent over the network, or written atomically by
-// storage::write_file_atomic) and decoded from bytes, never through OpenEXR's own file I/O.
+// OpenEXR streams over memory: for files encoded to bytes (sent over the network, or written atomically by
+// storage::write_file_atomic) and decoded from bytes.
 
 #include <ImfIO.h>
 
