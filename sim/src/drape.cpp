@@ -1,6 +1,7 @@
 #include "drapegen/sim/drape.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <fmt/format.h>
 
 #include <memory>
@@ -134,18 +135,30 @@ Expected<DrapeResult> simulate_drape(const DrapeConfig& config,
       }
     }
     // A ramped load: the steps before the last solve under a fraction of gravity, carrying the lagged state along.
+    // A step that diverges (or ends with a non-finite residual or energy, which the next step could not start from)
+    // ends the drape there with its report, as a single solve that does so ends with its own.
     SolveReport ramp;
-    for (int step = 1; step < config.load_steps; ++step) {
+    bool ramp_diverged = false;
+    for (int step = 1; step < config.load_steps && !ramp_diverged; ++step) {
       Gravity partial(mesh, fabric.density, config.gravity * step / config.load_steps);
       std::vector<EnergyTerm*> step_terms = terms;
       std::replace(step_terms.begin(), step_terms.end(), static_cast<EnergyTerm*>(&gravity),
                    static_cast<EnergyTerm*>(&partial));
-      const SolveReport report = solver.solve(step_terms, fixed, partial.vertex_weights().maxCoeff(), x);
-      ramp.add_work(report);
-      if (report.outcome == SolveOutcome::kDiverged) return Error{"a load step diverged: " + report.message};
+      SolveReport report = solver.solve(step_terms, fixed, partial.vertex_weights().maxCoeff(), x);
+      if (report.outcome == SolveOutcome::kDiverged || !std::isfinite(report.residual) ||
+          !std::isfinite(report.energy)) {
+        report.message = fmt::format("load step {} of {}: {}", step, config.load_steps, report.message);
+        report.add_work(ramp);
+        result.report = report;
+        ramp_diverged = true;
+      } else {
+        ramp.add_work(report);
+      }
     }
-    result.report = solver.solve(terms, fixed, gravity.vertex_weights().maxCoeff(), x);
-    result.report.add_work(ramp);
+    if (!ramp_diverged) {
+      result.report = solver.solve(terms, fixed, gravity.vertex_weights().maxCoeff(), x);
+      result.report.add_work(ramp);
+    }
     mesh.positions = x;
     if (const auto* hinges = dynamic_cast<const DihedralBending*>(bending.front().get())) {
       result.rest_angles = hinges->rest_angles();

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <numbers>
 
 #include "derivative_checks.hpp"
@@ -348,6 +349,23 @@ TEST(Effects, ARampedLoadEndsInAFullGravityEquilibriumAndGivesPlasticFlowAHistor
   const Expected<DrapeResult> refused = simulate_drape(c);
   ASSERT_FALSE(refused);
   EXPECT_EQ(refused.error().message, "load steps must be 1..100");
+}
+
+TEST(Effects, ALoadStepThatDivergesEndsTheDrapeWithItsReport) {
+  // An overflowing weight (the worker's poison job) leaves the first of two steps with a non-finite residual: the
+  // drape ends there with the report a single solve under that weight ends with, the step named, not an error that
+  // hides the solver's report (the worker files such a drape as diverged).
+  DrapeConfig c = drape_config();
+  c.gravity = std::numeric_limits<double>::max();
+  const Expected<DrapeResult> once = simulate_drape(c);
+  ASSERT_TRUE(once) << once.error().message;
+  EXPECT_FALSE(std::isfinite(once->report.residual));
+  c.load_steps = 2;
+  const Expected<DrapeResult> stepped = simulate_drape(c);
+  ASSERT_TRUE(stepped) << stepped.error().message;
+  EXPECT_EQ(stepped->report.outcome, once->report.outcome);
+  EXPECT_FALSE(std::isfinite(stepped->report.residual));
+  EXPECT_EQ(stepped->report.message.rfind("load step 1 of 2: ", 0), 0u) << stepped->report.message;
 }
 
 TEST(Effects, AYieldedSpecimenKeepsItsSetWhenReleased) {
