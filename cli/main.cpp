@@ -63,7 +63,10 @@ int main(int argc, char** argv) {
     try {
       return run();
     } catch (const std::bad_alloc&) {
-      std::cerr << "drapegen " << sub->get_name() << ": error: out of memory (try a smaller --resolution)\n";
+      // The commands that take a mesh resolution can be told how to need less.
+      const bool meshed = sub->get_option_no_throw("--resolution") != nullptr;
+      std::cerr << "drapegen " << sub->get_name() << ": error: out of memory"
+                << (meshed ? " (try a smaller --resolution)" : "") << "\n";
     } catch (const std::exception& e) {
       std::cerr << "drapegen " << sub->get_name() << ": error: " << e.what() << "\n";
     }

@@ -229,7 +229,8 @@ Runner add_simulate_command(CLI::App& app) {
   app.add_option("--tolerance", o->tolerance, "Residual force over the largest vertex weight")->capture_default_str();
   app.add_option("--coarse-start", o->coarse_start,
                  "Solve first at half the resolution, recursively down to this many vertices per side, and start "
-                 "from that drape (0: off; only where --resolution is at least twice it)")
+                 "from that drape (0: off; only where --resolution is at least twice it; not with --init mesh:FILE, "
+                 "--effect yield or --load-steps above 1)")
       ->capture_default_str();
   app.add_option("--lagged-updates", o->lagged_updates,
                  "Outer updates of the lagged state (curvature-rule directions, plastic flow, friction's normal "

@@ -83,6 +83,22 @@ TEST(Service, CurveRefusesUnauthorisedWorkers) {
                (dir / "open").string());
   EXPECT_EQ(open.wait(30s), 1);
   EXPECT_NE(open.err().find("without authentication"), std::string::npos) << open.err();
+  // curve = true with no keys in the file: refused without keys, served with them from the command line.
+  write_text(dir / "cli_keys.toml", small_config(dir / "cli_keys", 1, 1, "[security]\ncurve = true\n[testing]\nmode = \"noop\"\n"));
+  Process keyless({"run", "--config", (dir / "cli_keys.toml").string()}, (dir / "keyless").string());
+  EXPECT_EQ(keyless.wait(30s), 1);
+  EXPECT_NE(keyless.err().find("security.curve = true needs CurveZMQ keys"), std::string::npos) << keyless.err();
+  Process keyed({"run", "--config", (dir / "cli_keys.toml").string(), "--server-key", (dir / "server.key").string(),
+                 "--authorized-keys", (dir / "authorized").string()},
+                (dir / "keyed").string());
+  const std::string keyed_endpoint = wait_endpoint(dir / "cli_keys", keyed, 30s);
+  ASSERT_FALSE(keyed_endpoint.empty()) << keyed.err();
+  Process keyed_worker({"worker", "--connect", keyed_endpoint, "--name", "good", "--server-key", server_pub, "--key",
+                        (dir / "good.key").string(), "--heartbeat-ms", "100", "--liveness", "4", "--give-up", "30"},
+                       (dir / "keyed_worker").string());
+  ASSERT_EQ(keyed.wait(60s), 0) << keyed.err();
+  EXPECT_EQ(keyed_worker.wait(10s), 0) << keyed_worker.err();
+  EXPECT_NE(keyed.err().find("CurveZMQ on"), std::string::npos) << keyed.err();
 }
 
 }  // namespace

@@ -125,6 +125,10 @@ struct Coordinator::Impl {
       config.server_secret_key = options.server_secret_key;
       config.authorized_keys = options.authorized_keys;
     }
+    if (config.curve && config.server_secret_key.empty()) {
+      return sim::Error{"security.curve = true needs CurveZMQ keys: [security] server_secret_key and "
+                        "authorized_keys, or --server-key and --authorized-keys"};
+    }
     if (config.server_secret_key.empty()) return {};
     auto attached = CurveServer::attach(context, socket, config.server_secret_key, config.authorized_keys);
     if (!attached) return attached.error();

@@ -191,9 +191,6 @@ sim::Expected<RunConfig> parse_run_config(const std::string& toml_text, const st
   if (r.ok() && c.server_secret_key.empty() != c.authorized_keys.empty()) {
     r.fail("security", "server_secret_key and authorized_keys go together");
   }
-  if (r.ok() && c.curve && c.server_secret_key.empty()) {
-    r.fail("security.curve", "needs server_secret_key and authorized_keys");
-  }
 
   const toml::table* retry = r.table("retry");
   r.only_keys(retry, "retry", {"max_attempts"});

@@ -1,5 +1,6 @@
 #include "drapegen/worker/worker.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -166,7 +167,9 @@ sim::Status run_worker(const WorkerOptions& o, const std::atomic<bool>& stop) {
   }
   Executor executor(scratch);
   zmq::context_t context{1};
-  int backoff_ms = o.backoff_initial_ms;
+  // The first reconnect delay, doubled up to the longest: never above the longest, however small that is set.
+  const int backoff_initial_ms = std::min(o.backoff_initial_ms, o.backoff_max_ms);
+  int backoff_ms = backoff_initial_ms;
   auto last_contact = Clock::now();  // with any coordinator
   std::int64_t current_job = 0;      // job being computed (0: none)
   std::uint32_t current_attempt = 0;
@@ -228,7 +231,7 @@ sim::Status run_worker(const WorkerOptions& o, const std::atomic<bool>& stop) {
           if (decoded->body_case() != v1::Envelope::kDisconnect) last_contact = last_recv;
           if (!connected) {
             connected = true;
-            backoff_ms = o.backoff_initial_ms;
+            backoff_ms = backoff_initial_ms;
             log->info("worker {}: connected to {}", name, o.endpoint);
           }
           const v1::Envelope& e = *decoded;
@@ -319,7 +322,7 @@ sim::Status run_worker(const WorkerOptions& o, const std::atomic<bool>& stop) {
     }
     const auto until = Clock::now() + milliseconds(backoff_ms);
     while (Clock::now() < until && !stop.load()) std::this_thread::sleep_for(milliseconds(20));
-    backoff_ms = std::min(std::max(backoff_ms * 2, o.backoff_initial_ms), o.backoff_max_ms);
+    backoff_ms = std::min(std::max(backoff_ms * 2, backoff_initial_ms), o.backoff_max_ms);
   }
   return {};
 }

@@ -36,7 +36,7 @@ struct RunConfig {
   int liveness = 5;
   double lease_s = 900.0;
   // [security]
-  bool curve = false;               // require CurveZMQ on loopback too (always required on other addresses)
+  bool curve = false;               // refuse to bind without CurveZMQ keys, loopback too (keys turn it on anywhere)
   std::string server_secret_key;    // the coordinator's secret key file (drapegen keygen)
   std::string authorized_keys;      // worker public keys, one per line
   // [retry]

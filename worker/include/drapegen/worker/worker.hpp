@@ -15,7 +15,7 @@ struct WorkerOptions {
   std::string name;              // for logs and the manifest; default "HOST:PID"
   int heartbeat_ms = 1000;       // this worker's heartbeat interval
   int liveness = 5;              // coordinator silent for liveness x its interval: reconnect
-  int backoff_initial_ms = 250;  // first reconnect delay, doubled up to backoff_max_ms
+  int backoff_initial_ms = 250;  // first reconnect delay (at most backoff_max_ms), doubled up to backoff_max_ms
   int backoff_max_ms = 8000;
   double give_up_s = 0.0;        // > 0: fail after this long without hearing from a coordinator
   std::string scratch_dir;       // temporary files; default a fresh directory under the system temp dir
