@@ -128,12 +128,17 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0, 100));
   double measured_bending_error = 0.0;
   app.add_option("--measured-bending-error", measured_bending_error,
-                 "SIGMA > 0: every capture carries a measured bending, as drapegen reality --measured-bending-error "
+                 "SIGMA in 0.001 .. 1: every capture carries a measured bending, as drapegen reality --measured-bending-error "
                  "SIGMA writes it (the true fabric times e^(SIGMA g) per parameter, stated within e^(2 SIGMA)); "
                  "captures generated without one get it from their truth file (the same draw); diagnose with "
                  "--diagnose-args --ignore-measured-bending for the protocol without it (default 0: none)")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 1.0));
+      ->check(CLI::Range(0.0, 1.0))
+      ->check([](const std::string& text) {
+        const double sigma = std::stod(text);  // a number: the range check before this one has read it
+        return sigma == 0.0 || sigma >= diagnosis::kMinMeasuredBendingError ? std::string()
+                                                                            : std::string("0 (none) or 0.001 .. 1");
+      });
   app.add_flag("--quick", quick, "Diagnose with --quick");
   app.add_flag("--generate-only", generate_only, "Only generate the captures");
   app.add_flag("--score-only", score_only, "Only score existing diagnoses");

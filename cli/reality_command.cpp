@@ -49,8 +49,9 @@ int run_reality(const RealityOptions& o) {
   }
   spec.placement = o.placement;
   spec.noise = o.noise;
-  if (!(o.measured_bending_error >= 0.0 && o.measured_bending_error <= 1.0)) {
-    return fail("--measured-bending-error must be 0 (none) .. 1");
+  if (const double s = o.measured_bending_error;
+      !(s == 0.0 || (s >= diagnosis::kMinMeasuredBendingError && s <= 1.0))) {
+    return fail(fmt::format("--measured-bending-error must be 0 (none) or {:g} .. 1", diagnosis::kMinMeasuredBendingError));
   }
   spec.measured_bending_error = o.measured_bending_error;
   for (const auto& text : o.effects) {
@@ -62,7 +63,7 @@ int run_reality(const RealityOptions& o) {
   }
   if (sim::Status s = prepare_output_directory(o.out, "capture.json"); !s) return fail(s.error().message, kExitIo);
   auto r = diagnosis::generate_reality(spec, o.out);
-  if (!r) return fail(r.error().message);
+  if (!r) return fail(r.error());  // exit 3 where an output could not be written, 1 otherwise
   if (o.json) {
     nlohmann::json j = {{"capture", o.out}, {"truth", r->truth_path}, {"seconds", r->seconds},
                         {"converged", r->converged}};
@@ -102,7 +103,7 @@ Runner add_reality_command(CLI::App& app) {
       ->required();
   app.add_flag("!--no-noise", o->noise, "Clean depth (no sensor noise)");
   app.add_option("--measured-bending-error", o->measured_bending_error,
-                 "SIGMA > 0: the capture carries a measured bending, as a bending test (e.g. a cantilever) of this "
+                 "SIGMA in 0.001 .. 1: the capture carries a measured bending, as a bending test (e.g. a cantilever) of this "
                  "precision would report it: each of --alpha/--beta times its own e^(SIGMA g), g standard normal, the "
                  "same on every placement, stated within a factor e^(2 SIGMA) (docs/CAPTURE.md, \"Measured bending\"; "
                  "default 0: none)");

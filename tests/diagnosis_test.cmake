@@ -665,6 +665,9 @@ if(NOT factor_type STREQUAL "NULL")
   message(FATAL_ERROR "--start-alpha without --start-box on a capture with a measured bending: a box (${factor_type})")
 endif()
 expect_failure(1 "--measured-bending-error must be" reality ${FABRIC} --measured-bending-error 1.5 --out ${WORK}/bad)
+# A precision e^(2 SIGMA) that would round to 1, which the capture reader refuses: refused when asked for.
+expect_failure(1 "--measured-bending-error must be 0 (none) or 0.001 .. 1" reality ${FABRIC} --measured-bending-error 1e-17
+               --out ${WORK}/bad)
 # A known bending's box bounds the refits: they reach from the fit to either end of the box's geometric mean alpha,
 # wherever the fit ends. A start at alpha 280000 within e^0.2: the box's mean alpha is 280000 / 1.2214 = 229245 ..
 # 300000 (the whole box's cap at 300 g/m^2), so the refits' range must be exactly that (x 1/F .. F around the fit

@@ -142,7 +142,7 @@ sim::Expected<Capture> read_capture(const std::string& directory) {
     }
     if (!(c.specimen.cylinder_diameter >= 0.01 &&
           c.specimen.cylinder_diameter < std::min(c.specimen.size_x, c.specimen.size_y))) {
-      return sim::Error{fmt::format("{}: cylinder diameter must be 10 mm .. the specimen size", where)};
+      return sim::Error{fmt::format("{}: cylinder diameter must be at least 10 mm and less than the specimen size (the specimen overhangs it)", where)};
     }
     if (s.contains("measured_bending") && !s["measured_bending"].is_null()) {
       auto measured = measured_bending_from(s["measured_bending"], where + ": specimen.measured_bending");
@@ -159,6 +159,12 @@ sim::Expected<Capture> read_capture(const std::string& directory) {
       const std::string what = fmt::format("{}: views[{}]", where, v);
       CaptureView view;
       view.file = jv.at("depth").get<std::string>();
+      for (std::size_t u = 0; u < v; ++u) {  // one file under two poses would be a view missing, unnoticed
+        if (fs::equivalent(dir / view.file, dir / views[u].at("depth").get<std::string>(), ec)) {
+          return sim::Error{fmt::format("{}: depth {} is views[{}]'s file too; each view needs its own", what,
+                                        view.file, u)};
+        }
+      }
       view.camera.intrinsics.width = jv.at("width").get<int>();
       view.camera.intrinsics.height = jv.at("height").get<int>();
       if (view.camera.intrinsics.width < 8 || view.camera.intrinsics.height < 8 ||
@@ -171,6 +177,10 @@ sim::Expected<Capture> read_capture(const std::string& directory) {
         return sim::Error{what + ".K: last row must be 0 0 1"};
       if (!((*K)(0, 0) > 0.0 && (*K)(1, 1) > 0.0)) {
         return sim::Error{what + ".K: the focal lengths K[0][0] and K[1][1] must be positive"};
+      }
+      // With the last row 0 0 1, K is invertible where its upper left 2x2 is (a mistyped skew can make it singular).
+      if (std::abs(K->topLeftCorner(2, 2).determinant()) < 1e-9 * (*K)(0, 0) * (*K)(1, 1)) {
+        return sim::Error{what + ".K: singular (its upper left 2x2 has no inverse: check the skew K[0][1] and K[1][0])"};
       }
       view.camera.intrinsics.K = *K;
       auto T = matrix_from(jv.at("world_to_camera"), 4, 4, what + ".world_to_camera");
@@ -209,7 +219,7 @@ sim::Status write_capture(const std::string& directory, const Capture& capture) 
   const fs::path dir(directory);
   std::error_code ec;
   fs::create_directories(dir, ec);
-  if (ec) return sim::Error{fmt::format("{}: cannot create directory: {}", directory, ec.message())};
+  if (ec) return sim::Error{fmt::format("{}: cannot create directory: {}", directory, ec.message()), /*io=*/true};
   for (std::size_t v = 0; v < capture.views.size(); ++v) {
     const std::string file = view_file_name(capture.views[v], v);
     if (sim::Status s = write_depth_exr((dir / file).string(), capture.views[v].depth); !s) return s;

@@ -4,7 +4,6 @@
 #include <cmath>
 #include <filesystem>
 #include <fmt/format.h>
-#include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
 
@@ -17,6 +16,7 @@
 #include "drapegen/renderer/rig.hpp"
 #include "drapegen/renderer/sensor_error.hpp"
 #include "drapegen/sim/drape.hpp"
+#include "drapegen/storage/atomic_file.hpp"
 
 namespace drapegen::diagnosis {
 namespace fs = std::filesystem;
@@ -195,6 +195,9 @@ sim::Expected<Placement> make_placement(const RealitySpec& spec, int placement) 
 sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std::string& directory) {
   const auto start = std::chrono::steady_clock::now();
   if (spec.resolution < 5 || spec.resolution > 200) return sim::Error{"resolution must be 5 .. 200"};
+  if (const double s = spec.measured_bending_error; !(s == 0.0 || (s >= kMinMeasuredBendingError && s <= 1.0))) {
+    return sim::Error{fmt::format("the measured bending's error must be 0 (none) or {:g} .. 1", kMinMeasuredBendingError)};
+  }
   if (spec.placement < 0 || spec.placement > kMaxPlacement) {
     return sim::Error{fmt::format("placement must be 0 .. {}", kMaxPlacement)};
   }
@@ -297,9 +300,7 @@ sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std
   truth.update(bending_json(spec.bending));  // "alpha", "beta"
   RealityResult result;
   result.truth_path = (fs::path(directory) / "truth.json").string();
-  std::ofstream out(result.truth_path);
-  out << truth.dump(2) << "\n";
-  if (!out) return sim::Error{result.truth_path + ": cannot write"};
+  if (sim::Status s = storage::write_file_atomic(result.truth_path, truth.dump(2) + "\n"); !s) return s.error();
   result.converged = converged;
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;

@@ -5,26 +5,33 @@
 #include <cstdio>
 #include <filesystem>
 #include <fmt/format.h>
-#include <fstream>
 #include <nlohmann/json.hpp>
 
 #include "drapegen/renderer/preview.hpp"
+#include "drapegen/storage/atomic_file.hpp"
 #include "drapegen/storage/png.hpp"
 
 namespace drapegen::diagnosis {
 namespace fs = std::filesystem;
 
-sim::Status write_residual_png(const std::string& path, const std::vector<std::vector<float>>& residuals, int width,
-                               int height, double range) {
-  if (residuals.empty() || width <= 0 || height <= 0) return sim::Error{path + ": nothing to draw"};
+sim::Status write_residual_png(const std::string& path, const std::vector<ResidualImage>& residuals, double range) {
+  if (residuals.empty()) return sim::Error{path + ": nothing to draw"};
+  // Every cell is the largest view's size; a smaller view sits in its cell's top left corner (views may differ).
+  int width = 0, height = 0;
+  for (const auto& r : residuals) {
+    if (r.width <= 0 || r.height <= 0 || r.values.size() != static_cast<std::size_t>(r.width) * r.height)
+      return sim::Error{path + ": bad image size"};
+    width = std::max(width, r.width);
+    height = std::max(height, r.height);
+  }
   const int gap = 4;
   const int W = static_cast<int>(residuals.size()) * (width + gap) - gap, H = height;
   std::vector<unsigned char> rgb(static_cast<std::size_t>(W) * H * 3, 40);
   for (std::size_t k = 0; k < residuals.size(); ++k) {
-    if (residuals[k].size() != static_cast<std::size_t>(width) * height) return sim::Error{path + ": bad image size"};
-    for (int y = 0; y < height; ++y) {
-      for (int x = 0; x < width; ++x) {
-        const float r = residuals[k][static_cast<std::size_t>(y) * width + x];
+    const ResidualImage& img = residuals[k];
+    for (int y = 0; y < img.height; ++y) {
+      for (int x = 0; x < img.width; ++x) {
+        const float r = img.values[static_cast<std::size_t>(y) * img.width + x];
         unsigned char* px = &rgb[(static_cast<std::size_t>(y) * W + k * (width + gap) + x) * 3];
         if (!std::isfinite(r)) {
           px[0] = px[1] = px[2] = 0;
@@ -146,26 +153,23 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
   const fs::path dir(directory);
   std::error_code ec;
   fs::create_directories(dir, ec);
-  if (ec) return sim::Error{fmt::format("{}: cannot create directory: {}", directory, ec.message())};
+  if (ec) return sim::Error{fmt::format("{}: cannot create directory: {}", directory, ec.message()), /*io=*/true};
   const nlohmann::json j = to_json(r, capture);
-  {
-    std::ofstream out(dir / "report.json");
-    out << j.dump(2) << "\n";
-    if (!out) return sim::Error{(dir / "report.json").string() + ": cannot write"};
-  }
-  const int W = capture.views.front().depth.width, H = capture.views.front().depth.height;
+  if (sim::Status s = storage::write_file_atomic((dir / "report.json").string(), j.dump(2) + "\n"); !s) return s;
   const double range = model.settings().weights.truncation;
-  auto residuals = [](const ScoredDrape& d) {
-    std::vector<std::vector<float>> out;
-    for (const auto& v : d.views) out.push_back(v.residual);
+  auto residuals = [&capture](const ScoredDrape& d) {  // each view at its own size
+    std::vector<ResidualImage> out;
+    for (std::size_t k = 0; k < d.views.size() && k < capture.views.size(); ++k) {
+      out.push_back({capture.views[k].depth.width, capture.views[k].depth.height, d.views[k].residual});
+    }
     return out;
   };
-  if (sim::Status s = write_residual_png((dir / "residual.png").string(), residuals(r.gap_drape()), W, H, range); !s)
+  if (sim::Status s = write_residual_png((dir / "residual.png").string(), residuals(r.gap_drape()), range); !s)
     return s;
   const bool after = r.attribution.named && !r.attribution.candidates.empty();
   if (after) {
     if (sim::Status s = write_residual_png((dir / "residual_after.png").string(),
-                                           residuals(r.attribution.candidates[0].validated), W, H, range);
+                                           residuals(r.attribution.candidates[0].validated), range);
         !s) {
       return s;
     }
@@ -311,10 +315,7 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
                     "{} thread{}.\n",
                     r.seconds, r.seconds_fit, r.seconds_floors, r.seconds_attribution, r.cpu_seconds, r.jobs,
                     r.jobs == 1 ? "" : "s");
-  std::ofstream out(dir / "report.md");
-  out << md;
-  if (!out) return sim::Error{(dir / "report.md").string() + ": cannot write"};
-  return {};
+  return storage::write_file_atomic((dir / "report.md").string(), md);
 }
 
 }  // namespace drapegen::diagnosis

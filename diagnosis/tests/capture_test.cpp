@@ -164,7 +164,7 @@ TEST(Capture, FarDepthIsAClearError) {
   ASSERT_TRUE(write_capture(dir, c).ok());
   const std::string e = read_error(dir);
   EXPECT_NE(e.find("view 2"), std::string::npos) << e;
-  EXPECT_NE(e.find("at pixel (50, 60) is beyond 100 m; use 0 for no return"), std::string::npos) << e;
+  EXPECT_NE(e.find("at pixel (50, 60) is beyond 10 m; use 0 for no return"), std::string::npos) << e;
 }
 
 TEST(Capture, ACameraThatIsNoneIsAClearError) {
@@ -184,8 +184,22 @@ TEST(Capture, ACameraThatIsNoneIsAClearError) {
   EXPECT_NE(with("K", 1, 1, -300.0).find("must be positive"), std::string::npos);
   EXPECT_NE(with("world_to_camera", 3, 0, 0.5).find("last row must be 0 0 0 1"), std::string::npos);
   const std::string far = with("world_to_camera", 0, 3, 1000.0);
-  EXPECT_NE(far.find("views[1].world_to_camera: the camera is more than 100 m from the specimen"), std::string::npos)
+  EXPECT_NE(far.find("views[1].world_to_camera: the camera is more than 10 m from the specimen"), std::string::npos)
       << far;
+  // 20 m: farther than the diagnosis's renderer draws, so its model could never be compared with the capture.
+  EXPECT_NE(with("world_to_camera", 0, 3, 20.0).find("the camera is more than 10 m"), std::string::npos);
+  // A skew that makes K singular: every back-projected ray would be non-finite.
+  nlohmann::json singular = good;
+  singular["views"][1]["K"][0][1] = good["views"][1]["K"][0][0];
+  singular["views"][1]["K"][1][0] = good["views"][1]["K"][1][1];
+  std::ofstream(fs::path(dir) / "capture.json") << singular.dump();
+  EXPECT_NE(read_error(dir).find("views[1].K: singular"), std::string::npos) << read_error(dir);
+  // One depth file under two poses: a view missing, which the view count alone does not show.
+  nlohmann::json twice = good;
+  twice["views"][2]["depth"] = good["views"][0]["depth"];
+  std::ofstream(fs::path(dir) / "capture.json") << twice.dump();
+  EXPECT_NE(read_error(dir).find("views[2]: depth view0.exr is views[0]'s file too"), std::string::npos)
+      << read_error(dir);
   std::ofstream(fs::path(dir) / "capture.json") << good.dump();
   EXPECT_TRUE(read_capture(dir).has_value());
 }

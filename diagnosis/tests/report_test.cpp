@@ -2,7 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
+#include <cmath>
+#include <fstream>
 #include <string>
+
+#include "drapegen/renderer/preview.hpp"
 
 namespace drapegen::diagnosis {
 namespace {
@@ -10,6 +15,16 @@ namespace {
 constexpr const char* kCaveat = "rules out no effect whose drape an elastic fabric of another bending can match";
 
 bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+/// A PNG's width and height from its IHDR chunk (big-endian, bytes 16-23).
+std::array<int, 2> png_size(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  unsigned char b[24] = {};
+  in.read(reinterpret_cast<char*>(b), sizeof b);
+  if (!in) return {0, 0};
+  auto be = [&](int at) { return (b[at] << 24) | (b[at + 1] << 16) | (b[at + 2] << 8) | b[at + 3]; };
+  return {be(16), be(20)};
+}
 
 TEST(VerdictMarkdown, WithinTheFloorsSaysWhatItDoesNotRuleOut) {
   DiagnosisResult r;
@@ -62,6 +77,24 @@ TEST(VerdictMarkdown, AGapAboveTheFloorsHasNoCaveat) {
   unexplained.verdict = "unexplained";
   EXPECT_TRUE(contains(verdict_markdown(unexplained), "no candidate effect was refitted"));
   EXPECT_FALSE(contains(verdict_markdown(unexplained), kCaveat));
+}
+
+TEST(ReportImages, ViewsOfDifferentSizesEachTakeACellOfTheLargestSize) {
+  // A capture's views may differ in size (docs/CAPTURE.md): the residual maps and the views' preview draw each at
+  // its own size in cells of the largest, instead of failing once the whole diagnosis has run.
+  const std::string dir = testing::TempDir();
+  std::vector<ResidualImage> residuals{{8, 6, std::vector<float>(48, 0.01f)}, {5, 9, std::vector<float>(45, -0.01f)}};
+  residuals[1].values[3] = std::nanf("");
+  ASSERT_TRUE(static_cast<bool>(write_residual_png(dir + "/residual_sizes.png", residuals, 0.02)));
+  EXPECT_EQ(png_size(dir + "/residual_sizes.png"), (std::array<int, 2>{2 * 8 + 4, 9}));
+  residuals[1].values.pop_back();  // pixels that do not match the stated size: refused
+  EXPECT_FALSE(static_cast<bool>(write_residual_png(dir + "/residual_bad.png", residuals, 0.02)));
+
+  renderer::DepthImage a(8, 6), b(5, 9);
+  a.depth.assign(48, 0.5f);
+  b.depth.assign(45, 0.6f);
+  ASSERT_TRUE(static_cast<bool>(renderer::write_preview_png(dir + "/preview_sizes.png", {{a, b}, {b}})));
+  EXPECT_EQ(png_size(dir + "/preview_sizes.png"), (std::array<int, 2>{2 * 8 + 2, 2 * 9 + 2}));
 }
 
 }  // namespace

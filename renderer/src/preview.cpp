@@ -66,29 +66,30 @@ void paint(const DepthImage& img, std::vector<unsigned char>& rgb, int stride, i
 
 sim::Status write_preview_png(const std::string& path, const std::vector<std::vector<DepthImage>>& rows) {
   if (rows.empty() || rows[0].empty()) return sim::Error{"preview: no images"};
-  const int W = rows[0][0].width, H = rows[0][0].height;
+  // Every cell is the largest image's size; a smaller image sits in its cell's top left corner (views may differ).
+  int W = 0, H = 0;
   std::size_t columns = 0;
   for (const auto& row : rows) {
     columns = std::max(columns, row.size());
     for (const auto& img : row) {
-      if (img.width != W || img.height != H) return sim::Error{"preview: images differ in size"};
+      if (img.width <= 0 || img.height <= 0 || img.depth.size() != static_cast<std::size_t>(img.width) * img.height)
+        return sim::Error{"preview: an image is empty or its pixels do not match its size"};
+      W = std::max(W, img.width);
+      H = std::max(H, img.height);
     }
   }
   const int gap = 2;
   const int width = static_cast<int>(columns) * (W + gap) - gap;
   const int height = static_cast<int>(rows.size()) * (H + gap) - gap;
-  std::vector<unsigned char> rgb(static_cast<std::size_t>(width) * height * 3, 0);
+  // Dark grey where no image is (the gaps between cells, the rest of a smaller image's cell); black where one is.
+  std::vector<unsigned char> rgb(static_cast<std::size_t>(width) * height * 3, 64);
   for (std::size_t r = 0; r < rows.size(); ++r) {
     for (std::size_t c = 0; c < rows[r].size(); ++c) {
-      paint(rows[r][c], rgb, width, static_cast<int>(c) * (W + gap), static_cast<int>(r) * (H + gap));
-    }
-  }
-  // Gaps between the cells in dark grey.
-  for (int y = 0; y < height; ++y) {
-    for (int x = 0; x < width; ++x) {
-      if (x % (W + gap) >= W || y % (H + gap) >= H) {
-        std::memset(&rgb[(static_cast<std::size_t>(y) * width + x) * 3], 64, 3);
-      }
+      const DepthImage& img = rows[r][c];
+      const int x0 = static_cast<int>(c) * (W + gap), y0 = static_cast<int>(r) * (H + gap);
+      for (int v = 0; v < img.height; ++v)
+        std::memset(&rgb[(static_cast<std::size_t>(y0 + v) * width + x0) * 3], 0, static_cast<std::size_t>(img.width) * 3);
+      paint(img, rgb, width, x0, y0);
     }
   }
 

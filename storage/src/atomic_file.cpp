@@ -15,7 +15,7 @@ namespace drapegen::storage {
 namespace {
 
 sim::Error os_error(const std::string& what, const std::string& path) {
-  return sim::Error{what + " " + path + ": " + std::strerror(errno)};
+  return sim::Error{what + " " + path + ": " + std::strerror(errno), /*io=*/true};
 }
 
 }  // namespace

@@ -50,8 +50,9 @@ struct Capture {
 /// The number of views a capture must have (the tester's four).
 constexpr int kCaptureViews = 4;
 /// m: no depth and no camera of a drape tester lies farther than this from the specimen (a depth beyond it is a
-/// sensor's "no return" sentinel, or another unit).
-constexpr double kFarthestDepth = 100.0;
+/// sensor's "no return" sentinel, or another unit); the farthest depth the diagnosis's renderer draws
+/// (renderer::DepthRange's far plane), so every capture it accepts its model can render.
+constexpr double kFarthestDepth = 10.0;
 
 /// Reads DIR/capture.json and its depth files. Every failure is one line naming the file and the problem: missing
 /// capture.json or view, malformed JSON, wrong view count, depth size not the camera's, NaN/infinite/negative depth

@@ -34,6 +34,10 @@ struct RealityEffect {
 
 inline constexpr int kMaxPlacement = 100;
 
+/// The smallest nonzero measured-bending error (sigma): below it the stated precision e^(2 sigma) would round to a
+/// factor of 1, which no capture may state (docs/CAPTURE.md).
+inline constexpr double kMinMeasuredBendingError = 1e-3;
+
 struct RealitySpec {
   BendingParameters bending;
   double density = 300.0;   // g/m^2
@@ -49,7 +53,7 @@ struct RealitySpec {
   bool noise = true;
   /// > 0: the capture carries a measured bending (SpecimenFacts::measured_bending), measure_bending(bending, this,
   /// seed): what a bending test of this precision would have reported of the specimen, the same on every placement.
-  double measured_bending_error = 0.0;
+  double measured_bending_error = 0.0;  // 0 or kMinMeasuredBendingError .. 1
 };
 
 /// A bending test's report of a specimen whose true bending is `truth`: each of the six parameters times its own

@@ -8,10 +8,18 @@
 
 namespace drapegen::diagnosis {
 
+/// One view's signed residual, m, row-major, width x height.
+struct ResidualImage {
+  int width = 0;
+  int height = 0;
+  std::vector<float> values;
+};
+
 /// Signed residual images side by side, diverging colours (blue: the capture is nearer the camera than the model,
-/// red: farther), saturating at +-`range` m; black where neither returns. 8-bit RGB PNG via libpng.
-[[nodiscard]] sim::Status write_residual_png(const std::string& path, const std::vector<std::vector<float>>& residuals,
-                                             int width, int height, double range);
+/// red: farther), saturating at +-`range` m; black where neither returns. Each in a cell of the largest image's size
+/// (a capture's views may differ in size). 8-bit RGB PNG via libpng.
+[[nodiscard]] sim::Status write_residual_png(const std::string& path, const std::vector<ResidualImage>& residuals,
+                                             double range);
 
 /// report.md's verdict: the verdict line, why a named effect was put ahead of another where that happened, and
 /// under a verdict within the floors ("none") what it does not rule out.
