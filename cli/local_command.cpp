@@ -41,8 +41,9 @@ struct LocalOptions {
 const Failure fail{"local"};
 
 /// The worker processes: started after the coordinator binds, restarted if one dies before the run ends (at most
-/// kRestartsPerWorker x N restarts over the run). halt() is the flag the coordinator runs until: set by SIGINT/SIGTERM
-/// (`signal_stop`), or when every worker has died and no restart is left, since no worker would ever come again.
+/// kRestartsPerWorker x N restarts over the run; a worker that exits cleanly, told to stop by the coordinator or by
+/// SIGTERM, is not restarted). halt() is the flag the coordinator runs until: set by SIGINT/SIGTERM (`signal_stop`),
+/// or when no worker is left and none will be restarted, since no worker would ever come again.
 class WorkerPool {
  public:
   static constexpr int kRestartsPerWorker = 3;
@@ -50,7 +51,7 @@ class WorkerPool {
       : endpoint_(std::move(endpoint)), count_(count), signal_stop_(signal_stop) {}
 
   [[nodiscard]] const std::atomic<bool>& halt() const { return halt_; }
-  /// The pool halted the run: every worker died and the restarts were spent.
+  /// The pool halted the run: no worker was left (every one died with the restarts spent, or stopped).
   [[nodiscard]] bool exhausted() const { return exhausted_; }
 
   sim::Status start() {
@@ -110,10 +111,19 @@ class WorkerPool {
         int status = 0;
         if (pids_[k] <= 0 || ::waitpid(pids_[k], &status, WNOHANG) != pids_[k]) continue;
         pids_[k] = -1;
-        const bool clean_exit = WIFEXITED(status) && WEXITSTATUS(status) == 0;  // told to shut down
+        const bool clean_exit = WIFEXITED(status) && WEXITSTATUS(status) == kExitOk;  // the run is over
+        // SIGINT/SIGTERM: handled (exit 4), or before the worker installed its handlers (killed by it)
+        const bool stopped = (WIFEXITED(status) && WEXITSTATUS(status) == kExitStopped) ||
+                             (WIFSIGNALED(status) && (WTERMSIG(status) == SIGTERM || WTERMSIG(status) == SIGINT));
         const std::string how = WIFSIGNALED(status) ? fmt::format("signal {}", WTERMSIG(status))
                                                     : fmt::format("status {}", WEXITSTATUS(status));
-        if (finishing_ || clean_exit) continue;
+        if (finishing_) continue;
+        if (clean_exit) continue;  // the coordinator told it the run is over
+        if (stopped) {             // someone stopped it: not restarted
+          coordinator::logger()->warn("worker local-{} was stopped by a signal; not restarted", k);
+          ++stopped_;
+          continue;
+        }
         if (restarts >= kRestartsPerWorker * count_) {
           coordinator::logger()->warn("worker local-{} exited ({}); no restart left", k, how);
           continue;
@@ -122,10 +132,18 @@ class WorkerPool {
         if (auto pid = spawn(static_cast<int>(k))) pids_[k] = *pid;
         ++restarts;
       }
+      // None left and none to come (a restart happens above, at once, or never): the run cannot go on. (Workers
+      // that all left cleanly were told the run is over: the coordinator is finishing.)
       const bool none_left = std::all_of(pids_.begin(), pids_.end(), [](pid_t pid) { return pid <= 0; });
-      if (!finishing_ && !halt_ && none_left && restarts >= kRestartsPerWorker * count_) {
-        coordinator::logger()->error("every worker has died and the {} restarts are spent: stopping the run",
-                                     kRestartsPerWorker * count_);
+      // (A Ctrl-C reaches the workers and this process alike: that stop is the user's, not a lost pool.)
+      if (!finishing_ && !halt_ && !signal_stop_ && none_left &&
+          (restarts >= kRestartsPerWorker * count_ || stopped_ > 0)) {
+        if (restarts >= kRestartsPerWorker * count_) {
+          coordinator::logger()->error("every worker has died and the {} restarts are spent: stopping the run",
+                                       kRestartsPerWorker * count_);
+        } else {
+          coordinator::logger()->error("no worker is left ({} stopped by a signal): stopping the run", stopped_);
+        }
         exhausted_ = true;
         halt_ = true;
       }
@@ -140,6 +158,7 @@ class WorkerPool {
   std::atomic<bool> finishing_{false};
   std::atomic<bool> halt_{false};
   std::atomic<bool> exhausted_{false};
+  int stopped_ = 0;  // workers stopped by a signal (the supervisor's own count)
 };
 
 }  // namespace
@@ -163,6 +182,8 @@ Runner add_local_command(CLI::App& app) {
     const auto& stop = install_stop_signals();
     coordinator::CoordinatorOptions options;
     options.bind_override = "tcp://127.0.0.1:*";  // local workers only; any free port
+    options.command = "local";
+    options.keyless_workers = true;
     sim::Expected<std::unique_ptr<coordinator::Coordinator>> c = sim::Error{""};
     if (!o->resume.empty()) {
       c = coordinator::Coordinator::resume(o->resume, options);
@@ -189,8 +210,8 @@ Runner add_local_command(CLI::App& app) {
     const auto summary = (*c)->run(pool.halt());
     pool.finish();
     if (pool.exhausted() && summary.outcome == coordinator::RunOutcome::kStopped) {
-      std::cerr << "drapegen local: error: every worker died (the log above says how) and their restarts are spent; "
-                   "find the cause before resuming\n";
+      std::cerr << "drapegen local: error: no worker is left (the log above says how each ended); find the cause "
+                   "before resuming\n";
     }
     const int code = report_run(summary, (*c)->manifest_path(), "local");
     if (summary.outcome == coordinator::RunOutcome::kComplete) {

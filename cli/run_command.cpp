@@ -42,13 +42,13 @@ int report_run(const coordinator::RunSummary& s, const std::string& manifest, co
                                s.done, s.failed, s.total, s.recorded_this_session, s.seconds, manifest);
       return kExitOk;
     case coordinator::RunOutcome::kStopped:
-      std::cerr << fmt::format("drapegen {}: stopped with {} done, {} failed of {} jobs; continue with: drapegen run "
-                               "--resume {}\n",
+      std::cerr << fmt::format("drapegen {0}: stopped with {1} done, {2} failed of {3} jobs; continue with: drapegen "
+                               "{0} --resume {4}\n",
                                sub, s.done, s.failed, s.total, manifest);
       return kExitStopped;
     case coordinator::RunOutcome::kStorageError:
-      std::cerr << fmt::format("drapegen {}: error: {} (stopped with {} of {} jobs recorded; fix it, then: drapegen "
-                               "run --resume {})\n",
+      std::cerr << fmt::format("drapegen {0}: error: {1} (stopped with {2} of {3} jobs recorded; fix it, then: drapegen "
+                               "{0} --resume {4})\n",
                                sub, s.message, s.done + s.failed, s.total, manifest);
       return kExitIo;
   }

@@ -29,13 +29,9 @@ Runner add_stats_command(CLI::App& app) {
   return [o]() -> int {
     coordinator::StatsOptions options;
     options.fabrics_csv = o->fabrics;
+    options.plots_directory = o->plots;
     auto stats = coordinator::compute_stats(o->manifest, options);
-    if (!stats) return fail(stats.error().message);
-    if (!o->plots.empty()) {
-      auto written = coordinator::write_stat_plots(o->manifest, options, o->plots);
-      if (!written) return fail(written.error().message, kExitIo);
-      (*stats)["plots"] = *written;
-    }
+    if (!stats) return fail(stats.error());  // 3 where a plot could not be written, 1 otherwise
     if (o->json) {
       std::cout << stats->dump(2) << "\n";
     } else {

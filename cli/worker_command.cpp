@@ -44,7 +44,8 @@ Runner add_worker_command(CLI::App& app) {
     coordinator::logger()->set_level(spdlog::level::from_str(*level));
     const auto& stop = install_stop_signals();
     const sim::Status s = worker::run_worker(*o, stop);
-    const int code = s ? kExitOk : Failure{"worker"}(s.error().message);
+    // 0: the coordinator said the run is over; 4: stopped by SIGINT/SIGTERM (drapegen local does not restart it).
+    const int code = !s ? Failure{"worker"}(s.error().message) : stop.load() ? kExitStopped : kExitOk;
     // A computation still running cannot be interrupted: leave without waiting for it.
     std::fflush(stdout);
     std::fflush(stderr);

@@ -267,6 +267,8 @@ TEST(Service, StopsOnAnUnwritableOutputAndResumes) {
   EXPECT_NE(last.find("drapegen run --resume"), std::string::npos) << err;
   const long recorded = recorded_jobs(manifest);
   EXPECT_LT(recorded, 16);
+  // The count it reports is what the manifest holds (a pass rolled back on the fault is not counted).
+  EXPECT_NE(last.find("(stopped with " + std::to_string(recorded) + " of 16 jobs recorded"), std::string::npos) << err;
   EXPECT_EQ(worker.wait(10s), 0) << worker.err();
   // Fix it and resume.
   fs::remove(out / "data");
@@ -438,8 +440,48 @@ TEST(Service, LocalStopsWhenEveryWorkerHasDiedAndNoRestartIsLeft) {
   ASSERT_EQ(local.wait(1s), 4) << local.err();
   EXPECT_GE(kills, 4);
   EXPECT_NE(local.err().find("every worker has died and the 3 restarts are spent"), std::string::npos) << local.err();
-  EXPECT_NE(local.err().find("--resume " + manifest.string()), std::string::npos) << local.err();
+  EXPECT_NE(local.err().find("drapegen local --resume " + manifest.string()), std::string::npos) << local.err();
   check_manifest(manifest, 2);
+}
+
+// Workers stopped by SIGTERM exit 4 and are not restarted; once none is left, `drapegen local` stops the run with 4
+// instead of waiting for workers that will not come, and names itself in the resume hint.
+TEST(Service, LocalStopsWhenItsWorkersAreStoppedBySignals) {
+  const fs::path dir = test_dir("local_workers_stopped");
+  const fs::path out = dir / "run";
+  write_text(dir / "run.toml", small_config(out, 40, 2));
+  const fs::path manifest = out / "manifest.sqlite";
+  Process local({"local", "--workers", "2", "--config", (dir / "run.toml").string()}, (dir / "local").string());
+  ASSERT_FALSE(wait_endpoint(out, local, 30s).empty()) << local.err();
+  const fs::path tasks = fs::path("/proc") / std::to_string(local.pid()) / "task";
+  int stopped = 0;
+  const auto until = std::chrono::steady_clock::now() + 60s;
+  while (local.running() && std::chrono::steady_clock::now() < until) {
+    std::error_code ec;
+    for (const auto& task : fs::directory_iterator(tasks, ec)) {
+      std::istringstream pids(Process::slurp((task.path() / "children").string()));
+      for (pid_t pid = 0; pids >> pid;) stopped += ::kill(pid, SIGTERM) == 0;
+    }
+    std::this_thread::sleep_for(100ms);
+  }
+  ASSERT_EQ(local.wait(1s), 4) << local.err();
+  EXPECT_GE(stopped, 2);
+  EXPECT_NE(local.err().find("was stopped by a signal; not restarted"), std::string::npos) << local.err();
+  EXPECT_EQ(local.err().find("starting another"), std::string::npos) << local.err();
+  EXPECT_NE(local.err().find("no worker is left (2 stopped by a signal)"), std::string::npos) << local.err();
+  EXPECT_NE(local.err().find("drapegen local --resume " + manifest.string()), std::string::npos) << local.err();
+  check_manifest(manifest, 2);
+}
+
+// `drapegen local` starts its workers without keys: a configuration with CurveZMQ keys would lock them out (each
+// would give up after a minute), so it is refused at once.
+TEST(Service, LocalRefusesAConfigurationWithKeys) {
+  const fs::path dir = test_dir("local_keys");
+  write_text(dir / "run.toml", small_config(dir / "run", 2, 1, "[security]\ncurve = true\n"));
+  Process local({"local", "--workers", "1", "--config", (dir / "run.toml").string()}, (dir / "local").string());
+  ASSERT_EQ(local.wait(30s), 1) << local.err();
+  EXPECT_NE(local.err().find("drapegen local starts its workers without CurveZMQ keys"), std::string::npos)
+      << local.err();
 }
 
 // An output that cannot be created (its parent a regular file) is the file system's failure: exit 3, as a result

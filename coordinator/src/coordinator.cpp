@@ -94,6 +94,13 @@ struct Coordinator::Impl {
   std::map<std::string, Worker> workers;
   std::int64_t done = 0, failed = 0;
   std::int64_t recorded = 0, rejected = 0;
+  /// The counts as of the last commit: what the manifest holds (a failed commit rolls back what came after).
+  std::int64_t committed_done = 0, committed_failed = 0, committed_recorded = 0;
+  void counts_committed() {
+    committed_done = done;
+    committed_failed = failed;
+    committed_recorded = recorded;
+  }
   std::string storage_error;  // the first storage fault of this session; the run stops on it
   bool files_written = false;
 
@@ -125,6 +132,12 @@ struct Coordinator::Impl {
       config.server_secret_key = options.server_secret_key;
       config.authorized_keys = options.authorized_keys;
     }
+    if (options.keyless_workers && (config.curve || !config.server_secret_key.empty())) {
+      return sim::Error{fmt::format("drapegen {} starts its workers without CurveZMQ keys, on loopback: remove the "
+                                    "[security] section from the configuration (or use drapegen run and start the "
+                                    "workers with --server-key and --key)",
+                                    options.command)};
+    }
     if (config.curve && config.server_secret_key.empty()) {
       return sim::Error{"security.curve = true needs CurveZMQ keys: [security] server_secret_key and "
                         "authorized_keys, or --server-key and --authorized-keys"};
@@ -152,6 +165,7 @@ struct Coordinator::Impl {
             "refusing to bind {} without authentication: a non-loopback address needs [security] server_secret_key "
             "and authorized_keys (CurveZMQ; drapegen keygen makes keys)",
             candidate);
+        if (candidate != fallback && !fallback.empty()) log->warn("{}; binding {} instead", error, fallback);
         continue;
       }
       try {
@@ -222,6 +236,7 @@ struct Coordinator::Impl {
     if (sim::Status st = manifest->set_endpoint(endpoint); !st) return st;
     if (sim::Status st = manifest->commit(); !st) return st;
     done_at_start = done;
+    counts_committed();
     return {};
   }
 
@@ -250,10 +265,10 @@ struct Coordinator::Impl {
       if (!entry.is_regular_file()) continue;
       if (known.count(entry.path().filename().string())) continue;
       fs::remove(entry.path(), ec);
-      if (ec) return sim::Error{fmt::format("cannot remove {}: {}", entry.path().string(), ec.message())};
+      if (ec) return io_error(sim::Error{fmt::format("cannot remove {}: {}", entry.path().string(), ec.message())});
       ++removed;
     }
-    if (ec) return sim::Error{fmt::format("cannot list {}: {}", data_dir, ec.message())};
+    if (ec) return io_error(sim::Error{fmt::format("cannot list {}: {}", data_dir, ec.message())});
     if (removed > 0) log->info("removed {} file(s) of results that were never recorded", removed);
     return {};
   }
@@ -651,7 +666,11 @@ struct Coordinator::Impl {
       }
       files_written = false;
     }
-    if (sim::Status s = manifest->commit(); !s) storage_fault(s.error());
+    if (sim::Status s = manifest->commit(); !s) {
+      storage_fault(s.error());
+      return;
+    }
+    counts_committed();
   }
 
   void shutdown_workers(const std::string& reason) {
@@ -686,9 +705,10 @@ struct Coordinator::Impl {
     s.outcome = outcome;
     s.message = storage_error;
     s.total = static_cast<std::int64_t>(jobs.size());
-    s.done = done;
-    s.failed = failed;
-    s.recorded_this_session = recorded;
+    // What the manifest holds: after a storage fault, records not committed are gone (resume computes them again).
+    s.done = committed_done;
+    s.failed = committed_failed;
+    s.recorded_this_session = committed_recorded;
     s.rejected_messages = rejected;
     s.seconds = std::chrono::duration<double>(Clock::now() - start).count();
     return s;
@@ -801,8 +821,8 @@ sim::Expected<std::unique_ptr<Coordinator>> Coordinator::create(const std::strin
   if (sim::Status s = impl->claim_output(); !s) return s.error();
   // Checked under the lock: no other coordinator creates it meanwhile.
   if (fs::exists(impl->manifest_path)) {
-    return sim::Error{fmt::format("{} exists already: continue it with drapegen run --resume {}", impl->manifest_path,
-                                  impl->manifest_path)};
+    return sim::Error{fmt::format("{} exists already: continue it with drapegen {} --resume {}", impl->manifest_path,
+                                  options.command, impl->manifest_path)};
   }
   // Bind before planning, so a taken port fails fast and leaves no manifest behind.
   if (sim::Status s = impl->bind(options.bind_override.empty() ? config->bind : options.bind_override, ""); !s) {
@@ -819,12 +839,12 @@ sim::Expected<std::unique_ptr<Coordinator>> Coordinator::create(const std::strin
   run.code_version = DRAPEGEN_BUILD_ID;
   run.endpoint = impl->endpoint;
   auto manifest = storage::Manifest::create(impl->manifest_path, run, plan->samples, plan->jobs);
-  if (!manifest) return io_error(manifest.error());
+  if (!manifest) return manifest.error();  // the file system's failures are marked io where they arise
   impl->manifest = std::make_unique<storage::Manifest>(std::move(manifest).value());
-  if (sim::Status s = impl->load_state(); !s) return io_error(s.error());
+  if (sim::Status s = impl->load_state(); !s) return s.error();
   impl->log->info("run planned: {} jobs in {}; listening on {}", impl->jobs.size(), impl->manifest_path,
                   impl->endpoint);
-  if (sim::Status s = impl->publish_endpoint(); !s) return io_error(s.error());
+  if (sim::Status s = impl->publish_endpoint(); !s) return s.error();
   return std::unique_ptr<Coordinator>(new Coordinator(std::move(impl)));
 }
 
@@ -846,13 +866,13 @@ sim::Expected<std::unique_ptr<Coordinator>> Coordinator::resume(const std::strin
   impl->manifest = std::make_unique<storage::Manifest>(std::move(manifest).value());
   // Before anything is removed: the files a live run has not yet recorded are not orphans.
   if (sim::Status s = impl->claim_output(); !s) return s.error();
-  if (sim::Status s = impl->remove_orphans(); !s) return io_error(s.error());
+  if (sim::Status s = impl->remove_orphans(); !s) return s.error();
   const std::string preferred = options.bind_override.empty() ? run->endpoint : options.bind_override;
   if (sim::Status s = impl->bind(preferred, options.bind_override.empty() ? config->bind : ""); !s) return s.error();
-  if (sim::Status s = impl->load_state(); !s) return io_error(s.error());
+  if (sim::Status s = impl->load_state(); !s) return s.error();
   impl->log->info("resumed {}: {} of {} jobs done, {} failed; listening on {}", manifest_path, impl->done,
                   impl->jobs.size(), impl->failed, impl->endpoint);
-  if (sim::Status s = impl->publish_endpoint(); !s) return io_error(s.error());
+  if (sim::Status s = impl->publish_endpoint(); !s) return s.error();
   return std::unique_ptr<Coordinator>(new Coordinator(std::move(impl)));
 }
 

@@ -4,13 +4,13 @@
 #include <cmath>
 #include <filesystem>
 #include <fmt/format.h>
-#include <fstream>
 #include <map>
 
 #include "drapegen/coordinator/run_config.hpp"
 #include "drapegen/sampler/fabric_data.hpp"
 #include "drapegen/sampler/parameters.hpp"
 #include "drapegen/sampler/vae_model.hpp"
+#include "drapegen/storage/atomic_file.hpp"
 #include "drapegen/storage/manifest_reader.hpp"
 
 namespace drapegen::coordinator {
@@ -237,9 +237,44 @@ std::string fmt_number(const nlohmann::json& j, const char* key, const char* for
 
 }  // namespace
 
+namespace {
+
+/// The histograms of `d` as SVG files in `directory` (created); the files written.
+sim::Expected<std::vector<std::string>> write_plots(const Data* d, const std::string& directory) {
+  std::error_code ec;
+  std::filesystem::create_directories(directory, ec);
+  if (ec) return sim::Error{fmt::format("cannot create {}: {}", directory, ec.message()), /*io=*/true};
+  std::vector<std::pair<std::string, std::string>> plots = {
+      {"drape_coefficient.svg", histogram_svg("Drape coefficient", "Cusick drape coefficient", {{"run", d->dc}})},
+      {"folds.svg", histogram_svg("Folds", "folds (nodes of the hem)", {{"run", d->folds}})},
+      {"job_seconds.svg", histogram_svg("Time per job", "seconds (lease to result)", {{"run", d->seconds}})},
+  };
+  for (int i = 0; i < sampler::kFeatureCount; ++i) {
+    std::vector<std::pair<std::string, std::vector<double>>> series = {{"run", d->run_features[i]}};
+    if (!d->measured_features.empty()) series.emplace_back("measured fabrics", d->measured_features[i]);
+    plots.emplace_back(fmt::format("param_{}.svg", sampler::kFeatureNames[i]),
+                       histogram_svg(fmt::format("{} (run vs measured)", sampler::kFeatureNames[i]),
+                                     "sign(k) ln|k| at 300 g/m^2", series));
+  }
+  std::vector<std::string> written;
+  for (const auto& [name, svg] : plots) {
+    const std::string path = (std::filesystem::path(directory) / name).string();
+    if (sim::Status s = storage::write_file_atomic(path, svg); !s) return s.error();
+    written.push_back(path);
+  }
+  return written;
+}
+
+}  // namespace
+
 sim::Expected<nlohmann::json> compute_stats(const std::string& manifest_path, const StatsOptions& options) {
   auto d = gather(manifest_path, options);
   if (!d) return d.error();
+  if (!options.plots_directory.empty()) {
+    auto written = write_plots(&*d, options.plots_directory);
+    if (!written) return written.error();
+    d->stats["plots"] = *written;
+  }
   return d->stats;
 }
 
@@ -295,34 +330,5 @@ std::string format_stats(const nlohmann::json& s) {
   return out;
 }
 
-sim::Expected<std::vector<std::string>> write_stat_plots(const std::string& manifest_path,
-                                                         const StatsOptions& options, const std::string& directory) {
-  auto d = gather(manifest_path, options);
-  if (!d) return d.error();
-  std::error_code ec;
-  std::filesystem::create_directories(directory, ec);
-  if (ec) return sim::Error{fmt::format("cannot create {}: {}", directory, ec.message())};
-  std::vector<std::pair<std::string, std::string>> plots = {
-      {"drape_coefficient.svg", histogram_svg("Drape coefficient", "Cusick drape coefficient", {{"run", d->dc}})},
-      {"folds.svg", histogram_svg("Folds", "folds (nodes of the hem)", {{"run", d->folds}})},
-      {"job_seconds.svg", histogram_svg("Time per job", "seconds (lease to result)", {{"run", d->seconds}})},
-  };
-  for (int i = 0; i < sampler::kFeatureCount; ++i) {
-    std::vector<std::pair<std::string, std::vector<double>>> series = {{"run", d->run_features[i]}};
-    if (!d->measured_features.empty()) series.emplace_back("measured fabrics", d->measured_features[i]);
-    plots.emplace_back(fmt::format("param_{}.svg", sampler::kFeatureNames[i]),
-                       histogram_svg(fmt::format("{} (run vs measured)", sampler::kFeatureNames[i]),
-                                     "sign(k) ln|k| at 300 g/m^2", series));
-  }
-  std::vector<std::string> written;
-  for (const auto& [name, svg] : plots) {
-    const std::string path = (std::filesystem::path(directory) / name).string();
-    std::ofstream out(path, std::ios::binary);
-    out << svg;
-    if (!out) return sim::Error{"cannot write " + path};
-    written.push_back(path);
-  }
-  return written;
-}
 
 }  // namespace drapegen::coordinator

@@ -43,7 +43,8 @@ std::uint64_t parse_u64(const std::string& s) {
 }
 
 sim::Status sqlite_error(sqlite3* db, const std::string& what) {
-  return sim::Error{fmt::format("manifest: {}: {}", what, db ? sqlite3_errmsg(db) : "out of memory")};
+  return sim::Error{fmt::format("manifest: {}: {}", what, db ? sqlite3_errmsg(db) : "out of memory"),
+                    detail::file_system_error(db)};
 }
 
 /// Connection settings of every connection (writer and readers); they write nothing to the file.
@@ -85,8 +86,9 @@ sim::Expected<sqlite3*> open_db(const std::string& path, int flags) {
   sqlite3* db = nullptr;
   if (sqlite3_open_v2(path.c_str(), &db, flags | SQLITE_OPEN_NOMUTEX, nullptr) != SQLITE_OK) {
     std::string message = db ? sqlite3_errmsg(db) : "out of memory";
+    const bool io = detail::file_system_error(db);
     sqlite3_close(db);
-    return sim::Error{fmt::format("cannot open manifest {}: {}", path, message)};
+    return sim::Error{fmt::format("cannot open manifest {}: {}", path, message), io};
   }
   sqlite3_extended_result_codes(db, 1);
   return db;
@@ -116,16 +118,45 @@ ManifestReader::ManifestReader(ManifestReader&&) noexcept = default;
 ManifestReader& ManifestReader::operator=(ManifestReader&&) noexcept = default;
 ManifestReader::~ManifestReader() = default;
 
+namespace {
+
+/// SQLite's URI for reading `path` as an immutable file: no -shm to create, no lock to take.
+std::string immutable_uri(const std::string& path) {
+  std::string uri = "file:";
+  for (const char c : std::filesystem::absolute(path).string()) {
+    if (c == '%' || c == '?' || c == '#') {
+      uri += fmt::format("%{:02X}", static_cast<unsigned char>(c));
+    } else {
+      uri += c;
+    }
+  }
+  return uri + "?immutable=1";
+}
+
+}  // namespace
+
 sim::Expected<ManifestReader> ManifestReader::open(const std::string& path) {
   if (!std::filesystem::is_regular_file(path)) return no_manifest_at(path);
-  auto db = open_db(path, SQLITE_OPEN_READONLY);
-  if (!db) return db.error();
-  auto impl = std::make_unique<Impl>();
-  impl->db = *db;
-  impl->owns = true;
-  if (sim::Status s = configure(impl->db); !s) return s.error();
-  if (sim::Status s = check_schema(impl->db, path); !s) return s.error();
-  return ManifestReader(std::move(impl), directory_of(path));
+  auto open_as = [&](const std::string& name, int flags) -> sim::Expected<std::unique_ptr<Impl>> {
+    auto db = open_db(name, flags);
+    if (!db) return db.error();
+    auto impl = std::make_unique<Impl>();
+    impl->db = *db;
+    impl->owns = true;
+    if (sim::Status s = configure(impl->db); !s) return s.error();
+    if (sim::Status s = check_schema(impl->db, path); !s) return s.error();
+    return impl;
+  };
+  auto impl = open_as(path, SQLITE_OPEN_READONLY);
+  // A WAL database read where this user may not create its -shm (another user's run, a read-only mount) fails to
+  // open. With no -wal beside it (the run's coordinator has closed it: every commit is in the file), the file is all
+  // there is: read it as immutable.
+  std::error_code ec;
+  if (!impl && !std::filesystem::exists(path + "-wal", ec)) {
+    if (auto immutable = open_as(immutable_uri(path), SQLITE_OPEN_READONLY | SQLITE_OPEN_URI)) impl = std::move(immutable);
+  }
+  if (!impl) return impl.error();
+  return ManifestReader(std::move(*impl), directory_of(path));
 }
 
 sim::Expected<RunRecord> ManifestReader::run() const {
@@ -473,14 +504,14 @@ sim::Expected<Manifest> Manifest::create(const std::string& path, const RunRecor
   // Make the database durable under its temporary name, then publish it.
   {
     std::FILE* f = std::fopen(tmp.c_str(), "rb+");
-    if (!f) return sim::Error{fmt::format("cannot reopen {}: {}", tmp, std::strerror(errno))};
+    if (!f) return sim::Error{fmt::format("cannot reopen {}: {}", tmp, std::strerror(errno)), /*io=*/true};
     const bool synced = ::fsync(fileno(f)) == 0;
     std::fclose(f);
-    if (!synced) return sim::Error{fmt::format("cannot sync {}: {}", tmp, std::strerror(errno))};
+    if (!synced) return sim::Error{fmt::format("cannot sync {}: {}", tmp, std::strerror(errno)), /*io=*/true};
   }
   std::error_code ec;
   std::filesystem::rename(tmp, path, ec);
-  if (ec) return sim::Error{fmt::format("cannot rename {} to {}: {}", tmp, path, ec.message())};
+  if (ec) return sim::Error{fmt::format("cannot rename {} to {}: {}", tmp, path, ec.message()), /*io=*/true};
   if (sim::Status s = sync_directory(directory_of(path)); !s) return s.error();
   return open(path);
 }

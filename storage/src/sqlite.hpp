@@ -11,6 +11,21 @@
 
 namespace drapegen::storage::detail {
 
+/// Whether SQLite's last error on `db` is the file system's (I/O, disk full, cannot open, read-only, permission): the
+/// command exits with its I/O code, not its bad-input code (sim::Error::io).
+inline bool file_system_error(sqlite3* db) {
+  switch (db ? sqlite3_errcode(db) & 0xff : SQLITE_NOMEM) {
+    case SQLITE_IOERR:
+    case SQLITE_FULL:
+    case SQLITE_CANTOPEN:
+    case SQLITE_READONLY:
+    case SQLITE_PERM:
+      return true;
+    default:
+      return false;
+  }
+}
+
 class Statement {
  public:
   Statement() = default;
@@ -63,9 +78,9 @@ class Statement {
     while ((rc = step()) == SQLITE_ROW) {
     }
     if (rc != SQLITE_DONE) {
-      std::string message = sqlite3_errmsg(db_);
+      sim::Error error{std::string("manifest: ") + sqlite3_errmsg(db_), file_system_error(db_)};
       sqlite3_reset(stmt_);
-      return sim::Error{"manifest: " + message};
+      return error;
     }
     sqlite3_reset(stmt_);
     return {};
@@ -91,7 +106,7 @@ inline sim::Status exec(sqlite3* db, const char* sql) {
   if (sqlite3_exec(db, sql, nullptr, nullptr, &message) != SQLITE_OK) {
     std::string text = message ? message : sqlite3_errmsg(db);
     sqlite3_free(message);
-    return sim::Error{"manifest: " + text};
+    return sim::Error{"manifest: " + text, file_system_error(db)};
   }
   return {};
 }

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 #include <sqlite3.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -79,6 +80,32 @@ TEST_F(ManifestTest, CreatesThePlanAtomicallyAndReadsItBack) {
   const auto again = Manifest::create(path_, RunRecord{}, {}, {});
   ASSERT_FALSE(again);
   EXPECT_NE(again.error().message.find("--resume"), std::string::npos);
+}
+
+TEST_F(ManifestTest, ReadsAManifestInADirectoryItCannotWrite) {
+  // Another user's finished run, or a read-only mount: SQLite cannot create the WAL database's -shm beside it. With
+  // no -wal left (the coordinator closed it), the reader reads the file as it is instead of calling it no manifest.
+  if (::geteuid() != 0) GTEST_SKIP() << "needs root, to read as another user (nobody)";
+  { auto m = make(); }
+  ASSERT_FALSE(std::filesystem::exists(path_ + "-wal"));
+  namespace fs = std::filesystem;
+  fs::permissions(dir_, fs::perms::owner_all | fs::perms::group_read | fs::perms::group_exec |
+                            fs::perms::others_read | fs::perms::others_exec);
+  fs::permissions(path_, fs::perms::owner_read | fs::perms::group_read | fs::perms::others_read);
+  fs::permissions(dir_, fs::perms::owner_read | fs::perms::owner_exec | fs::perms::group_read |
+                            fs::perms::group_exec | fs::perms::others_read | fs::perms::others_exec);
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {  // as nobody: the directory and the file read-only to it
+    if (::setgid(65534) != 0 || ::setuid(65534) != 0) ::_exit(2);
+    auto reader = ManifestReader::open(path_);
+    ::_exit(reader && reader->jobs() && reader->jobs()->size() == 4 ? 0 : 1);
+  }
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  fs::permissions(dir_, fs::perms::owner_all);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0) << "1: not read; 2: could not become nobody";
 }
 
 TEST_F(ManifestTest, RecordsEachJobExactlyOnce) {
@@ -192,6 +219,11 @@ TEST_F(ManifestTest, RefusesToStartOverALogLeftByAManifestThatIsGone) {
   ASSERT_FALSE(again);
   EXPECT_NE(again.error().message.find(wal + " is left from a manifest"), std::string::npos)
       << again.error().message;
+  EXPECT_FALSE(again.error().io);  // the user's to remove, not a file system failure: a command exits 1, not 3
+  // A directory that is not there: SQLite cannot open the file, the file system's failure (exit 3).
+  const auto nowhere = Manifest::create((dir_ / "missing" / "manifest.sqlite").string(), RunRecord{}, {}, {});
+  ASSERT_FALSE(nowhere);
+  EXPECT_TRUE(nowhere.error().io) << nowhere.error().message;
   EXPECT_TRUE(std::filesystem::exists(wal));  // not ours to delete
   EXPECT_FALSE(std::filesystem::exists(path_));
   std::filesystem::remove(wal);

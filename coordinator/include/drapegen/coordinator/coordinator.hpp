@@ -27,6 +27,11 @@ struct CoordinatorOptions {
   std::string endpoint_file;
   /// After the run completes, keep answering workers with Shutdown for this long (so reconnecting ones exit too).
   int shutdown_linger_ms = 1000;
+  /// The drapegen command the coordinator runs under ("run" or "local"), named in the hints it gives.
+  std::string command = "run";
+  /// Its workers connect without CurveZMQ keys (drapegen local's own): CurveZMQ keys in the configuration, or
+  /// `security.curve = true`, would lock them out, so they are refused at start.
+  bool keyless_workers = false;
 };
 
 enum class RunOutcome {

@@ -15,6 +15,10 @@ struct StatsOptions {
   /// (an installed binary without the source) only drops the comparison. A file named here that cannot be read is
   /// an error.
   std::string fabrics_csv;
+  /// Also write SVG histograms into this directory (created), from the same read of the manifest as the figures:
+  /// drape_coefficient.svg, folds.svg, job_seconds.svg and one per parameter feature (run against measured
+  /// fabrics); the statistics' "plots" lists the files. Empty: none.
+  std::string plots_directory;
 };
 
 /// Reads the manifest (read-only; safe while a coordinator writes) and computes the statistics.
@@ -22,10 +26,6 @@ struct StatsOptions {
                                                           const StatsOptions& options);
 /// A few lines a person can read.
 [[nodiscard]] std::string format_stats(const nlohmann::json& stats);
-/// Histograms as SVG files in `directory` (created): drape_coefficient.svg, folds.svg, job_seconds.svg and one
-/// per parameter feature (run against measured fabrics). Returns the files written.
-[[nodiscard]] sim::Expected<std::vector<std::string>> write_stat_plots(const std::string& manifest_path,
-                                                                       const StatsOptions& options,
-                                                                       const std::string& directory);
+
 
 }  // namespace drapegen::coordinator
