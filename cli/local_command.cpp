@@ -41,8 +41,8 @@ struct LocalOptions {
 const Failure fail{"local"};
 
 /// The worker processes: started after the coordinator binds, restarted if one dies before the run ends (at most
-/// kRestartsPerWorker x N restarts over the run; a worker that exits cleanly, told to stop by the coordinator or by
-/// SIGTERM, is not restarted). halt() is the flag the coordinator runs until: set by SIGINT/SIGTERM (`signal_stop`),
+/// kRestartsPerWorker x N restarts over the run; a worker the coordinator told the run is over (exit 0), or one
+/// stopped by SIGINT/SIGTERM (exit 4, or killed by it), is not restarted). halt() is the flag the coordinator runs until: set by SIGINT/SIGTERM (`signal_stop`),
 /// or when no worker is left and none will be restarted, since no worker would ever come again.
 class WorkerPool {
  public:
@@ -118,7 +118,10 @@ class WorkerPool {
         const std::string how = WIFSIGNALED(status) ? fmt::format("signal {}", WTERMSIG(status))
                                                     : fmt::format("status {}", WEXITSTATUS(status));
         if (finishing_) continue;
-        if (clean_exit) continue;  // the coordinator told it the run is over
+        if (clean_exit) {  // the coordinator told it the run is over
+          run_over_ = true;
+          continue;
+        }
         if (stopped) {             // someone stopped it: not restarted
           coordinator::logger()->warn("worker local-{} was stopped by a signal; not restarted", k);
           ++stopped_;
@@ -129,20 +132,27 @@ class WorkerPool {
           continue;
         }
         coordinator::logger()->warn("worker local-{} exited ({}); starting another", k, how);
-        if (auto pid = spawn(static_cast<int>(k))) pids_[k] = *pid;
         ++restarts;
+        if (auto pid = spawn(static_cast<int>(k))) {
+          pids_[k] = *pid;
+        } else {
+          coordinator::logger()->error("worker local-{}: {}", k, pid.error().message);
+          ++lost_;
+        }
       }
-      // None left and none to come (a restart happens above, at once, or never): the run cannot go on. (Workers
-      // that all left cleanly were told the run is over: the coordinator is finishing.)
+      // None left and none to come (a restart happens above, at once, or never): the run cannot go on. Not once a
+      // worker was told the run is over (the coordinator is finishing), nor on a Ctrl-C, which reaches the workers
+      // and this process alike (the stop is the user's, not a lost pool).
       const bool none_left = std::all_of(pids_.begin(), pids_.end(), [](pid_t pid) { return pid <= 0; });
-      // (A Ctrl-C reaches the workers and this process alike: that stop is the user's, not a lost pool.)
-      if (!finishing_ && !halt_ && !signal_stop_ && none_left &&
-          (restarts >= kRestartsPerWorker * count_ || stopped_ > 0)) {
+      if (!finishing_ && !halt_ && !signal_stop_ && !run_over_ && none_left &&
+          (restarts >= kRestartsPerWorker * count_ || stopped_ > 0 || lost_ > 0)) {
         if (restarts >= kRestartsPerWorker * count_) {
           coordinator::logger()->error("every worker has died and the {} restarts are spent: stopping the run",
                                        kRestartsPerWorker * count_);
         } else {
-          coordinator::logger()->error("no worker is left ({} stopped by a signal): stopping the run", stopped_);
+          coordinator::logger()->error("no worker is left ({} stopped by a signal, {} could not be restarted): "
+                                       "stopping the run",
+                                       stopped_, lost_);
         }
         exhausted_ = true;
         halt_ = true;
@@ -158,7 +168,9 @@ class WorkerPool {
   std::atomic<bool> finishing_{false};
   std::atomic<bool> halt_{false};
   std::atomic<bool> exhausted_{false};
-  int stopped_ = 0;  // workers stopped by a signal (the supervisor's own count)
+  int stopped_ = 0;        // workers stopped by a signal (the supervisor's own counts)
+  int lost_ = 0;           // restarts that could not be started
+  bool run_over_ = false;  // a worker was told the run is over
 };
 
 }  // namespace
@@ -216,7 +228,7 @@ Runner add_local_command(CLI::App& app) {
     const int code = report_run(summary, (*c)->manifest_path(), "local");
     if (summary.outcome == coordinator::RunOutcome::kComplete) {
       auto stats = coordinator::compute_stats((*c)->manifest_path(), {});
-      if (!stats) return fail(stats.error().message);
+      if (!stats) return fail(stats.error());
       std::cout << coordinator::format_stats(*stats);
     }
     return code;

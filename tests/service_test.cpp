@@ -415,6 +415,24 @@ TEST(Service, ASecondCoordinatorOnALiveOutputIsRefused) {
       << after.err();
 }
 
+// Sends `signal` to every child of `parent` (drapegen local's workers) every `every` until it exits, at most 60 s;
+// the signals delivered. A child is listed under the thread that started it (restarts: the supervisor's), so every
+// thread's list is read.
+int signal_children_until_exit(Process& parent, int signal, std::chrono::milliseconds every) {
+  const fs::path tasks = fs::path("/proc") / std::to_string(parent.pid()) / "task";
+  int delivered = 0;
+  const auto until = std::chrono::steady_clock::now() + 60s;
+  while (parent.running() && std::chrono::steady_clock::now() < until) {
+    std::error_code ec;
+    for (const auto& task : fs::directory_iterator(tasks, ec)) {
+      std::istringstream pids(Process::slurp((task.path() / "children").string()));
+      for (pid_t pid = 0; pids >> pid;) delivered += ::kill(pid, signal) == 0;
+    }
+    std::this_thread::sleep_for(every);
+  }
+  return delivered;
+}
+
 // `drapegen local` restarts a worker that dies, up to 3 x N times over the run; once every worker has died and no
 // restart is left it stops the run (exit 4, the cause named) instead of waiting for workers that never come.
 TEST(Service, LocalStopsWhenEveryWorkerHasDiedAndNoRestartIsLeft) {
@@ -424,19 +442,8 @@ TEST(Service, LocalStopsWhenEveryWorkerHasDiedAndNoRestartIsLeft) {
   const fs::path manifest = out / "manifest.sqlite";
   Process local({"local", "--workers", "1", "--config", (dir / "run.toml").string()}, (dir / "local").string());
   ASSERT_FALSE(wait_endpoint(out, local, 30s).empty()) << local.err();
-  // Kill the worker process (local's only child) each time one runs: the first and its 3 restarts. A child is listed
-  // under the thread that started it (the restarts: the supervisor's), so every thread's list is read.
-  const fs::path tasks = fs::path("/proc") / std::to_string(local.pid()) / "task";
-  int kills = 0;
-  const auto until = std::chrono::steady_clock::now() + 60s;
-  while (local.running() && std::chrono::steady_clock::now() < until) {
-    std::error_code ec;
-    for (const auto& task : fs::directory_iterator(tasks, ec)) {
-      std::istringstream pids(Process::slurp((task.path() / "children").string()));
-      for (pid_t pid = 0; pids >> pid;) kills += ::kill(pid, SIGKILL) == 0;
-    }
-    std::this_thread::sleep_for(20ms);
-  }
+  // Kill the worker process (local's only child) each time one runs: the first and its 3 restarts.
+  const int kills = signal_children_until_exit(local, SIGKILL, 20ms);
   ASSERT_EQ(local.wait(1s), 4) << local.err();
   EXPECT_GE(kills, 4);
   EXPECT_NE(local.err().find("every worker has died and the 3 restarts are spent"), std::string::npos) << local.err();
@@ -453,22 +460,13 @@ TEST(Service, LocalStopsWhenItsWorkersAreStoppedBySignals) {
   const fs::path manifest = out / "manifest.sqlite";
   Process local({"local", "--workers", "2", "--config", (dir / "run.toml").string()}, (dir / "local").string());
   ASSERT_FALSE(wait_endpoint(out, local, 30s).empty()) << local.err();
-  const fs::path tasks = fs::path("/proc") / std::to_string(local.pid()) / "task";
-  int stopped = 0;
-  const auto until = std::chrono::steady_clock::now() + 60s;
-  while (local.running() && std::chrono::steady_clock::now() < until) {
-    std::error_code ec;
-    for (const auto& task : fs::directory_iterator(tasks, ec)) {
-      std::istringstream pids(Process::slurp((task.path() / "children").string()));
-      for (pid_t pid = 0; pids >> pid;) stopped += ::kill(pid, SIGTERM) == 0;
-    }
-    std::this_thread::sleep_for(100ms);
-  }
+  const int stopped = signal_children_until_exit(local, SIGTERM, 100ms);
   ASSERT_EQ(local.wait(1s), 4) << local.err();
   EXPECT_GE(stopped, 2);
   EXPECT_NE(local.err().find("was stopped by a signal; not restarted"), std::string::npos) << local.err();
   EXPECT_EQ(local.err().find("starting another"), std::string::npos) << local.err();
-  EXPECT_NE(local.err().find("no worker is left (2 stopped by a signal)"), std::string::npos) << local.err();
+  EXPECT_NE(local.err().find("no worker is left (2 stopped by a signal, 0 could not be restarted)"), std::string::npos)
+      << local.err();
   EXPECT_NE(local.err().find("drapegen local --resume " + manifest.string()), std::string::npos) << local.err();
   check_manifest(manifest, 2);
 }
@@ -477,11 +475,14 @@ TEST(Service, LocalStopsWhenItsWorkersAreStoppedBySignals) {
 // would give up after a minute), so it is refused at once.
 TEST(Service, LocalRefusesAConfigurationWithKeys) {
   const fs::path dir = test_dir("local_keys");
-  write_text(dir / "run.toml", small_config(dir / "run", 2, 1, "[security]\ncurve = true\n"));
-  Process local({"local", "--workers", "1", "--config", (dir / "run.toml").string()}, (dir / "local").string());
-  ASSERT_EQ(local.wait(30s), 1) << local.err();
-  EXPECT_NE(local.err().find("drapegen local starts its workers without CurveZMQ keys"), std::string::npos)
-      << local.err();
+  for (const std::string security : {"curve = true\n", "server_secret_key = \"s.key\"\nauthorized_keys = \"a\"\n"}) {
+    write_text(dir / "run.toml", small_config(dir / "run", 2, 1, "[security]\n" + security));
+    Process local({"local", "--workers", "1", "--config", (dir / "run.toml").string()}, (dir / "local").string());
+    ASSERT_EQ(local.wait(30s), 1) << local.err();
+    EXPECT_NE(local.err().find("drapegen local starts its workers without CurveZMQ keys"), std::string::npos)
+        << local.err();
+    EXPECT_FALSE(fs::exists(dir / "run")) << "refused before the output is touched";
+  }
 }
 
 // An output that cannot be created (its parent a regular file) is the file system's failure: exit 3, as a result

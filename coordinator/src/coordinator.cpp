@@ -123,8 +123,9 @@ struct Coordinator::Impl {
   // ---------------------------------------------------------------------------------------------------------------
   // Setup
 
-  /// CurveZMQ: the server key on the ROUTER and a ZAP handler that admits only the authorised worker keys.
-  sim::Status setup_curve() {
+  /// The command line's CurveZMQ keys over the configuration's, and whether the workers can connect with them:
+  /// checked before the output is claimed or touched. `resumed`: the configuration is the manifest's stored one.
+  sim::Status merge_keys(bool resumed) {
     if (!options.server_secret_key.empty() || !options.authorized_keys.empty()) {
       if (options.server_secret_key.empty() || options.authorized_keys.empty()) {
         return sim::Error{"--server-key and --authorized-keys go together"};
@@ -133,15 +134,29 @@ struct Coordinator::Impl {
       config.authorized_keys = options.authorized_keys;
     }
     if (options.keyless_workers && (config.curve || !config.server_secret_key.empty())) {
-      return sim::Error{fmt::format("drapegen {} starts its workers without CurveZMQ keys, on loopback: remove the "
-                                    "[security] section from the configuration (or use drapegen run and start the "
-                                    "workers with --server-key and --key)",
+      if (resumed) {
+        return sim::Error{fmt::format(
+            "drapegen {} starts its workers without CurveZMQ keys, and this run's stored configuration has a "
+            "[security] section: continue it with drapegen run --resume {} --server-key FILE --authorized-keys FILE "
+            "and workers started with --server-key and --key",
+            options.command, manifest_path)};
+      }
+      return sim::Error{fmt::format("drapegen {} starts its workers without CurveZMQ keys, on loopback: remove "
+                                    "server_secret_key, authorized_keys and curve = true from the configuration's "
+                                    "[security] section (or use drapegen run and start the workers with "
+                                    "--server-key and --key)",
                                     options.command)};
     }
     if (config.curve && config.server_secret_key.empty()) {
       return sim::Error{"security.curve = true needs CurveZMQ keys: [security] server_secret_key and "
                         "authorized_keys, or --server-key and --authorized-keys"};
     }
+    return {};
+  }
+
+  /// CurveZMQ (where there are keys, after merge_keys): the server key on the ROUTER and a ZAP handler that admits
+  /// only the authorised worker keys.
+  sim::Status setup_curve() {
     if (config.server_secret_key.empty()) return {};
     auto attached = CurveServer::attach(context, socket, config.server_secret_key, config.authorized_keys);
     if (!attached) return attached.error();
@@ -818,6 +833,7 @@ sim::Expected<std::unique_ptr<Coordinator>> Coordinator::create(const std::strin
   impl->out_dir = config->output;
   impl->data_dir = config->output + "/data";
   impl->manifest_path = config->output + "/manifest.sqlite";
+  if (sim::Status s = impl->merge_keys(false); !s) return s.error();
   if (sim::Status s = impl->claim_output(); !s) return s.error();
   // Checked under the lock: no other coordinator creates it meanwhile.
   if (fs::exists(impl->manifest_path)) {
@@ -864,6 +880,7 @@ sim::Expected<std::unique_ptr<Coordinator>> Coordinator::resume(const std::strin
   impl->out_dir = manifest->reader().directory();
   impl->data_dir = impl->out_dir + "/data";
   impl->manifest = std::make_unique<storage::Manifest>(std::move(manifest).value());
+  if (sim::Status s = impl->merge_keys(true); !s) return s.error();
   // Before anything is removed: the files a live run has not yet recorded are not orphans.
   if (sim::Status s = impl->claim_output(); !s) return s.error();
   if (sim::Status s = impl->remove_orphans(); !s) return s.error();

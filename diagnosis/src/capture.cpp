@@ -8,6 +8,7 @@
 
 #include "drapegen/diagnosis/bending_json.hpp"
 #include "drapegen/diagnosis/depth_exr.hpp"
+#include "drapegen/sim/platform.hpp"
 #include "drapegen/storage/atomic_file.hpp"
 
 namespace drapegen::diagnosis {
@@ -192,9 +193,13 @@ sim::Expected<Capture> read_capture(const std::string& directory) {
       if (T->row(3) != Eigen::RowVector4d(0.0, 0.0, 0.0, 1.0)) {
         return sim::Error{what + ".world_to_camera: not a rigid transform (last row must be 0 0 0 1)"};
       }
-      if (T->topRightCorner(3, 1).norm() > kFarthestDepth) {
-        return sim::Error{fmt::format("{}.world_to_camera: the camera is more than {} m from the specimen", what,
-                                      kFarthestDepth)};
+      // The model must draw the whole scene: the farthest point of the specimen and the platform under it (half
+      // the specimen's diagonal out, the platform's height down) lies within kFarthestDepth of the camera.
+      const double reach = std::hypot(0.5 * std::hypot(c.specimen.size_x, c.specimen.size_y), sim::PlatformSpec{}.height);
+      if (const double farthest = kFarthestDepth - reach; T->topRightCorner(3, 1).norm() > farthest) {
+        return sim::Error{fmt::format("{}.world_to_camera: the camera is more than {:.2f} m from the specimen (the "
+                                      "model renders to {} m)",
+                                      what, farthest, kFarthestDepth)};
       }
       view.camera.world_to_camera.matrix() = *T;
       auto depth = read_depth_exr((dir / view.file).string());

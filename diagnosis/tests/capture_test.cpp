@@ -184,10 +184,12 @@ TEST(Capture, ACameraThatIsNoneIsAClearError) {
   EXPECT_NE(with("K", 1, 1, -300.0).find("must be positive"), std::string::npos);
   EXPECT_NE(with("world_to_camera", 3, 0, 0.5).find("last row must be 0 0 0 1"), std::string::npos);
   const std::string far = with("world_to_camera", 0, 3, 1000.0);
-  EXPECT_NE(far.find("views[1].world_to_camera: the camera is more than 10 m from the specimen"), std::string::npos)
+  EXPECT_NE(far.find("views[1].world_to_camera: the camera is more than 9.67 m from the specimen (the model renders "
+                     "to 10 m)"),
+            std::string::npos)
       << far;
   // 20 m: farther than the diagnosis's renderer draws, so its model could never be compared with the capture.
-  EXPECT_NE(with("world_to_camera", 0, 3, 20.0).find("the camera is more than 10 m"), std::string::npos);
+  EXPECT_NE(with("world_to_camera", 0, 3, 20.0).find("the camera is more than 9.67 m"), std::string::npos);
   // A skew that makes K singular: every back-projected ray would be non-finite.
   nlohmann::json singular = good;
   singular["views"][1]["K"][0][1] = good["views"][1]["K"][0][0];

@@ -71,6 +71,9 @@ sim::Error no_manifest_at(const std::string& path) {
 
 sim::Status check_schema(sqlite3* db, const std::string& path) {
   Statement st(db, "SELECT value FROM meta WHERE key = 'schema_version'");
+  // The first read of the file: where it fails, the file system may be the cause rather than the file.
+  if (!st.ok() && detail::file_system_error(db))
+    return sim::Error{fmt::format("cannot read manifest {}: {}", path, st.prepare_error()), /*io=*/true};
   if (!st.ok()) return sim::Error{fmt::format("{} is not a drapegen manifest ({})", path, st.prepare_error())};
   if (st.step() != SQLITE_ROW)
     return sim::Error{fmt::format("{} is not a drapegen manifest (no schema version)", path)};
@@ -122,8 +125,10 @@ namespace {
 
 /// SQLite's URI for reading `path` as an immutable file: no -shm to create, no lock to take.
 std::string immutable_uri(const std::string& path) {
-  std::string uri = "file:";
-  for (const char c : std::filesystem::absolute(path).string()) {
+  std::error_code ec;
+  const std::filesystem::path absolute = std::filesystem::absolute(path, ec);
+  std::string uri = "file://";  // an empty authority, then the absolute path ("//host/x" would name a host)
+  for (const char c : (ec ? std::filesystem::path(path) : absolute).string()) {
     if (c == '%' || c == '?' || c == '#') {
       uri += fmt::format("%{:02X}", static_cast<unsigned char>(c));
     } else {

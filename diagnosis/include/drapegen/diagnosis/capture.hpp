@@ -51,7 +51,7 @@ struct Capture {
 constexpr int kCaptureViews = 4;
 /// m: no depth and no camera of a drape tester lies farther than this from the specimen (a depth beyond it is a
 /// sensor's "no return" sentinel, or another unit); the farthest depth the diagnosis's renderer draws
-/// (renderer::DepthRange's far plane), so every capture it accepts its model can render.
+/// (renderer::DepthRange's far plane): a camera is accepted where the whole specimen and platform lie within it.
 constexpr double kFarthestDepth = 10.0;
 
 /// Reads DIR/capture.json and its depth files. Every failure is one line naming the file and the problem: missing
