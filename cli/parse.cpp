@@ -1,5 +1,6 @@
 #include "parse.hpp"
 
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -87,6 +88,14 @@ sim::Expected<sim::PhysicalEffects> parse_effects(const std::vector<std::string>
 sim::Status check_writable(const std::string& path) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) return sim::Error{"cannot write '" + path + "': it is a directory"};
+  // An existing device or pipe (/dev/stdout, /dev/null, a FIFO) is written in place: open it, as the write will (a
+  // probe beside it, in /dev, needs rights the write does not). No reader on a FIFO yet (ENXIO) is not an error.
+  if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec)) {
+    const int fd = ::open(path.c_str(), O_WRONLY | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0 && errno != ENXIO) return sim::Error{"cannot write '" + path + "': " + std::strerror(errno)};
+    if (fd >= 0) ::close(fd);
+    return {};
+  }
   // A unique probe beside the target (never touches an existing file), removed again.
   std::string probe = path + ".probe-XXXXXX";
   const int fd = ::mkstemp(probe.data());

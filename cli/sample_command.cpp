@@ -236,7 +236,8 @@ int run(const SampleOptions& o) {
   if (o.n <= 0) return fail(fmt::format("--n must be positive, got {}", o.n));
   if (o.n > 10'000'000) return fail("--n must be at most 10000000");
   if (!(o.range_margin >= 0.0 && o.range_margin <= 10.0)) return fail("--range-margin must be 0..10");
-  if (!(o.duplicate_distance >= 0.0 && o.duplicate_distance <= 10.0)) return fail("--duplicate-distance must be 0..10");
+  if (!(o.duplicate_distance == 0.0 || (o.duplicate_distance >= 1e-6 && o.duplicate_distance <= 10.0)))
+    return fail("--duplicate-distance must be 0 (off) or 1e-6..10");
   if (o.states < 1 || o.states > sampler::kMaxStatesPerSample) {
     return fail(fmt::format("--states must be 1..{}, got {}", sampler::kMaxStatesPerSample, o.states));
   }

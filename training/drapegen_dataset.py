@@ -30,7 +30,7 @@ def features(moduli, density):
     out = []
     for k in moduli:
         k = k * STANDARD_DENSITY / density
-        out.append(math.copysign(math.log(abs(k)), k))
+        out.append(math.copysign(1.0, k) * math.log(abs(k)))  # sign(k) ln|k|, negative where |k| < 1
     return out
 
 

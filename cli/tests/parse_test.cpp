@@ -1,4 +1,7 @@
 #include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <string>
 
 #include "parse.hpp"
 
@@ -33,6 +36,19 @@ TEST(CheckWritable, ReportsMissingDirectory) {
   const auto s = check_writable("/nonexistent-dir/x.ply");
   ASSERT_FALSE(s);
   EXPECT_NE(s.error().message.find("/nonexistent-dir/x.ply"), std::string::npos);
+}
+
+TEST(CheckWritable, TakesAnExistingDeviceOrPipeAsItIs) {
+  // `--out /dev/stdout` into a pipe: written in place, so no probe file is made beside it (/proc/self/fd, like /dev
+  // for a user, takes none).
+  int fds[2];
+  ASSERT_EQ(::pipe(fds), 0);
+  const std::string pipe_path = "/proc/self/fd/" + std::to_string(fds[1]);
+  const auto s = check_writable(pipe_path);
+  EXPECT_TRUE(s) << s.error().message;
+  ::close(fds[0]);
+  ::close(fds[1]);
+  EXPECT_TRUE(check_writable("/dev/null"));
 }
 
 TEST(ParseEffects, EveryEffectAndItsErrors) {

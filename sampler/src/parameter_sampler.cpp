@@ -21,8 +21,10 @@ sim::Status validate(const SamplerOptions& o) {
     return sim::Error{"sigma range must satisfy 0 < low <= high"};
   }
   if (!(o.range_margin >= 0.0) || !std::isfinite(o.range_margin)) return sim::Error{"range margin must be >= 0"};
-  if (!(o.duplicate_distance >= 0.0) || !std::isfinite(o.duplicate_distance)) {
-    return sim::Error{"duplicate distance must be >= 0"};
+  // Off (0) or at least 1e-6: the duplicate index's grid cells are the distance wide, and a smaller one would put
+  // cell coordinates beyond any integer.
+  if (!(o.duplicate_distance == 0.0 || (o.duplicate_distance >= 1e-6 && std::isfinite(o.duplicate_distance)))) {
+    return sim::Error{"duplicate distance must be 0 (off) or at least 1e-6"};
   }
   if (o.max_candidates_per_sample < 1) return sim::Error{"max candidates per sample must be >= 1"};
   return {};

@@ -146,6 +146,12 @@ TEST(ParameterSampler, BadOptionsAreErrors) {
   o = {};
   o.range_margin = -1;
   EXPECT_FALSE(sample_parameters(model, o));
+  // A duplicate distance so small its grid cells' coordinates would overflow an integer: refused, not undefined.
+  o = {};
+  o.duplicate_distance = 1e-19;
+  const auto tiny = sample_parameters(model, o);
+  ASSERT_FALSE(tiny);
+  EXPECT_NE(tiny.error().message.find("duplicate distance must be 0 (off) or at least 1e-6"), std::string::npos);
   // An empty accepted range: every candidate is rejected and the sampler gives up with an explanation.
   VaeModel narrow = model;
   narrow.range_low = narrow.range_high = Features{50, 50, 50, 50, 50, 50};

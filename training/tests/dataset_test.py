@@ -3,6 +3,7 @@
 Usage: dataset_test.py DRAPEGEN_BINARY WORK_DIR
 """
 
+import math
 import os
 import shutil
 import sqlite3
@@ -59,6 +60,10 @@ assert np.allclose(targets.mean(axis=0), 0.0, atol=1e-5), targets.mean(axis=0)
 row = db.execute("SELECT alpha_warp, alpha_bias, alpha_weft, beta_warp, beta_bias, beta_weft, density "
                  "FROM samples WHERE sample = ?", (ds.items[0]["sample"],)).fetchone()
 assert np.allclose(ds.denormalise(target.numpy()), features(row[:6], row[6]), atol=1e-5)
+# The feature map is the sampler's, sign(k) ln|k| at 300 g/m^2, also where |k| < 1 (ln|k| < 0).
+assert np.allclose(features([0.5, -0.5, 2.0, -2.0, 600.0, 1.0], 300.0),
+                   [math.log(0.5), -math.log(0.5), math.log(2.0), -math.log(2.0), math.log(600.0), 0.0])
+assert np.allclose(features([0.5], 150.0), [0.0])  # at 150 g/m^2: k = 0.5 * 300 / 150 = 1 at 300 g/m^2
 db.close()  # the last connection: no log or shared-memory file left beside the manifest, as after a finished run
 
 # Two orientations of one drape differ (other table angles), the same item read twice does not.

@@ -9,7 +9,12 @@ PY=/usr/bin/python3
 T=training/vae
 DIR=$T/results/crossval
 args=("$@")
-for ((i = 0; i < ${#args[@]}; ++i)); do [[ ${args[i]} == --dir ]] && DIR=${args[i + 1]}; done
+for ((i = 0; i < ${#args[@]}; ++i)); do
+  case ${args[i]} in
+    --dir) DIR=${args[i + 1]} ;;
+    --dir=*) DIR=${args[i]#--dir=} ;;
+  esac
+done
 mkdir -p "$DIR"
 : > "$DIR/wall.txt"
 for fold in 0 1 2 3 4; do

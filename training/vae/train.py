@@ -88,11 +88,27 @@ def main():
     m, s = x[tr].mean(0), x[tr].std(0)
     logdet = float(np.log(s).sum())
     export_name, export_path = (args.export.split("=", 1) if args.export else (None, None))
+    # Checked before any training: a request that would be dropped, or a path found unwritable only afterwards.
+    names = args.models.split(",")
+    unknown = [n for n in names if not n.startswith("GMM-") and n not in vae.ARCHITECTURES]
+    if unknown:
+        log(f"train.py: error: unknown model(s) {', '.join(unknown)} (GMM-K or one of {', '.join(vae.ARCHITECTURES)})")
+        return 1
+    if args.export and (export_path is None or export_name not in vae.ARCHITECTURES or export_name not in names):
+        log(f"train.py: error: --export NAME=PATH needs NAME to be a VAE in --models ({args.export!r})")
+        return 1
+    if args.checkpoint and not args.export:
+        log("train.py: error: --checkpoint saves the exported VAE: it needs --export")
+        return 1
+    for path in (export_path, args.checkpoint, args.results):
+        if path and not os.access(os.path.dirname(os.path.abspath(path)), os.W_OK):
+            log(f"train.py: error: cannot write {path}: its directory is missing or not writable")
+            return 1
     log(f"{len(x)} distinct fabrics: {len(tr)} train, {len(va)} validation (seed {args.seed})")
     results = {"seed": args.seed, "epochs": args.epochs, "iw_samples": args.iw_samples,
                "generated": args.generated, "distinct_fabrics": len(x), "train": len(tr), "validation": len(va),
                "models": {}}
-    for name in args.models.split(","):
+    for name in names:
         t0 = time.time()
         if name.startswith("GMM-"):
             k = int(name[4:])
