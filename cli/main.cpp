@@ -61,7 +61,13 @@ int main(int argc, char** argv) {
   for (const auto& [sub, run] : runners) {
     if (!sub->parsed()) continue;
     try {
-      return run();
+      const int code = run();
+      // What a command printed (a summary, --json) is an output too: lost to a full disk or a closed pipe, exit 3.
+      if (!std::cout.flush()) {
+        std::cerr << "drapegen " << sub->get_name() << ": error: cannot write the standard output\n";
+        return drapegen::cli::kExitIo;
+      }
+      return code;
     } catch (const std::bad_alloc&) {
       // The commands that take a mesh resolution can be told how to need less.
       const bool meshed = sub->get_option_no_throw("--resolution") != nullptr;

@@ -78,7 +78,7 @@ int run_simulate(const SimulateOptions& o) {
   const auto beta = parse_directional(o.beta, "--beta");
   if (!beta) return fail(beta.error().message);
   if (!(o.density >= 1.0 && o.density <= 1e5)) return fail("--density must be between 1 and 100000 g/m^2");
-  if (o.resolution < 3 || o.resolution > 1000) return fail("--resolution must be between 3 and 1000");
+  if (o.resolution < 5 || o.resolution > 1000) return fail("--resolution must be between 5 and 1000");
   auto initial = sim::parse_initial_state(o.init);
   if (!initial) return fail(initial.error().message);
   const auto drift = parse_drift(o.drift, o.seed);
@@ -222,7 +222,8 @@ Runner add_simulate_command(CLI::App& app) {
                      },
                      "Triangulation: perturbed (the default: the paper's random diagonals and jittered vertices), "
                      "union-jack (alternating diagonals), uniform (every quad split along the same diagonal) or "
-                     "equilateral (rows of equilateral triangles)")
+                     "equilateral (rows of nearly equilateral triangles, odd rows offset by half a spacing; the row spacing is the "
+                     "column spacing, so 53/63/63 degrees)")
                    ->check(CLI::IsMember(mesh_names));
   app.add_flag("--structured", o->structured, "Shorthand for --mesh union-jack")->excludes(mesh);
   app.add_option("--max-iterations", o->max_iterations, "Newton iteration limit")->capture_default_str();

@@ -49,6 +49,15 @@ set(expect_said "unknown command 'frobnicate'; the commands: simulate")
 expect_failure(1 frobnicate)
 unset(expect_said)
 expect_failure(1 simulate --alpha 1000 --resolution 2)
+expect_failure(1 simulate --alpha 1000 --resolution 4)  # below 5: no vertex on the platform top at all
+# The summary is an output too: a full disk (/dev/full) under the standard output is exit 3, not a silent 0.
+if(EXISTS /dev/full)
+  execute_process(COMMAND ${DRAPEGEN} sample --n 3 --seed 1 --out ${WORK}/full_params.csv --json
+                  OUTPUT_FILE /dev/full RESULT_VARIABLE code ERROR_VARIABLE err)
+  if(NOT code EQUAL 3 OR NOT err MATCHES "cannot write the standard output")
+    message(FATAL_ERROR "a summary written to a full disk: exit ${code}, ${err}")
+  endif()
+endif()
 set(expect_said "--coarse-start must be 0 (off) or at least 3")
 expect_failure(1 simulate --alpha 1000 --coarse-start 2)
 set(expect_said "--lagged-updates must be 1..1000")

@@ -135,8 +135,8 @@ Expected<DrapeResult> simulate_drape(const DrapeConfig& config,
       }
     }
     // A ramped load: the steps before the last solve under a fraction of gravity, carrying the lagged state along.
-    // A step that diverges (or ends with a non-finite residual or energy, which the next step could not start from)
-    // ends the drape there with its report, as a single solve that does so ends with its own.
+    // Each step is solved to equilibrium: one that does not converge ends the drape there with its report (the
+    // loading history would not be the one asked for), as a single solve that does not ends with its own.
     SolveReport ramp;
     bool ramp_diverged = false;
     for (int step = 1; step < config.load_steps && !ramp_diverged; ++step) {
@@ -145,7 +145,7 @@ Expected<DrapeResult> simulate_drape(const DrapeConfig& config,
       std::replace(step_terms.begin(), step_terms.end(), static_cast<EnergyTerm*>(&gravity),
                    static_cast<EnergyTerm*>(&partial));
       SolveReport report = solver.solve(step_terms, fixed, partial.vertex_weights().maxCoeff(), x);
-      if (report.outcome == SolveOutcome::kDiverged || !std::isfinite(report.residual) ||
+      if (report.outcome != SolveOutcome::kConverged || !std::isfinite(report.residual) ||
           !std::isfinite(report.energy)) {
         report.message = fmt::format("load step {} of {}: {}", step, config.load_steps, report.message);
         report.add_work(ramp);

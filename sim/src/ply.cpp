@@ -1,6 +1,7 @@
 #include "drapegen/sim/ply.hpp"
 
-#include <unistd.h>  // fsync, getpid
+#include <sys/stat.h>  // stat: a device or pipe is written in place
+#include <unistd.h>    // fsync, getpid
 
 #include <algorithm>
 #include <array>
@@ -11,6 +12,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <filesystem>
 #include <limits>
 #include <optional>
 #include <string>
@@ -311,6 +313,10 @@ Expected<Layout> find_layout(const Header& header, std::size_t data_bytes) {
   if (vertex.count > kMaxCount || face.count > kMaxCount) return Error{"bad header: too many vertices or faces"};
   // Every item of an element with properties takes at least one byte; this bounds the allocations below.
   for (const Element& element : header.elements) {
+    if (element.properties.empty() && element.count > kMaxCount) {  // nothing to read, but one loop turn each
+      return Error{"bad header: the '" + element.name + "' element declares " + std::to_string(element.count) +
+                   " items"};
+    }
     if (!element.properties.empty() && static_cast<std::uint64_t>(element.count) > data_bytes) {
       return Error{"truncated data: the header declares " + std::to_string(element.count) + " '" + element.name +
                    "' items but only " + std::to_string(data_bytes) + " bytes of data follow"};
@@ -350,6 +356,8 @@ class BinaryReader {
   }
 
   [[nodiscard]] const std::string& problem() const { return problem_; }
+  /// Bytes after the last value read.
+  [[nodiscard]] std::size_t unread() const { return data_.size() - pos_; }
 
  private:
   std::string_view data_;
@@ -385,6 +393,15 @@ class AsciiReader {
   }
 
   [[nodiscard]] const std::string& problem() const { return problem_; }
+  /// Bytes after the last value read other than whitespace.
+  [[nodiscard]] std::size_t unread() const {
+    std::size_t n = 0;
+    for (std::size_t i = pos_; i < data_.size(); ++i) {
+      const char c = data_[i];
+      n += !(c == ' ' || c == '\t' || c == '\n' || c == '\r');
+    }
+    return n;
+  }
 
  private:
   std::string_view data_;
@@ -481,7 +498,23 @@ Expected<std::string> read_file(const std::string& path) {
 
 /// Writes `bytes` to a temporary file of its own beside `path` (`path.tmp.PID.N`: writers racing for one path never
 /// share it), syncs it and renames it over `path`.
-Status write_file_atomically(const std::string& path, const std::string& bytes) {
+Status write_file_atomically(const std::string& given, const std::string& bytes) {
+  // A device or pipe (/dev/stdout, /dev/null, a FIFO) is written in place: a rename would replace it with a file.
+  // A symbolic link is followed: the file it names is replaced, not the link.
+  struct stat st {};
+  if (::stat(given.c_str(), &st) == 0 && !S_ISREG(st.st_mode) && !S_ISDIR(st.st_mode)) {
+    std::FILE* out = std::fopen(given.c_str(), "wb");
+    if (out == nullptr) return Error{"write_ply: '" + given + "': cannot open: " + system_reason(errno)};
+    const bool written = std::fwrite(bytes.data(), 1, bytes.size(), out) == bytes.size();
+    const int write_errno = errno;
+    if (std::fclose(out) != 0 || !written)
+      return Error{"write_ply: '" + given + "': cannot write: " + system_reason(written ? errno : write_errno)};
+    return {};
+  }
+  std::error_code ec;  // no such file: not a link, written as named
+  const bool link = std::filesystem::is_symlink(std::filesystem::symlink_status(given, ec));
+  const std::string path = link ? std::filesystem::weakly_canonical(given, ec).string() : given;
+  if (link && ec) return Error{"write_ply: '" + given + "': cannot follow the link: " + ec.message()};
   static std::atomic<std::uint64_t> counter{0};
   const std::string temporary = path + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(counter++);
   auto fail = [&](const std::string& what, int error_number) {
@@ -562,13 +595,22 @@ Expected<ClothMesh> read_ply(const std::string& path) {
   const Expected<Layout> layout = find_layout(*header, data.size());
   if (!layout) return prefixed(layout.error());
 
+  // The data must end where the header's counts say: more (a count too small) would drop part of the mesh unseen.
+  auto read_all = [&](auto& reader) -> Expected<ClothMesh> {
+    Expected<ClothMesh> body = read_body(*header, *layout, reader);
+    if (body && reader.unread() > 0) {
+      return Error{"trailing data: " + std::to_string(reader.unread()) +
+                   " bytes follow the last item the header declares (an element count too small?)"};
+    }
+    return body;
+  };
   Expected<ClothMesh> mesh = Error{};
   if (header->format == Format::kAscii) {
     AsciiReader reader(data);
-    mesh = read_body(*header, *layout, reader);
+    mesh = read_all(reader);
   } else {
     BinaryReader reader(data);
-    mesh = read_body(*header, *layout, reader);
+    mesh = read_all(reader);
   }
   if (!mesh) return prefixed(mesh.error());
   return mesh;

@@ -103,6 +103,21 @@ TEST(Ply, WriteReplacesAnExistingFile) {
   EXPECT_EQ(read->triangle_count(), mesh.triangle_count());
 }
 
+TEST(Ply, WritesAPipeInPlace) {
+  // `simulate --out /dev/stdout` into a pipe: the PLY goes down the pipe, no file is renamed over it.
+  int fds[2];
+  ASSERT_EQ(::pipe(fds), 0);
+  const std::string pipe_path = "/proc/self/fd/" + std::to_string(fds[1]);
+  const Status s = write_ply(pipe_path, sample_mesh());  // a few hundred bytes: within the pipe's buffer
+  ASSERT_TRUE(s.ok()) << s.error().message;
+  ::close(fds[1]);
+  std::string got;
+  char chunk[4096];
+  for (ssize_t n; (n = ::read(fds[0], chunk, sizeof chunk)) > 0;) got.append(chunk, static_cast<std::size_t>(n));
+  ::close(fds[0]);
+  EXPECT_EQ(got.rfind("ply\nformat binary_little_endian 1.0\n", 0), 0u);
+}
+
 TEST(Ply, ReadsAsciiWithoutRestCoordinates) {
   const std::string path = temp_path("ascii.ply");
   write_text(path,
@@ -199,6 +214,18 @@ TEST(Ply, TruncatedBinaryFileIsAnError) {
 TEST(Ply, TruncatedAsciiFileIsAnError) {
   expect_read_error("truncated_ascii.ply", std::string(kAsciiHeader) + "0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2",
                     "truncated");
+}
+
+TEST(Ply, DataBeyondTheDeclaredCountsIsAnError) {
+  // A face count too small (a hand-edited file): the second face would be dropped unseen, a hole in the drape.
+  std::string one_face = kAsciiHeader;
+  one_face.replace(one_face.find("element face 2"), 14, "element face 1");
+  expect_read_error("face_count_small.ply", one_face + "0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n",
+                    "trailing data");
+  // An element without properties whose count no loop should run through.
+  std::string junk = kAsciiHeader;
+  junk.replace(junk.find("end_header"), 10, "element junk 9223372036854775807\nend_header");
+  expect_read_error("junk_count.ply", junk + "0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n", "bad header");
 }
 
 TEST(Ply, IndexOutOfRangeIsAnError) {

@@ -1,6 +1,7 @@
 #include "drapegen/storage/atomic_file.hpp"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <fmt/format.h>
@@ -10,6 +11,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 
 namespace drapegen::storage {
 namespace {
@@ -25,7 +27,39 @@ std::string temporary_path(const std::string& path) {
   return fmt::format("{}.tmp.{}.{}", path, ::getpid(), counter.fetch_add(1));
 }
 
-sim::Status write_file_atomic(const std::string& path, std::string_view bytes, unsigned mode) {
+namespace {
+
+/// Writes `bytes` to an existing device or pipe as it is (no temporary, no rename, no sync: /dev/null takes none).
+sim::Status write_in_place(const std::string& path, std::string_view bytes) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_NOCTTY | O_CLOEXEC);
+  if (fd < 0) return os_error("cannot open", path);
+  for (std::size_t done = 0; done < bytes.size();) {
+    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) {
+      sim::Error e = os_error("cannot write", path);
+      ::close(fd);
+      return e;
+    }
+    done += static_cast<std::size_t>(n);
+  }
+  if (::close(fd) != 0) return os_error("cannot close", path);
+  return {};
+}
+
+}  // namespace
+
+sim::Status write_file_atomic(const std::string& given, std::string_view bytes, unsigned mode) {
+  // A device or pipe (/dev/stdout, /dev/null, a FIFO) is written in place: a rename would replace it with a file.
+  // A symbolic link is followed: the file it names is replaced, not the link.
+  struct stat st {};
+  if (::stat(given.c_str(), &st) == 0 && !S_ISREG(st.st_mode) && !S_ISDIR(st.st_mode)) {
+    return write_in_place(given, bytes);
+  }
+  std::error_code ec;  // no such file: not a link, written as named
+  const bool link = std::filesystem::is_symlink(std::filesystem::symlink_status(given, ec));
+  const std::string path = link ? std::filesystem::weakly_canonical(given, ec).string() : given;
+  if (link && ec) return sim::Error{fmt::format("cannot follow the link {}: {}", given, ec.message()), /*io=*/true};
   // O_EXCL: the file is new, this call's alone, and has `mode` from its first byte. A name can still exist: left by
   // a crashed process that had this PID (a restarted container), or by one on another host sharing the directory;
   // the next name is tried then.

@@ -70,6 +70,32 @@ TEST(AtomicFile, WritesAndChecksums) {
   fs::remove_all(dir);
 }
 
+TEST(AtomicFile, WritesADeviceOrPipeInPlaceAndFollowsALink) {
+  // --out /dev/stdout into a pipe: the bytes go down the pipe; a rename over /proc/self/fd/N would fail (or, for
+  // /dev/stdout as root, replace the device link with a file).
+  int fds[2];
+  ASSERT_EQ(::pipe(fds), 0);
+  const std::string pipe_path = "/proc/self/fd/" + std::to_string(fds[1]);
+  const auto s = write_file_atomic(pipe_path, "through the pipe");
+  ASSERT_TRUE(s) << s.error().message;
+  char got[32] = {};
+  ASSERT_EQ(::read(fds[0], got, sizeof got), 16);
+  EXPECT_EQ(std::string(got, 16), "through the pipe");
+  ::close(fds[0]);
+  ::close(fds[1]);
+  // A symbolic link: its target is replaced, the link stays a link.
+  const auto dir = std::filesystem::path(::testing::TempDir()) / ("atomic_link_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "target") << "old";
+  std::filesystem::remove(dir / "link");
+  std::filesystem::create_symlink(dir / "target", dir / "link");
+  ASSERT_TRUE(write_file_atomic((dir / "link").string(), "new"));
+  EXPECT_TRUE(std::filesystem::is_symlink(dir / "link"));
+  std::ifstream in(dir / "target");
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}), "new");
+  std::filesystem::remove_all(dir);
+}
+
 TEST(AtomicFile, TemporaryNamesAreDistinctAndLeftOnesAreSkipped) {
   const std::string a = temporary_path("/x/y.exr"), b = temporary_path("/x/y.exr");
   EXPECT_NE(a, b);

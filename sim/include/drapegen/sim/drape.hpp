@@ -56,9 +56,9 @@ struct DrapeConfig {
   int coarse_start_resolution = 25;
   /// Gravity ramped in this many equal steps, each solved to equilibrium from the last (1: all at once). A loading
   /// history for the lagged effects (plastic flow) that does not follow the Newton path of one solve; experimental
-  /// (docs/PHYSICS.md, "Bending plasticity"). More than 1 turns the coarse start off. A step that diverges, or ends
-  /// with a non-finite residual or energy, ends the drape there: the report is that step's (its message names the
-  /// step) with the earlier steps' work, as one solve that does so ends with its own report.
+  /// (docs/PHYSICS.md, "Bending plasticity"). More than 1 turns the coarse start off. A step that does not converge
+  /// ends the drape there: the report is that step's (its message names the step) with the earlier steps' work, as
+  /// one solve that does not converge ends with its own report.
   int load_steps = 1;
 };
 

@@ -15,7 +15,9 @@ namespace drapegen::storage {
 /// PID, earlier or on another host, may have used it: write_file_atomic creates it exclusively and moves on if so.)
 [[nodiscard]] std::string temporary_path(const std::string& path);
 /// Writes `bytes` to `path` atomically (tmp, fsync, rename), the file created with `mode` (less the umask) from the
-/// start. Errors name the path and the OS error (e.g. "No space left on device", "Permission denied").
+/// start. Errors name the path and the OS error (e.g. "No space left on device", "Permission denied"). An existing
+/// device or pipe (/dev/stdout, a FIFO) is written in place instead; a symbolic link is followed (its target is
+/// replaced, not the link).
 [[nodiscard]] sim::Status write_file_atomic(const std::string& path, std::string_view bytes, unsigned mode = 0644);
 /// fsync of a directory, so that renames into it are durable.
 [[nodiscard]] sim::Status sync_directory(const std::string& directory);
