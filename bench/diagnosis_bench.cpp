@@ -128,8 +128,9 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0, 100));
   double measured_bending_error = 0.0;
   app.add_option("--measured-bending-error", measured_bending_error,
-                 "SIGMA in 0.001 .. 1: every capture carries a measured bending, as drapegen reality --measured-bending-error "
-                 "SIGMA writes it (the true fabric times e^(SIGMA g) per parameter, stated within e^(2 SIGMA)); "
+                 "SIGMA in 0.001 .. 1: every capture carries a measured bending, as drapegen reality "
+                 "--measured-bending-error SIGMA writes it (the true fabric times e^(SIGMA g) per parameter, stated "
+                 "within e^(2 SIGMA)); "
                  "captures generated without one get it from their truth file (the same draw); diagnose with "
                  "--diagnose-args --ignore-measured-bending for the protocol without it (default 0: none)")
       ->capture_default_str()

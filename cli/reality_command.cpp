@@ -51,7 +51,8 @@ int run_reality(const RealityOptions& o) {
   spec.noise = o.noise;
   if (const double s = o.measured_bending_error;
       !(s == 0.0 || (s >= diagnosis::kMinMeasuredBendingError && s <= 1.0))) {
-    return fail(fmt::format("--measured-bending-error must be 0 (none) or {:g} .. 1", diagnosis::kMinMeasuredBendingError));
+    return fail(
+        fmt::format("--measured-bending-error must be 0 (none) or {:g} .. 1", diagnosis::kMinMeasuredBendingError));
   }
   spec.measured_bending_error = o.measured_bending_error;
   for (const auto& text : o.effects) {
@@ -103,10 +104,10 @@ Runner add_reality_command(CLI::App& app) {
       ->required();
   app.add_flag("!--no-noise", o->noise, "Clean depth (no sensor noise)");
   app.add_option("--measured-bending-error", o->measured_bending_error,
-                 "SIGMA in 0.001 .. 1: the capture carries a measured bending, as a bending test (e.g. a cantilever) of this "
-                 "precision would report it: each of --alpha/--beta times its own e^(SIGMA g), g standard normal, the "
-                 "same on every placement, stated within a factor e^(2 SIGMA) (docs/CAPTURE.md, \"Measured bending\"; "
-                 "default 0: none)");
+                 "SIGMA in 0.001 .. 1: the capture carries a measured bending, as a bending test (e.g. a cantilever) "
+                 "of this precision would report it: each of --alpha/--beta times its own e^(SIGMA g), g standard "
+                 "normal, the same on every placement, stated within a factor e^(2 SIGMA) (docs/CAPTURE.md, "
+                 "\"Measured bending\"; default 0: none)");
   app.add_flag("--json", o->json, "Print the summary as JSON");
   return [o] { return run_reality(*o); };
 }

@@ -47,8 +47,8 @@ int report_run(const coordinator::RunSummary& s, const std::string& manifest, co
                                sub, s.done, s.failed, s.total, manifest);
       return kExitStopped;
     case coordinator::RunOutcome::kStorageError:
-      std::cerr << fmt::format("drapegen {0}: error: {1} (stopped with {2} of {3} jobs recorded; fix it, then: drapegen "
-                               "{0} --resume {4})\n",
+      std::cerr << fmt::format("drapegen {0}: error: {1} (stopped with {2} of {3} jobs recorded; fix it, then: "
+                               "drapegen {0} --resume {4})\n",
                                sub, s.message, s.done + s.failed, s.total, manifest);
       return kExitIo;
   }

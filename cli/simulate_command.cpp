@@ -222,8 +222,8 @@ Runner add_simulate_command(CLI::App& app) {
                      },
                      "Triangulation: perturbed (the default: the paper's random diagonals and jittered vertices), "
                      "union-jack (alternating diagonals), uniform (every quad split along the same diagonal) or "
-                     "equilateral (rows of nearly equilateral triangles, odd rows offset by half a spacing; the row spacing is the "
-                     "column spacing, so 53/63/63 degrees)")
+                     "equilateral (rows of nearly equilateral triangles, odd rows offset by half a spacing; the row "
+                     "spacing is the column spacing, so 53/63/63 degrees)")
                    ->check(CLI::IsMember(mesh_names));
   app.add_flag("--structured", o->structured, "Shorthand for --mesh union-jack")->excludes(mesh);
   app.add_option("--max-iterations", o->max_iterations, "Newton iteration limit")->capture_default_str();

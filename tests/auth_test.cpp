@@ -84,7 +84,8 @@ TEST(Service, CurveRefusesUnauthorisedWorkers) {
   EXPECT_EQ(open.wait(30s), 1);
   EXPECT_NE(open.err().find("without authentication"), std::string::npos) << open.err();
   // curve = true with no keys in the file: refused without keys, served with them from the command line.
-  write_text(dir / "cli_keys.toml", small_config(dir / "cli_keys", 1, 1, "[security]\ncurve = true\n[testing]\nmode = \"noop\"\n"));
+  write_text(dir / "cli_keys.toml",
+             small_config(dir / "cli_keys", 1, 1, "[security]\ncurve = true\n[testing]\nmode = \"noop\"\n"));
   Process keyless({"run", "--config", (dir / "cli_keys.toml").string()}, (dir / "keyless").string());
   EXPECT_EQ(keyless.wait(30s), 1);
   EXPECT_NE(keyless.err().find("security.curve = true needs CurveZMQ keys"), std::string::npos) << keyless.err();

@@ -143,7 +143,9 @@ sim::Expected<Capture> read_capture(const std::string& directory) {
     }
     if (!(c.specimen.cylinder_diameter >= 0.01 &&
           c.specimen.cylinder_diameter < std::min(c.specimen.size_x, c.specimen.size_y))) {
-      return sim::Error{fmt::format("{}: cylinder diameter must be at least 10 mm and less than the specimen size (the specimen overhangs it)", where)};
+      return sim::Error{fmt::format(
+          "{}: cylinder diameter must be at least 10 mm and less than the specimen size (the specimen overhangs it)",
+          where)};
     }
     if (s.contains("measured_bending") && !s["measured_bending"].is_null()) {
       auto measured = measured_bending_from(s["measured_bending"], where + ": specimen.measured_bending");
@@ -181,7 +183,8 @@ sim::Expected<Capture> read_capture(const std::string& directory) {
       }
       // With the last row 0 0 1, K is invertible where its upper left 2x2 is (a mistyped skew can make it singular).
       if (std::abs(K->topLeftCorner(2, 2).determinant()) < 1e-9 * (*K)(0, 0) * (*K)(1, 1)) {
-        return sim::Error{what + ".K: singular (its upper left 2x2 has no inverse: check the skew K[0][1] and K[1][0])"};
+        return sim::Error{what +
+                          ".K: singular (its upper left 2x2 has no inverse: check the skew K[0][1] and K[1][0])"};
       }
       view.camera.intrinsics.K = *K;
       auto T = matrix_from(jv.at("world_to_camera"), 4, 4, what + ".world_to_camera");
@@ -195,7 +198,8 @@ sim::Expected<Capture> read_capture(const std::string& directory) {
       }
       // The model must draw the whole scene: the farthest point of the specimen and the platform under it (half
       // the specimen's diagonal out, the platform's height down) lies within kFarthestDepth of the camera.
-      const double reach = std::hypot(0.5 * std::hypot(c.specimen.size_x, c.specimen.size_y), sim::PlatformSpec{}.height);
+      const double reach =
+          std::hypot(0.5 * std::hypot(c.specimen.size_x, c.specimen.size_y), sim::PlatformSpec{}.height);
       if (const double farthest = kFarthestDepth - reach; T->topRightCorner(3, 1).norm() > farthest) {
         return sim::Error{fmt::format("{}.world_to_camera: the camera is more than {:.2f} m from the specimen (the "
                                       "model renders to {} m)",

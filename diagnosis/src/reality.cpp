@@ -196,7 +196,8 @@ sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std
   const auto start = std::chrono::steady_clock::now();
   if (spec.resolution < 5 || spec.resolution > 200) return sim::Error{"resolution must be 5 .. 200"};
   if (const double s = spec.measured_bending_error; !(s == 0.0 || (s >= kMinMeasuredBendingError && s <= 1.0))) {
-    return sim::Error{fmt::format("the measured bending's error must be 0 (none) or {:g} .. 1", kMinMeasuredBendingError)};
+    return sim::Error{
+        fmt::format("the measured bending's error must be 0 (none) or {:g} .. 1", kMinMeasuredBendingError)};
   }
   if (spec.placement < 0 || spec.placement > kMaxPlacement) {
     return sim::Error{fmt::format("placement must be 0 .. {}", kMaxPlacement)};

@@ -88,7 +88,8 @@ sim::Status write_preview_png(const std::string& path, const std::vector<std::ve
       const DepthImage& img = rows[r][c];
       const int x0 = static_cast<int>(c) * (W + gap), y0 = static_cast<int>(r) * (H + gap);
       for (int v = 0; v < img.height; ++v)
-        std::memset(&rgb[(static_cast<std::size_t>(y0 + v) * width + x0) * 3], 0, static_cast<std::size_t>(img.width) * 3);
+        std::memset(&rgb[(static_cast<std::size_t>(y0 + v) * width + x0) * 3], 0,
+                    static_cast<std::size_t>(img.width) * 3);
       paint(img, rgb, width, x0, y0);
     }
   }

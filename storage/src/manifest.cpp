@@ -158,7 +158,8 @@ sim::Expected<ManifestReader> ManifestReader::open(const std::string& path) {
   // there is: read it as immutable.
   std::error_code ec;
   if (!impl && !std::filesystem::exists(path + "-wal", ec)) {
-    if (auto immutable = open_as(immutable_uri(path), SQLITE_OPEN_READONLY | SQLITE_OPEN_URI)) impl = std::move(immutable);
+    auto immutable = open_as(immutable_uri(path), SQLITE_OPEN_READONLY | SQLITE_OPEN_URI);
+    if (immutable) impl = std::move(immutable);
   }
   if (!impl) return impl.error();
   return ManifestReader(std::move(*impl), directory_of(path));
