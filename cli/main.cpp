@@ -62,10 +62,11 @@ int main(int argc, char** argv) {
     if (!sub->parsed()) continue;
     try {
       const int code = run();
-      // What a command printed (a summary, --json) is an output too: lost to a full disk or a closed pipe, exit 3.
+      // What a command printed (a summary, --json) is an output too: lost to a full disk, exit 3 (unless the command
+      // failed already: its own code stands).
       if (!std::cout.flush()) {
         std::cerr << "drapegen " << sub->get_name() << ": error: cannot write the standard output\n";
-        return drapegen::cli::kExitIo;
+        return code == drapegen::cli::kExitOk ? drapegen::cli::kExitIo : code;
       }
       return code;
     } catch (const std::bad_alloc&) {

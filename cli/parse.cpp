@@ -12,6 +12,8 @@
 #include <sstream>
 #include <vector>
 
+#include "drapegen/storage/atomic_file.hpp"
+
 namespace drapegen::cli {
 
 sim::Expected<sim::DirectionalValues> parse_directional(const std::string& text, const std::string& what) {
@@ -88,10 +90,10 @@ sim::Expected<sim::PhysicalEffects> parse_effects(const std::vector<std::string>
 sim::Status check_writable(const std::string& path) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) return sim::Error{"cannot write '" + path + "': it is a directory"};
-  // An existing device or pipe (/dev/stdout, /dev/null, a FIFO) is written in place: open it, as the write will (a
-  // probe beside it, in /dev, needs rights the write does not). No reader on a FIFO yet (ENXIO) is not an error.
-  if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec)) {
-    const int fd = ::open(path.c_str(), O_WRONLY | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
+  // Written in place (a device, a pipe, /dev/stdout; storage::written_in_place): open it, as the write will (a probe
+  // beside it, in /dev, needs rights the write does not). No reader on a FIFO yet (ENXIO) is not an error.
+  if (storage::written_in_place(path)) {
+    const int fd = ::open(path.c_str(), O_WRONLY | O_APPEND | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
     if (fd < 0 && errno != ENXIO) return sim::Error{"cannot write '" + path + "': " + std::strerror(errno)};
     if (fd >= 0) ::close(fd);
     return {};

@@ -429,6 +429,7 @@ Expected<ClothMesh> read_body(const Header& header, const Layout& layout, Reader
     const Element& element = header.elements[e];
     const bool is_vertex = e == layout.vertex_element;
     const bool is_face = e == layout.face_element;
+    if (element.properties.empty()) continue;  // nothing to read, however many items it declares
     for (std::int64_t item = 0; item < element.count; ++item) {
       for (int p = 0; p < static_cast<int>(element.properties.size()); ++p) {
         const Property& property = element.properties[p];
@@ -498,23 +499,23 @@ Expected<std::string> read_file(const std::string& path) {
 
 /// Writes `bytes` to a temporary file of its own beside `path` (`path.tmp.PID.N`: writers racing for one path never
 /// share it), syncs it and renames it over `path`.
-Status write_file_atomically(const std::string& given, const std::string& bytes) {
-  // A device or pipe (/dev/stdout, /dev/null, a FIFO) is written in place: a rename would replace it with a file.
-  // A symbolic link is followed: the file it names is replaced, not the link.
+Status write_file_atomically(const std::string& path, const std::string& bytes) {
+  // An existing device or pipe (a FIFO, /dev/null), or a path under /dev or /proc (/dev/stdout, also redirected to a
+  // file): written in place and appended, as storage::write_file_atomic does; a rename would replace the device or
+  // the system's link with a file. A symbolic link elsewhere is replaced, not followed.
   struct stat st {};
-  if (::stat(given.c_str(), &st) == 0 && !S_ISREG(st.st_mode) && !S_ISDIR(st.st_mode)) {
-    std::FILE* out = std::fopen(given.c_str(), "wb");
-    if (out == nullptr) return Error{"write_ply: '" + given + "': cannot open: " + system_reason(errno)};
+  std::error_code ec;
+  const std::string absolute = std::filesystem::absolute(path, ec).lexically_normal().string();
+  if (::stat(path.c_str(), &st) == 0 && !S_ISDIR(st.st_mode) &&
+      (!S_ISREG(st.st_mode) || absolute.rfind("/dev/", 0) == 0 || absolute.rfind("/proc/", 0) == 0)) {
+    std::FILE* out = std::fopen(path.c_str(), "ab");
+    if (out == nullptr) return Error{"write_ply: '" + path + "': cannot open: " + system_reason(errno)};
     const bool written = std::fwrite(bytes.data(), 1, bytes.size(), out) == bytes.size();
     const int write_errno = errno;
     if (std::fclose(out) != 0 || !written)
-      return Error{"write_ply: '" + given + "': cannot write: " + system_reason(written ? errno : write_errno)};
+      return Error{"write_ply: '" + path + "': cannot write: " + system_reason(written ? errno : write_errno)};
     return {};
   }
-  std::error_code ec;  // no such file: not a link, written as named
-  const bool link = std::filesystem::is_symlink(std::filesystem::symlink_status(given, ec));
-  const std::string path = link ? std::filesystem::weakly_canonical(given, ec).string() : given;
-  if (link && ec) return Error{"write_ply: '" + given + "': cannot follow the link: " + ec.message()};
   static std::atomic<std::uint64_t> counter{0};
   const std::string temporary = path + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(counter++);
   auto fail = [&](const std::string& what, int error_number) {

@@ -366,6 +366,15 @@ TEST(Effects, ALoadStepThatDivergesEndsTheDrapeWithItsReport) {
   EXPECT_EQ(stepped->report.outcome, once->report.outcome);
   EXPECT_FALSE(std::isfinite(stepped->report.residual));
   EXPECT_EQ(stepped->report.message.rfind("load step 1 of 2: ", 0), 0u) << stepped->report.message;
+  // A step that stops short of equilibrium (here at its iteration limit) ends the drape too: the loading history
+  // asked for is one of equilibria.
+  DrapeConfig short_steps = drape_config();
+  short_steps.load_steps = 2;
+  short_steps.solver.max_iterations = 2;
+  const Expected<DrapeResult> cut = simulate_drape(short_steps);
+  ASSERT_TRUE(cut) << cut.error().message;
+  EXPECT_NE(cut->report.outcome, SolveOutcome::kConverged);
+  EXPECT_EQ(cut->report.message.rfind("load step 1 of 2: ", 0), 0u) << cut->report.message;
 }
 
 TEST(Effects, AYieldedSpecimenKeepsItsSetWhenReleased) {

@@ -228,6 +228,15 @@ TEST(Ply, DataBeyondTheDeclaredCountsIsAnError) {
   expect_read_error("junk_count.ply", junk + "0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n", "bad header");
 }
 
+TEST(Ply, BinaryDataBeyondTheDeclaredCountsIsAnError) {
+  const std::string path = temp_path("binary_trailing.ply");
+  ASSERT_TRUE(write_ply(path, sample_mesh()).ok());
+  std::ofstream(path, std::ios::app | std::ios::binary) << 'x';
+  const Expected<ClothMesh> read = read_ply(path);
+  ASSERT_FALSE(read.has_value());
+  EXPECT_NE(read.error().message.find("trailing data: 1 bytes"), std::string::npos) << read.error().message;
+}
+
 TEST(Ply, IndexOutOfRangeIsAnError) {
   expect_read_error("bad_index.ply", std::string(kAsciiHeader) + "0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 4\n",
                     "out of range");

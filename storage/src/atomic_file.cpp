@@ -22,6 +22,15 @@ sim::Error os_error(const std::string& what, const std::string& path) {
 
 }  // namespace
 
+bool written_in_place(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) return false;  // a new file
+  if (!S_ISREG(st.st_mode)) return !S_ISDIR(st.st_mode);
+  std::error_code ec;
+  const std::string absolute = std::filesystem::absolute(path, ec).lexically_normal().string();
+  return absolute.rfind("/dev/", 0) == 0 || absolute.rfind("/proc/", 0) == 0;
+}
+
 std::string temporary_path(const std::string& path) {
   static std::atomic<std::uint64_t> counter{0};
   return fmt::format("{}.tmp.{}.{}", path, ::getpid(), counter.fetch_add(1));
@@ -29,9 +38,11 @@ std::string temporary_path(const std::string& path) {
 
 namespace {
 
-/// Writes `bytes` to an existing device or pipe as it is (no temporary, no rename, no sync: /dev/null takes none).
+/// Writes `bytes` to an existing device or pipe, or through /dev or /proc (/dev/stdout), as it is: no temporary, no
+/// rename (it would replace the device or the system's link with a file), no sync (/dev/null takes none); appended
+/// where the link leads to a regular file (a redirected standard output).
 sim::Status write_in_place(const std::string& path, std::string_view bytes) {
-  const int fd = ::open(path.c_str(), O_WRONLY | O_NOCTTY | O_CLOEXEC);
+  const int fd = ::open(path.c_str(), O_WRONLY | O_APPEND | O_NOCTTY | O_CLOEXEC);
   if (fd < 0) return os_error("cannot open", path);
   for (std::size_t done = 0; done < bytes.size();) {
     const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
@@ -49,17 +60,8 @@ sim::Status write_in_place(const std::string& path, std::string_view bytes) {
 
 }  // namespace
 
-sim::Status write_file_atomic(const std::string& given, std::string_view bytes, unsigned mode) {
-  // A device or pipe (/dev/stdout, /dev/null, a FIFO) is written in place: a rename would replace it with a file.
-  // A symbolic link is followed: the file it names is replaced, not the link.
-  struct stat st {};
-  if (::stat(given.c_str(), &st) == 0 && !S_ISREG(st.st_mode) && !S_ISDIR(st.st_mode)) {
-    return write_in_place(given, bytes);
-  }
-  std::error_code ec;  // no such file: not a link, written as named
-  const bool link = std::filesystem::is_symlink(std::filesystem::symlink_status(given, ec));
-  const std::string path = link ? std::filesystem::weakly_canonical(given, ec).string() : given;
-  if (link && ec) return sim::Error{fmt::format("cannot follow the link {}: {}", given, ec.message()), /*io=*/true};
+sim::Status write_file_atomic(const std::string& path, std::string_view bytes, unsigned mode) {
+  if (written_in_place(path)) return write_in_place(path, bytes);
   // O_EXCL: the file is new, this call's alone, and has `mode` from its first byte. A name can still exist: left by
   // a crashed process that had this PID (a restarted container), or by one on another host sharing the directory;
   // the next name is tried then.

@@ -9,6 +9,7 @@
 #include <string>
 #include <thread>
 #include <vector>
+#include <fcntl.h>
 #include <unistd.h>
 
 #include "drapegen/storage/atomic_file.hpp"
@@ -70,7 +71,7 @@ TEST(AtomicFile, WritesAndChecksums) {
   fs::remove_all(dir);
 }
 
-TEST(AtomicFile, WritesADeviceOrPipeInPlaceAndFollowsALink) {
+TEST(AtomicFile, WritesADeviceOrPipeInPlaceAndReplacesALinkElsewhere) {
   // --out /dev/stdout into a pipe: the bytes go down the pipe; a rename over /proc/self/fd/N would fail (or, for
   // /dev/stdout as root, replace the device link with a file).
   int fds[2];
@@ -83,16 +84,24 @@ TEST(AtomicFile, WritesADeviceOrPipeInPlaceAndFollowsALink) {
   EXPECT_EQ(std::string(got, 16), "through the pipe");
   ::close(fds[0]);
   ::close(fds[1]);
-  // A symbolic link: its target is replaced, the link stays a link.
   const auto dir = std::filesystem::path(::testing::TempDir()) / ("atomic_link_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
+  // /dev/stdout redirected to a file (here /proc/self/fd/N of a file): appended in place, the file kept.
+  std::ofstream(dir / "redirected") << "before ";
+  const int fd = ::open((dir / "redirected").c_str(), O_WRONLY);
+  ASSERT_GE(fd, 0);
+  ASSERT_TRUE(write_file_atomic("/proc/self/fd/" + std::to_string(fd), "after"));
+  ::close(fd);
+  std::ifstream redirected(dir / "redirected");
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(redirected), {}), "before after");
+  // A symbolic link elsewhere (one planted in a scratch directory): the link is replaced, its target untouched.
   std::ofstream(dir / "target") << "old";
   std::filesystem::remove(dir / "link");
   std::filesystem::create_symlink(dir / "target", dir / "link");
   ASSERT_TRUE(write_file_atomic((dir / "link").string(), "new"));
-  EXPECT_TRUE(std::filesystem::is_symlink(dir / "link"));
-  std::ifstream in(dir / "target");
-  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}), "new");
+  EXPECT_FALSE(std::filesystem::is_symlink(dir / "link"));
+  std::ifstream target(dir / "target");
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(target), {}), "old");
   std::filesystem::remove_all(dir);
 }
 

@@ -14,10 +14,12 @@ namespace drapegen::storage {
 /// A name beside `path` that no other call of this process returns: `path.tmp.PID.N`. (Another process with the same
 /// PID, earlier or on another host, may have used it: write_file_atomic creates it exclusively and moves on if so.)
 [[nodiscard]] std::string temporary_path(const std::string& path);
+/// An existing device or pipe (a FIFO, /dev/null), or a path under /dev or /proc (/dev/stdout, /proc/self/fd/N,
+/// also where it leads to a regular file: a redirected standard output): written in place, no rename, appended.
+[[nodiscard]] bool written_in_place(const std::string& path);
 /// Writes `bytes` to `path` atomically (tmp, fsync, rename), the file created with `mode` (less the umask) from the
-/// start. Errors name the path and the OS error (e.g. "No space left on device", "Permission denied"). An existing
-/// device or pipe (/dev/stdout, a FIFO) is written in place instead; a symbolic link is followed (its target is
-/// replaced, not the link).
+/// start. Errors name the path and the OS error (e.g. "No space left on device", "Permission denied"). Where
+/// written_in_place(path), it is written in place instead. A symbolic link elsewhere is replaced, not followed.
 [[nodiscard]] sim::Status write_file_atomic(const std::string& path, std::string_view bytes, unsigned mode = 0644);
 /// fsync of a directory, so that renames into it are durable.
 [[nodiscard]] sim::Status sync_directory(const std::string& directory);
