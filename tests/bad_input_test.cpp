@@ -256,6 +256,89 @@ TEST(Service, ExpiredLeasesAreRequeued) {
   EXPECT_NE(coordinator.err().find("after its lease expired"), std::string::npos) << coordinator.err();
 }
 
+// A retry goes to another worker while there is one: the worker that failed a job is freed first and took the retry
+// straight back, so a worker with a full scratch directory spent every attempt of each job it was given.
+TEST(Service, ARetryGoesToAnotherWorker) {
+  const fs::path dir = test_dir("retry_elsewhere");
+  const fs::path out = dir / "run";
+  write_text(dir / "run.toml", small_config(out, 2, 1, "[testing]\nmode = \"noop\"\n[retry]\nmax_attempts = 3\n"));
+  Process coordinator({"run", "--config", (dir / "run.toml").string()}, (dir / "coordinator").string());
+  const std::string endpoint = wait_endpoint(out, coordinator, 30s);
+  ASSERT_FALSE(endpoint.empty()) << coordinator.err();
+  zmq::context_t context(1);
+  FakeWorker a(context, endpoint), b(context, endpoint);
+  a.send(ready("a"));
+  auto a1 = a.expect(v1::Envelope::kJob, 5s);
+  ASSERT_TRUE(a1);
+  b.send(ready("b"));
+  auto b1 = b.expect(v1::Envelope::kJob, 5s);
+  ASSERT_TRUE(b1);
+  ASSERT_NE(a1->job().job_id(), b1->job().job_id());
+  a.send(failure(a1->job().job_id(), 1));
+  EXPECT_FALSE(a.expect(v1::Envelope::kJob, 1s)) << "the job a failed went back to a while b is connected";
+  b.send(failure(b1->job().job_id(), 1));
+  auto a2 = a.expect(v1::Envelope::kJob, 5s);
+  auto b2 = b.expect(v1::Envelope::kJob, 5s);
+  ASSERT_TRUE(a2 && b2) << coordinator.err();
+  EXPECT_EQ(a2->job().job_id(), b1->job().job_id());
+  EXPECT_EQ(b2->job().job_id(), a1->job().job_id());
+  EXPECT_EQ(a2->job().attempt(), 2u);
+  a.send(result(a2->job().job_id(), 2));
+  b.send(result(b2->job().job_id(), 2));
+  ASSERT_EQ(coordinator.wait(60s), 0) << coordinator.err();
+  auto reader = storage::ManifestReader::open((out / "manifest.sqlite").string());
+  ASSERT_TRUE(reader);
+  const auto failures = all(reader->failures());
+  ASSERT_EQ(failures.size(), 2u);
+  for (const auto& j : all(reader->jobs())) EXPECT_EQ(j.state, storage::JobState::kDone);
+}
+
+// A failure whose reason this coordinator does not know (a newer worker's, or none at all) is recorded as
+// "unspecified" with its number; the manifest's check on reasons once refused it, which stopped the whole run.
+TEST(Service, AFailureOfAnUnknownReasonIsRecordedNotFatal) {
+  const fs::path dir = test_dir("unknown_reason");
+  const fs::path out = dir / "run";
+  write_text(dir / "run.toml", small_config(out, 1, 1, "[retry]\nmax_attempts = 5\n"));
+  const fs::path manifest = out / "manifest.sqlite";
+  Process coordinator({"run", "--config", (dir / "run.toml").string()}, (dir / "coordinator").string());
+  const std::string endpoint = wait_endpoint(out, coordinator, 30s);
+  ASSERT_FALSE(endpoint.empty()) << coordinator.err();
+  zmq::context_t context(1);
+  {
+    FakeWorker newer(context, endpoint);
+    v1::Envelope hello = ready("newer");
+    hello.mutable_ready()->set_interval_ms(500);
+    newer.send(hello);
+    auto job = newer.expect(v1::Envelope::kJob, 5s);
+    ASSERT_TRUE(job);
+    v1::Envelope e;
+    e.mutable_failure()->set_job_id(job->job().job_id());
+    e.mutable_failure()->set_attempt(job->job().attempt());
+    e.mutable_failure()->set_reason(static_cast<v1::FailureReason>(42));
+    e.mutable_failure()->set_message("a reason from a later release");
+    newer.send(e);
+    const auto recorded = [&] {
+      auto r = storage::ManifestReader::open(manifest.string());
+      if (!r) return false;
+      auto f = r->failures();
+      return f && !f->empty();
+    };
+    const auto until = std::chrono::steady_clock::now() + 10s;
+    while (!recorded() && std::chrono::steady_clock::now() < until) std::this_thread::sleep_for(10ms);
+    ASSERT_TRUE(recorded()) << coordinator.err();
+  }  // the newer worker goes away
+  Process worker = start_worker(endpoint, dir, 1);
+  ASSERT_EQ(coordinator.wait(120s), 0) << coordinator.err();
+  check_manifest(manifest, 2);
+  auto reader = storage::ManifestReader::open(manifest.string());
+  ASSERT_TRUE(reader);
+  const auto failures = all(reader->failures());
+  ASSERT_GE(failures.size(), 1u);
+  EXPECT_EQ(failures[0].reason, "unspecified");
+  EXPECT_EQ(failures[0].message, "(reason 42) a reason from a later release");
+  for (const auto& j : all(reader->jobs())) EXPECT_EQ(j.state, storage::JobState::kDone);
+}
+
 // A worker older than the bending-model field drapes with the paper's model whatever the run asks, and says nothing
 // about it: the coordinator refuses its result (an invalid_job failure, no files kept) and another worker does the job.
 TEST(Service, ResultOfAnotherBendingModelIsRefused) {

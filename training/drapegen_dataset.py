@@ -110,8 +110,9 @@ class DrapeDataset(Dataset):
                 raise ValueError(f"{self.manifest}: not a drapegen manifest ({e})") from None
             if row is None or state is None:
                 raise ValueError(f"{self.manifest}: not a drapegen manifest (no schema version or no run)")
-            if row[0] != "1":
-                raise ValueError(f"{self.manifest}: manifest schema version {row[0]}, this reader reads 1")
+            # Version 2 only added failure reasons, which this reader does not read.
+            if row[0] not in ("1", "2"):
+                raise ValueError(f"{self.manifest}: manifest schema version {row[0]}, this reader reads 1 and 2")
             self.run_state = state[0]
             self.read_immutable = immutable  # read as a finished file (its directory not writable here)
             rows = db.execute(

@@ -70,6 +70,7 @@ struct Coordinator::Impl {
     double lease_started = 0.0;
     Clock::time_point deadline;
     std::int64_t waiting_on = 0;  // source job of a drape recipe, while it is pending
+    std::vector<std::string> failed_on;  // routing ids of the workers whose attempts failed, this session
   };
   struct Worker {
     std::string identity;
@@ -506,6 +507,7 @@ struct Coordinator::Impl {
   void record_failed_attempt(JobSlot& slot, v1::FailureReason reason, const std::string& message,
                              const std::string& worker_name) {
     slot.leased = false;
+    if (!slot.worker.empty()) slot.failed_on.push_back(slot.worker);
     slot.worker.clear();
     const bool final = slot.attempts >= config.max_attempts;
     storage::JobRecord rec = slot.rec;
@@ -513,8 +515,12 @@ struct Coordinator::Impl {
     rec.worker = worker_name;
     rec.started_at = slot.lease_started;
     rec.finished_at = unix_now();
-    storage::FailureRecord failure{rec.id, slot.attempts, proto::reason_name(reason), message, worker_name,
-                                   rec.finished_at};
+    // A reason this build does not know (a newer worker's) is kept as "unspecified" with its number, not refused.
+    const std::string reason_text = proto::reason_name(reason);
+    const bool unknown = reason_text == "unspecified" && reason != v1::FAILURE_REASON_UNSPECIFIED;
+    storage::FailureRecord failure{rec.id, slot.attempts, reason_text,
+                                   unknown ? fmt::format("(reason {}) {}", static_cast<int>(reason), message) : message,
+                                   worker_name, rec.finished_at};
     if (sim::Status s = manifest->begin(); !s) {
       storage_fault(s.error());
       return;
@@ -597,13 +603,32 @@ struct Coordinator::Impl {
     return e;
   }
 
+  /// The ready job for a free worker: the first one it has not failed, or one it has failed if every other worker
+  /// has too or is stuck on a job whose lease expired (a retry goes to another worker when there is one: a worker
+  /// with a full scratch directory or a broken renderer would otherwise spend every attempt of the job it just
+  /// failed, freed first as it is; a busy worker is free within a lease).
+  std::set<std::int64_t>::iterator next_job_for(const std::string& identity) {
+    for (auto it = ready.begin(); it != ready.end(); ++it) {
+      const auto& failed_on = jobs[static_cast<std::size_t>(*it - 1)].failed_on;
+      if (std::find(failed_on.begin(), failed_on.end(), identity) == failed_on.end()) return it;
+      const bool another = std::any_of(workers.begin(), workers.end(), [&](const auto& entry) {
+        return entry.second.stale_job == 0 &&
+               std::find(failed_on.begin(), failed_on.end(), entry.first) == failed_on.end();
+      });
+      if (!another) return it;
+    }
+    return ready.end();
+  }
+
   void dispatch() {
     if (ready.empty()) return;
     for (auto& [identity, w] : workers) {
       if (ready.empty()) return;
       if (w.job != 0 || w.stale_job != 0) continue;
-      const std::int64_t id = *ready.begin();
-      ready.erase(ready.begin());
+      const auto next = next_job_for(identity);
+      if (next == ready.end()) continue;
+      const std::int64_t id = *next;
+      ready.erase(next);
       JobSlot& slot = jobs[static_cast<std::size_t>(id - 1)];
       ++slot.attempts;
       auto job = make_job(slot);
@@ -886,6 +911,11 @@ sim::Expected<std::unique_ptr<Coordinator>> Coordinator::resume(const std::strin
   if (sim::Status s = impl->remove_orphans(); !s) return s.error();
   const std::string preferred = options.bind_override.empty() ? run->endpoint : options.bind_override;
   if (sim::Status s = impl->bind(preferred, options.bind_override.empty() ? config->bind : ""); !s) return s.error();
+  // Holding the run's lock, once nothing before the run can fail: an older build refuses the upgraded file.
+  if (const int from = impl->manifest->schema_version(); from != storage::kSchemaVersion) {
+    if (sim::Status s = impl->manifest->upgrade_schema(); !s) return s.error();
+    impl->log->info("manifest upgraded from schema version {} to {}", from, storage::kSchemaVersion);
+  }
   if (sim::Status s = impl->load_state(); !s) return s.error();
   impl->log->info("resumed {}: {} of {} jobs done, {} failed; listening on {}", manifest_path, impl->done,
                   impl->jobs.size(), impl->failed, impl->endpoint);

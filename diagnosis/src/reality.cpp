@@ -296,6 +296,7 @@ sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std
         {"multipath_gain_m", sensor.multipath_gain}}},
       {"noise", noise.describe()},
       {"converged", converged},
+      {"lagged_capped", drape->report.lagged_capped},
       {"drape_coefficient", drape->measures.drape_coefficient},
       {"folds", drape->measures.folds}};
   truth.update(bending_json(spec.bending));  // "alpha", "beta"

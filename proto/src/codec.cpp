@@ -106,10 +106,8 @@ sim::Status check(const v1::Envelope& e) {
     case v1::Envelope::kFailure:
       if (e.failure().job_id() == 0) return sim::Error{"failure: job id 0"};
       if (e.failure().attempt() == 0) return sim::Error{"failure: attempt 0"};
-      if (e.failure().reason() == v1::FAILURE_REASON_UNSPECIFIED ||
-          !v1::FailureReason_IsValid(e.failure().reason())) {
-        return sim::Error{"failure: unknown reason"};
-      }
+      // Any reason passes, none or one newer than this build included: dropping the failure would leave its job
+      // leased until the lease expires (the coordinator records it as "unspecified", with its number).
       return {};
     case v1::Envelope::kDisconnect:
     case v1::Envelope::kShutdown:
@@ -145,6 +143,7 @@ const char* reason_name(v1::FailureReason reason) {
     case v1::FAILURE_REASON_WORKER_LOST: return "worker_lost";
     case v1::FAILURE_REASON_TIMEOUT: return "timeout";
     case v1::FAILURE_REASON_INVALID_JOB: return "invalid_job";
+    case v1::FAILURE_REASON_WORKER_ERROR: return "worker_error";
     default: break;
   }
   return "unspecified";

@@ -92,7 +92,11 @@ TEST(Codec, ChecksFieldRules) {
   v1::Envelope f;
   f.mutable_failure()->set_job_id(3);
   f.mutable_failure()->set_attempt(1);
-  EXPECT_FALSE(decode(encode(f)));  // no reason
+  EXPECT_TRUE(decode(encode(f)));  // no reason: still a failure of its job, recorded as "unspecified"
+  EXPECT_STREQ(reason_name(f.failure().reason()), "unspecified");
+  f.mutable_failure()->set_reason(static_cast<v1::FailureReason>(42));  // a newer build's reason
+  EXPECT_TRUE(decode(encode(f)));
+  EXPECT_STREQ(reason_name(f.failure().reason()), "unspecified");
   f.mutable_failure()->set_reason(v1::FAILURE_REASON_DIVERGED);
   EXPECT_TRUE(decode(encode(f)));
   EXPECT_STREQ(reason_name(v1::FAILURE_REASON_DIVERGED), "diverged");

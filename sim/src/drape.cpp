@@ -200,6 +200,7 @@ nlohmann::json to_json(const DrapeResult& result) {
       {"pcg_iterations", r.pcg_iterations},
       {"pcg_failures", r.pcg_failures},
       {"lagged_change", r.lagged_change},
+      {"lagged_capped", r.lagged_capped},
       {"line_search_failures", r.line_search_failures},
       {"vertices", result.mesh.vertex_count()},
       {"triangles", result.mesh.triangle_count()},

@@ -165,6 +165,7 @@ SolveReport NewtonSolver::solve(const std::vector<EnergyTerm*>& terms, const std
       // drape has formed (a flat start, where no hinge has bent yet) says nothing about convergence, yet it froze
       // them for good, so that plasticity never acted on drapes from a flat initial state.
       frozen = outer && (change < options_.lagged_tolerance || outer_updates >= options_.max_lagged_outer_updates);
+      report.lagged_capped = frozen && change >= options_.lagged_tolerance;
     }
     bool exact = it > 0 && report.residual < options_.exact_hessian_below && exact_cooldown == 0;
     exact_cooldown = std::max(0, exact_cooldown - 1);
@@ -185,6 +186,10 @@ SolveReport NewtonSolver::solve(const std::vector<EnergyTerm*>& terms, const std
     }
     if (report.residual <= options_.tolerance && frozen) {
       report.outcome = SolveOutcome::kConverged;
+      if (report.lagged_capped) {
+        report.message = fmt::format("state-dependent parameters fixed after {} outer updates, still changing by "
+                                     "{:.3g}", outer_updates, report.lagged_change);
+      }
       break;
     }
 

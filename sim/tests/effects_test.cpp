@@ -7,6 +7,8 @@
 #include <limits>
 #include <numbers>
 
+#include <nlohmann/json.hpp>
+
 #include "derivative_checks.hpp"
 #include "drapegen/sim/bending.hpp"
 #include "drapegen/sim/dihedral.hpp"
@@ -306,6 +308,26 @@ TEST(Effects, PlasticityActsFromAFlatStartOnAnIsotropicFabric) {
   }
   std::printf("[ drape    ] smallest fold gap %.3f rad\n", smallest_gap);
   EXPECT_GT(smallest_gap, 0.05);
+}
+
+// A solve whose lagged state is still moving when the outer updates run out says so: it is converged on the energy
+// with that state fixed, not a plastic fixed point (docs/PHYSICS.md, "Bending plasticity").
+TEST(Effects, AnOuterLoopStoppedByItsCapIsReported) {
+  DrapeConfig base = drape_config();
+  base.fabric = fabric_from_paper_units({1420, 1420, 1420}, {-3550, -3550, -3550}, 200.0);
+  base.specimen.vertices_x = base.specimen.vertices_y = 16;
+  base.initial.shape = InitialShape::kFlat;
+  base.solver.max_lagged_outer_updates = 1;
+  const DrapeResult elastic = drape(base, "isotropic, one outer update");
+  EXPECT_FALSE(elastic.report.lagged_capped) << elastic.report.lagged_change;  // nothing lagged moves
+  EXPECT_LT(elastic.report.lagged_change, base.solver.lagged_tolerance);
+  DrapeConfig plastic = base;
+  plastic.effects.bending_yield_curvature = 10.0;
+  const DrapeResult capped = drape(plastic, "yield 10 /m, one outer update");
+  EXPECT_TRUE(capped.report.lagged_capped);
+  EXPECT_GE(capped.report.lagged_change, base.solver.lagged_tolerance);
+  EXPECT_NE(capped.report.message.find("still changing"), std::string::npos) << capped.report.message;
+  EXPECT_EQ(to_json(capped).at("lagged_capped"), true);
 }
 
 // A yielding drape is solved on its own mesh from the start: from a coarse drape interpolated onto it (piecewise

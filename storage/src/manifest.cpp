@@ -69,7 +69,8 @@ sim::Error no_manifest_at(const std::string& path) {
   return sim::Error{fmt::format("no manifest at {}", path)};
 }
 
-sim::Status check_schema(sqlite3* db, const std::string& path) {
+/// The manifest's schema version (1 .. kSchemaVersion), or why the file is not a manifest this build reads.
+sim::Expected<int> check_schema(sqlite3* db, const std::string& path) {
   Statement st(db, "SELECT value FROM meta WHERE key = 'schema_version'");
   // The first read of the file: where it fails, the file system may be the cause rather than the file.
   if (!st.ok() && detail::file_system_error(db))
@@ -78,9 +79,27 @@ sim::Status check_schema(sqlite3* db, const std::string& path) {
   if (st.step() != SQLITE_ROW)
     return sim::Error{fmt::format("{} is not a drapegen manifest (no schema version)", path)};
   const std::string version = st.text(0);
-  if (version != std::to_string(kSchemaVersion)) {
-    return sim::Error{fmt::format("{} has manifest schema version {}; this build reads version {}", path, version,
-                                  kSchemaVersion)};
+  for (int v = 1; v <= kSchemaVersion; ++v) {
+    if (version == std::to_string(v)) return v;
+  }
+  return sim::Error{fmt::format("{} has manifest schema version {}; this build reads versions 1 to {}", path, version,
+                                kSchemaVersion)};
+}
+
+/// Brings a manifest of an older schema version to kSchemaVersion, in one transaction (all or nothing). Version 1
+/// is the only older one.
+sim::Status upgrade_tables(sqlite3* db, int version, const std::string& path) {
+  if (version == kSchemaVersion) return {};
+  if (sim::Status s = exec(db, "BEGIN IMMEDIATE"); !s) return s;
+  sim::Status s = exec(db, detail::kUpgradeFrom1SetAsideSql);
+  if (s) s = exec(db, detail::kFailuresSql);
+  if (s) s = exec(db, detail::kUpgradeFrom1RefillSql);
+  if (s) s = exec(db, "COMMIT");
+  if (!s) {
+    (void)exec(db, "ROLLBACK");
+    return sim::Error{fmt::format("cannot upgrade manifest {} from schema version {}: {}", path, version,
+                                  s.error().message),
+                      s.error().io};
   }
   return {};
 }
@@ -149,7 +168,7 @@ sim::Expected<ManifestReader> ManifestReader::open(const std::string& path) {
     impl->db = *db;
     impl->owns = true;
     if (sim::Status s = configure(impl->db); !s) return s.error();
-    if (sim::Status s = check_schema(impl->db, path); !s) return s.error();
+    if (auto version = check_schema(impl->db, path); !version) return version.error();
     return impl;
   };
   auto impl = open_as(path, SQLITE_OPEN_READONLY);
@@ -343,6 +362,8 @@ sim::Expected<std::string> ManifestReader::integrity_check() const {
 
 struct Manifest::Impl {
   sqlite3* db = nullptr;
+  std::string path;
+  int schema_version = kSchemaVersion;
   bool in_transaction = false;
   Statement begin, commit, rollback, savepoint, release, rollback_to;
   Statement job_done, insert_result, insert_file, job_failed, job_attempt, insert_failure, update_recipe;
@@ -456,6 +477,7 @@ sim::Expected<Manifest> Manifest::create(const std::string& path, const RunRecor
     // Build in rollback-journal mode with one fsync at the end, then switch to WAL for the run.
     if (sim::Status s = exec(db, "PRAGMA foreign_keys = ON; PRAGMA synchronous = FULL; BEGIN"); !s) return fail(s);
     if (sim::Status s = exec(db, detail::kSchemaSql); !s) return fail(s);
+    if (sim::Status s = exec(db, detail::kFailuresSql); !s) return fail(s);
     {
       Statement meta(db, "INSERT INTO meta (key, value) VALUES (?1, ?2)");
       if (sim::Status s = meta.reset().bind(1, "schema_version").bind(2, std::to_string(kSchemaVersion)).run(); !s) {
@@ -529,8 +551,11 @@ sim::Expected<Manifest> Manifest::open(const std::string& path) {
   auto impl = std::make_unique<Impl>();
   impl->db = *db;
   if (sim::Status s = configure(impl->db); !s) return s.error();
-  if (sim::Status s = check_schema(impl->db, path); !s) return s.error();  // before anything writes to the file
+  auto version = check_schema(impl->db, path);  // before anything writes to the file
+  if (!version) return version.error();
   if (sim::Status s = configure_writer(impl->db); !s) return s.error();
+  impl->path = path;
+  impl->schema_version = *version;
   if (sim::Status s = impl->prepare(); !s) return s.error();
   auto reader_impl = std::make_unique<ManifestReader::Impl>();
   reader_impl->db = impl->db;
@@ -538,6 +563,15 @@ sim::Expected<Manifest> Manifest::open(const std::string& path) {
   auto reader = std::unique_ptr<ManifestReader>(new ManifestReader(std::move(reader_impl), directory_of(path)));
   return Manifest(std::move(impl), std::move(reader));
 }
+
+sim::Status Manifest::upgrade_schema() {
+  if (impl_->in_transaction) return sim::Error{"manifest: schema upgrade inside a transaction"};
+  if (sim::Status s = upgrade_tables(impl_->db, impl_->schema_version, impl_->path); !s) return s;
+  impl_->schema_version = kSchemaVersion;
+  return {};
+}
+
+int Manifest::schema_version() const { return impl_->schema_version; }
 
 sim::Status Manifest::begin() {
   if (impl_->in_transaction) return {};

@@ -1,5 +1,5 @@
 #pragma once
-// The manifest schema, version 1 (docs/SERVICE.md, "Manifest schema"). Private to drapegen::storage.
+// The manifest schema, version 2 (docs/SERVICE.md, "Manifest schema"). Private to drapegen::storage.
 
 namespace drapegen::storage::detail {
 
@@ -74,18 +74,38 @@ CREATE TABLE files (
   bytes  INTEGER NOT NULL,
   UNIQUE (job_id, kind, idx)
 );
+)sql";
+
+/// The failures table (part of the schema; also what the upgrade from version 1 builds). Version 2 added the reasons
+/// 'worker_error' and 'unspecified'.
+inline constexpr const char* kFailuresSql = R"sql(
 CREATE TABLE failures (
   id      INTEGER PRIMARY KEY,
   job_id  INTEGER NOT NULL REFERENCES jobs (id),
   attempt INTEGER NOT NULL,
   reason  TEXT    NOT NULL CHECK (reason IN ('not_converged', 'diverged', 'self_intersection', 'render_error',
-                                             'worker_lost', 'timeout', 'invalid_job')),
+                                             'worker_lost', 'timeout', 'invalid_job', 'worker_error',
+                                             'unspecified')),
   message TEXT    NOT NULL,
   worker  TEXT    NOT NULL,
   at      REAL    NOT NULL
 );
 CREATE INDEX failures_by_job ON failures (job_id);
 CREATE INDEX failures_by_reason ON failures (reason);
+)sql";
+
+/// Version 1 -> 2, inside the caller's transaction: set the old failures table aside, create kFailuresSql's, refill
+/// it with the old rows.
+inline constexpr const char* kUpgradeFrom1SetAsideSql = R"sql(
+DROP INDEX failures_by_job;
+DROP INDEX failures_by_reason;
+ALTER TABLE failures RENAME TO failures_v1;
+)sql";
+inline constexpr const char* kUpgradeFrom1RefillSql = R"sql(
+INSERT INTO failures (id, job_id, attempt, reason, message, worker, at)
+  SELECT id, job_id, attempt, reason, message, worker, at FROM failures_v1;
+DROP TABLE failures_v1;
+UPDATE meta SET value = '2' WHERE key = 'schema_version';
 )sql";
 
 }  // namespace drapegen::storage::detail

@@ -152,6 +152,88 @@ TEST_F(ManifestTest, RecordsEachJobExactlyOnce) {
   EXPECT_EQ(*m.reader().integrity_check(), "ok");
 }
 
+// A run started by a build of schema version 1 (whose failures could not say "worker_error" or "unspecified"): read
+// as it is; resumed, upgraded in place with its failures kept.
+TEST_F(ManifestTest, AVersion1ManifestIsReadAndUpgradedOnResume) {
+  {
+    auto m = make();
+    JobRecord j1;
+    j1.id = 1;
+    j1.attempts = 1;
+    ASSERT_TRUE(m.begin());
+    ASSERT_TRUE(m.record_failure(j1, {1, 1, "timeout", "slow", "w1", 5.0}, false));
+    ASSERT_TRUE(m.commit());
+  }
+  // Version 1's failures table, as that build created it, holding the row.
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open(path_.c_str(), &db), SQLITE_OK);
+  const char* to_version_1 = R"sql(
+    DROP INDEX failures_by_job;
+    DROP INDEX failures_by_reason;
+    ALTER TABLE failures RENAME TO failures_new;
+    CREATE TABLE failures (
+      id      INTEGER PRIMARY KEY,
+      job_id  INTEGER NOT NULL REFERENCES jobs (id),
+      attempt INTEGER NOT NULL,
+      reason  TEXT    NOT NULL CHECK (reason IN ('not_converged', 'diverged', 'self_intersection', 'render_error',
+                                                 'worker_lost', 'timeout', 'invalid_job')),
+      message TEXT    NOT NULL,
+      worker  TEXT    NOT NULL,
+      at      REAL    NOT NULL
+    );
+    CREATE INDEX failures_by_job ON failures (job_id);
+    CREATE INDEX failures_by_reason ON failures (reason);
+    INSERT INTO failures SELECT * FROM failures_new;
+    DROP TABLE failures_new;
+    UPDATE meta SET value = '1' WHERE key = 'schema_version';)sql";
+  char* error = nullptr;
+  ASSERT_EQ(sqlite3_exec(db, to_version_1, nullptr, nullptr, &error), SQLITE_OK) << error;
+  sqlite3_close(db);
+  auto schema_version = [&] {
+    sqlite3* d = nullptr;
+    sqlite3_open(path_.c_str(), &d);
+    sqlite3_stmt* st = nullptr;
+    sqlite3_prepare_v2(d, "SELECT value FROM meta WHERE key = 'schema_version'", -1, &st, nullptr);
+    std::string v = sqlite3_step(st) == SQLITE_ROW ? reinterpret_cast<const char*>(sqlite3_column_text(st, 0)) : "";
+    sqlite3_finalize(st);
+    sqlite3_close(d);
+    return v;
+  };
+  {
+    auto reader = ManifestReader::open(path_);  // a reader leaves the file as it is
+    ASSERT_TRUE(reader) << reader.error().message;
+    ASSERT_EQ(reader->failures()->size(), 1u);
+  }
+  EXPECT_EQ(schema_version(), "1");
+  {
+    auto m = Manifest::open(path_);
+    ASSERT_TRUE(m) << m.error().message;
+    EXPECT_EQ(m->schema_version(), 1);
+    EXPECT_EQ(schema_version(), "1");  // opening writes nothing: the caller upgrades once it holds the run's lock
+    ASSERT_TRUE(m->upgrade_schema());
+    EXPECT_EQ(m->schema_version(), kSchemaVersion);
+    EXPECT_EQ(schema_version(), std::to_string(kSchemaVersion));
+    JobRecord j2;
+    j2.id = 2;
+    j2.attempts = 1;
+    ASSERT_TRUE(m->begin());
+    ASSERT_TRUE(m->record_failure(j2, {2, 1, "worker_error", "scratch full", "w2", 6.0}, false));
+    ASSERT_TRUE(m->record_failure(j2, {2, 2, "unspecified", "(reason 42) later", "w2", 7.0}, false));
+    ASSERT_TRUE(m->commit());
+    const auto failures = *m->reader().failures();
+    ASSERT_EQ(failures.size(), 3u);
+    EXPECT_EQ(failures[0].reason, "timeout");
+    EXPECT_EQ(failures[0].message, "slow");
+    EXPECT_EQ(failures[1].reason, "worker_error");
+    EXPECT_EQ(*m->reader().integrity_check(), "ok");
+  }
+  auto again = Manifest::open(path_);
+  ASSERT_TRUE(again) << again.error().message;
+  EXPECT_EQ(again->schema_version(), kSchemaVersion);
+  EXPECT_TRUE(again->upgrade_schema());  // nothing left to do
+  EXPECT_EQ(again->reader().failures()->size(), 3u);
+}
+
 // What a snapshot sees (the last commit; the writer's own pass on its connection) and that its read transaction ends
 // (a reader left in one would never see another commit). That no commit lands between its table reads is SQLite's
 // isolation of one read transaction, which a single-threaded test cannot interleave.

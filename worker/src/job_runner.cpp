@@ -108,9 +108,9 @@ v1::Envelope JobRunner::run(const v1::Job& job) {
   try {
     return compute(job);
   } catch (const std::bad_alloc&) {
-    return failure(job, v1::FAILURE_REASON_INVALID_JOB, "out of memory");
-  } catch (const std::exception& e) {
-    return failure(job, v1::FAILURE_REASON_INVALID_JOB, std::string("unexpected error: ") + e.what());
+    return failure(job, v1::FAILURE_REASON_WORKER_ERROR, "out of memory");
+  } catch (const std::exception& e) {  // the scratch directory's creation, or a defect: the worker's, not the job's
+    return failure(job, v1::FAILURE_REASON_WORKER_ERROR, std::string("unexpected error: ") + e.what());
   }
 }
 
@@ -138,7 +138,7 @@ v1::Envelope JobRunner::compute(const v1::Job& job) {
   if (spec.recipe().kind() == v1::Recipe::KIND_DRAPE) {
     if (job.source_mesh().empty()) return failure(job, v1::FAILURE_REASON_INVALID_JOB, "drape recipe without mesh");
     if (sim::Status s = storage::write_file_atomic(source_path, job.source_mesh()); !s) {
-      return failure(job, v1::FAILURE_REASON_INVALID_JOB, s.error().message);
+      return failure(job, v1::FAILURE_REASON_WORKER_ERROR, s.error().message);
     }
   }
   auto config = drape_config(spec, source_path);
@@ -177,11 +177,12 @@ v1::Envelope JobRunner::compute(const v1::Job& job) {
                                spec.max_self_intersections()),
                    &metrics);
   }
+  // The scratch round trip is the worker's own: a full or unwritable scratch directory is no fault of the job.
   if (sim::Status s = sim::write_ply(mesh_path, drape->mesh); !s) {
-    return failure(job, v1::FAILURE_REASON_INVALID_JOB, s.error().message, &metrics);
+    return failure(job, v1::FAILURE_REASON_WORKER_ERROR, s.error().message, &metrics);
   }
   auto mesh_bytes = storage::read_file(mesh_path);
-  if (!mesh_bytes) return failure(job, v1::FAILURE_REASON_INVALID_JOB, mesh_bytes.error().message, &metrics);
+  if (!mesh_bytes) return failure(job, v1::FAILURE_REASON_WORKER_ERROR, mesh_bytes.error().message, &metrics);
 
   const auto render_start = std::chrono::steady_clock::now();
   const auto cloth = renderer::cloth_triangles(drape->mesh);

@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <unistd.h>
 
+#include "drapegen/proto/codec.hpp"
 #include "drapegen/proto/recipe.hpp"
 #include "drapegen/proto/simulation.hpp"
 #include "drapegen/proto/text.hpp"
@@ -176,10 +177,26 @@ TEST(JobRunner, FailureMessagesAreOneLineOfValidUtf8) {
   ASSERT_EQ(answer.body_case(), v1::Envelope::kFailure);
   const std::string& message = answer.failure().message();
   EXPECT_NE(message.find("latin1-?t?"), std::string::npos) << message;
+  EXPECT_EQ(answer.failure().reason(), v1::FAILURE_REASON_WORKER_ERROR);  // the worker's scratch, not the job
   EXPECT_TRUE(proto::is_utf8(message));
   EXPECT_EQ(message.find('\n'), std::string::npos);
   v1::Envelope back;
   EXPECT_TRUE(back.ParseFromString(proto::encode(answer)));
+}
+
+// A scratch file the worker cannot write is the worker's failure: the job itself is fine, and statistics that called
+// it an invalid job sent the user looking for bad parameters.
+TEST(JobRunner, AScratchFileItCannotWriteIsAWorkerError) {
+  const std::string dir = scratch() + "/blocked";
+  std::error_code ec;
+  std::filesystem::create_directories(dir + "/drape_5.ply/inside", ec);  // a directory where the mesh goes
+  ASSERT_FALSE(ec) << ec.message();
+  JobRunner runner(dir);
+  const auto answer = runner.run(tiny_job(v1::JOB_MODE_DRAPE));
+  ASSERT_EQ(answer.body_case(), v1::Envelope::kFailure);
+  EXPECT_EQ(answer.failure().reason(), v1::FAILURE_REASON_WORKER_ERROR) << answer.failure().message();
+  EXPECT_NE(answer.failure().message().find("drape_5.ply"), std::string::npos) << answer.failure().message();
+  EXPECT_STREQ(proto::reason_name(answer.failure().reason()), "worker_error");
 }
 
 TEST(JobRunner, NoopAnswersAtOnce) {

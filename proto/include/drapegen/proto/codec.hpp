@@ -47,7 +47,8 @@ inline constexpr std::size_t kMaxReadyText = 256;
 [[nodiscard]] const char* body_name(const v1::Envelope& envelope);
 
 /// The failure reason as stored in the manifest: "not_converged", "diverged", "self_intersection", "render_error",
-/// "worker_lost", "timeout", "invalid_job" ("unspecified" otherwise).
+/// "worker_lost", "timeout", "invalid_job", "worker_error" ("unspecified" otherwise: none given, or a value newer
+/// than this build).
 [[nodiscard]] const char* reason_name(v1::FailureReason reason);
 
 }  // namespace drapegen::proto

@@ -84,6 +84,11 @@ struct SolveReport {
   int pcg_failures = 0;              // PCG attempts that failed (too many iterations, negative curvature)
   double pcg_seconds = 0.0;
   double lagged_change = 0.0;        // relative change at the last update
+  /// The state-dependent parameters were fixed by `max_lagged_outer_updates` while the last update still changed
+  /// them by `lagged_tolerance` or more: a converged solve is an equilibrium of the energy with those parameters, not
+  /// a fixed point of their update (plastic flow still under way, directions cycling). Never set for a solve whose
+  /// parameters settled.
+  bool lagged_capped = false;
   int line_search_failures = 0;
   std::string message;
 

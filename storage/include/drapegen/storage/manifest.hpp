@@ -23,12 +23,18 @@ class Manifest {
   [[nodiscard]] static sim::Expected<Manifest> create(const std::string& path, const RunRecord& run,
                                                       const std::vector<SampleRecord>& samples,
                                                       const std::vector<JobRecord>& jobs);
-  /// Opens an existing manifest for writing (resume). Checks the schema version.
+  /// Opens an existing manifest for writing (resume). Checks the schema version (1 .. kSchemaVersion); writes
+  /// nothing until the caller does (an older version stays as it is until upgrade_schema()).
   [[nodiscard]] static sim::Expected<Manifest> open(const std::string& path);
 
   Manifest(Manifest&&) noexcept;
   Manifest& operator=(Manifest&&) noexcept;
   ~Manifest();
+
+  /// Brings a manifest of an older schema version to kSchemaVersion in one transaction, its rows kept (no-op when
+  /// current). Call it holding the run's output lock: a build of the older version then refuses the file.
+  [[nodiscard]] sim::Status upgrade_schema();
+  [[nodiscard]] int schema_version() const;
 
   [[nodiscard]] sim::Status begin();
   [[nodiscard]] sim::Status commit();

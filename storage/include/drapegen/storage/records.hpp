@@ -10,8 +10,9 @@
 
 namespace drapegen::storage {
 
-/// The manifest schema this build writes and reads (meta.schema_version).
-inline constexpr int kSchemaVersion = 1;
+/// The manifest schema this build writes (meta.schema_version). It reads every version from 1; opening an older
+/// manifest for writing (a resumed run) upgrades it.
+inline constexpr int kSchemaVersion = 2;
 
 enum class JobState { kPending, kDone, kFailed };
 [[nodiscard]] std::string_view to_string(JobState state);
@@ -84,7 +85,7 @@ struct FailureRecord {
   std::int64_t job_id = 0;
   int attempt = 0;
   std::string reason;           // not_converged, diverged, self_intersection, render_error, worker_lost, timeout,
-                                // invalid_job
+                                // invalid_job, worker_error, unspecified (none given, or unknown to this build)
   std::string message;
   std::string worker;
   double at = 0.0;              // unix seconds
