@@ -2,6 +2,7 @@
 // sent to the coordinator's port leave it running and the manifest unchanged.
 #include <arpa/inet.h>
 #include <cmath>
+#include <functional>
 #include <netinet/in.h>
 #include <random>
 #include <sys/socket.h>
@@ -339,17 +340,21 @@ TEST(Service, AFailureOfAnUnknownReasonIsRecordedNotFatal) {
   for (const auto& j : all(reader->jobs())) EXPECT_EQ(j.state, storage::JobState::kDone);
 }
 
-// A worker older than the bending-model field drapes with the paper's model whatever the run asks, and says nothing
-// about it: the coordinator refuses its result (an invalid_job failure, no files kept) and another worker does the job.
-TEST(Service, ResultOfAnotherBendingModelIsRefused) {
-  const fs::path dir = test_dir("model_mismatch");
+/// A fake worker "old" takes the run's first job and answers with a complete result (mesh, one EXR per orientation)
+/// that `spoil` makes unrecordable; the coordinator must refuse it as a failed attempt of `reason` (no files kept)
+/// and a real worker then does the job. Returns the failures.
+std::vector<storage::FailureRecord> refused_then_done(const std::string& name, const std::string& extra,
+                                                      const std::function<void(v1::Result&)>& spoil,
+                                                      const std::string& reason) {
+  const fs::path dir = test_dir(name);
   const fs::path out = dir / "run";
   // Attempts to spare: the retry may be leased back to the old worker before it goes away.
-  write_text(dir / "run.toml", small_config(out, 1, 1, "bending_model = \"triangle\"\n[retry]\nmax_attempts = 5\n"));
+  write_text(dir / "run.toml", small_config(out, 1, 1, extra + "[retry]\nmax_attempts = 5\n"));
   const fs::path manifest = out / "manifest.sqlite";
   Process coordinator({"run", "--config", (dir / "run.toml").string()}, (dir / "coordinator").string());
   const std::string endpoint = wait_endpoint(out, coordinator, 30s);
-  ASSERT_FALSE(endpoint.empty()) << coordinator.err();
+  EXPECT_FALSE(endpoint.empty()) << coordinator.err();
+  if (endpoint.empty()) return {};
   zmq::context_t context(1);
   {
     FakeWorker old(context, endpoint);
@@ -358,37 +363,60 @@ TEST(Service, ResultOfAnotherBendingModelIsRefused) {
     hello.mutable_ready()->set_interval_ms(500);
     old.send(hello);
     auto job = old.expect(v1::Envelope::kJob, 5s);
-    ASSERT_TRUE(job);
-    EXPECT_EQ(job->job().spec().bending_model(), "triangle");
-    // A complete result (mesh and one file per orientation) without Metrics.bending_model.
+    EXPECT_TRUE(job);
+    if (!job) return {};
     v1::Envelope e = result(job->job().job_id(), job->job().attempt());
     e.mutable_result()->mutable_metrics()->set_outcome("converged");
+    e.mutable_result()->mutable_metrics()->set_bending_model(job->job().spec().bending_model());
     e.mutable_result()->set_mesh_ply("ply");
     for (int k = 0; k < 2; ++k) e.mutable_result()->add_exr("exr");
+    spoil(*e.mutable_result());
     old.send(e);
     const auto refused = [&] {
       auto r = storage::ManifestReader::open(manifest.string());
       if (!r) return false;
       auto f = r->failures();
-      return f && !f->empty() && f->front().reason == "invalid_job";
+      return f && !f->empty() && f->front().reason == reason;
     };
     const auto until = std::chrono::steady_clock::now() + 10s;
     while (!refused() && std::chrono::steady_clock::now() < until) std::this_thread::sleep_for(10ms);
-    ASSERT_TRUE(refused()) << coordinator.err();
+    EXPECT_TRUE(refused()) << coordinator.err();
   }  // the old worker goes away
   Process worker = start_worker(endpoint, dir, 1);
-  ASSERT_EQ(coordinator.wait(120s), 0) << coordinator.err();
+  EXPECT_EQ(coordinator.wait(120s), 0) << coordinator.err();
   check_manifest(manifest, 2);
   auto reader = storage::ManifestReader::open(manifest.string());
-  ASSERT_TRUE(reader);
-  const auto failures = all(reader->failures());
-  ASSERT_GE(failures.size(), 1u);
-  EXPECT_EQ(failures[0].reason, "invalid_job");
-  EXPECT_EQ(failures[0].worker, "old");
-  EXPECT_NE(failures[0].message.find("dihedral (unnamed)"), std::string::npos) << failures[0].message;
-  EXPECT_NE(failures[0].message.find("triangle"), std::string::npos) << failures[0].message;
+  EXPECT_TRUE(reader);
+  if (!reader) return {};
   for (const auto& j : all(reader->jobs())) EXPECT_EQ(j.state, storage::JobState::kDone);
   EXPECT_EQ(all(reader->results()).size(), 1u);
+  auto failures = all(reader->failures());
+  EXPECT_GE(failures.size(), 1u);
+  if (!failures.empty()) {
+    EXPECT_EQ(failures[0].reason, reason);
+    EXPECT_EQ(failures[0].worker, "old");
+  }
+  return failures;
+}
+
+// A worker older than the bending-model field drapes with the paper's model whatever the run asks, and says nothing
+// about it: the coordinator refuses its result (an invalid_job failure, no files kept) and another worker does the job.
+TEST(Service, ResultOfAnotherBendingModelIsRefused) {
+  const auto failures = refused_then_done(
+      "model_mismatch", "bending_model = \"triangle\"\n",
+      [](v1::Result& r) { r.mutable_metrics()->clear_bending_model(); }, "invalid_job");
+  ASSERT_FALSE(failures.empty());
+  EXPECT_NE(failures[0].message.find("dihedral (unnamed)"), std::string::npos) << failures[0].message;
+  EXPECT_NE(failures[0].message.find("triangle"), std::string::npos) << failures[0].message;
+}
+
+// A result with one file per orientation but an empty one among them would be recorded, checksum and all, and fail
+// the training stage's reader later: it is an incomplete result (render_error) like one with a file missing.
+TEST(Service, AResultWithAnEmptyFileIsRefused) {
+  const auto failures = refused_then_done(
+      "empty_exr", "", [](v1::Result& r) { r.mutable_exr(1)->clear(); }, "render_error");
+  ASSERT_FALSE(failures.empty());
+  EXPECT_NE(failures[0].message.find("EXR file 2 of 2 is empty"), std::string::npos) << failures[0].message;
 }
 
 // A result whose metrics are not finite (SQLite would store NaN as NULL in a NOT NULL column) is a failed attempt

@@ -1,6 +1,7 @@
 // The distributed generation service end to end (issue 5 acceptance 1, 2, 3, 5, 6): real coordinator and worker
 // processes on 127.0.0.1 with ephemeral ports, coarse meshes.
 #include <random>
+#include <sqlite3.h>
 
 #include "service_harness.hpp"
 
@@ -402,8 +403,20 @@ TEST(Service, ASecondCoordinatorOnALiveOutputIsRefused) {
 
   ::kill(first.pid(), SIGTERM);
   ASSERT_EQ(first.wait(30s), 4) << first.err();
-  // The lock went with the process: the resume runs, and removes the file no run recorded.
-  ASSERT_TRUE(resume_to_completion(manifest, out, dir, 1));
+  // The lock went with the process: the resume runs, and removes the file no run recorded. As if the run had been
+  // planned by another build, the resume says whose code computes its remaining jobs.
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open(manifest.c_str(), &db), SQLITE_OK);
+  ASSERT_EQ(sqlite3_exec(db, "UPDATE runs SET code_version = '0.1-older'", nullptr, nullptr, nullptr), SQLITE_OK);
+  sqlite3_close(db);
+  {
+    Coordinator resumed = start_coordinator({"--resume", manifest.string()}, out, dir / "resumed");
+    ASSERT_FALSE(resumed.endpoint.empty()) << resumed.process.err();
+    Process worker = start_worker(resumed.endpoint, dir, 1);
+    ASSERT_EQ(resumed.process.wait(120s), 0) << resumed.process.err();
+    EXPECT_NE(resumed.process.err().find("planned by drapegen 0.1-older and is resumed by"), std::string::npos)
+        << resumed.process.err();
+  }
   EXPECT_FALSE(fs::exists(unrecorded));
   check_manifest(manifest, 2);
   EXPECT_EQ(recorded_jobs(manifest), 2);

@@ -119,7 +119,7 @@ struct Coordinator::Impl {
   const std::string blas_kernels = sim::blas_kernels_description();  // a worker's other than these is warned about
   bool terminal_progress = false;
   Clock::time_point start = Clock::now(), last_progress = Clock::now(), last_reject_log{};
-  std::int64_t done_at_start = 0;
+  std::int64_t finished_at_start = 0;  // jobs done or failed before this session: not its rate
 
   // ---------------------------------------------------------------------------------------------------------------
   // Setup
@@ -251,7 +251,7 @@ struct Coordinator::Impl {
     if (sim::Status st = manifest->set_run_state("running"); !st) return st;
     if (sim::Status st = manifest->set_endpoint(endpoint); !st) return st;
     if (sim::Status st = manifest->commit(); !st) return st;
-    done_at_start = done;
+    finished_at_start = done + failed;
     counts_committed();
     return {};
   }
@@ -417,6 +417,12 @@ struct Coordinator::Impl {
       return refuse_result(w, r, v1::FAILURE_REASON_RENDER_ERROR,
                            fmt::format("incomplete result: {} mesh bytes, {} of {} EXR files", r.mesh_ply().size(),
                                        r.exr_size(), config.orientations));
+    }
+    for (int k = 0; !noop && k < r.exr_size(); ++k) {  // an empty file would be recorded, checksum and all
+      if (r.exr(k).empty()) {
+        return refuse_result(w, r, v1::FAILURE_REASON_RENDER_ERROR,
+                             fmt::format("incomplete result: EXR file {} of {} is empty", k + 1, r.exr_size()));
+      }
     }
     // A worker that does not know the run's bending model (older than the field) drapes with the paper's: its result
     // would be mislabelled data, so it counts as a failed attempt and the job goes to another worker.
@@ -680,7 +686,7 @@ struct Coordinator::Impl {
     last_progress = now;
     const double elapsed = std::chrono::duration<double>(now - start).count();
     const std::int64_t total = static_cast<std::int64_t>(jobs.size());
-    const double rate = elapsed > 0 ? static_cast<double>(done + failed - done_at_start) / elapsed : 0.0;
+    const double rate = elapsed > 0 ? static_cast<double>(done + failed - finished_at_start) / elapsed : 0.0;
     const std::int64_t left = total - done - failed;
     const std::string eta = rate > 0 ? format_duration(static_cast<double>(left) / rate) : "?";
     const std::string line =
@@ -919,6 +925,13 @@ sim::Expected<std::unique_ptr<Coordinator>> Coordinator::resume(const std::strin
   if (sim::Status s = impl->load_state(); !s) return s.error();
   impl->log->info("resumed {}: {} of {} jobs done, {} failed; listening on {}", manifest_path, impl->done,
                   impl->jobs.size(), impl->failed, impl->endpoint);
+  // The stored configuration is the text as given: keys it leaves out take this build's defaults.
+  if (run->code_version != DRAPEGEN_BUILD_ID) {
+    impl->log->warn("the run was planned by drapegen {} and is resumed by {}: its remaining jobs are computed with "
+                    "this build's code and the defaults of the keys its configuration leaves out (drapegen local "
+                    "--print-config shows them)",
+                    run->code_version, DRAPEGEN_BUILD_ID);
+  }
   if (sim::Status s = impl->publish_endpoint(); !s) return s.error();
   return std::unique_ptr<Coordinator>(new Coordinator(std::move(impl)));
 }

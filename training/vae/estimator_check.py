@@ -24,7 +24,12 @@ def main():
     torch.set_num_threads(1)
     model, state = vae.load_checkpoint(args.checkpoint)
     x = fabrics.distinct_fabrics(args.data)
-    _, va = fabrics.split(len(x), args.seed)
+    tr, va = fabrics.split(len(x), args.seed)
+    try:
+        vae.check_split(model, x, tr)
+    except ValueError as e:
+        print(f"{os.path.basename(__file__)}: error: {e}", file=sys.stderr)
+        return 1
     m, s = model.feature_mean.numpy(), model.feature_std.numpy()
     logdet = float(np.log(s).sum())
     sv = torch.as_tensor((x[va] - m) / s)

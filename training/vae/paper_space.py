@@ -128,8 +128,7 @@ def main():
     # VAE-3, committed: decoder means of prior latents (as the sampler and the table), and, as a sensitivity check,
     # the full generative model (decoder mean plus the learned Student-t observation noise)
     model, state = vae.load_checkpoint(args.checkpoint)
-    assert np.allclose(model.feature_mean.numpy(), mx) and np.allclose(model.feature_std.numpy(), sx), \
-        "checkpoint standardisation differs from this split's"
+    vae.check_split(model, x, tr)
     g = torch.Generator().manual_seed(args.seed)
     with torch.no_grad():
         ll_x = {part: model.log_likelihood(torch.as_tensor((x[idx] - mx) / sx), args.iw_samples, g).numpy() - log_sx

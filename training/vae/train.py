@@ -87,14 +87,26 @@ def main():
     tr, va = fabrics.split(len(x), args.seed)
     m, s = x[tr].mean(0), x[tr].std(0)
     logdet = float(np.log(s).sum())
-    export_name, export_path = (args.export.split("=", 1) if args.export else (None, None))
+    export_name, _, export_path = (args.export.partition("=") if args.export else (None, None, None))
     # Checked before any training: a request that would be dropped, or a path found unwritable only afterwards.
     names = args.models.split(",")
-    unknown = [n for n in names if not n.startswith("GMM-") and n not in vae.ARCHITECTURES]
-    if unknown:
-        log(f"train.py: error: unknown model(s) {', '.join(unknown)} (GMM-K or one of {', '.join(vae.ARCHITECTURES)})")
+
+    def known(name):
+        if name in vae.ARCHITECTURES:
+            return True
+        k = name[4:] if name.startswith("GMM-") else ""
+        return k.isdigit() and int(k) >= 1
+
+    unknown = [n for n in names if not known(n)]
+    if args.generated < len(x):
+        log(f"train.py: error: --generated {args.generated}: the coverage metric needs at least one draw per "
+            f"distinct fabric ({len(x)})")
         return 1
-    if args.export and (export_path is None or export_name not in vae.ARCHITECTURES or export_name not in names):
+    if unknown:
+        log(f"train.py: error: unknown model(s) {', '.join(unknown)} (GMM-K with K >= 1, or one of "
+            f"{', '.join(vae.ARCHITECTURES)})")
+        return 1
+    if args.export and (not export_path or export_name not in vae.ARCHITECTURES or export_name not in names):
         log(f"train.py: error: --export NAME=PATH needs NAME to be a VAE in --models ({args.export!r})")
         return 1
     if args.checkpoint and not args.export:

@@ -190,6 +190,15 @@ def add_checkpoint_arguments(parser, repo):
     parser.add_argument("--seed", type=int, default=0, help="the split seed of the training run")
 
 
+def check_split(model, x, tr):
+    """Raises ValueError unless the model was trained on the split `tr` of `x` (its stored standardisation is that
+    split's): with another --seed, the "validation" fabrics would include the model's training fabrics."""
+    if not (np.allclose(model.feature_mean.numpy(), x[tr].mean(0)) and np.allclose(model.feature_std.numpy(),
+                                                                                     x[tr].std(0))):
+        raise ValueError("the checkpoint was trained on another split of the data (its standardisation differs from "
+                         "this --seed's training split): pass the training run's --seed and --data")
+
+
 def load_checkpoint(path):
     """A model saved by train.py --checkpoint, in eval mode, and the saved state (name, hidden, latent, ...)."""
     state = torch.load(path)

@@ -29,6 +29,11 @@ def main():
     model.eval()
     x = fabrics.distinct_fabrics(args.data)
     tr, va = fabrics.split(len(x), args.seed)
+    try:
+        vae.check_split(model, x, tr)
+    except ValueError as e:
+        print(f"{os.path.basename(__file__)}: error: {e}", file=sys.stderr)
+        return 1
     m, s = model.feature_mean.numpy(), model.feature_std.numpy()
     logdet = float(np.log(s).sum())
     mixture = gmm.GaussianMixture(3, iterations=200, seed=args.seed).fit((x[tr] - m) / s)
