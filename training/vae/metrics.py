@@ -11,7 +11,8 @@ def wasserstein_exact(generated, data):
     n = len(data)
     chunks = len(generated) // n
     if chunks == 0:
-        raise ValueError(f"{len(generated)} generated points: the exact W1 needs at least as many as the {n} data points")
+        raise ValueError(f"{len(generated)} generated points: the exact W1 needs at least as many as the {n} data "
+                         "points")
     values = []
     for c in range(chunks):
         cost = cdist(generated[c * n:(c + 1) * n], data)
