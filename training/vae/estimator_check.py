@@ -10,7 +10,6 @@ import numpy as np
 import torch
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import fabrics  # noqa: E402
 import vae  # noqa: E402
 
 REPO = os.path.abspath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
@@ -22,14 +21,7 @@ def main():
     ap.add_argument("--worst", type=int, default=3)
     args = ap.parse_args()
     torch.set_num_threads(1)
-    model, state = vae.load_checkpoint(args.checkpoint)
-    x = fabrics.distinct_fabrics(args.data)
-    tr, va = fabrics.split(len(x), args.seed)
-    try:
-        vae.check_split(model, x, tr)
-    except ValueError as e:
-        print(f"{os.path.basename(__file__)}: error: {e}", file=sys.stderr)
-        return 1
+    model, state, x, tr, va = vae.load_for_evaluation(args)
     m, s = model.feature_mean.numpy(), model.feature_std.numpy()
     logdet = float(np.log(s).sum())
     sv = torch.as_tensor((x[va] - m) / s)

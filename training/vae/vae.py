@@ -3,6 +3,7 @@ or Student-t observation model (OBSERVATIONS) with one learned scale per feature
 float64 on standardised features (feature - mean) / std with the training set's mean and std."""
 import math
 import os
+import sys
 
 import numpy as np
 import torch
@@ -197,6 +198,21 @@ def check_split(model, x, tr):
                                                                                      x[tr].std(0))):
         raise ValueError("the checkpoint was trained on another split of the data (its standardisation differs from "
                          "this --seed's training split): pass the training run's --seed and --data")
+
+
+def load_for_evaluation(args):
+    """For the evaluation scripts (add_checkpoint_arguments): the checkpoint's model and state, the distinct fabrics
+    and the training run's split (train, validation). Exits with an error when the checkpoint was trained on another
+    split."""
+    import fabrics  # noqa: E402 (the evaluation scripts' dependency, not the model's)
+    model, state = load_checkpoint(args.checkpoint)
+    x = fabrics.distinct_fabrics(args.data)
+    tr, va = fabrics.split(len(x), args.seed)
+    try:
+        check_split(model, x, tr)
+    except ValueError as e:
+        raise SystemExit(f"{os.path.basename(sys.argv[0])}: error: {e}") from None
+    return model, state, x, tr, va
 
 
 def load_checkpoint(path):

@@ -11,7 +11,6 @@ import numpy as np
 import torch
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import fabrics  # noqa: E402
 import gmm  # noqa: E402
 import vae  # noqa: E402
 
@@ -24,16 +23,8 @@ def main():
     ap.add_argument("--worst", type=int, default=6)
     args = ap.parse_args()
     torch.set_num_threads(1)
-    model, state = vae.load_checkpoint(args.checkpoint)
+    model, state, x, tr, va = vae.load_for_evaluation(args)
     observation = state.get("observation", "gaussian")
-    model.eval()
-    x = fabrics.distinct_fabrics(args.data)
-    tr, va = fabrics.split(len(x), args.seed)
-    try:
-        vae.check_split(model, x, tr)
-    except ValueError as e:
-        print(f"{os.path.basename(__file__)}: error: {e}", file=sys.stderr)
-        return 1
     m, s = model.feature_mean.numpy(), model.feature_std.numpy()
     logdet = float(np.log(s).sum())
     mixture = gmm.GaussianMixture(3, iterations=200, seed=args.seed).fit((x[tr] - m) / s)
