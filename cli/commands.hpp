@@ -16,6 +16,7 @@ enum ExitCode : int {
   kExitNotConverged = 2, // the computation ran but did not reach its goal (the outcome says why)
   kExitIo = 3,           // an output could not be written
   kExitStopped = 4,      // a run stopped by SIGINT/SIGTERM before it completed (continue with --resume)
+  kExitRunStopped = 5,   // drapegen worker: the coordinator stopped the run before its end (a resume wants workers)
 };
 
 /// A ZeroMQ endpoint option: tcp:// or ipc://, as the configuration's network.bind.

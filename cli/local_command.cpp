@@ -112,14 +112,16 @@ class WorkerPool {
         int status = 0;
         if (pids_[k] <= 0 || ::waitpid(pids_[k], &status, WNOHANG) != pids_[k]) continue;
         pids_[k] = -1;
-        const bool clean_exit = WIFEXITED(status) && WEXITSTATUS(status) == kExitOk;  // the run is over
+        // The coordinator told it the run is over, or stopped (a storage error): it is finishing.
+        const bool clean_exit =
+            WIFEXITED(status) && (WEXITSTATUS(status) == kExitOk || WEXITSTATUS(status) == kExitRunStopped);
         // SIGINT/SIGTERM: handled (exit 4), or before the worker installed its handlers (killed by it)
         const bool stopped = (WIFEXITED(status) && WEXITSTATUS(status) == kExitStopped) ||
                              (WIFSIGNALED(status) && (WTERMSIG(status) == SIGTERM || WTERMSIG(status) == SIGINT));
         const std::string how = WIFSIGNALED(status) ? fmt::format("signal {}", WTERMSIG(status))
                                                     : fmt::format("status {}", WEXITSTATUS(status));
         if (finishing_) continue;
-        if (clean_exit) {  // the coordinator told it the run is over
+        if (clean_exit) {
           run_over_ = true;
           continue;
         }
@@ -171,7 +173,7 @@ class WorkerPool {
   std::atomic<bool> exhausted_{false};
   int stopped_ = 0;        // workers stopped by a signal (the supervisor's own counts)
   int lost_ = 0;           // restarts that could not be started
-  bool run_over_ = false;  // a worker was told the run is over
+  bool run_over_ = false;  // a worker was told the run is over or stopped: the coordinator is finishing
 };
 
 }  // namespace

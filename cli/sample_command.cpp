@@ -244,8 +244,8 @@ int run(const SampleOptions& o) {
   if (!(o.max_drift_mm >= 0.0 && o.max_drift_mm <= sampler::kMaxDriftMm)) {
     return fail(fmt::format("--max-drift must be 0..{} (mm)", sampler::kMaxDriftMm));
   }
-  const std::string model_path = o.model.empty() ? sampler::default_model_path() : o.model;
-  auto model = sampler::load_vae_model(model_path);
+  const std::string model_path = o.model.empty() ? "built-in (sampler/models/vae3.dgvae)" : o.model;
+  auto model = o.model.empty() ? sampler::builtin_vae_model() : sampler::load_vae_model(o.model);
   if (!model) return fail(model.error().message);
   return o.report ? run_report(o, *model, model_path) : run_sample(o, *model, model_path);
 }
@@ -259,7 +259,7 @@ Runner add_sample_command(CLI::App& app) {
       ->check(kSeed)
       ->capture_default_str();
   app.add_option("--out", o->out, "Write the parameter vectors to this CSV file (paper units at 300 g/m^2)");
-  app.add_option("--model", o->model, "VAE model file (default: the committed sampler/models/vae3.dgvae)");
+  app.add_option("--model", o->model, "VAE model file (default: the committed sampler/models/vae3.dgvae, built into the program)");
   app.add_flag("--json", o->json, "Print the summary (or the report) as JSON");
   app.add_option("--recipes", o->recipes, "Write the initial-state recipes, one line each, to this file");
   app.add_option("--states", o->states, "Initial states per parameter vector")->capture_default_str();

@@ -43,9 +43,17 @@ Runner add_worker_command(CLI::App& app) {
     if (!std::isfinite(o->give_up_s)) return Failure{"worker"}("--give-up: must be a number of seconds");
     coordinator::logger()->set_level(spdlog::level::from_str(*level));
     const auto& stop = install_stop_signals();
-    const sim::Status s = worker::run_worker(*o, stop);
-    // 0: the coordinator said the run is over; 4: stopped by SIGINT/SIGTERM (drapegen local does not restart it).
-    const int code = !s ? Failure{"worker"}(s.error().message) : stop.load() ? kExitStopped : kExitOk;
+    const auto end = worker::run_worker(*o, stop);
+    // 0: the coordinator said the run is over; 4: stopped by SIGINT/SIGTERM (drapegen local does not restart it);
+    // 5: the coordinator said the run stopped before its end (a Kubernetes Job restarts it, to serve the resumption).
+    int code = kExitStopped;
+    if (!end) {
+      code = Failure{"worker"}(end.error().message);
+    } else if (!stop.load() && *end == worker::WorkerEnd::kRunOver) {
+      code = kExitOk;
+    } else if (!stop.load() && *end == worker::WorkerEnd::kRunStopped) {
+      code = kExitRunStopped;
+    }
     // A computation still running cannot be interrupted: leave without waiting for it.
     std::fflush(stdout);
     std::fflush(stderr);

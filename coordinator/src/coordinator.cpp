@@ -719,10 +719,12 @@ struct Coordinator::Impl {
     counts_committed();
   }
 
-  void shutdown_workers(const std::string& reason) {
+  /// Tells every worker to exit; `stopped`: the run is not over (a worker may serve its resumption).
+  void shutdown_workers(const std::string& reason, bool stopped) {
     for (auto& [identity, w] : workers) {
       v1::Envelope e;
       e.mutable_shutdown()->set_reason(reason);
+      e.mutable_shutdown()->set_stopped(stopped);
       send(identity, std::move(e));
     }
     // Answer late or reconnecting workers with Shutdown for a moment too.
@@ -742,6 +744,7 @@ struct Coordinator::Impl {
       if (frames.empty()) continue;
       v1::Envelope e;
       e.mutable_shutdown()->set_reason(reason);
+      e.mutable_shutdown()->set_stopped(stopped);
       send(frames[0].to_string(), std::move(e));
     }
   }
@@ -833,7 +836,7 @@ struct Coordinator::Impl {
     progress(true);
     if (terminal_progress) std::fprintf(stderr, "\n");
     if (rejected > 0) log->warn("{} message(s) dropped during this session (undecodable, stale or forged)", rejected);
-    shutdown_workers(reason);
+    shutdown_workers(reason, outcome != RunOutcome::kComplete);
     return summary(outcome);
   }
 };

@@ -32,8 +32,7 @@ sampler::InitialStateRecipe fallback_recipe(const RunConfig& config, std::int64_
 }
 
 sim::Expected<Plan> plan_run(const RunConfig& config) {
-  const std::string model_path = config.model.empty() ? sampler::default_model_path() : config.model;
-  auto model = sampler::load_vae_model(model_path);
+  auto model = config.model.empty() ? sampler::builtin_vae_model() : sampler::load_vae_model(config.model);
   if (!model) return model.error();
   sampler::SamplerOptions options;
   options.count = config.samples;

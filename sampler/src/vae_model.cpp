@@ -1,11 +1,15 @@
 #include "drapegen/sampler/vae_model.hpp"
 
+#include "builtin_model.hpp"
+
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <numbers>
+#include <span>
+#include <vector>
 
 namespace drapegen::sampler {
 namespace {
@@ -236,6 +240,15 @@ sim::Expected<VaeModel> load_vae_model(const std::string& path) {
   if (!in) return sim::Error{"cannot open " + where};
   std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   if (in.bad()) return sim::Error{"cannot read " + where};
+  return parse_vae_model(bytes, where);
+}
+
+sim::Expected<VaeModel> builtin_vae_model() {
+  const std::span<const unsigned char> bytes = detail::builtin_model_bytes();
+  return parse_vae_model(std::vector<unsigned char>(bytes.begin(), bytes.end()), "the built-in model");
+}
+
+sim::Expected<VaeModel> parse_vae_model(const std::vector<unsigned char>& bytes, const std::string& where) {
   if (bytes.size() < sizeof kMagic || std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0) {
     return sim::Error{where + " is not a drapegen VAE model (bad magic bytes)"};
   }

@@ -206,6 +206,12 @@ TEST(VaeModel, CommittedModelLoads) {
   EXPECT_EQ(loaded->latent_dim, 8);
   EXPECT_EQ(loaded->hidden, (std::vector<int>{128, 32, 16}));
   EXPECT_EQ(loaded->observation, Observation::student_t);  // docs/SAMPLER.md, "Models"
+  // The program's default is the same model built in: no source tree needed where it runs.
+  auto builtin = builtin_vae_model();
+  ASSERT_TRUE(builtin) << builtin.error().message;
+  EXPECT_EQ(builtin->hidden, loaded->hidden);
+  const Eigen::MatrixXd z = Eigen::MatrixXd::Random(loaded->latent_dim, 5);
+  EXPECT_EQ(builtin->decode_standardised(z), loaded->decode_standardised(z));
 }
 
 }  // namespace

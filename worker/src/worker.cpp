@@ -111,7 +111,7 @@ std::string default_name() {
 
 }  // namespace
 
-sim::Status run_worker(const WorkerOptions& o, const std::atomic<bool>& stop) {
+sim::Expected<WorkerEnd> run_worker(const WorkerOptions& o, const std::atomic<bool>& stop) {
   auto log = coordinator::logger();
   const std::string name = o.name.empty() ? default_name() : o.name;
   // The coordinator drops a Ready whose name is too long or not UTF-8, and the worker would register for ever.
@@ -270,7 +270,7 @@ sim::Status run_worker(const WorkerOptions& o, const std::atomic<bool>& stop) {
               break;
             case v1::Envelope::kShutdown:
               log->info("worker {}: shutdown ({})", name, e.shutdown().reason());
-              return {};
+              return e.shutdown().stopped() ? WorkerEnd::kRunStopped : WorkerEnd::kRunOver;
             default:
               log->warn("worker {}: unexpected {} from the coordinator", name, proto::body_name(e));
               break;
@@ -324,7 +324,7 @@ sim::Status run_worker(const WorkerOptions& o, const std::atomic<bool>& stop) {
     while (Clock::now() < until && !stop.load()) std::this_thread::sleep_for(milliseconds(20));
     backoff_ms = std::min(std::max(backoff_ms * 2, backoff_initial_ms), o.backoff_max_ms);
   }
-  return {};
+  return WorkerEnd::kStopped;
 }
 
 }  // namespace drapegen::worker

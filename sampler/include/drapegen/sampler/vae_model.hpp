@@ -69,10 +69,16 @@ struct VaeModel {
 /// Loads a model file. Errors name the file and say what is wrong: missing, unreadable, not a model file, an
 /// unsupported version, implausible sizes, truncated or with trailing bytes, a checksum mismatch, non-finite values.
 [[nodiscard]] sim::Expected<VaeModel> load_vae_model(const std::string& path);
+/// A model from the bytes of a model file; errors name it as `where`.
+[[nodiscard]] sim::Expected<VaeModel> parse_vae_model(const std::vector<unsigned char>& bytes, const std::string& where);
+/// The committed model (sampler/models/vae3.dgvae), embedded in the program at build time: the sampler's default,
+/// which needs no source tree where the program runs.
+[[nodiscard]] sim::Expected<VaeModel> builtin_vae_model();
 /// Writes `model` in the format above (for tests and tools; training writes the same bytes from Python).
 [[nodiscard]] sim::Status save_vae_model(const VaeModel& model, const std::string& path);
 
-/// The model committed with the source (sampler/models/vae3.dgvae), as an absolute path fixed at build time.
+/// The model committed with the source (sampler/models/vae3.dgvae), as an absolute path fixed at build time (for
+/// tests and tools in the source tree; the program's default is builtin_vae_model()).
 [[nodiscard]] std::string default_model_path();
 
 /// The measured fabrics committed with the source (sampler/data/fabrics618.csv), an absolute path fixed at build time.

@@ -23,9 +23,16 @@ struct WorkerOptions {
   std::string key_file;          // CurveZMQ: this worker's secret key file (its public key must be authorised)
 };
 
-/// Runs until the coordinator sends Shutdown (Status ok), `stop` becomes true (ok), or give_up_s passes without a
-/// coordinator (an error). A job still computing when the worker returns is abandoned (the coordinator re-queues
-/// it); callers should exit the process promptly (the computing thread cannot be interrupted).
-[[nodiscard]] sim::Status run_worker(const WorkerOptions& options, const std::atomic<bool>& stop);
+/// Why a worker returned.
+enum class WorkerEnd {
+  kRunOver,     // the coordinator said the run is over
+  kRunStopped,  // the coordinator said the run stopped before its end (it will be resumed)
+  kStopped,     // `stop` became true (SIGINT/SIGTERM)
+};
+
+/// Runs until the coordinator sends Shutdown, `stop` becomes true, or give_up_s passes without a coordinator (an
+/// error). A job still computing when the worker returns is abandoned (the coordinator re-queues it); callers should
+/// exit the process promptly (the computing thread cannot be interrupted).
+[[nodiscard]] sim::Expected<WorkerEnd> run_worker(const WorkerOptions& options, const std::atomic<bool>& stop);
 
 }  // namespace drapegen::worker
