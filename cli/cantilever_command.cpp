@@ -11,6 +11,7 @@
 #include "drapegen/sim/cantilever.hpp"
 #include "drapegen/sim/cantilever_fit.hpp"
 #include "drapegen/sim/elastica.hpp"
+#include "drapegen/storage/json_text.hpp"
 
 namespace drapegen::cli {
 namespace {
@@ -62,7 +63,7 @@ int run_cantilever(const CantileverOptions& o) {
     out["fitted_beta"] = fit->beta * 1e12;
   }
   if (o.json) {
-    std::cout << out.dump(2) << "\n";
+    std::cout << storage::json_text(out) << "\n";
   } else {
     std::cout << fmt::format("cantilever: {} ({} iterations), Gamma = {:.4g}, H/W = {:.4f}",
                              out["outcome"].get<std::string>(), result->report.iterations, result->gamma,

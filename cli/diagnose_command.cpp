@@ -20,6 +20,7 @@
 #include "drapegen/diagnosis/report.hpp"
 #include "drapegen/sim/logging.hpp"
 #include "drapegen/storage/atomic_file.hpp"
+#include "drapegen/storage/json_text.hpp"
 #include "parse.hpp"
 #include "usable_cpus.hpp"
 
@@ -223,11 +224,17 @@ int run_diagnose(const DiagnoseOptions& o) {
   }
   const nlohmann::json j = diagnosis::to_json(*result, *capture);
   if (o.json) {
-    std::cout << j.dump(2) << "\n";
+    std::cout << storage::json_text(j) << "\n";
   } else {
     const auto& r = *result;
     std::cout << fmt::format("diagnose: {} in {:.0f} s\n", o.capture, r.seconds);
-    std::cout << fmt::format("  gap {:.2f} mm (all views), {:.2f} mm (held-out view); floor {:.2f} / {:.2f} mm\n",
+    // The verdict's tests first: the scores' own floors are for reference (report.md, "Gap and floors").
+    const diagnosis::GapTerms gap = r.gap();
+    std::cout << fmt::format("  tests: stable term {:.2f} mm against its floor {:.2f} mm; shape distance {:.2f} "
+                             "against its floor {:.2f}\n",
+                             gap.stable * 1e3, r.floors.stable * 1e3, gap.shape, r.floors.shape);
+    std::cout << fmt::format("  score {:.2f} mm (all views), {:.2f} mm (held-out view); the scores' floors {:.2f} / "
+                             "{:.2f} mm\n",
                              r.gap_all * 1e3, r.gap_held_out * 1e3, r.floors.all * 1e3, r.floors.held_out * 1e3);
     std::cout << fmt::format("  localised: {}\n", diagnosis::region_name(r.localisation.dominant));
     if (r.verdict == "none") {
@@ -238,8 +245,11 @@ int run_diagnose(const DiagnoseOptions& o) {
     } else if (r.verdict == "not attributed") {
       std::cout << "  verdict: above the floors (attribution not run: --gap-only)\n";
     } else {
-      std::cout << fmt::format("  verdict: {} (confidence {:.2f}, runner-up {}), shrinkage {:.0f}%\n", r.verdict,
-                               r.attribution.confidence, r.runner_up, 100 * r.attribution.candidates[0].shrinkage);
+      const std::string against =
+          r.runner_up.empty() ? std::string("the only candidate refitted")
+                              : fmt::format("confidence {:.2f}, runner-up {}", r.attribution.confidence, r.runner_up);
+      std::cout << fmt::format("  verdict: {} ({}), shrinkage {:.0f}%\n", r.verdict, against,
+                               100 * r.attribution.candidates[0].shrinkage);
     }
     if (!o.report.empty()) std::cout << "  report: " << o.report << "/report.md\n";
   }
@@ -259,7 +269,7 @@ Runner add_diagnose_command(CLI::App& app) {
                  "candidate refit (the mean of both captures' fit scores; a yielding candidate is laid again on it "
                  "with the plastic set its drape on the capture left) and in the gate (the mean of both captures' "
                  "terms); not in the baseline fit");
-  app.add_option("--report", o->report, "Write report.json, report.md and residual PNGs here");
+  app.add_option("--report", o->report, "Write report.json, report.md, views.png and the residual PNGs here");
   app.add_flag("--json", o->json, "Print the result as JSON");
   auto* quick = app.add_flag("--quick", o->quick, "Small budgets (16x16 mesh, 2 initial states, fewer evaluations)");
   app.add_flag("--fine", o->fine,

@@ -9,6 +9,7 @@
 #include "commands.hpp"
 #include "failure.hpp"
 #include "drapegen/diagnosis/reality.hpp"
+#include "drapegen/storage/json_text.hpp"
 #include "parse.hpp"
 
 namespace drapegen::cli {
@@ -68,7 +69,7 @@ int run_reality(const RealityOptions& o) {
   if (o.json) {
     nlohmann::json j = {{"capture", o.out}, {"truth", r->truth_path}, {"seconds", r->seconds},
                         {"converged", r->converged}};
-    std::cout << j.dump(2) << "\n";
+    std::cout << storage::json_text(j) << "\n";
   } else {
     std::cout << fmt::format("reality: capture written to {} in {:.1f} s (truth in {}, which the diagnosis never "
                              "reads){}\n",

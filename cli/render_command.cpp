@@ -14,6 +14,7 @@
 #include "drapegen/renderer/make_renderer.hpp"
 #include "drapegen/renderer/preview.hpp"
 #include "drapegen/sim/ply.hpp"
+#include "drapegen/storage/json_text.hpp"
 #include "parse.hpp"
 
 namespace drapegen::cli {
@@ -128,7 +129,7 @@ int run_render(const RenderOptions& o) {
                               {"seconds", seconds},
                               {"files", files}};
     if (!o.preview.empty()) summary["preview"] = o.preview;
-    std::cout << summary.dump(2) << "\n";
+    std::cout << storage::json_text(summary) << "\n";
   } else {
     std::cout << fmt::format("render: {} data points x {} views of {} in {:.2f} s, {:.0f} bytes per view\n",
                              points->size(), request.rig.views, o.mesh, seconds,

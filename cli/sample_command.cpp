@@ -16,6 +16,7 @@
 #include "drapegen/sampler/parameter_sampler.hpp"
 #include "drapegen/sampler/recipe_generator.hpp"
 #include "drapegen/sampler/scatter_plot.hpp"
+#include "drapegen/storage/json_text.hpp"
 #include "parse.hpp"
 
 namespace drapegen::cli {
@@ -119,7 +120,7 @@ int run_sample(const SampleOptions& o, const sampler::VaeModel& model, const std
     summary["recipe_kinds"] = {{"sine", kinds[0]}, {"fold", kinds[1]}, {"drape", kinds[2]}};
   }
   if (o.json) {
-    std::cout << summary.dump(2) << "\n";
+    std::cout << storage::json_text(summary) << "\n";
   } else {
     std::cout << fmt::format("sampled {} parameter vectors (seed {}) from {} candidates: {} outside the range, {} "
                              "near-duplicates; written to {}\n",
@@ -211,7 +212,7 @@ int run_report(const SampleOptions& o, const sampler::VaeModel& model, const std
     j["wasserstein_solver"] = "exact W1, Euclidean cost, optimal assignment per chunk of generated vectors the size of "
                               "the data, mean over the disjoint chunks";
     if (!plot_caption.empty()) j["plot"] = plot_caption;
-    std::cout << j.dump(2) << "\n";
+    std::cout << storage::json_text(j) << "\n";
     return kExitOk;
   }
   std::cout << fmt::format("coverage of {} distinct fabrics ({} rows of {}) by {}, seed {}, {} generated vectors\n",

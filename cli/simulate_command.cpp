@@ -15,6 +15,7 @@
 #include "drapegen/sim/drape.hpp"
 #include "drapegen/sim/logging.hpp"
 #include "drapegen/sim/ply.hpp"
+#include "drapegen/storage/json_text.hpp"
 #include "parse.hpp"
 
 namespace drapegen::cli {
@@ -166,7 +167,7 @@ int run_simulate(const SimulateOptions& o) {
   if (!o.effects.empty()) summary["effects"] = o.effects;
   if (!o.out.empty()) summary["mesh"] = o.out;
   if (o.json) {
-    std::cout << summary.dump(2) << "\n";
+    std::cout << storage::json_text(summary) << "\n";
   } else {
     const auto& r = result->report;
     const auto& c = result->coarse_report;

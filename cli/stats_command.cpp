@@ -5,6 +5,7 @@
 #include "commands.hpp"
 #include "failure.hpp"
 #include "drapegen/coordinator/stats.hpp"
+#include "drapegen/storage/json_text.hpp"
 
 namespace drapegen::cli {
 namespace {
@@ -33,7 +34,7 @@ Runner add_stats_command(CLI::App& app) {
     auto stats = coordinator::compute_stats(o->manifest, options);
     if (!stats) return fail(stats.error());  // 3 where a plot could not be written, 1 otherwise
     if (o->json) {
-      std::cout << stats->dump(2) << "\n";
+      std::cout << storage::json_text(*stats) << "\n";
     } else {
       std::cout << coordinator::format_stats(*stats);
       if (stats->contains("plots"))

@@ -1,6 +1,8 @@
 #include "drapegen/diagnosis/capture.hpp"
 
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fmt/format.h>
 #include <fstream>
@@ -10,6 +12,7 @@
 #include "drapegen/diagnosis/depth_exr.hpp"
 #include "drapegen/sim/platform.hpp"
 #include "drapegen/storage/atomic_file.hpp"
+#include "drapegen/storage/json_text.hpp"
 
 namespace drapegen::diagnosis {
 namespace fs = std::filesystem;
@@ -108,8 +111,9 @@ sim::Expected<Capture> read_capture(const std::string& directory) {
   if (!fs::is_directory(dir, ec)) return sim::Error{fmt::format("{}: not a directory", directory)};
   if (!fs::is_regular_file(json_path, ec)) return sim::Error{fmt::format("{}: no such file", json_path.string())};
   nlohmann::json j;
+  std::ifstream in(json_path);
+  if (!in) return sim::Error{fmt::format("{}: cannot read: {}", json_path.string(), std::strerror(errno))};
   try {
-    std::ifstream in(json_path);
     j = nlohmann::json::parse(in);
   } catch (const std::exception& e) {
     return sim::Error{fmt::format("{}: malformed JSON: {}", json_path.string(), e.what())};
@@ -119,7 +123,10 @@ sim::Expected<Capture> read_capture(const std::string& directory) {
     if (!j.is_object() || j.value("format", "") != kFormat) {
       return sim::Error{fmt::format("{}: not a capture (\"format\" must be \"{}\")", where, kFormat)};
     }
-    if (j.value("version", 0) != 1) return sim::Error{fmt::format("{}: unsupported version (expected 1)", where)};
+    // Integers as integers: 1.5 would pass as 1 (get<int> truncates).
+    if (!j.contains("version") || !j["version"].is_number_integer() || j["version"].get<int>() != 1) {
+      return sim::Error{fmt::format("{}: unsupported version (expected 1)", where)};
+    }
     Capture c;
     c.directory = directory;
     c.source = j.value("source", "");
@@ -160,6 +167,13 @@ sim::Expected<Capture> read_capture(const std::string& directory) {
     for (std::size_t v = 0; v < views.size(); ++v) {
       const auto& jv = views[v];
       const std::string what = fmt::format("{}: views[{}]", where, v);
+      if (!jv.is_object()) return sim::Error{what + ": not an object"};
+      for (const char* key : {"depth", "width", "height", "K", "world_to_camera"}) {
+        if (!jv.contains(key)) return sim::Error{fmt::format("{}: missing \"{}\"", what, key)};
+      }
+      if (!jv["width"].is_number_integer() || !jv["height"].is_number_integer()) {
+        return sim::Error{what + ": width and height must be integers"};
+      }
       CaptureView view;
       view.file = jv.at("depth").get<std::string>();
       for (std::size_t u = 0; u < v; ++u) {  // one file under two poses would be a view missing, unnoticed
@@ -263,7 +277,7 @@ sim::Status write_capture_json(const std::string& directory, const Capture& capt
   }
   if (capture.scan_mesh) j["scan"] = *capture.scan_mesh;
   // Atomically: a reader (or a crash) never sees half a capture.json.
-  return storage::write_file_atomic((dir / "capture.json").string(), j.dump(2) + "\n");
+  return storage::write_file_atomic((dir / "capture.json").string(), storage::json_text(j) + "\n");
 }
 
 }  // namespace drapegen::diagnosis

@@ -17,6 +17,7 @@
 #include "drapegen/renderer/sensor_error.hpp"
 #include "drapegen/sim/drape.hpp"
 #include "drapegen/storage/atomic_file.hpp"
+#include "drapegen/storage/json_text.hpp"
 
 namespace drapegen::diagnosis {
 namespace fs = std::filesystem;
@@ -271,8 +272,17 @@ sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std
     preview[0].push_back(view.depth);
     capture.views.push_back(std::move(view));
   }
+  // A directory written before holds another capture's truth and preview: gone first, so that a write failing below
+  // cannot leave them beside this capture.
+  for (const char* stale : {"truth.json", "preview.png"}) {
+    std::error_code ec;
+    fs::remove(fs::path(directory) / stale, ec);
+    if (ec) return sim::Error{fmt::format("cannot remove {}'s old {}: {}", directory, stale, ec.message()), true};
+  }
   if (sim::Status s = write_capture(directory, capture); !s) return s.error();
-  (void)renderer::write_preview_png((fs::path(directory) / "preview.png").string(), preview);
+  if (sim::Status s = renderer::write_preview_png((fs::path(directory) / "preview.png").string(), preview); !s) {
+    return s.error();
+  }
 
   nlohmann::json truth = {
       {"warning", "ground truth: the diagnosis never reads this file"},
@@ -302,7 +312,9 @@ sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std
   truth.update(bending_json(spec.bending));  // "alpha", "beta"
   RealityResult result;
   result.truth_path = (fs::path(directory) / "truth.json").string();
-  if (sim::Status s = storage::write_file_atomic(result.truth_path, truth.dump(2) + "\n"); !s) return s.error();
+  if (sim::Status s = storage::write_file_atomic(result.truth_path, storage::json_text(truth) + "\n"); !s) {
+    return s.error();
+  }
   result.converged = converged;
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;

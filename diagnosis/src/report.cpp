@@ -10,6 +10,7 @@
 #include "drapegen/renderer/preview.hpp"
 #include "drapegen/storage/atomic_file.hpp"
 #include "drapegen/storage/png.hpp"
+#include "drapegen/storage/json_text.hpp"
 
 namespace drapegen::diagnosis {
 namespace fs = std::filesystem;
@@ -123,10 +124,14 @@ std::string verdict_markdown(const DiagnosisResult& r) {
     const char* drapes = r.validated_second     ? "the capture's and the second capture's"
                          : r.validated_held_out ? "the capture's and the held-out capture's"
                                                 : "the capture's";
-    md += fmt::format("**Verdict: {}** (confidence {:.2f} against the runner-up, {}); adding it shrinks the gap's "
-                      "excess above the floors by {:.0f}% ({} drapes from fresh initial states) and the score on the "
-                      "held-out {} by {:.0f}%.\n\n",
-                      r.verdict, r.attribution.confidence, r.runner_up, 100.0 * c.shrinkage, drapes,
+    // One candidate (--candidates): nothing to be confident against.
+    const std::string against = r.runner_up.empty()
+                                    ? std::string("the only candidate refitted")
+                                    : fmt::format("confidence {:.2f} against the runner-up, {}", r.attribution.confidence,
+                                                  r.runner_up);
+    md += fmt::format("**Verdict: {}** ({}); adding it shrinks the gap's excess above the floors by {:.0f}% ({} drapes "
+                      "from fresh initial states) and the score on the held-out {} by {:.0f}%.\n\n",
+                      r.verdict, against, 100.0 * c.shrinkage, drapes,
                       r.validated_held_out ? "capture" : "view", 100.0 * c.held_out_shrinkage);
     if (r.attribution.near_tie_promoted && !r.attribution.curl_promoted)
       md += fmt::format("It is named ahead of a candidate whose shrinkage is larger by less than {:.2f}, a tie within "
@@ -154,8 +159,12 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
   std::error_code ec;
   fs::create_directories(dir, ec);
   if (ec) return sim::Error{fmt::format("{}: cannot create directory: {}", directory, ec.message()), /*io=*/true};
-  const nlohmann::json j = to_json(r, capture);
-  if (sim::Status s = storage::write_file_atomic((dir / "report.json").string(), j.dump(2) + "\n"); !s) return s;
+  // A directory reused: an earlier report's files go first (a residual_after.png of another verdict beside this one,
+  // or a mix if a write fails below); report.json is written last, so that it stands only beside a complete report.
+  for (const char* name : {"report.json", "report.md", "residual.png", "residual_after.png", "views.png"}) {
+    fs::remove(dir / name, ec);
+    if (ec) return sim::Error{fmt::format("{}: cannot remove the old {}: {}", directory, name, ec.message()), true};
+  }
   const double range = model.settings().weights.truncation;
   auto residuals = [&capture](const ScoredDrape& d) {  // each view at its own size
     std::vector<ResidualImage> out;
@@ -187,8 +196,8 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
   md += "## Gap and floors (score in mm: stable-region RMS + 4 mm x shape-feature distance)\n\n";
   md += "| | all views | held-out view |\n|---|---|---|\n";
   md += fmt::format("| gap (baseline fit) | {:.2f} | {:.2f} |\n", r.gap_all * 1e3, r.gap_held_out * 1e3);
-  md += fmt::format("| floor (x{:.2f} margin) | {:.2f} | {:.2f} |\n\n", r.floors.margin, r.floors.all * 1e3,
-                    r.floors.held_out * 1e3);
+  md += fmt::format("| floor (x{:.2f} margin; for reference: the verdict's tests are below) | {:.2f} | {:.2f} |\n\n",
+                    r.floors.margin, r.floors.all * 1e3, r.floors.held_out * 1e3);
   const GapTerms gap = r.gap();
   md += fmt::format(
       "Tests (all views{}): stable-region term {:.2f} mm against its floor {:.2f} mm; shape distance {:.2f} "
@@ -315,7 +324,8 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
                     "{} thread{}.\n",
                     r.seconds, r.seconds_fit, r.seconds_floors, r.seconds_attribution, r.cpu_seconds, r.jobs,
                     r.jobs == 1 ? "" : "s");
-  return storage::write_file_atomic((dir / "report.md").string(), md);
+  if (sim::Status s = storage::write_file_atomic((dir / "report.md").string(), md); !s) return s;
+  return storage::write_file_atomic((dir / "report.json").string(), storage::json_text(to_json(r, capture)) + "\n");
 }
 
 }  // namespace drapegen::diagnosis

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <nlohmann/json.hpp>
 
@@ -126,6 +127,28 @@ TEST(Capture, MissingJsonAndWrongViewCount) {
   j["views"].erase(3);
   std::ofstream(fs::path(dir) / "capture.json") << j.dump();
   EXPECT_NE(read_error(dir).find("3 views listed"), std::string::npos);
+}
+
+// Integers that are not (get<int> truncated 240.7 to 240 and version 1.5 to 1), and a view's missing key named with
+// its view.
+TEST(Capture, NonIntegersAndAViewsMissingKeyAreClearErrors) {
+  const std::string dir = fresh_dir("fields");
+  ASSERT_TRUE(write_capture(dir, plane_capture()).ok());
+  const nlohmann::json good = nlohmann::json::parse(std::ifstream(fs::path(dir) / "capture.json"));
+  auto with = [&](const std::function<void(nlohmann::json&)>& edit) {
+    nlohmann::json j = good;
+    edit(j);
+    std::ofstream(fs::path(dir) / "capture.json") << j.dump();
+    return read_error(dir);
+  };
+  EXPECT_NE(with([](nlohmann::json& j) { j["version"] = 1.5; }).find("unsupported version"), std::string::npos);
+  const std::string width =
+      with([](nlohmann::json& j) { j["views"][1]["width"] = j["views"][1]["width"].get<double>() + 0.7; });
+  EXPECT_NE(width.find("views[1]: width and height must be integers"), std::string::npos) << width;
+  const std::string pose = with([](nlohmann::json& j) { j["views"][2].erase("world_to_camera"); });
+  EXPECT_NE(pose.find("views[2]: missing \"world_to_camera\""), std::string::npos) << pose;
+  std::ofstream(fs::path(dir) / "capture.json") << good.dump();
+  EXPECT_TRUE(read_capture(dir).has_value());
 }
 
 TEST(Capture, WrongSize) {

@@ -5,6 +5,7 @@
 #include <atomic>
 #include <chrono>
 #include <mutex>
+#include <new>
 #include <set>
 #include <thread>
 #include <vector>
@@ -41,6 +42,19 @@ TEST(RunOnThreads, RunsEveryThreadIndexOnceTheFirstOnTheCaller) {
   seen.clear();
   run_on_threads(0, [&](int t) { seen.insert(t); });  // fewer than one: one, on the caller
   EXPECT_EQ(seen, (std::multiset<int>{0}));
+}
+
+// An exception on a helper thread reaches the caller once every thread has returned; it ended the process before
+// (std::terminate), so an out-of-memory error on a refit thread aborted the diagnosis without a message.
+TEST(RunOnThreads, AnExceptionOnAHelperThreadReachesTheCaller) {
+  std::atomic<int> finished{0};
+  EXPECT_THROW(run_on_threads(3,
+                              [&](int t) {
+                                if (t == 2) throw std::bad_alloc();
+                                ++finished;
+                              }),
+               std::bad_alloc);
+  EXPECT_EQ(finished.load(), 2);  // the others ran to their end
 }
 
 TEST(RunOnThreads, SharesAQueueSoEveryItemIsDoneOnceWhileASlowItemHoldsUpItsThread) {

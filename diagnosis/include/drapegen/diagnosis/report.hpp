@@ -26,7 +26,8 @@ struct ResidualImage {
 [[nodiscard]] std::string verdict_markdown(const DiagnosisResult& result);
 
 /// Writes DIR/report.json, DIR/report.md, DIR/residual.png (capture - fitted baseline per view), DIR/views.png
-/// (capture over fitted drape) and DIR/residual_after.png (after adding the named effect, if any).
+/// (capture over fitted drape) and DIR/residual_after.png (after adding the named effect, if any). An earlier
+/// report's files in DIR are removed first; report.json comes last (present only beside a complete report).
 [[nodiscard]] sim::Status write_report(const std::string& directory, const DiagnosisResult& result,
                                        const Capture& capture, ForwardModel& model);
 
