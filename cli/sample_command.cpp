@@ -260,7 +260,8 @@ Runner add_sample_command(CLI::App& app) {
       ->check(kSeed)
       ->capture_default_str();
   app.add_option("--out", o->out, "Write the parameter vectors to this CSV file (paper units at 300 g/m^2)");
-  app.add_option("--model", o->model, "VAE model file (default: the committed sampler/models/vae3.dgvae, built into the program)");
+  app.add_option("--model", o->model,
+                 "VAE model file (default: the committed sampler/models/vae3.dgvae, built into the program)");
   app.add_flag("--json", o->json, "Print the summary (or the report) as JSON");
   app.add_option("--recipes", o->recipes, "Write the initial-state recipes, one line each, to this file");
   app.add_option("--states", o->states, "Initial states per parameter vector")->capture_default_str();

@@ -920,11 +920,6 @@ sim::Expected<std::unique_ptr<Coordinator>> Coordinator::resume(const std::strin
   if (sim::Status s = impl->remove_orphans(); !s) return s.error();
   const std::string preferred = options.bind_override.empty() ? run->endpoint : options.bind_override;
   if (sim::Status s = impl->bind(preferred, options.bind_override.empty() ? config->bind : ""); !s) return s.error();
-  // Holding the run's lock, once nothing before the run can fail: an older build refuses the upgraded file.
-  if (const int from = impl->manifest->schema_version(); from != storage::kSchemaVersion) {
-    if (sim::Status s = impl->manifest->upgrade_schema(); !s) return s.error();
-    impl->log->info("manifest upgraded from schema version {} to {}", from, storage::kSchemaVersion);
-  }
   if (sim::Status s = impl->load_state(); !s) return s.error();
   impl->log->info("resumed {}: {} of {} jobs done, {} failed; listening on {}", manifest_path, impl->done,
                   impl->jobs.size(), impl->failed, impl->endpoint);
@@ -936,6 +931,12 @@ sim::Expected<std::unique_ptr<Coordinator>> Coordinator::resume(const std::strin
                     run->code_version, DRAPEGEN_BUILD_ID);
   }
   if (sim::Status s = impl->publish_endpoint(); !s) return s.error();
+  // Last, holding the run's lock, once nothing before the run can fail: an older build refuses the upgraded file.
+  // (Nothing above writes a failure, the only rows version 1 cannot hold.)
+  if (const int from = impl->manifest->schema_version(); from != storage::kSchemaVersion) {
+    if (sim::Status s = impl->manifest->upgrade_schema(); !s) return s.error();
+    impl->log->info("manifest upgraded from schema version {} to {}", from, storage::kSchemaVersion);
+  }
   return std::unique_ptr<Coordinator>(new Coordinator(std::move(impl)));
 }
 

@@ -14,6 +14,7 @@ sim::Expected<v1::Job> make_job_message(const RunConfig& config, const storage::
   job.set_job_id(static_cast<std::uint64_t>(rec.id));
   job.set_attempt(static_cast<std::uint32_t>(attempt));
   job.set_lease_ms(static_cast<std::uint64_t>(config.lease_s * 1000.0));
+  job.set_any_failure_reason(true);
   auto* spec = job.mutable_spec();
   spec->set_mode(rec.mode == "noop" ? v1::JOB_MODE_NOOP : rec.mode == "poison" ? v1::JOB_MODE_POISON
                                                                                 : v1::JOB_MODE_DRAPE);

@@ -224,6 +224,7 @@ struct SimulationFleet::Impl {
       auto* job = e.mutable_job();
       job->set_job_id(w.task->id);
       job->set_attempt(static_cast<std::uint32_t>(w.task->attempts));
+      job->set_any_failure_reason(true);
       job->mutable_spec()->set_mode(v1::JOB_MODE_SIMULATE);
       *job->mutable_spec()->mutable_simulation() = w.task->simulation;
       send(identity, std::move(e));

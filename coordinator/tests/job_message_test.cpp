@@ -21,6 +21,7 @@ TEST(JobMessage, CarriesTheRunsBendingModel) {
     auto message = make_job_message(*config, plan->samples.front(), job, 1, "");
     ASSERT_TRUE(message) << message.error().message;
     EXPECT_EQ(message->spec().bending_model(), expected) << toml;
+    EXPECT_TRUE(message->any_failure_reason());  // this coordinator records worker_error (older ones dropped it)
     proto::v1::Envelope envelope;
     *envelope.mutable_job() = *message;
     const auto decoded = proto::decode(proto::encode(envelope));

@@ -125,10 +125,10 @@ std::string verdict_markdown(const DiagnosisResult& r) {
                          : r.validated_held_out ? "the capture's and the held-out capture's"
                                                 : "the capture's";
     // One candidate (--candidates): nothing to be confident against.
-    const std::string against = r.runner_up.empty()
-                                    ? std::string("the only candidate refitted")
-                                    : fmt::format("confidence {:.2f} against the runner-up, {}", r.attribution.confidence,
-                                                  r.runner_up);
+    const std::string against =
+        r.runner_up.empty()
+            ? std::string("the only candidate refitted")
+            : fmt::format("confidence {:.2f} against the runner-up, {}", r.attribution.confidence, r.runner_up);
     md += fmt::format("**Verdict: {}** ({}); adding it shrinks the gap's excess above the floors by {:.0f}% ({} drapes "
                       "from fresh initial states) and the score on the held-out {} by {:.0f}%.\n\n",
                       r.verdict, against, 100.0 * c.shrinkage, drapes,

@@ -31,7 +31,9 @@ v1::Envelope failure(const v1::Job& job, v1::FailureReason reason, std::string m
   auto* f = e.mutable_failure();
   f->set_job_id(job.job_id());
   f->set_attempt(job.attempt());
-  f->set_reason(reason);
+  // A sender older than the reason would drop the whole failure (and wait out the lease): the reason it knows.
+  const bool known = reason != v1::FAILURE_REASON_WORKER_ERROR || job.any_failure_reason();
+  f->set_reason(known ? reason : v1::FAILURE_REASON_INVALID_JOB);
   // One line of valid UTF-8: the receiver drops a frame whose string is not (a path in another encoding).
   f->set_message(proto::one_line_utf8(message, kMaxFailureMessage));
   if (metrics) *f->mutable_metrics() = *metrics;

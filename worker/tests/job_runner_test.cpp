@@ -173,7 +173,9 @@ TEST(JobRunner, RefusesADrapeRecipeWithoutItsMesh) {
 // whose string field is not UTF-8, and the job would wait out its lease.
 TEST(JobRunner, FailureMessagesAreOneLineOfValidUtf8) {
   JobRunner runner("/proc/1/latin1-\xE9t\xE9\nscratch");  // cannot be made: the error names it
-  const auto answer = runner.run(tiny_job(v1::JOB_MODE_DRAPE));
+  v1::Job job = tiny_job(v1::JOB_MODE_DRAPE);
+  job.set_any_failure_reason(true);
+  const auto answer = runner.run(job);
   ASSERT_EQ(answer.body_case(), v1::Envelope::kFailure);
   const std::string& message = answer.failure().message();
   EXPECT_NE(message.find("latin1-?t?"), std::string::npos) << message;
@@ -192,11 +194,17 @@ TEST(JobRunner, AScratchFileItCannotWriteIsAWorkerError) {
   std::filesystem::create_directories(dir + "/drape_5.ply/inside", ec);  // a directory where the mesh goes
   ASSERT_FALSE(ec) << ec.message();
   JobRunner runner(dir);
-  const auto answer = runner.run(tiny_job(v1::JOB_MODE_DRAPE));
+  v1::Job job = tiny_job(v1::JOB_MODE_DRAPE);
+  job.set_any_failure_reason(true);
+  const auto answer = runner.run(job);
   ASSERT_EQ(answer.body_case(), v1::Envelope::kFailure);
   EXPECT_EQ(answer.failure().reason(), v1::FAILURE_REASON_WORKER_ERROR) << answer.failure().message();
   EXPECT_NE(answer.failure().message().find("drape_5.ply"), std::string::npos) << answer.failure().message();
   EXPECT_STREQ(proto::reason_name(answer.failure().reason()), "worker_error");
+  // From a coordinator older than the reason, whose check would drop it (the job then waits out its lease): the
+  // reason it knows.
+  job.set_any_failure_reason(false);
+  EXPECT_EQ(runner.run(job).failure().reason(), v1::FAILURE_REASON_INVALID_JOB);
 }
 
 TEST(JobRunner, NoopAnswersAtOnce) {

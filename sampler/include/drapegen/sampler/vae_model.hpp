@@ -70,7 +70,8 @@ struct VaeModel {
 /// unsupported version, implausible sizes, truncated or with trailing bytes, a checksum mismatch, non-finite values.
 [[nodiscard]] sim::Expected<VaeModel> load_vae_model(const std::string& path);
 /// A model from the bytes of a model file; errors name it as `where`.
-[[nodiscard]] sim::Expected<VaeModel> parse_vae_model(const std::vector<unsigned char>& bytes, const std::string& where);
+[[nodiscard]] sim::Expected<VaeModel> parse_vae_model(const std::vector<unsigned char>& bytes,
+                                                     const std::string& where);
 /// The committed model (sampler/models/vae3.dgvae), embedded in the program at build time: the sampler's default,
 /// which needs no source tree where the program runs.
 [[nodiscard]] sim::Expected<VaeModel> builtin_vae_model();

@@ -24,8 +24,8 @@ struct ManifestSnapshot {
 
 class ManifestReader {
  public:
-  /// Opens `path` read-only. Errors: missing file, not SQLite, not a drapegen manifest, a schema version newer than this
-  /// build's.
+  /// Opens `path` read-only. Errors: missing file, not SQLite, not a drapegen manifest, a schema version newer than
+  /// this build's.
   [[nodiscard]] static sim::Expected<ManifestReader> open(const std::string& path);
 
   ManifestReader(ManifestReader&&) noexcept;
