@@ -42,9 +42,9 @@ const Failure fail{"local"};
 
 /// The worker processes: started after the coordinator binds, restarted if one dies before the run ends (at most
 /// kRestartsPerWorker x N restarts over the run; a worker the coordinator told the run is over (exit 0) or stopped
-/// before its end (exit 5), or one stopped by SIGINT/SIGTERM (exit 4, or killed by it), is not restarted). halt() is the flag the coordinator runs
-/// until: set by SIGINT/SIGTERM (`signal_stop`), or when no worker is left and none will be restarted, since no
-/// worker would ever come again.
+/// before its end (exit 5), or one stopped by SIGINT/SIGTERM (exit 4, or killed by it), is not restarted). halt() is
+/// the flag the coordinator runs until: set by SIGINT/SIGTERM (`signal_stop`), or when no worker is left and none will
+/// be restarted, since no worker would ever come again.
 class WorkerPool {
  public:
   static constexpr int kRestartsPerWorker = 3;
