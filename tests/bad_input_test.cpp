@@ -294,58 +294,11 @@ TEST(Service, ARetryGoesToAnotherWorker) {
   for (const auto& j : all(reader->jobs())) EXPECT_EQ(j.state, storage::JobState::kDone);
 }
 
-// A failure whose reason this coordinator does not know (a newer worker's, or none at all) is recorded as
-// "unspecified" with its number; the manifest's check on reasons once refused it, which stopped the whole run.
-TEST(Service, AFailureOfAnUnknownReasonIsRecordedNotFatal) {
-  const fs::path dir = test_dir("unknown_reason");
-  const fs::path out = dir / "run";
-  write_text(dir / "run.toml", small_config(out, 1, 1, "[retry]\nmax_attempts = 5\n"));
-  const fs::path manifest = out / "manifest.sqlite";
-  Process coordinator({"run", "--config", (dir / "run.toml").string()}, (dir / "coordinator").string());
-  const std::string endpoint = wait_endpoint(out, coordinator, 30s);
-  ASSERT_FALSE(endpoint.empty()) << coordinator.err();
-  zmq::context_t context(1);
-  {
-    FakeWorker newer(context, endpoint);
-    v1::Envelope hello = ready("newer");
-    hello.mutable_ready()->set_interval_ms(500);
-    newer.send(hello);
-    auto job = newer.expect(v1::Envelope::kJob, 5s);
-    ASSERT_TRUE(job);
-    v1::Envelope e;
-    e.mutable_failure()->set_job_id(job->job().job_id());
-    e.mutable_failure()->set_attempt(job->job().attempt());
-    e.mutable_failure()->set_reason(static_cast<v1::FailureReason>(42));
-    e.mutable_failure()->set_message("a reason from a later release");
-    newer.send(e);
-    const auto recorded = [&] {
-      auto r = storage::ManifestReader::open(manifest.string());
-      if (!r) return false;
-      auto f = r->failures();
-      return f && !f->empty();
-    };
-    const auto until = std::chrono::steady_clock::now() + 10s;
-    while (!recorded() && std::chrono::steady_clock::now() < until) std::this_thread::sleep_for(10ms);
-    ASSERT_TRUE(recorded()) << coordinator.err();
-  }  // the newer worker goes away
-  Process worker = start_worker(endpoint, dir, 1);
-  ASSERT_EQ(coordinator.wait(120s), 0) << coordinator.err();
-  check_manifest(manifest, 2);
-  auto reader = storage::ManifestReader::open(manifest.string());
-  ASSERT_TRUE(reader);
-  const auto failures = all(reader->failures());
-  ASSERT_GE(failures.size(), 1u);
-  EXPECT_EQ(failures[0].reason, "unspecified");
-  EXPECT_EQ(failures[0].message, "(reason 42) a reason from a later release");
-  for (const auto& j : all(reader->jobs())) EXPECT_EQ(j.state, storage::JobState::kDone);
-}
-
-/// A fake worker "old" takes the run's first job and answers with a complete result (mesh, one EXR per orientation)
-/// that `spoil` makes unrecordable; the coordinator must refuse it as a failed attempt of `reason` (no files kept)
-/// and a real worker then does the job. Returns the failures.
-std::vector<storage::FailureRecord> refused_then_done(const std::string& name, const std::string& extra,
-                                                      const std::function<void(v1::Result&)>& spoil,
-                                                      const std::string& reason) {
+/// A fake worker "old" takes the run's first job and sends `answer(job)`, which the coordinator must record as a
+/// failed attempt of `reason` (no files kept); a real worker then does the job. Returns the failures.
+std::vector<storage::FailureRecord> failed_then_done(const std::string& name, const std::string& extra,
+                                                     const std::function<v1::Envelope(const v1::Job&)>& answer,
+                                                     const std::string& reason) {
   const fs::path dir = test_dir(name);
   const fs::path out = dir / "run";
   // Attempts to spare: the retry may be leased back to the old worker before it goes away.
@@ -365,22 +318,16 @@ std::vector<storage::FailureRecord> refused_then_done(const std::string& name, c
     auto job = old.expect(v1::Envelope::kJob, 5s);
     EXPECT_TRUE(job);
     if (!job) return {};
-    v1::Envelope e = result(job->job().job_id(), job->job().attempt());
-    e.mutable_result()->mutable_metrics()->set_outcome("converged");
-    e.mutable_result()->mutable_metrics()->set_bending_model(job->job().spec().bending_model());
-    e.mutable_result()->set_mesh_ply("ply");
-    for (int k = 0; k < 2; ++k) e.mutable_result()->add_exr("exr");
-    spoil(*e.mutable_result());
-    old.send(e);
-    const auto refused = [&] {
+    old.send(answer(job->job()));
+    const auto recorded = [&] {
       auto r = storage::ManifestReader::open(manifest.string());
       if (!r) return false;
       auto f = r->failures();
       return f && !f->empty() && f->front().reason == reason;
     };
     const auto until = std::chrono::steady_clock::now() + 10s;
-    while (!refused() && std::chrono::steady_clock::now() < until) std::this_thread::sleep_for(10ms);
-    EXPECT_TRUE(refused()) << coordinator.err();
+    while (!recorded() && std::chrono::steady_clock::now() < until) std::this_thread::sleep_for(10ms);
+    EXPECT_TRUE(recorded()) << coordinator.err();
   }  // the old worker goes away
   Process worker = start_worker(endpoint, dir, 1);
   EXPECT_EQ(coordinator.wait(120s), 0) << coordinator.err();
@@ -399,12 +346,25 @@ std::vector<storage::FailureRecord> refused_then_done(const std::string& name, c
   return failures;
 }
 
+/// A complete result for `job` (mesh, one EXR per orientation, the job's bending model) that `spoil` then edits.
+std::function<v1::Envelope(const v1::Job&)> spoiled_result(const std::function<void(v1::Result&)>& spoil) {
+  return [spoil](const v1::Job& job) {
+    v1::Envelope e = result(job.job_id(), job.attempt());
+    e.mutable_result()->mutable_metrics()->set_outcome("converged");
+    e.mutable_result()->mutable_metrics()->set_bending_model(job.spec().bending_model());
+    e.mutable_result()->set_mesh_ply("ply");
+    for (int k = 0; k < 2; ++k) e.mutable_result()->add_exr("exr");
+    spoil(*e.mutable_result());
+    return e;
+  };
+}
+
 // A worker older than the bending-model field drapes with the paper's model whatever the run asks, and says nothing
 // about it: the coordinator refuses its result (an invalid_job failure, no files kept) and another worker does the job.
 TEST(Service, ResultOfAnotherBendingModelIsRefused) {
-  const auto failures = refused_then_done(
+  const auto failures = failed_then_done(
       "model_mismatch", "bending_model = \"triangle\"\n",
-      [](v1::Result& r) { r.mutable_metrics()->clear_bending_model(); }, "invalid_job");
+      spoiled_result([](v1::Result& r) { r.mutable_metrics()->clear_bending_model(); }), "invalid_job");
   ASSERT_FALSE(failures.empty());
   EXPECT_NE(failures[0].message.find("dihedral (unnamed)"), std::string::npos) << failures[0].message;
   EXPECT_NE(failures[0].message.find("triangle"), std::string::npos) << failures[0].message;
@@ -413,10 +373,29 @@ TEST(Service, ResultOfAnotherBendingModelIsRefused) {
 // A result with one file per orientation but an empty one among them would be recorded, checksum and all, and fail
 // the training stage's reader later: it is an incomplete result (render_error) like one with a file missing.
 TEST(Service, AResultWithAnEmptyFileIsRefused) {
-  const auto failures = refused_then_done(
-      "empty_exr", "", [](v1::Result& r) { r.mutable_exr(1)->clear(); }, "render_error");
+  const auto failures = failed_then_done(
+      "empty_exr", "", spoiled_result([](v1::Result& r) { r.mutable_exr(1)->clear(); }), "render_error");
   ASSERT_FALSE(failures.empty());
   EXPECT_NE(failures[0].message.find("EXR file 2 of 2 is empty"), std::string::npos) << failures[0].message;
+}
+
+// A failure whose reason this coordinator does not know (a newer worker's) is recorded as "unspecified" with its
+// number; the codec's check dropped it before (the job waited out its lease), and the manifest's check on reasons
+// refused "unspecified", which stopped the whole run.
+TEST(Service, AFailureOfAnUnknownReasonIsRecordedNotFatal) {
+  const auto failures = failed_then_done(
+      "unknown_reason", "",
+      [](const v1::Job& job) {
+        v1::Envelope e;
+        e.mutable_failure()->set_job_id(job.job_id());
+        e.mutable_failure()->set_attempt(job.attempt());
+        e.mutable_failure()->set_reason(static_cast<v1::FailureReason>(42));
+        e.mutable_failure()->set_message("a reason from a later release");
+        return e;
+      },
+      "unspecified");
+  ASSERT_FALSE(failures.empty());
+  EXPECT_EQ(failures[0].message, "(reason 42) a reason from a later release");
 }
 
 // A result whose metrics are not finite (SQLite would store NaN as NULL in a NOT NULL column) is a failed attempt
