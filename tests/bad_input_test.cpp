@@ -60,8 +60,10 @@ class FakeWorker {
     }
     return std::nullopt;
   }
-  void heartbeat() {
+  /// A heartbeat naming the job being computed (0: idle), as a worker sends it.
+  void heartbeat(std::uint64_t job = 0) {
     v1::Envelope e;
+    e.mutable_heartbeat()->set_job_id(job);
     e.mutable_heartbeat()->set_interval_ms(10000);
     send(std::move(e));
   }
@@ -224,9 +226,9 @@ TEST(Service, ExpiredLeasesAreRequeued) {
   auto job = slow.expect(v1::Envelope::kJob, 5s);
   ASSERT_TRUE(job);
   const std::uint64_t id = job->job().job_id();
-  // Alive but silent about the job for 1.5 s (three leases).
+  // Alive, still computing the job for 1.5 s (three leases).
   for (int i = 0; i < 15; ++i) {
-    slow.heartbeat();
+    slow.heartbeat(id);
     std::this_thread::sleep_for(100ms);
   }
   slow.send(result(id, job->job().attempt()));  // too late: dropped
@@ -255,6 +257,38 @@ TEST(Service, ExpiredLeasesAreRequeued) {
     }
   }
   EXPECT_NE(coordinator.err().find("after its lease expired"), std::string::npos) << coordinator.err();
+}
+
+// A worker whose answer never arrived (lost, or dropped by the coordinator's checks) and whose lease then expired
+// says it is idle in its heartbeats: it is free for the next job. Before, it stayed marked as computing the expired
+// job for the rest of the run, heartbeating and idle.
+TEST(Service, AWorkerWhoseAnswerNeverCameIsFreeOnceIdle) {
+  const fs::path dir = test_dir("lost_answer");
+  const fs::path out = dir / "run";
+  std::string text = small_config(out, 2, 1, "[testing]\nmode = \"noop\"\n[retry]\nmax_attempts = 3\n");
+  text.replace(text.find("liveness = 4\n"), 13, "liveness = 4\nlease_s = 0.5\n");
+  write_text(dir / "run.toml", text);
+  Process coordinator({"run", "--config", (dir / "run.toml").string()}, (dir / "coordinator").string());
+  const std::string endpoint = wait_endpoint(out, coordinator, 30s);
+  ASSERT_FALSE(endpoint.empty()) << coordinator.err();
+  zmq::context_t context(1);
+  FakeWorker w(context, endpoint);
+  w.send(ready("w"));
+  auto first = w.expect(v1::Envelope::kJob, 5s);
+  ASSERT_TRUE(first);
+  for (int i = 0; i < 10; ++i) {  // computing it past its lease (0.5 s)
+    w.heartbeat(first->job().job_id());
+    std::this_thread::sleep_for(100ms);
+  }
+  w.heartbeat();  // done, but its answer never arrived
+  auto next = w.expect(v1::Envelope::kJob, 5s);
+  ASSERT_TRUE(next) << "an idle worker was left without work: " << coordinator.err();
+  w.send(result(next->job().job_id(), next->job().attempt()));
+  auto last = w.expect(v1::Envelope::kJob, 5s);
+  ASSERT_TRUE(last) << coordinator.err();
+  w.send(result(last->job().job_id(), last->job().attempt()));
+  ASSERT_EQ(coordinator.wait(30s), 0) << coordinator.err();
+  EXPECT_NE(coordinator.err().find("is idle without having answered job"), std::string::npos) << coordinator.err();
 }
 
 // A retry goes to another worker while there is one: the worker that failed a job is freed first and took the retry

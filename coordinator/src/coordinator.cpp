@@ -364,6 +364,13 @@ struct Coordinator::Impl {
       case v1::Envelope::kHeartbeat:
         if (e.heartbeat().interval_ms() > 0) w.interval_ms = static_cast<int>(e.heartbeat().interval_ms());
         if (e.heartbeat().liveness() > 0) w.liveness = static_cast<int>(e.heartbeat().liveness());
+        // Idle while its expired lease's answer never came (one connection keeps order: an answer sent before this
+        // heartbeat would have cleared it): the answer was lost or dropped, and the worker is free, not stuck.
+        if (w.stale_job != 0 && e.heartbeat().job_id() == 0) {
+          log->info("worker {} is idle without having answered job {} (its lease expired): free again", w.name,
+                    w.stale_job);
+          w.stale_job = 0;
+        }
         return;
       case v1::Envelope::kResult:
         return on_result(w, e.result());
