@@ -6,6 +6,7 @@
 #include "commands.hpp"
 #include "drapegen/coordinator/curve_keys.hpp"
 #include "failure.hpp"
+#include "parse.hpp"
 
 namespace drapegen::cli {
 
@@ -22,6 +23,9 @@ Runner add_keygen_command(CLI::App& app) {
                     " exists already: the peers that hold its public key would be cut off; use "
                     "--force to replace it");
       }
+      // Both checked before either is written: a pair replaced by half (a new secret key, no public key to match it)
+      // would cut every peer off.
+      if (sim::Status s = check_writable(*prefix + suffix); !s) return fail(s.error().message, kExitIo);
     }
     auto pair = coordinator::make_curve_keypair();
     if (!pair) return fail(pair.error().message);

@@ -22,6 +22,10 @@ namespace drapegen::cli {
 /// there is an error, not a file that can be replaced.
 [[nodiscard]] sim::Status check_writable(const std::string& path);
 
+/// Whether two paths name one file (existing or not): the same path after resolving `.`, `..` and links, or one
+/// existing file under two names. Two outputs of one command (or an output and an input) must not.
+[[nodiscard]] bool same_file(const std::string& a, const std::string& b);
+
 /// Creates `directory` (and its parents) for an output written later, and checks that `file` can be created in it:
 /// an error now rather than after the work.
 [[nodiscard]] sim::Status prepare_output_directory(const std::string& directory, const std::string& file);

@@ -66,6 +66,15 @@ int run_render(const RenderOptions& o) {
   // Refuse unwritable outputs before rendering.
   std::vector<std::string> paths;
   for (int k = 0; k < o.orientations; ++k) paths.push_back(output_path(o.out, k, o.orientations));
+  // No output over the input or over another output (the mesh replaced by an EXR, an EXR by the preview).
+  if (!o.preview.empty()) paths.push_back(o.preview);
+  for (std::size_t i = 0; i < paths.size(); ++i) {
+    if (same_file(paths[i], o.mesh)) return fail(fmt::format("{} would overwrite the input mesh", paths[i]));
+    for (std::size_t j = 0; j < i; ++j) {
+      if (same_file(paths[i], paths[j])) return fail(fmt::format("{} is two of the outputs", paths[i]));
+    }
+  }
+  if (!o.preview.empty()) paths.pop_back();
   for (const auto& path : paths) {
     if (sim::Status s = check_writable(path); !s) return fail(s.error().message, kExitIo);
   }
@@ -169,7 +178,7 @@ Runner add_render_command(CLI::App& app) {
   app.add_option("--compression", o->compression,
                  "EXR compression: none, rle, zips, zip, piz, pxr24, b44, b44a, dwaa, dwab")
       ->capture_default_str();
-  app.add_option("--quantum", o->quantum, "Round stored depth to multiples of this, metres (0: off)")
+  app.add_option("--quantum", o->quantum, "Round stored depth to multiples of this, metres (0: off; else 1e-9 .. 0.01)")
       ->capture_default_str();
   return [o] { return run_render(*o); };
 }

@@ -16,6 +16,7 @@
 #include "drapegen/sampler/parameter_sampler.hpp"
 #include "drapegen/sampler/recipe_generator.hpp"
 #include "drapegen/sampler/scatter_plot.hpp"
+#include "drapegen/storage/atomic_file.hpp"
 #include "drapegen/storage/json_text.hpp"
 #include "parse.hpp"
 
@@ -55,20 +56,17 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-sim::Status write_parameters(const std::string& path, const sampler::SampledParameters& s) {
-  std::ofstream out(path, std::ios::trunc);
-  if (!out) return sim::Error{"cannot create '" + path + "'"};
-  out << "sample";
-  for (const char* name : sampler::kFeatureNames) out << "," << name;
-  out << "\n";
+/// The parameters as CSV text (written whole, atomically: a failed write leaves the old file, not half a table).
+std::string parameters_csv(const sampler::SampledParameters& s) {
+  std::string out = "sample";
+  for (const char* name : sampler::kFeatureNames) out += fmt::format(",{}", name);
+  out += "\n";
   for (std::size_t i = 0; i < s.vectors.size(); ++i) {
     const auto& v = s.vectors[i];
-    out << fmt::format("{},{},{},{},{},{},{}\n", i, v.alpha.warp, v.alpha.bias, v.alpha.weft, v.beta.warp,
+    out += fmt::format("{},{},{},{},{},{},{}\n", i, v.alpha.warp, v.alpha.bias, v.alpha.weft, v.beta.warp,
                        v.beta.bias, v.beta.weft);
   }
-  out.close();
-  if (!out) return sim::Error{"cannot write '" + path + "'"};
-  return {};
+  return out;
 }
 
 int run_sample(const SampleOptions& o, const sampler::VaeModel& model, const std::string& model_path) {
@@ -80,6 +78,7 @@ int run_sample(const SampleOptions& o, const sampler::VaeModel& model, const std
   if (sim::Status s = sampler::validate(recipe_options); !s) return fail(s.error().message);
   if (sim::Status s = check_writable(o.out); !s) return fail(s.error().message, kExitIo);
   if (!o.recipes.empty()) {
+    if (same_file(o.out, o.recipes)) return fail("--out and --recipes name the same file");
     if (sim::Status s = check_writable(o.recipes); !s) return fail(s.error().message, kExitIo);
   }
   const auto start = std::chrono::steady_clock::now();
@@ -91,19 +90,20 @@ int run_sample(const SampleOptions& o, const sampler::VaeModel& model, const std
   auto sampled = sampler::sample_parameters(model, options);
   if (!sampled) return fail(sampled.error().message);
   const double sample_seconds = seconds_since(start);
-  if (sim::Status s = write_parameters(o.out, *sampled); !s) return fail(s.error().message, kExitIo);
   std::int64_t kinds[3] = {0, 0, 0};
-  if (!o.recipes.empty()) {
-    std::ofstream out(o.recipes, std::ios::trunc);
-    if (!out) return fail("cannot create '" + o.recipes + "'", kExitIo);
-    for (int i = 0; i < o.n; ++i) {
-      for (const auto& r : sampler::make_recipes_in_order(recipe_options, i)) {
-        ++kinds[static_cast<int>(r.kind)];
-        out << sampler::to_text(r) << "\n";
-      }
+  std::string recipes;
+  for (int i = 0; !o.recipes.empty() && i < o.n; ++i) {
+    for (const auto& r : sampler::make_recipes_in_order(recipe_options, i)) {
+      ++kinds[static_cast<int>(r.kind)];
+      recipes += sampler::to_text(r) + "\n";
     }
-    out.close();
-    if (!out) return fail("cannot write '" + o.recipes + "'", kExitIo);
+  }
+  // The recipes first: a failure there leaves both files as they were (the parameters' write is the last step).
+  if (!o.recipes.empty()) {
+    if (sim::Status s = storage::write_file_atomic(o.recipes, recipes); !s) return fail(s.error().message, kExitIo);
+  }
+  if (sim::Status s = storage::write_file_atomic(o.out, parameters_csv(*sampled)); !s) {
+    return fail(s.error().message, kExitIo);
   }
   nlohmann::json summary{{"samples", o.n},
                          {"seed", o.seed},

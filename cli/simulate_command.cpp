@@ -110,7 +110,10 @@ int run_simulate(const SimulateOptions& o) {
   config.membrane.stiffness = o.sigma;
   {
     const auto comma = o.band.find(',');
-    if (comma == std::string::npos) return fail("--band: expected LOW,HIGH, e.g. 0.99,1.01");
+    // Exactly two numbers (a third one was parsed as a directional triple and dropped).
+    if (comma == std::string::npos || o.band.find(',', comma + 1) != std::string::npos) {
+      return fail("--band: expected LOW,HIGH, e.g. 0.99,1.01");
+    }
     // One number each: the strict parser of W,B,F values accepts a single value.
     const auto low = parse_directional(o.band.substr(0, comma), "--band");
     const auto high = parse_directional(o.band.substr(comma + 1), "--band");

@@ -82,6 +82,7 @@ expect_failure(1 simulate --alpha 1000 --tolerance 0)
 expect_failure(1 simulate --alpha 1000 --drift 1,x)
 expect_failure(1 simulate --alpha 1000 --band 1.2,1.3)
 expect_failure(1 simulate --alpha 1000 --band 0.99x,1.01)
+expect_failure(1 simulate --alpha 1000 --band 0.99,1.05,7)  # a third value was parsed and dropped
 expect_failure(1 simulate --alpha 1000 --resolution 5000)
 expect_failure(1 simulate --alpha 1000 --resolution 10 --drift 1000)
 expect_failure(1 simulate --alpha 1000 --resolution 10 --drift 1e300)

@@ -94,3 +94,11 @@ expect_failure(3 render --mesh ${WORK}/drape.ply --out ${WORK}/x.exr --preview /
 expect_failure(1 render --mesh ${WORK}/drape.ply --out ${WORK}/x.exr --orientations 0)
 expect_failure(1 render --mesh ${WORK}/drape.ply --out ${WORK}/x.exr --compression jpeg)
 expect_failure(1 render --mesh ${WORK}/drape.ply --out ${WORK}/x.exr --quantum -1)
+# A denormal quantum overflowed z / q to infinity in every stored depth; outputs over the input or over each other.
+expect_drapegen_error(CODE 1 SUB render SAYS "quantum must be 0 (none) or in [1e-9, 0.01] m"
+                      ARGS render --mesh ${WORK}/drape.ply --out ${WORK}/x.exr --quantum 1e-320)
+expect_drapegen_error(CODE 1 SUB render SAYS "would overwrite the input mesh"
+                      ARGS render --mesh ${WORK}/drape.ply --out ${WORK}/drape.ply --orientations 1)
+expect_drapegen_error(CODE 1 SUB render SAYS "is two of the outputs"
+                      ARGS render --mesh ${WORK}/drape.ply --out ${WORK}/c.exr --orientations 2
+                      --preview ${WORK}/c_00.exr)

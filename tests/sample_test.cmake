@@ -114,3 +114,4 @@ file(WRITE ${WORK}/bad.csv "density,linear warp,linear weft,linear diag,nonlinea
 expect_failure(1 "line 2" --report --data ${WORK}/bad.csv --no-plot)
 expect_failure(1 "--plot-x" --report --data ${DATA} --plot-x gamma)
 expect_failure(1 "at least" --report --data ${DATA} --n 100 --no-plot)
+expect_failure(1 "--out and --recipes name the same file" --n 10 --out ${WORK}/same.csv --recipes ${WORK}/./same.csv)

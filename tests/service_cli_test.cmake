@@ -70,6 +70,15 @@ file(READ ${WORK}/pair.key replaced)
 if(NOT code EQUAL 0 OR replaced STREQUAL first_key)
   message(FATAL_ERROR "keygen --force did not replace the key pair: ${code}")
 endif()
+# A public key that cannot be written: the secret key is left as it was (half a new pair would cut every peer off).
+file(REMOVE ${WORK}/pair.pub)
+file(MAKE_DIRECTORY ${WORK}/pair.pub)
+expect_failure(3 keygen --out ${WORK}/pair --force)
+file(READ ${WORK}/pair.key after)
+if(NOT after STREQUAL replaced)
+  message(FATAL_ERROR "keygen --force replaced the secret key although the public key could not be written")
+endif()
+file(REMOVE_RECURSE ${WORK}/pair.pub)
 expect_failure(1 local --config ${WORK}/typo.toml)
 
 # The embedded configuration parses and names its keys.

@@ -144,7 +144,10 @@ sim::Status ExrWriter::validate() const {
   if (!compressions().contains(storage_.compression)) {
     return sim::Error{fmt::format("unknown EXR compression '{}'", storage_.compression)};
   }
-  if (!(storage_.quantum >= 0.0 && storage_.quantum <= 0.01)) return sim::Error{"EXR quantum must be in [0, 0.01] m"};
+  // A quantum below a nanometre is no quantisation, and a denormal one overflows z / q to infinity.
+  if (!(storage_.quantum == 0.0 || (storage_.quantum >= 1e-9 && storage_.quantum <= 0.01))) {
+    return sim::Error{"EXR quantum must be 0 (none) or in [1e-9, 0.01] m"};
+  }
   if (storage_.zip_level < 1 || storage_.zip_level > 9) return sim::Error{"zip level must be 1..9"};
   return {};
 }
