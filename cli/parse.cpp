@@ -1,6 +1,7 @@
 #include "parse.hpp"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -9,6 +10,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <iostream>
 #include <sstream>
 #include <vector>
 
@@ -85,6 +87,18 @@ sim::Expected<sim::PhysicalEffects> parse_effects(const std::vector<std::string>
     }
   }
   return effects;
+}
+
+std::ostream& summary_stream(const std::vector<std::string>& outputs) {
+  struct stat out {};
+  if (::fstat(STDOUT_FILENO, &out) != 0) return std::cout;
+  for (const std::string& path : outputs) {
+    struct stat st {};
+    if (!path.empty() && ::stat(path.c_str(), &st) == 0 && st.st_dev == out.st_dev && st.st_ino == out.st_ino) {
+      return std::cerr;
+    }
+  }
+  return std::cout;
 }
 
 bool same_file(const std::string& a, const std::string& b) {

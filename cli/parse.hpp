@@ -1,6 +1,7 @@
 #pragma once
 // Parsing of command-line values shared by the subcommands.
 
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -25,6 +26,10 @@ namespace drapegen::cli {
 /// Whether two paths name one file (existing or not): the same path after resolving `.`, `..` and links, or one
 /// existing file under two names. Two outputs of one command (or an output and an input) must not.
 [[nodiscard]] bool same_file(const std::string& a, const std::string& b);
+
+/// Where a command's summary goes: standard output, unless one of `outputs` is the file standard output writes to (an
+/// output named /dev/stdout): then standard error, since the summary on the same descriptor would write over it.
+[[nodiscard]] std::ostream& summary_stream(const std::vector<std::string>& outputs);
 
 /// Creates `directory` (and its parents) for an output written later, and checks that `file` can be created in it:
 /// an error now rather than after the work.

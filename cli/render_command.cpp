@@ -126,6 +126,9 @@ int run_render(const RenderOptions& o) {
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const int views = o.orientations * request.rig.views;
+  std::vector<std::string> outputs = paths;
+  outputs.push_back(o.preview);
+  std::ostream& out = summary_stream(outputs);  // not over a file written to standard output
   if (o.json) {
     nlohmann::json summary = {{"mesh", o.mesh},
                               {"renderer", (*renderer)->name()},
@@ -138,13 +141,13 @@ int run_render(const RenderOptions& o) {
                               {"seconds", seconds},
                               {"files", files}};
     if (!o.preview.empty()) summary["preview"] = o.preview;
-    std::cout << storage::json_text(summary) << "\n";
+    out << storage::json_text(summary) << "\n";
   } else {
-    std::cout << fmt::format("render: {} data points x {} views of {} in {:.2f} s, {:.0f} bytes per view\n",
+    out << fmt::format("render: {} data points x {} views of {} in {:.2f} s, {:.0f} bytes per view\n",
                              points->size(), request.rig.views, o.mesh, seconds,
                              static_cast<double>(total_bytes) / views);
-    std::cout << fmt::format("  written to {}{}\n", paths.front(), paths.size() > 1 ? " ... " + paths.back() : "");
-    if (!o.preview.empty()) std::cout << "  preview " << o.preview << "\n";
+    out << fmt::format("  written to {}{}\n", paths.front(), paths.size() > 1 ? " ... " + paths.back() : "");
+    if (!o.preview.empty()) out << "  preview " << o.preview << "\n";
   }
   return kExitOk;
 }

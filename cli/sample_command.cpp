@@ -119,15 +119,16 @@ int run_sample(const SampleOptions& o, const sampler::VaeModel& model, const std
     summary["recipes_per_sample"] = o.states;
     summary["recipe_kinds"] = {{"sine", kinds[0]}, {"fold", kinds[1]}, {"drape", kinds[2]}};
   }
+  std::ostream& out = summary_stream({o.out, o.recipes});  // not over a file written to standard output
   if (o.json) {
-    std::cout << storage::json_text(summary) << "\n";
+    out << storage::json_text(summary) << "\n";
   } else {
-    std::cout << fmt::format("sampled {} parameter vectors (seed {}) from {} candidates: {} outside the range, {} "
+    out << fmt::format("sampled {} parameter vectors (seed {}) from {} candidates: {} outside the range, {} "
                              "near-duplicates; written to {}\n",
                              o.n, o.seed, sampled->candidates, sampled->rejected_range, sampled->rejected_duplicate,
                              o.out);
     if (!o.recipes.empty()) {
-      std::cout << fmt::format("  {} initial-state recipes ({} sine, {} fold, {} drape) written to {}\n",
+      out << fmt::format("  {} initial-state recipes ({} sine, {} fold, {} drape) written to {}\n",
                                o.n * o.states, kinds[0], kinds[1], kinds[2], o.recipes);
     }
   }

@@ -169,19 +169,20 @@ int run_simulate(const SimulateOptions& o) {
   summary["blas_kernels"] = sim::blas_kernels_description();
   if (!o.effects.empty()) summary["effects"] = o.effects;
   if (!o.out.empty()) summary["mesh"] = o.out;
+  std::ostream& out = summary_stream({o.out});  // not over a mesh written to standard output
   if (o.json) {
-    std::cout << storage::json_text(summary) << "\n";
+    out << storage::json_text(summary) << "\n";
   } else {
     const auto& r = result->report;
     const auto& c = result->coarse_report;
-    std::cout << fmt::format(
+    out << fmt::format(
         "drape: {} in {} iterations (+{} on coarser levels), {:.2f} s (coarser levels {:.2f} s), residual {:.2e}\n"
         "  drape coefficient {:.3f}, folds {}, self-intersections {}, lowest point {:.1f} mm\n",
         sim::to_string(r.outcome), r.iterations, c.iterations, r.seconds + c.seconds, c.seconds, r.residual,
         result->measures.drape_coefficient, result->measures.folds, result->measures.self_intersections,
         result->measures.lowest_point * 1e3);
-    if (!r.message.empty()) std::cout << "  " << r.message << "\n";
-    if (!o.out.empty()) std::cout << "  mesh written to " << o.out << "\n";
+    if (!r.message.empty()) out << "  " << r.message << "\n";
+    if (!o.out.empty()) out << "  mesh written to " << o.out << "\n";
   }
   return result->report.outcome == sim::SolveOutcome::kConverged ? kExitOk : kExitNotConverged;
 }

@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <iostream>
 #include <string>
 
 #include "parse.hpp"
@@ -49,6 +50,22 @@ TEST(CheckWritable, TakesAnExistingDeviceOrPipeAsItIs) {
   ::close(fds[0]);
   ::close(fds[1]);
   EXPECT_TRUE(check_writable("/dev/null"));
+}
+
+// An output that is the file standard output writes to (`--out /dev/stdout`, redirected or piped) takes the summary
+// off standard output: on the same descriptor it wrote over the mesh (under `>`) or into it (down a pipe).
+TEST(SummaryStream, StandardErrorWhenAnOutputIsStandardOutputsFile) {
+  EXPECT_EQ(&summary_stream({}), &std::cout);
+  EXPECT_EQ(&summary_stream({"", ::testing::TempDir() + "/other.ply"}), &std::cout);
+  EXPECT_EQ(&summary_stream({"/proc/self/fd/1"}), &std::cerr);
+  EXPECT_EQ(&summary_stream({"", "/dev/stdout"}), &std::cerr);
+}
+
+// Two outputs of one command, or an output and its input, under two spellings of one path.
+TEST(SameFile, OnePathUnderTwoSpellings) {
+  const std::string dir = ::testing::TempDir();
+  EXPECT_TRUE(same_file(dir + "/a.csv", dir + "/./a.csv"));
+  EXPECT_FALSE(same_file(dir + "/a.csv", dir + "/b.csv"));
 }
 
 TEST(ParseEffects, EveryEffectAndItsErrors) {
