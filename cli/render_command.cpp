@@ -67,14 +67,14 @@ int run_render(const RenderOptions& o) {
   std::vector<std::string> paths;
   for (int k = 0; k < o.orientations; ++k) paths.push_back(output_path(o.out, k, o.orientations));
   // No output over the input or over another output (the mesh replaced by an EXR, an EXR by the preview).
-  if (!o.preview.empty()) paths.push_back(o.preview);
-  for (std::size_t i = 0; i < paths.size(); ++i) {
-    if (same_file(paths[i], o.mesh)) return fail(fmt::format("{} would overwrite the input mesh", paths[i]));
+  std::vector<std::string> outputs = paths;
+  if (!o.preview.empty()) outputs.push_back(o.preview);
+  for (std::size_t i = 0; i < outputs.size(); ++i) {
+    if (same_file(outputs[i], o.mesh)) return fail(fmt::format("{} would overwrite the input mesh", outputs[i]));
     for (std::size_t j = 0; j < i; ++j) {
-      if (same_file(paths[i], paths[j])) return fail(fmt::format("{} is two of the outputs", paths[i]));
+      if (same_file(outputs[i], outputs[j])) return fail(fmt::format("{} is two of the outputs", outputs[i]));
     }
   }
-  if (!o.preview.empty()) paths.pop_back();
   for (const auto& path : paths) {
     if (sim::Status s = check_writable(path); !s) return fail(s.error().message, kExitIo);
   }
@@ -126,8 +126,6 @@ int run_render(const RenderOptions& o) {
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const int views = o.orientations * request.rig.views;
-  std::vector<std::string> outputs = paths;
-  outputs.push_back(o.preview);
   std::ostream& out = summary_stream(outputs);  // not over a file written to standard output
   if (o.json) {
     nlohmann::json summary = {{"mesh", o.mesh},
