@@ -14,6 +14,7 @@
 #include "drapegen/renderer/make_renderer.hpp"
 #include "drapegen/renderer/preview.hpp"
 #include "drapegen/sim/ply.hpp"
+#include "drapegen/storage/atomic_file.hpp"
 #include "drapegen/storage/json_text.hpp"
 #include "parse.hpp"
 
@@ -102,12 +103,22 @@ int run_render(const RenderOptions& o) {
   }
   const double render_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - render_start).count();
 
+  // Every data point's file written as one set: a failed write leaves an earlier render's files all as they were.
+  std::vector<std::vector<char>> encoded;
+  for (const auto& p : *points) {
+    auto bytes = writer.encode(p);
+    if (!bytes) return fail(bytes.error().message);
+    encoded.push_back(std::move(*bytes));
+  }
+  std::vector<storage::FileBytes> set;
+  for (std::size_t k = 0; k < encoded.size(); ++k) set.push_back({paths[k], {encoded[k].data(), encoded[k].size()}});
+  if (sim::Status s = storage::write_files_atomic(set); !s) return fail(s.error().message, kExitIo);
+
   nlohmann::json files = nlohmann::json::array();
   std::uintmax_t total_bytes = 0;
   for (std::size_t k = 0; k < points->size(); ++k) {
     const auto& p = (*points)[k];
-    if (sim::Status s = writer.write_file(paths[k], p); !s) return fail(s.error().message, kExitIo);
-    const auto bytes = std::filesystem::file_size(paths[k]);
+    const std::uintmax_t bytes = encoded[k].size();
     total_bytes += bytes;
     nlohmann::json views = nlohmann::json::array();
     for (const auto& v : p.views) {

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <vector>
 #include <nlohmann/json.hpp>
 
 #include <fmt/format.h>
@@ -98,13 +99,11 @@ int run_sample(const SampleOptions& o, const sampler::VaeModel& model, const std
       recipes += sampler::to_text(r) + "\n";
     }
   }
-  // The recipes first: a failure there leaves both files as they were (the parameters' write is the last step).
-  if (!o.recipes.empty()) {
-    if (sim::Status s = storage::write_file_atomic(o.recipes, recipes); !s) return fail(s.error().message, kExitIo);
-  }
-  if (sim::Status s = storage::write_file_atomic(o.out, parameters_csv(*sampled)); !s) {
-    return fail(s.error().message, kExitIo);
-  }
+  // Both files as one set: a failed write leaves both as they were (no new recipes beside old parameters).
+  const std::string parameters = parameters_csv(*sampled);
+  std::vector<storage::FileBytes> files{{o.out, parameters}};
+  if (!o.recipes.empty()) files.push_back({o.recipes, recipes});
+  if (sim::Status s = storage::write_files_atomic(files); !s) return fail(s.error().message, kExitIo);
   nlohmann::json summary{{"samples", o.n},
                          {"seed", o.seed},
                          {"model", model_path},

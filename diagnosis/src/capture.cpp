@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <vector>
 
 #include "drapegen/diagnosis/bending_json.hpp"
 #include "drapegen/diagnosis/depth_exr.hpp"
@@ -243,15 +244,23 @@ sim::Status write_capture(const std::string& directory, const Capture& capture) 
   std::error_code ec;
   fs::create_directories(dir, ec);
   if (ec) return sim::Error{fmt::format("{}: cannot create directory: {}", directory, ec.message()), /*io=*/true};
+  // Every view and capture.json together: a failed write leaves the directory's earlier capture whole.
+  std::vector<std::string> bytes;
+  std::vector<storage::FileBytes> files;
   for (std::size_t v = 0; v < capture.views.size(); ++v) {
-    const std::string file = view_file_name(capture.views[v], v);
-    if (sim::Status s = write_depth_exr((dir / file).string(), capture.views[v].depth); !s) return s;
+    const std::string path = (dir / view_file_name(capture.views[v], v)).string();
+    auto exr = encode_depth_exr(capture.views[v].depth);
+    if (!exr) return sim::Error{fmt::format("{}: {}", path, exr.error().message)};
+    bytes.push_back(std::move(*exr));
+    files.push_back({path, {}});
   }
-  return write_capture_json(directory, capture);
+  bytes.push_back(capture_json_text(capture));
+  files.push_back({(dir / "capture.json").string(), {}});
+  for (std::size_t i = 0; i < files.size(); ++i) files[i].bytes = bytes[i];
+  return storage::write_files_atomic(files);
 }
 
-sim::Status write_capture_json(const std::string& directory, const Capture& capture) {
-  const fs::path dir(directory);
+std::string capture_json_text(const Capture& capture) {
   nlohmann::json views = nlohmann::json::array();
   for (std::size_t v = 0; v < capture.views.size(); ++v) {
     const auto& view = capture.views[v];
@@ -276,8 +285,12 @@ sim::Status write_capture_json(const std::string& directory, const Capture& capt
     j["specimen"]["measured_bending"] = measured;
   }
   if (capture.scan_mesh) j["scan"] = *capture.scan_mesh;
+  return storage::json_text(j) + "\n";
+}
+
+sim::Status write_capture_json(const std::string& directory, const Capture& capture) {
   // Atomically: a reader (or a crash) never sees half a capture.json.
-  return storage::write_file_atomic((dir / "capture.json").string(), storage::json_text(j) + "\n");
+  return storage::write_file_atomic((fs::path(directory) / "capture.json").string(), capture_json_text(capture));
 }
 
 }  // namespace drapegen::diagnosis

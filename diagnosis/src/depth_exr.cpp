@@ -16,10 +16,10 @@
 
 namespace drapegen::diagnosis {
 
-sim::Status write_depth_exr(const std::string& path, const renderer::DepthImage& depth) {
+sim::Expected<std::string> encode_depth_exr(const renderer::DepthImage& depth) {
   if (depth.width <= 0 || depth.height <= 0 ||
       depth.depth.size() != static_cast<std::size_t>(depth.width) * depth.height) {
-    return sim::Error{fmt::format("{}: bad depth image size {}x{}", path, depth.width, depth.height)};
+    return sim::Error{fmt::format("bad depth image size {}x{}", depth.width, depth.height)};
   }
   try {
     Imf::Header header(depth.width, depth.height);
@@ -35,10 +35,16 @@ sim::Status write_depth_exr(const std::string& path, const renderer::DepthImage&
       file.setFrameBuffer(fb);
       file.writePixels(depth.height);
     }
-    return storage::write_file_atomic(path, std::string_view(stream.data.data(), stream.data.size()));
+    return std::string(stream.data.data(), stream.data.size());
   } catch (const std::exception& e) {
-    return sim::Error{fmt::format("{}: cannot write: {}", path, e.what())};
+    return sim::Error{fmt::format("cannot encode: {}", e.what())};
   }
+}
+
+sim::Status write_depth_exr(const std::string& path, const renderer::DepthImage& depth) {
+  const auto bytes = encode_depth_exr(depth);
+  if (!bytes) return sim::Error{fmt::format("{}: {}", path, bytes.error().message)};
+  return storage::write_file_atomic(path, *bytes);
 }
 
 sim::Expected<renderer::DepthImage> read_depth_exr(const std::string& path) {

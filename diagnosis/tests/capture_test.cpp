@@ -64,6 +64,24 @@ TEST(Capture, RoundTrip) {
   }
 }
 
+TEST(Capture, AFailedWriteLeavesTheEarlierCaptureWhole) {
+  const std::string dir = fresh_dir("rewrite");
+  const Capture c = plane_capture();
+  ASSERT_TRUE(write_capture(dir, c).ok());
+  Capture other = plane_capture();
+  for (auto& view : other.views) view.depth.at(100, 100) = 0.7f;
+  other.views[3].depth.depth.pop_back();  // the last view cannot be encoded
+  const auto s = write_capture(dir, other);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.error().message.find("view3.exr: bad depth image size"), std::string::npos) << s.error().message;
+  const auto r = read_capture(dir);  // the first capture, every view of it
+  ASSERT_TRUE(r.has_value()) << r.error().message;
+  for (int v = 0; v < 4; ++v) EXPECT_EQ(r->views[v].depth.depth, c.views[v].depth.depth) << "view " << v;
+  std::size_t entries = 0;
+  for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir)) ++entries;
+  EXPECT_EQ(entries, 5u);  // four views and capture.json: no temporary left
+}
+
 TEST(Capture, MeasuredBendingRoundTripsAndIsOptional) {
   const std::string dir = fresh_dir("measured");
   Capture c = plane_capture();

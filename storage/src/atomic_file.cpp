@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <vector>
 
 namespace drapegen::storage {
 namespace {
@@ -26,6 +27,10 @@ bool written_in_place(const std::string& path) {
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0) return false;  // a new file
   if (!S_ISREG(st.st_mode)) return !S_ISDIR(st.st_mode);
+  // A regular file: in place only where the system's link under /dev or /proc leads to it (/dev/stdout,
+  // /proc/self/fd/N of a redirected output). A file that lives there (/dev/shm/x.csv) is replaced like any other.
+  struct stat link {};
+  if (::lstat(path.c_str(), &link) != 0 || !S_ISLNK(link.st_mode)) return false;
   std::error_code ec;
   const std::string absolute = std::filesystem::absolute(path, ec).lexically_normal().string();
   return absolute.rfind("/dev/", 0) == 0 || absolute.rfind("/proc/", 0) == 0;
@@ -60,8 +65,10 @@ sim::Status write_in_place(const std::string& path, std::string_view bytes) {
 
 }  // namespace
 
-sim::Status write_file_atomic(const std::string& path, std::string_view bytes, unsigned mode) {
-  if (written_in_place(path)) return write_in_place(path, bytes);
+namespace {
+
+/// `bytes` in a new temporary beside `path`, synced and closed: its name, or the error (nothing left behind).
+sim::Expected<std::string> write_temporary(const std::string& path, std::string_view bytes, unsigned mode) {
   // O_EXCL: the file is new, this call's alone, and has `mode` from its first byte. A name can still exist: left by
   // a crashed process that had this PID (a restarted container), or by one on another host sharing the directory;
   // the next name is tried then.
@@ -96,10 +103,50 @@ sim::Status write_file_atomic(const std::string& path, std::string_view bytes, u
     ::unlink(tmp.c_str());
     return e;
   }
+  return tmp;
+}
+
+sim::Status rename_over(const std::string& tmp, const std::string& path) {
   if (std::rename(tmp.c_str(), path.c_str()) != 0) {
     sim::Error e = os_error("cannot rename to", path);
     ::unlink(tmp.c_str());
     return e;
+  }
+  return {};
+}
+
+}  // namespace
+
+sim::Status write_file_atomic(const std::string& path, std::string_view bytes, unsigned mode) {
+  if (written_in_place(path)) return write_in_place(path, bytes);
+  const auto tmp = write_temporary(path, bytes, mode);
+  if (!tmp) return tmp.error();
+  return rename_over(*tmp, path);
+}
+
+sim::Status write_files_atomic(std::span<const FileBytes> files, unsigned mode) {
+  std::vector<std::string> temporaries(files.size());  // empty: written in place at the end
+  const auto remove_temporaries = [&](std::size_t from) {
+    for (std::size_t i = from; i < temporaries.size(); ++i) {
+      if (!temporaries[i].empty()) ::unlink(temporaries[i].c_str());
+    }
+  };
+  for (std::size_t i = 0; i < files.size(); ++i) {
+    if (written_in_place(files[i].path)) continue;
+    auto tmp = write_temporary(files[i].path, files[i].bytes, mode);
+    if (!tmp) {
+      remove_temporaries(0);
+      return tmp.error();
+    }
+    temporaries[i] = std::move(*tmp);
+  }
+  for (std::size_t i = 0; i < files.size(); ++i) {
+    sim::Status s = temporaries[i].empty() ? write_in_place(files[i].path, files[i].bytes)
+                                           : rename_over(temporaries[i], files[i].path);
+    if (!s) {
+      remove_temporaries(i + 1);
+      return s;
+    }
   }
   return {};
 }

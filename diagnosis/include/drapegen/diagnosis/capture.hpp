@@ -60,9 +60,11 @@ constexpr double kFarthestDepth = 10.0;
 /// pose not rigid or farther than kFarthestDepth), implausible specimen facts.
 [[nodiscard]] sim::Expected<Capture> read_capture(const std::string& directory);
 
-/// Writes the depth EXRs (float), then capture.json (through a temporary file, so that it is whole or absent), into
-/// `directory` (created if needed). capture.directory is ignored.
+/// Writes the depth EXRs (float) and capture.json into `directory` (created if needed), as one set
+/// (storage::write_files_atomic): a failed write leaves an earlier capture there whole. capture.directory is ignored.
 [[nodiscard]] sim::Status write_capture(const std::string& directory, const Capture& capture);
+/// capture.json's text for `capture`, naming the depth files write_capture writes.
+[[nodiscard]] std::string capture_json_text(const Capture& capture);
 /// Writes capture.json alone (through a temporary file), naming the depth files write_capture would: for a capture
 /// read from `directory` whose description changes (e.g. a measured bending added), the depth files stay as they are.
 [[nodiscard]] sim::Status write_capture_json(const std::string& directory, const Capture& capture);

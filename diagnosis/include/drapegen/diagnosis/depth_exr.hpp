@@ -9,6 +9,8 @@
 
 namespace drapegen::diagnosis {
 
+/// The file's bytes (for a set of files written together).
+[[nodiscard]] sim::Expected<std::string> encode_depth_exr(const renderer::DepthImage& depth);
 [[nodiscard]] sim::Status write_depth_exr(const std::string& path, const renderer::DepthImage& depth);
 /// Reads channel "Z" (or the file's only channel); the image is the display window, pixels outside the data window
 /// are 0. Fails with a message on a missing or damaged file.
