@@ -421,6 +421,7 @@ struct Manifest::Impl {
   template <class F>
   sim::Status atomically(F&& body) {
     if (!in_transaction) return sim::Error{"manifest: write outside begin()/commit()"};
+    if (sim::Status s = group_alive(); !s) return s;
     if (sim::Status s = savepoint.run(); !s) return s;
     sim::Status s = body();
     if (!s) {
@@ -429,6 +430,14 @@ struct Manifest::Impl {
       return s;
     }
     return release.run();
+  }
+
+  /// After some errors (a full disk, I/O, memory, a trigger's RAISE(ROLLBACK)) SQLite rolls the whole transaction
+  /// back by itself: the group is gone, and a write now would commit alone, outside it.
+  sim::Status group_alive() {
+    if (!sqlite3_get_autocommit(db)) return {};
+    return sim::Error{"manifest: the group was rolled back by SQLite after an earlier error; none of it is recorded",
+                      /*io=*/true};
   }
 
   sim::Status expect_one_change(const char* what, std::int64_t job_id) {
@@ -470,8 +479,10 @@ sim::Expected<Manifest> Manifest::create(const std::string& path, const RunRecor
     if (!opened) return opened.error();
     sqlite3* db = *opened;
     auto fail = [&](sim::Status s) -> sim::Expected<Manifest> {
-      sqlite3_close(db);
-      std::filesystem::remove(tmp);
+      // close_v2: the connection closes (and rolls the build back) once this block's statements are finalised;
+      // sqlite3_close would refuse while they live and leave it open, its files held and its journal behind.
+      sqlite3_close_v2(db);
+      for (const char* suffix : {"", "-wal", "-shm", "-journal"}) std::filesystem::remove(tmp + suffix);
       return s.error();
     };
     // Build in rollback-journal mode with one fsync at the end, then switch to WAL for the run.
@@ -582,6 +593,10 @@ sim::Status Manifest::begin() {
 
 sim::Status Manifest::commit() {
   if (!impl_->in_transaction) return {};
+  if (sim::Status s = impl_->group_alive(); !s) {
+    impl_->in_transaction = false;
+    return s;
+  }
   sim::Status s = impl_->commit.run();
   if (!s) {
     rollback();

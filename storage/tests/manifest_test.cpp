@@ -82,6 +82,26 @@ TEST_F(ManifestTest, CreatesThePlanAtomicallyAndReadsItBack) {
   EXPECT_NE(again.error().message.find("--resume"), std::string::npos);
 }
 
+int open_descriptors() {
+  int n = 0;
+  for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator("/proc/self/fd")) ++n;
+  return n;
+}
+
+TEST_F(ManifestTest, AFailedCreateLeavesNoFileAndNoOpenConnection) {
+  std::vector<JobRecord> jobs(2);
+  for (auto& j : jobs) {
+    j.id = 7;  // twice: the plan's second insert fails with its statements alive
+    j.recipe_json = "{}";
+  }
+  const int before = open_descriptors();
+  const auto m = Manifest::create(path_, RunRecord{}, {SampleRecord{}}, jobs);
+  ASSERT_FALSE(m);
+  EXPECT_NE(m.error().message.find("UNIQUE"), std::string::npos) << m.error().message;
+  EXPECT_EQ(open_descriptors(), before);  // the connection closed: no database or journal held
+  EXPECT_TRUE(std::filesystem::is_empty(dir_));  // no manifest, no temporary, no journal
+}
+
 TEST_F(ManifestTest, ReadsAManifestInADirectoryItCannotWrite) {
   // Another user's finished run, or a read-only mount: SQLite cannot create the WAL database's -shm beside it. With
   // no -wal left (the coordinator closed it), the reader reads the file as it is instead of calling it no manifest.
@@ -280,6 +300,40 @@ TEST_F(ManifestTest, UncommittedGroupsVanish) {
   ASSERT_TRUE(reader);
   EXPECT_EQ(reader->results()->size(), 0u);
   EXPECT_EQ((*reader->jobs())[0].state, JobState::kPending);
+}
+
+// SQLite rolls the whole transaction back after some errors (a full disk; here a trigger's RAISE(ROLLBACK)): the
+// group's later writes are refused, not committed one by one outside it.
+TEST_F(ManifestTest, AGroupSQLiteRolledBackTakesNoMoreWrites) {
+  auto m = make();
+  {
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open(path_.c_str(), &db), SQLITE_OK);
+    ASSERT_EQ(sqlite3_exec(db, "CREATE TRIGGER no_results BEFORE INSERT ON results BEGIN "
+                               "SELECT RAISE(ROLLBACK, 'disk full'); END",
+                           nullptr, nullptr, nullptr),
+              SQLITE_OK);
+    sqlite3_close(db);
+  }
+  ASSERT_TRUE(m.begin());
+  FailureRecord failure;
+  failure.job_id = 2;
+  failure.attempt = 1;
+  failure.reason = "timeout";
+  JobRecord job;
+  job.id = 2;
+  job.attempts = 1;
+  ASSERT_TRUE(m.record_failure(job, failure, /*final=*/false));
+  job.id = 1;
+  ASSERT_FALSE(m.record_result(job, ResultRecord{}, {}));  // rolls the group back, job 2's failure with it
+  failure.job_id = job.id = 3;
+  const auto after = m.record_failure(job, failure, /*final=*/false);
+  ASSERT_FALSE(after);
+  EXPECT_NE(after.error().message.find("rolled back"), std::string::npos) << after.error().message;
+  EXPECT_FALSE(m.commit());
+  auto reader = ManifestReader::open(path_);
+  ASSERT_TRUE(reader);
+  EXPECT_TRUE(reader->failures()->empty());  // neither job 2's nor job 3's
 }
 
 TEST_F(ManifestTest, RefusesToStartOverALogLeftByAManifestThatIsGone) {
