@@ -67,6 +67,7 @@ Expected<DrapeResult> simulate_drape(const DrapeConfig& config,
   // The residual test is relative to the heaviest vertex's weight: without weight every solve would end "diverged".
   if (!(config.gravity > 0.0) || !std::isfinite(config.gravity)) return Error{"gravity must be positive and finite"};
   if (config.load_steps < 1 || config.load_steps > 100) return Error{"load steps must be 1..100"};
+  if (Status s = validate(config.solver); !s) return s.error();
   DrapeResult result;
   try {
     result.mesh = make_specimen(config.specimen);

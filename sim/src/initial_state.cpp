@@ -102,6 +102,13 @@ Status apply_initial_state(const InitialStateSpec& spec, ClothMesh& mesh) {
       return Error{"initial mesh '" + spec.mesh_path + "' is not this specimen: it needs the same triangle count, "
                    "rest coordinates (u, v) of the same area and counter-clockwise rest triangles"};
     }
+    // The warp's direction is the specimen's: a drape of another cut (or a file without the comment, angle 0, for a
+    // turned specimen) would drape the fabric along other directions.
+    if (!(std::abs(loaded->material_angle - mesh.material_angle) <= 1e-9)) {
+      return Error{"initial mesh '" + spec.mesh_path + "' has the material angle " +
+                   std::to_string(loaded->material_angle) + " rad; the specimen's is " +
+                   std::to_string(mesh.material_angle) + " rad"};
+    }
     mesh = std::move(loaded).value();
     // The drape sits where its own drift and rotation put it: bring its centre point back onto the axis, so that
     // `drift` places the centre as it does for the other shapes instead of adding to the source's drift.

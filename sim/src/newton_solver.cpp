@@ -87,6 +87,26 @@ bool preconditioned_cg(const HessianAssembler& a, double shift, SparseCholesky& 
 
 }  // namespace
 
+Status validate(const SolverOptions& o) {
+  const auto positive = [](double v) { return v > 0.0 && std::isfinite(v); };
+  if (o.max_iterations < 1) return Error{"solver: max_iterations must be at least 1"};
+  if (!positive(o.tolerance)) return Error{"solver: tolerance must be positive and finite"};
+  if (!positive(o.max_step)) return Error{"solver: max_step must be positive and finite"};
+  if (!(o.armijo > 0.0 && o.armijo < 1.0)) return Error{"solver: armijo must be in (0, 1)"};
+  if (o.max_line_search < 1) return Error{"solver: max_line_search must be at least 1"};
+  if (!positive(o.max_regularization)) return Error{"solver: max_regularization must be positive and finite"};
+  if (!positive(o.lagged_tolerance)) return Error{"solver: lagged_tolerance must be positive and finite"};
+  if (o.max_lagged_outer_updates < 1) return Error{"solver: max_lagged_outer_updates must be at least 1"};
+  if (!(o.pcg_tolerance > 0.0 && o.pcg_tolerance < 1.0)) return Error{"solver: pcg_tolerance must be in (0, 1)"};
+  if (o.max_pcg_iterations < 0) return Error{"solver: max_pcg_iterations must not be negative"};
+  for (const double threshold : {o.exact_hessian_below, o.gauss_newton_above, o.lagged_every_above,
+                                 o.lagged_outer_below, o.extrapolate_above, o.max_extrapolation,
+                                 o.pcg_refactor_fraction}) {
+    if (std::isnan(threshold) || threshold < 0.0) return Error{"solver: thresholds must not be negative or NaN"};
+  }
+  return {};
+}
+
 SolveReport NewtonSolver::solve(const std::vector<EnergyTerm*>& terms, const std::vector<bool>& fixed,
                                 double reference_force, Eigen::Matrix3Xd& x) const {
   const auto start = Clock::now();
@@ -194,10 +214,18 @@ SolveReport NewtonSolver::solve(const std::vector<EnergyTerm*>& terms, const std
     }
 
     // Find a descent step, shifting the diagonal until the factorisation succeeds and the line search passes.
-    double mean_diagonal = 0.0;
-    for (int p : assembler.diagonal_positions()) mean_diagonal += assembler.values()[p];
-    mean_diagonal = std::max(mean_diagonal / n, 1e-300);
-    bool accepted = false;
+    // The shift's scale: the mean diagonal of the Hessian assembled last (measured again after a fallback from the
+    // exact Hessian, whose diagonal may be small or negative where the projected one's is not).
+    const auto diagonal_mean = [&] {
+      double sum = 0.0;
+      for (int p : assembler.diagonal_positions()) sum += assembler.values()[p];
+      return std::max(sum / n, 1e-300);
+    };
+    double mean_diagonal = diagonal_mean();
+    // A start that is an equilibrium already (a zero gradient) has no descent step to find, and the outer loop that
+    // may freeze the lagged state starts at iteration 2: no step until then (the search would raise the shift to
+    // its limit and report it stalled).
+    bool accepted = !frozen && it <= 1 && report.residual <= options_.tolerance;
     double step_length = 0.0;
     // Inexact Newton: while an earlier factorisation still preconditions the current Hessian well, conjugate
     // gradients replace the factorisation (a product and two triangular solves per iteration instead of a
@@ -241,6 +269,7 @@ SolveReport NewtonSolver::solve(const std::vector<EnergyTerm*>& terms, const std
         gradient.setZero();
         energy = assembler.assemble(x, psd, gradient);
         report.assembly_seconds += since(t0);
+        mean_diagonal = diagonal_mean();
         continue;
       }
       if (status == FactorStatus::kFailed) {
@@ -294,6 +323,7 @@ SolveReport NewtonSolver::solve(const std::vector<EnergyTerm*>& terms, const std
         exact_cooldown = 5;
         gradient.setZero();
         energy = assembler.assemble(x, psd, gradient);
+        mean_diagonal = diagonal_mean();
         continue;
       }
       if (!accepted) {

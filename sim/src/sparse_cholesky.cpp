@@ -194,7 +194,10 @@ struct SparseCholesky::Impl {
     const std::vector<int>& ri = matrix.row_indices();
     cholmod_sparse a = view_of(cp, ri, matrix.values());
     cholmod_factor* ordering = cholmod_analyze(&a, &common);
-    if (ordering == nullptr || common.status < CHOLMOD_OK) return false;
+    if (ordering == nullptr || common.status < CHOLMOD_OK) {
+      if (ordering != nullptr) cholmod_free_factor(&ordering, &common);
+      return false;
+    }
     const int method = common.method[common.selected].ordering;
     order.assign(static_cast<const int*>(ordering->Perm), static_cast<const int*>(ordering->Perm) + n);
     cholmod_free_factor(&ordering, &common);
@@ -290,6 +293,7 @@ FactorStatus SparseCholesky::factorize(const HessianAssembler& matrix, double sh
 bool SparseCholesky::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution) {
   Impl& m = *impl_;
   if (m.factor == nullptr || rhs.size() != static_cast<Eigen::Index>(m.order.size())) return false;
+  if (m.factor->minor < m.factor->n) return false;  // the last factorisation failed part way: no factor to solve with
   // The factor is of P A P^T: solve (P A P^T) y = P rhs, then the solution is P^T y.
   m.permuted_rhs.resize(rhs.size());
   for (Eigen::Index k = 0; k < rhs.size(); ++k) m.permuted_rhs[k] = rhs[m.order[k]];

@@ -1,6 +1,7 @@
 #include "drapegen/sim/specimen.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <random>
 #include <vector>
 #include <stdexcept>
@@ -105,6 +106,8 @@ ClothMesh make_specimen(const SpecimenSpec& spec) {
   if (spec.vertices_x < 2 || spec.vertices_y < 2) throw std::invalid_argument("specimen needs at least 2x2 vertices");
   if (!(spec.size_x > 0.0) || !(spec.size_y > 0.0)) throw std::invalid_argument("specimen size must be positive");
   if (!(spec.jitter >= 0.0 && spec.jitter <= 0.3)) throw std::invalid_argument("specimen jitter must be in [0, 0.3]");
+  // A NaN angle read as 0 downstream (every hinge the warp's): an anisotropic fabric draped as an isotropic one.
+  if (!std::isfinite(spec.material_angle)) throw std::invalid_argument("specimen material angle must be finite");
   std::mt19937_64 rng(spec.seed);
   ClothMesh mesh = spec.triangulation == Triangulation::kEquilateral ? equilateral_specimen(spec, rng)
                                                                      : grid_specimen(spec, rng);

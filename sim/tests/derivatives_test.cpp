@@ -130,6 +130,14 @@ TEST(Derivatives, GravityGradientIsWeight) {
   gravity.evaluate(mesh.positions, &g, nullptr);
   EXPECT_NEAR(g.row(2).sum(), 0.3 * kStandardGravity * 0.02 * 0.02, 1e-15);
   EXPECT_EQ(g.topRows<2>().norm(), 0.0);
+  // The energy against its gradient (central differences; the energy is linear, so they agree to round-off): a sign
+  // or scale error in the energy would pass the weight check above.
+  for (int i = 0; i < static_cast<int>(mesh.positions.size()); ++i) {
+    Eigen::Matrix3Xd xp = mesh.positions, xm = mesh.positions;
+    xp.data()[i] += 1e-4;
+    xm.data()[i] -= 1e-4;
+    EXPECT_NEAR((gravity.energy(xp) - gravity.energy(xm)) / 2e-4, g.data()[i], 1e-12) << i;
+  }
 }
 
 }  // namespace

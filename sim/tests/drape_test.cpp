@@ -17,6 +17,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <filesystem>
 #include <cstdio>
@@ -83,6 +84,27 @@ TEST(DrapePhysics, AWeightlessDrapeIsAnInputError) {
     ASSERT_FALSE(r.has_value()) << g;
     EXPECT_NE(r.error().message.find("gravity must be positive"), std::string::npos) << r.error().message;
   }
+}
+
+// Solver options a solve cannot run with are refused up front, each by name (a zero max_step crept at t = 0 into
+// "stalled"; a NaN tolerance never converged).
+TEST(DrapePhysics, SolverOptionsItCannotRunWithAreInputErrors) {
+  const std::vector<std::pair<std::function<void(SolverOptions&)>, std::string>> cases{
+      {[](SolverOptions& o) { o.max_step = 0.0; }, "max_step"},
+      {[](SolverOptions& o) { o.tolerance = std::numeric_limits<double>::quiet_NaN(); }, "tolerance"},
+      {[](SolverOptions& o) { o.max_iterations = 0; }, "max_iterations"},
+      {[](SolverOptions& o) { o.armijo = 1.5; }, "armijo"},
+      {[](SolverOptions& o) { o.lagged_outer_below = -1.0; }, "thresholds"}};
+  for (const auto& [spoil, name] : cases) {
+    DrapeConfig c;
+    c.specimen.vertices_x = c.specimen.vertices_y = 10;
+    spoil(c.solver);
+    const Expected<DrapeResult> r = simulate_drape(c);
+    ASSERT_FALSE(r.has_value()) << name;
+    EXPECT_NE(r.error().message.find(name), std::string::npos) << r.error().message;
+  }
+  EXPECT_TRUE(validate(DrapeConfig{}.solver));
+  EXPECT_TRUE(validate(SolverOptions{}));
 }
 
 // (a) Section 5.1.2, Fig. 14. Scaling alpha, beta and rho by s scales bending and gravity by s; the paper argues that

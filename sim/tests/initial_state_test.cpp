@@ -77,6 +77,12 @@ TEST(InitialState, AMeshIsBroughtOntoTheAxisBeforeItsDrift) {
     }
   }
   EXPECT_TRUE(mesh.positions.row(2).isApprox(stored->positions.row(2)));
+  // A specimen cut at another angle is not this drape's.
+  ClothMesh turned = small_specimen();
+  turned.material_angle = 0.5;
+  const Status other = apply_initial_state(from_mesh, turned);
+  ASSERT_FALSE(other);
+  EXPECT_NE(other.error().message.find("material angle"), std::string::npos) << other.error().message;
   std::filesystem::remove(path);
 }
 

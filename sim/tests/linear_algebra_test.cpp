@@ -84,6 +84,26 @@ TEST(LinearAlgebra, ProductsAndSolvesMatchDenseAlgebra) {
   }
 }
 
+// A factorisation that fails part way (an indefinite matrix) leaves no factor to solve with: both solves say so,
+// where they solved with the partial factor before; the next successful one solves again. (The supernodal LL'
+// factor; CHOLMOD's simplicial LDL' of the small system factorises an indefinite matrix without complaint.)
+TEST(LinearAlgebra, NoSolveAfterAFailedFactorisation) {
+  for (int n : {20, 30}) {
+    const System s = make_system(n);
+    const HessianAssembler& a = *s.assembler;
+    const double mean_diagonal = dense(a).diagonal().mean();
+    SparseCholesky cholesky;
+    ASSERT_EQ(cholesky.factorize(a, -10.0 * mean_diagonal), FactorStatus::kNotPositiveDefinite) << n;
+    const Eigen::VectorXd rhs = Eigen::VectorXd::Ones(a.dof_count());
+    Eigen::VectorXd x;
+    EXPECT_FALSE(cholesky.solve(rhs, x)) << n;
+    EXPECT_FALSE(cholesky.solve_approximate(rhs, x)) << n;
+    ASSERT_EQ(cholesky.factorize(a), FactorStatus::kOk) << n;
+    EXPECT_TRUE(cholesky.solve(rhs, x)) << n;
+    EXPECT_TRUE(cholesky.solve_approximate(rhs, x)) << n;
+  }
+}
+
 TEST(LinearAlgebra, CompactSolveOfALargeFactorPreconditionsConjugateGradients) {
   // 100 x 100 vertices: a factor of several million values, whose rows below the supernodes' diagonal blocks the
   // approximate solve keeps in bfloat16 (sparse_cholesky.cpp). Its error is a few per mille; as a preconditioner it

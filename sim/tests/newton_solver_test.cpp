@@ -91,5 +91,18 @@ TEST(NewtonSolver, TheIterationLimitIsAnOutcome) {
   EXPECT_LT((x - target).norm(), (Eigen::Matrix3Xd::Zero(3, 4) - target).norm());  // it moved towards the minimum
 }
 
+// A start that is already the minimum (zero gradient): converged, not "no descent step" after raising the shift.
+TEST(NewtonSolver, AStartAtTheMinimumConverges) {
+  const Eigen::Matrix3Xd target = Eigen::Matrix3Xd::Constant(3, 4, 1e-3);
+  StiffModelSpring spring(target, 10.0, 1.0);
+  Eigen::Matrix3Xd x = target;
+  const SolveReport report = NewtonSolver(SolverOptions{}).solve({&spring}, std::vector<bool>(4, false), 1e-6, x);
+  EXPECT_EQ(report.outcome, SolveOutcome::kConverged) << report.message;
+  EXPECT_EQ(report.residual, 0.0);
+  EXPECT_EQ(x, target);
+  EXPECT_LE(report.iterations, 3);
+  EXPECT_EQ(report.regularized_iterations, 0);
+}
+
 }  // namespace
 }  // namespace drapegen::sim

@@ -74,6 +74,8 @@ TEST(Specimen, RejectsBadSpecs) {
   EXPECT_THROW(make_specimen(SpecimenSpec{0.1, 0.1, 5, 5, 0.5, Triangulation::kRandom, 0, 0.0}), std::invalid_argument);
   EXPECT_THROW(make_specimen(SpecimenSpec{-0.1, 0.1, 5, 5, 0.0, Triangulation::kRandom, 0, 0.0}),
                std::invalid_argument);
+  EXPECT_THROW(make_specimen(SpecimenSpec{0.1, 0.1, 5, 5, 0.0, Triangulation::kUniform, 0, std::nan("")}),
+               std::invalid_argument);
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "drapegen/sim/energy.hpp"
+#include "drapegen/sim/expected.hpp"
 
 namespace drapegen::sim {
 
@@ -67,6 +68,10 @@ struct SolverOptions {
 
   [[nodiscard]] bool operator==(const SolverOptions&) const = default;
 };
+
+/// Options a solve can run with: positive finite tolerance, step and thresholds, at least one iteration. A zero or
+/// negative max_step passes the line search's test with a zero or uphill step; a NaN tolerance never converges.
+[[nodiscard]] Status validate(const SolverOptions& options);
 
 struct SolveReport {
   SolveOutcome outcome = SolveOutcome::kIterationLimit;

@@ -30,7 +30,7 @@ class SparseCholesky {
   /// Factorises the assembler's matrix plus `shift` on the diagonal. The first call analyses the pattern (fill-
   /// reducing ordering, supernodes); later calls reuse that analysis, since the pattern never changes.
   FactorStatus factorize(const HessianAssembler& matrix, double shift = 0.0);
-  /// Solves with the last successful factorisation.
+  /// Solves with the last factorisation; false if it failed (a failed one leaves no usable factor) or none ran.
   [[nodiscard]] bool solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution);
   /// Solves approximately with a compact copy of the last successful factorisation (made on first use after each
   /// factorisation): the supernodes' diagonal blocks in single precision, the rows below them in single precision,
