@@ -27,6 +27,9 @@ bool is_header(std::string_view line) {
     const std::size_t comma = line.find(',');
     const std::string_view text = line.substr(0, comma);
     if (field >= kNames.size() || text.find(kNames[field]) == std::string_view::npos) return false;
+    // The linear block first, then the nonlinear one (a swapped file would put beta into alpha).
+    const bool nonlinear = text.find("nonlinear") != std::string_view::npos;
+    if (field >= 1 && (nonlinear != (field >= 4) || text.find("linear") == std::string_view::npos)) return false;
     ++field;
     if (comma == std::string_view::npos) break;
     line.remove_prefix(comma + 1);
@@ -70,11 +73,25 @@ sim::Expected<std::vector<MeasuredFabric>> read_fabric_csv(const std::string& pa
       return sim::Error{"fabric data '" + path + "' line " + std::to_string(line_number) +
                         ": density must be positive and moduli non-zero"};
     }
+    if (!(v[1] > 0.0 && v[2] > 0.0 && v[3] > 0.0)) {
+      return sim::Error{"fabric data '" + path + "' line " + std::to_string(line_number) +
+                        ": the linear moduli (bending stiffness) must be positive"};
+    }
     MeasuredFabric f;
     f.density_g_per_m2 = v[0] * 1e3;
     // CSV: warp, weft, diag; the paper (and DirectionalValues): warp, bias (= diag), weft.
     f.moduli.alpha = {v[1], v[3], v[2]};
     f.moduli.beta = {v[4], v[6], v[5]};
+    // The features sign(k) ln|k| are one-to-one only for |k| > 1 (at 300 g/m^2, paper units): a smaller modulus is
+    // in other units (SI rather than SI*1e9 and SI*1e12) and would turn into a feature of the other sign.
+    const ParameterVector n = normalise_density(f.moduli, f.density_g_per_m2);
+    for (const double k : {n.alpha.warp, n.alpha.bias, n.alpha.weft, n.beta.warp, n.beta.bias, n.beta.weft}) {
+      if (std::abs(k) <= 1.0) {
+        return sim::Error{"fabric data '" + path + "' line " + std::to_string(line_number) + ": a modulus of " +
+                          std::to_string(k) + " at 300 g/m^2 (|k| <= 1): the columns are in SI*1e9 (linear) and " +
+                          "SI*1e12 (nonlinear), density in kg/m^2"};
+      }
+    }
     fabrics.push_back(f);
   }
   if (in.bad()) return sim::Error{"error reading fabric data '" + path + "'"};

@@ -127,7 +127,13 @@ TEST(ParameterSampler, VectorsAreTheDecodedLatents) {
   for (std::size_t a = 0; a < s->features.size(); ++a) {
     const Eigen::MatrixXd f = model.decode(draw_latent(o, s->candidate_index[a], model.latent_dim));
     for (int i = 0; i < kFeatureCount; ++i) EXPECT_EQ(f(i, 0), s->features[a][i]);
-    EXPECT_DOUBLE_EQ(s->vectors[a].beta.warp, from_features(s->features[a]).beta.warp);
+    const ParameterVector v = from_features({f(0, 0), f(1, 0), f(2, 0), f(3, 0), f(4, 0), f(5, 0)});
+    EXPECT_DOUBLE_EQ(s->vectors[a].alpha.warp, v.alpha.warp);
+    EXPECT_DOUBLE_EQ(s->vectors[a].alpha.bias, v.alpha.bias);
+    EXPECT_DOUBLE_EQ(s->vectors[a].alpha.weft, v.alpha.weft);
+    EXPECT_DOUBLE_EQ(s->vectors[a].beta.warp, v.beta.warp);
+    EXPECT_DOUBLE_EQ(s->vectors[a].beta.bias, v.beta.bias);
+    EXPECT_DOUBLE_EQ(s->vectors[a].beta.weft, v.beta.weft);
   }
 }
 

@@ -111,6 +111,15 @@ TEST_F(CsvErrors, BadFilesSayWhatIsWrong) {
   EXPECT_NE(error_of(header + "0.1,1,2,3,4,nan,6\n").find("finite"), std::string::npos);
   EXPECT_NE(error_of(header + "-0.1,1,2,3,4,5,6\n").find("positive"), std::string::npos);
   EXPECT_NE(error_of(header + "0.1,1,0,3,4,5,6\n").find("non-zero"), std::string::npos);
+  // The nonlinear block first: its moduli would be read as alpha.
+  EXPECT_NE(error_of("density, nonlinear warp, nonlinear weft, nonlinear diag, linear warp, linear weft, linear diag\n"
+                     "0.1,-4,-5,-6,1,2,3\n")
+                .find("line 1"),
+            std::string::npos);
+  EXPECT_NE(error_of(header + "0.1,-1,2,3,4,5,6\n").find("line 2: the linear moduli"), std::string::npos);
+  // Moduli in SI (1.8e-6 rather than 1779.9): ln would turn them into large features of the other sign.
+  EXPECT_NE(error_of(header + "0.0673,1.78e-6,3.07e-6,2.24e-6,-8.4e-9,-4.1e-9,-3.3e-9\n").find("line 2: a modulus"),
+            std::string::npos);
   EXPECT_TRUE(error_of(header + "0.1, 1 ,2,3,4,5,6\r\n\n").empty());
   auto missing = read_fabric_csv("/nonexistent/fabrics.csv");
   ASSERT_FALSE(missing);

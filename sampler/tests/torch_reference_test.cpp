@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -53,7 +54,11 @@ double max_difference(const VaeModel& model, const std::string& reference, int e
     for (double& v : torch_out) fields >> v;
     EXPECT_FALSE(fields.fail()) << "short reference line: " << line;
     const Eigen::MatrixXd ours = model.decode(z);
-    for (int i = 0; i < kFeatureCount; ++i) worst = std::max(worst, std::abs(ours(i, 0) - torch_out[i]));
+    for (int i = 0; i < kFeatureCount; ++i) {
+      const double difference = std::abs(ours(i, 0) - torch_out[i]);
+      EXPECT_TRUE(std::isfinite(difference)) << "feature " << i << " of " << line;  // max() would skip a NaN
+      if (std::isfinite(difference)) worst = std::max(worst, difference);
+    }
     ++lines;
   }
   EXPECT_EQ(lines, expected_lines);

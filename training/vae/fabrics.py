@@ -27,7 +27,11 @@ def read_rows(path):
     except (OSError, UnicodeDecodeError) as e:
         raise DataError(f"cannot read fabric data '{path}': {e}") from e
     # The header fixes the columns' order (CSV_TO_FEATURE); a file without one would lose its first fabric.
-    if len(header) != 7 or any(name not in field for name, field in zip(HEADER_NAMES, header)):
+    # The linear block first, then the nonlinear one (a swapped file would put beta into alpha).
+    blocks_in_order = all(("nonlinear" in field) == (k >= 4) and "linear" in field
+                          for k, field in enumerate(header[1:], start=1))
+    if len(header) != 7 or not blocks_in_order or any(name not in field
+                                                      for name, field in zip(HEADER_NAMES, header)):
         raise DataError(f"'{path}' line 1: expected the header (density, linear warp, linear weft, linear diag, "
                         "nonlinear warp, nonlinear weft, nonlinear diag)")
     try:
@@ -38,6 +42,12 @@ def read_rows(path):
         raise DataError(f"'{path}': expected 7 columns (density and six moduli), got shape {raw.shape}")
     if not np.all(np.isfinite(raw)) or np.any(raw[:, 0] <= 0) or np.any(raw[:, 1:] == 0):
         raise DataError(f"'{path}': non-finite values, non-positive densities or zero moduli")
+    if np.any(raw[:, 1:4] <= 0):
+        raise DataError(f"'{path}': the linear moduli (bending stiffness) must be positive")
+    # signlog is one-to-one only for |k| > 1 at 300 g/m^2 (paper units): smaller moduli are in other units.
+    if np.any(np.abs(raw[:, 1:] * (STANDARD_DENSITY / raw[:, :1])) <= 1):
+        raise DataError(f"'{path}': a modulus with |k| <= 1 at 300 g/m^2: the columns are in SI*1e9 (linear) and "
+                        "SI*1e12 (nonlinear), density in kg/m^2")
     return raw[:, 0], raw[:, CSV_TO_FEATURE]
 
 
