@@ -4,8 +4,10 @@ file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
 
 include(${CMAKE_CURRENT_LIST_DIR}/expect_error.cmake)
-function(expect_failure code_expected)
-  expect_drapegen_error(CODE ${code_expected} SUB render ARGS ${ARGN})
+include(${CMAKE_CURRENT_LIST_DIR}/json_number.cmake)
+# expect_failure(EXIT NEEDLE ARGS...): `drapegen ARGS...` (a render) fails with a one-line error that says NEEDLE.
+function(expect_failure code_expected needle)
+  expect_drapegen_error(CODE ${code_expected} SUB render SAYS "${needle}" ARGS ${ARGN})
 endfunction()
 
 function(run)
@@ -22,8 +24,8 @@ run(${DRAPEGEN} simulate --alpha 13923,11455,8821 --beta=-35390,-29660,-22042 --
 # Three data points with noise, a preview, the JSON summary.
 run(${DRAPEGEN} render --mesh ${WORK}/drape.ply --out ${WORK}/a.exr --orientations 3 --seed 5
     --preview ${WORK}/views.png --json)
-string(JSON views GET "${out}" views)
-string(JSON bytes GET "${out}" bytes_per_view)
+json_number(views "${out}" views)
+json_number(bytes "${out}" bytes_per_view)
 if(NOT views EQUAL 12)
   message(FATAL_ERROR "expected 12 views: ${out}")
 endif()
@@ -82,18 +84,23 @@ if(NOT out MATCHES "drapegen.noise \\(type string\\): \"none\"")
 endif()
 
 # Bad meshes: missing, empty, non-finite, out of view (millimetres); unwritable outputs.
-expect_failure(1 render --mesh ${WORK}/missing.ply --out ${WORK}/x.exr)
+expect_failure(1 "'${WORK}/missing.ply': cannot open" render --mesh ${WORK}/missing.ply --out ${WORK}/x.exr)
 file(WRITE ${WORK}/empty.ply "ply\nformat ascii 1.0\nelement vertex 0\nproperty float x\nproperty float y\nproperty float z\nelement face 0\nproperty list uchar int vertex_indices\nend_header\n")
-expect_failure(1 render --mesh ${WORK}/empty.ply --out ${WORK}/x.exr)
+expect_failure(1 "'${WORK}/empty.ply': the file has no vertices" render --mesh ${WORK}/empty.ply --out ${WORK}/x.exr)
 file(WRITE ${WORK}/nan.ply "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\nnan 0.1 0\n0 0.1 0\n3 0 1 2\n")
-expect_failure(1 render --mesh ${WORK}/nan.ply --out ${WORK}/x.exr)
+expect_failure(1 "'${WORK}/nan.ply': non-finite vertex coordinate" render --mesh ${WORK}/nan.ply
+               --out ${WORK}/x.exr)
 file(WRITE ${WORK}/mm.ply "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n-150 -150 0\n150 -150 0\n0 150 0\n3 0 1 2\n")
-expect_failure(1 render --mesh ${WORK}/mm.ply --out ${WORK}/x.exr)
-expect_failure(3 render --mesh ${WORK}/drape.ply --out /nonexistent-dir/x.exr)
-expect_failure(3 render --mesh ${WORK}/drape.ply --out ${WORK}/x.exr --preview /nonexistent-dir/v.png)
-expect_failure(1 render --mesh ${WORK}/drape.ply --out ${WORK}/x.exr --orientations 0)
-expect_failure(1 render --mesh ${WORK}/drape.ply --out ${WORK}/x.exr --compression jpeg)
-expect_failure(1 render --mesh ${WORK}/drape.ply --out ${WORK}/x.exr --quantum -1)
+expect_failure(1 "mesh is out of the camera's view" render --mesh ${WORK}/mm.ply --out ${WORK}/x.exr)
+expect_failure(3 "cannot write '/nonexistent-dir/x" render --mesh ${WORK}/drape.ply --out /nonexistent-dir/x.exr)
+expect_failure(3 "cannot write '/nonexistent-dir/v.png'" render --mesh ${WORK}/drape.ply --out ${WORK}/x.exr
+               --preview /nonexistent-dir/v.png)
+expect_failure(1 "--orientations must be between 1 and 360" render --mesh ${WORK}/drape.ply --out ${WORK}/x.exr
+               --orientations 0)
+expect_failure(1 "unknown EXR compression 'jpeg'" render --mesh ${WORK}/drape.ply --out ${WORK}/x.exr
+               --compression jpeg)
+expect_failure(1 "quantum must be 0 (none) or in [1e-9, 0.01] m" render --mesh ${WORK}/drape.ply
+               --out ${WORK}/x.exr --quantum -1)
 # A denormal quantum overflowed z / q to infinity in every stored depth; outputs over the input or over each other.
 expect_drapegen_error(CODE 1 SUB render SAYS "quantum must be 0 (none) or in [1e-9, 0.01] m"
                       ARGS render --mesh ${WORK}/drape.ply --out ${WORK}/x.exr --quantum 1e-320)

@@ -11,7 +11,9 @@ std::string error_of(const std::string& text) {
   return c ? std::string() : c.error().message;
 }
 
+// Every key, each with a value other than its default: a key the parser drops fails here.
 TEST(RunConfig, ParsesEveryKey) {
+  const RunConfig d;  // the defaults
   auto c = parse_run_config(R"(
 seed = 7
 samples = 3
@@ -23,9 +25,9 @@ renderer = "software"
 density = 250
 bending_model = "triangle"
 output = "x"
-model = ""
+model = "m.dgvae"
 [recipes]
-weight_sine = 1
+weight_sine = 2
 weight_fold = 0.5
 weight_drape = 0
 max_drift_mm = 2
@@ -39,6 +41,10 @@ bind = "tcp://127.0.0.1:*"
 heartbeat_ms = 100
 liveness = 3
 lease_s = 60
+[security]
+curve = true
+server_secret_key = "server.key"
+authorized_keys = "workers.pub"
 [retry]
 max_attempts = 4
 [progress]
@@ -50,17 +56,63 @@ poison_samples = [1, 2]
                             "run.toml");
   ASSERT_TRUE(c) << c.error().message;
   EXPECT_EQ(c->seed, 7u);
+  EXPECT_EQ(c->samples, 3);
+  EXPECT_EQ(c->states_per_sample, 2);
+  EXPECT_EQ(c->orientations, 2);
   EXPECT_EQ(c->resolution, 15);
   EXPECT_EQ(c->noise, "none");
   EXPECT_EQ(c->renderer, "software");
   EXPECT_EQ(c->density, 250.0);
   EXPECT_EQ(c->bending_model, "triangle");
+  EXPECT_EQ(c->output, "x");
+  EXPECT_EQ(c->model, "m.dgvae");
+  EXPECT_EQ(c->weight_sine, 2.0);
   EXPECT_EQ(c->weight_fold, 0.5);
+  EXPECT_EQ(c->weight_drape, 0.0);
+  EXPECT_EQ(c->max_drift_mm, 2.0);
+  EXPECT_EQ(c->max_iterations, 50);
+  EXPECT_EQ(c->tolerance, 1e-4);
+  EXPECT_EQ(c->coarse_start_resolution, 0);
   EXPECT_EQ(c->max_self_intersections, 3);
+  EXPECT_EQ(c->bind, "tcp://127.0.0.1:*");
+  EXPECT_EQ(c->heartbeat_ms, 100);
+  EXPECT_EQ(c->liveness, 3);
   EXPECT_EQ(c->lease_s, 60.0);
+  EXPECT_TRUE(c->curve);
+  EXPECT_EQ(c->server_secret_key, "server.key");
+  EXPECT_EQ(c->authorized_keys, "workers.pub");
   EXPECT_EQ(c->max_attempts, 4);
+  EXPECT_EQ(c->progress_interval_s, 1.0);
   EXPECT_EQ(c->mode, "noop");
   EXPECT_EQ(c->poison_samples, (std::vector<std::int64_t>{1, 2}));
+  // Each value above differs from its default (else a dropped key would pass unseen).
+  EXPECT_NE(d.seed, 7u);
+  EXPECT_NE(d.samples, 3);
+  EXPECT_NE(d.states_per_sample, 2);
+  EXPECT_NE(d.orientations, 2);
+  EXPECT_NE(d.resolution, 15);
+  EXPECT_NE(d.noise, "none");
+  EXPECT_NE(d.renderer, "software");
+  EXPECT_NE(d.density, 250.0);
+  EXPECT_NE(d.bending_model, "triangle");
+  EXPECT_NE(d.output, "x");
+  EXPECT_NE(d.model, "m.dgvae");
+  EXPECT_NE(d.weight_sine, 2.0);
+  EXPECT_NE(d.weight_fold, 0.5);
+  EXPECT_NE(d.weight_drape, 0.0);
+  EXPECT_NE(d.max_drift_mm, 2.0);
+  EXPECT_NE(d.max_iterations, 50);
+  EXPECT_NE(d.tolerance, 1e-4);
+  EXPECT_NE(d.coarse_start_resolution, 0);
+  EXPECT_NE(d.max_self_intersections, 3);
+  EXPECT_NE(d.bind, "tcp://127.0.0.1:*");
+  EXPECT_NE(d.heartbeat_ms, 100);
+  EXPECT_NE(d.liveness, 3);
+  EXPECT_NE(d.lease_s, 60.0);
+  EXPECT_FALSE(d.curve);
+  EXPECT_NE(d.max_attempts, 4);
+  EXPECT_NE(d.progress_interval_s, 1.0);
+  EXPECT_NE(d.mode, "noop");
   EXPECT_TRUE(parse_run_config(default_config_toml(), "default"));
 }
 

@@ -98,9 +98,15 @@ TEST(SimulationFleet, PassesOnWhatTheWorkerCannotBuildAndWhatCannotBeSent) {
   auto failed = (*fleet)->simulate(bad);
   ASSERT_FALSE(failed);
   EXPECT_NE(failed.error().message.find("worker test-0"), std::string::npos) << failed.error().message;
+  const auto before = (*fleet)->counters();
   sim::DrapeConfig mesh = small_drape(1);
   mesh.initial.shape = sim::InitialShape::kMesh;
-  EXPECT_FALSE((*fleet)->simulate(mesh));
+  const auto unsent = (*fleet)->simulate(mesh);  // refused here, before any worker sees it
+  ASSERT_FALSE(unsent);
+  EXPECT_NE(unsent.error().message.find("a mesh initial state is not sent"), std::string::npos)
+      << unsent.error().message;
+  EXPECT_EQ((*fleet)->counters().simulated, before.simulated);
+  EXPECT_EQ((*fleet)->counters().lost_attempts, before.lost_attempts);
 }
 
 TEST(SimulationFleet, FailsADrapeThatNoWorkerComesFor) {
@@ -272,6 +278,7 @@ TEST(SimulationFleet, AdmitsOnlyAuthorisedWorkersAndNeedsCurveBeyondLoopback) {
   auto drape = (*fleet)->simulate(small_drape(2));
   ASSERT_TRUE(drape) << drape.error().message;
   EXPECT_EQ(drape->mesh.positions, sim::simulate_drape(small_drape(2))->mesh.positions);
+  EXPECT_EQ((*fleet)->counters().workers_seen, 1);  // the stranger never registered
   std::filesystem::remove_all(dir);
 }
 

@@ -81,12 +81,12 @@ TEST(JobRunner, ComputesADrapeWithItsFilesInMemory) {
   EXPECT_EQ(again.result().exr(0), r.exr(0));
 }
 
-// The job names its renderer: both draw the same drape (the mesh bytes are equal) into nearly the same depth, each
-// deterministically.
+// The job names its renderer: both draw the same drape (the mesh bytes are equal) into nearly the same depth, not
+// the same bytes, each deterministically; a renderer this build lacks fails the job as a render error.
 TEST(JobRunner, RendersWithTheJobsRenderer) {
   JobRunner runner(scratch());
   std::vector<v1::Envelope> answers;
-  for (const char* name : {"osmesa", "software", "software"}) {
+  for (const char* name : {"osmesa", "software", "software", "osmesa"}) {
     v1::Job job = tiny_job(v1::JOB_MODE_DRAPE);
     job.mutable_spec()->set_renderer(name);
     job.mutable_spec()->set_noise("none");
@@ -95,6 +95,14 @@ TEST(JobRunner, RendersWithTheJobsRenderer) {
   }
   EXPECT_EQ(answers[0].result().mesh_ply(), answers[1].result().mesh_ply());
   EXPECT_EQ(answers[1].result().exr(0), answers[2].result().exr(0));
+  EXPECT_EQ(answers[0].result().exr(0), answers[3].result().exr(0));
+  EXPECT_NE(answers[0].result().exr(0), answers[1].result().exr(0));  // the field was read: another rasteriser
+  v1::Job unknown = tiny_job(v1::JOB_MODE_DRAPE);
+  unknown.mutable_spec()->set_renderer("vulkan");
+  const auto refused = runner.run(unknown);
+  ASSERT_EQ(refused.body_case(), v1::Envelope::kFailure);
+  EXPECT_EQ(refused.failure().reason(), v1::FAILURE_REASON_RENDER_ERROR);
+  EXPECT_NE(refused.failure().message().find("vulkan"), std::string::npos) << refused.failure().message();
   const auto decode = [](const v1::Envelope& e) {
     return renderer::read_exr(std::vector<char>(e.result().exr(0).begin(), e.result().exr(0).end()));
   };
