@@ -141,6 +141,11 @@ double DihedralBending::update_lagged(const Eigen::Matrix3Xd& x) {
     hinge_bending_angles(current, *topology_, rule_, phi_);
     change = assign_laws();
   }
+  return change;
+}
+
+double DihedralBending::update_history(const Eigen::Matrix3Xd& x) {
+  double change = 0.0;
   if (std::isfinite(yield_curvature_)) {
     // Return mapping: the elastic angle |theta - rest| may not exceed the one whose torque is the yield torque,
     // i.e. min(yield curvature, the law's peak) / c. The change is measured against the hinge's yield angle.

@@ -178,6 +178,10 @@ SolveReport NewtonSolver::solve(const std::vector<EnergyTerm*>& terms, const std
     if (!frozen && (it == 0 || outer || early)) {
       double change = 0.0;
       for (EnergyTerm* t : terms) change = std::max(change, t->update_lagged(x));
+      // History (plastic flow) only from an equilibrium: the start and the way down carry curvatures no load caused.
+      if (outer) {
+        for (EnergyTerm* t : terms) change = std::max(change, t->update_history(x));
+      }
       ++report.lagged_updates;
       outer_updates += outer ? 1 : 0;
       report.lagged_change = change;

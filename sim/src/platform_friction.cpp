@@ -1,5 +1,6 @@
 #include "drapegen/sim/platform_friction.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -27,8 +28,10 @@ double PlatformFriction::update_lagged(const Eigen::Matrix3Xd& x) {
   Eigen::Matrix3Xd force = Eigen::Matrix3Xd::Zero(3, x.cols());
   contact_->evaluate(x, &force, nullptr);
   Eigen::VectorXd updated(normal_.size());
+  // The top's share of the contact force (its upward component; `force` holds the energy's gradient): a vertex that
+  // slid over the rim onto the wall is pushed sideways, and friction in the top's plane would pull it into the wall.
   for (std::size_t i = 0; i < vertices_.size(); ++i)
-    updated[static_cast<Eigen::Index>(i)] = force.col(vertices_[i]).norm();
+    updated[static_cast<Eigen::Index>(i)] = std::max(0.0, -force(2, vertices_[i]));
   const double scale = std::max(updated.maxCoeff(), normal_.size() > 0 ? normal_.maxCoeff() : 0.0);
   const double change = scale > 0.0 ? (updated - normal_).cwiseAbs().maxCoeff() / scale : 0.0;
   normal_ = updated;

@@ -99,7 +99,9 @@ TEST(Effects, PlasticHingesFlowToTheYieldTorque) {
     before[i] = dihedral_angle(mesh.positions.col(h.v0), mesh.positions.col(h.v1), mesh.positions.col(h.v2),
                                mesh.positions.col(h.v3));
   }
-  EXPECT_GT(bending.update_lagged(mesh.positions), 0.0);
+  EXPECT_EQ(bending.update_lagged(mesh.positions), 0.0);  // directions only: no flow on the way to equilibrium
+  EXPECT_EQ(bending.rest_angles().cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_GT(bending.update_history(mesh.positions), 0.0);
   for (std::size_t i = 0; i < topo.hinges.size(); ++i) {
     const double limit = yield * 0.5 * rest[i].height_sum;
     const double elastic_angle = before[i] - bending.rest_angles()[static_cast<Eigen::Index>(i)];
@@ -115,7 +117,7 @@ TEST(Effects, PlasticHingesFlowToTheYieldTorque) {
   }
   EXPECT_GT(yielded, 0);
   EXPECT_GT(elastic, 0);
-  EXPECT_LT(bending.update_lagged(mesh.positions), 1e-12);
+  EXPECT_LT(bending.update_history(mesh.positions), 1e-12);
 }
 
 TEST(Effects, EdgeCurlLiftsTheEdges) {
@@ -198,6 +200,28 @@ TEST(Effects, FrictionDerivatives) {
   friction.evaluate(x, &force, nullptr);
   EXPECT_NEAR(force.col(1).norm(), 0.4 * friction.normal_forces()[1], 1e-12);
   EXPECT_LT(force.col(0).norm(), 0.4 * friction.normal_forces()[0]);
+}
+
+// Friction acts in the top's plane, with the top's normal force: a vertex that slid over the rim and is pressed
+// against the wall gets none (the wall's sideways push, taken as its normal force, pulled it into the wall).
+TEST(Effects, FrictionTakesOnlyTheTopsNormalForce) {
+  SpecimenSpec spec{0.02, 0.02, 4, 4, 0.0, Triangulation::kAlternating, 0, 0.0};
+  ClothMesh mesh = make_specimen(spec);
+  PlatformSpec platform;
+  PlatformContact contact(mesh, platform);
+  Eigen::Matrix3Xd x = mesh.positions;
+  x.row(2).setConstant(platform.contact_offset - 2e-4);  // pressed into the top
+  x.col(0) = Eigen::Vector3d(platform.radius + platform.contact_offset - 2e-4, 0.0, -0.01);  // into the wall
+  std::vector<int> all(mesh.vertex_count());
+  for (int v = 0; v < mesh.vertex_count(); ++v) all[v] = v;
+  PlatformFriction friction(contact, all, x, FrictionParameters{0.4, 1e-4});
+  (void)friction.update_lagged(x);
+  Eigen::Matrix3Xd contact_gradient = Eigen::Matrix3Xd::Zero(3, mesh.vertex_count());
+  contact.evaluate(x, &contact_gradient, nullptr);
+  EXPECT_GT(contact_gradient.col(0).norm(), 0.0);  // the wall pushes vertex 0 ...
+  EXPECT_EQ(friction.normal_forces()[0], 0.0);     // ... but it is not on the top
+  EXPECT_GT(friction.normal_forces()[1], 0.0);
+  EXPECT_NEAR(friction.normal_forces()[1], contact_gradient.col(1).norm(), 1e-15);
 }
 
 // The drapes below use a 25 x 25 specimen and the median fabric, like sim/tests/drape_test.cpp.
@@ -454,7 +478,7 @@ TEST(Effects, AYieldedSpecimenKeepsItsSetWhenReleased) {
   std::printf("[ set      ] mean vertex distance: laid again as before %.2f mm; laid otherwise, set vs fresh %.2f mm\n",
               same * kMm, other * kMm);
   EXPECT_LT(same, 0.5e-3);
-  EXPECT_GT(other, 2e-3);
+  EXPECT_GT(other, 1e-3);  // 1.8 mm since the flow acts at equilibrium only (2.5 mm when it acted on the way too)
 
   DrapeConfig wrong = plastic;
   wrong.rest_angles = Eigen::VectorXd::Zero(7);

@@ -56,6 +56,8 @@ class DihedralBending final : public EnergyTerm {
 
   /// Recomputes each hinge's bending direction (curvature rule) and its torque law by Eq. 8.
   double update_lagged(const Eigen::Matrix3Xd& x) override;
+  /// Plastic flow (set_yield_curvature): the return mapping of every hinge loaded beyond its yield angle.
+  double update_history(const Eigen::Matrix3Xd& x) override;
   /// False if a hinge's angle wraps (changes by more than pi) between the two states: folded through pi.
   [[nodiscard]] bool admissible_step(const Eigen::Matrix3Xd& from, const Eigen::Matrix3Xd& to) const;
   /// Includes each hinge's fold barrier (fold_barrier.hpp).
@@ -73,8 +75,9 @@ class DihedralBending final : public EnergyTerm {
   [[nodiscard]] const Eigen::VectorXd& rest_angles() const { return rest_angle_; }
 
   /// Elastoplastic hinges (bending hysteresis, internal friction): the torque cannot exceed the torque the hinge's
-  /// law gives at `yield_curvature` (1/m). At every update_lagged() a hinge loaded beyond it flows: its rest angle
-  /// moves until the torque equals the yield torque (return mapping). Infinity (the default) is elastic.
+  /// law gives at `yield_curvature` (1/m). At every update_history() (at equilibrium: the solver's outer loop) a
+  /// hinge loaded beyond it flows: its rest angle moves until the torque equals the yield torque (return mapping).
+  /// Infinity (the default) is elastic.
   void set_yield_curvature(double yield_curvature);
 
  private:

@@ -41,6 +41,10 @@ class EnergyTerm {
   /// directions of the curvature-based anisotropy). Returns the largest relative change of any element's parameters
   /// (0 for terms without such quantities). The energy is a fixed function of x between two calls.
   virtual double update_lagged(const Eigen::Matrix3Xd& /*x*/) { return 0.0; }
+  /// Updates history variables that only the loads at equilibrium may change (a yielding bending term's plastic rest
+  /// angles): called in the solver's outer loop alone, never on the way there, where the initial state and the
+  /// unbalanced steps carry curvatures no load caused. Returns the largest relative change, as update_lagged does.
+  virtual double update_history(const Eigen::Matrix3Xd& /*x*/) { return 0.0; }
 
   [[nodiscard]] virtual double energy(const Eigen::Matrix3Xd& x) const = 0;
   /// The energy at the end `to` of a straight step from `from`, or +infinity when the step leaves the region where

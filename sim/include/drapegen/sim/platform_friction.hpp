@@ -20,8 +20,9 @@ struct FrictionParameters {
 /// E = sum_v mu N_v f(|P (x_v - anchor_v)|) over the vertices that start on the top, with P the projection onto the
 /// horizontal top plane, anchor_v the vertex's start position, f(u) = u^2 / (2 eps) below eps = stick_distance and
 /// u - eps / 2 beyond: the force is mu N_v u / eps while sticking and mu N_v when sliding. The normal force N_v is
-/// lagged (update_lagged reads it from the contact term at the current state), as in incremental-potential friction.
-/// Every vertex that leaves the top (N_v = 0) carries no friction.
+/// lagged (update_lagged reads it from the contact term at the current state: the upward component of its force), as
+/// in incremental-potential friction. Every vertex that leaves the top (N_v = 0) carries no friction, also one that
+/// slid over the rim onto the wall (pushed sideways only).
 class PlatformFriction final : public EnergyTerm {
  public:
   PlatformFriction(const PlatformContact& contact, std::vector<int> vertices, const Eigen::Matrix3Xd& anchors,
