@@ -117,13 +117,6 @@ sim::Status rename_over(const std::string& tmp, const std::string& path) {
 
 }  // namespace
 
-sim::Status write_file_atomic(const std::string& path, std::string_view bytes, unsigned mode) {
-  if (written_in_place(path)) return write_in_place(path, bytes);
-  const auto tmp = write_temporary(path, bytes, mode);
-  if (!tmp) return tmp.error();
-  return rename_over(*tmp, path);
-}
-
 sim::Status write_files_atomic(std::span<const FileBytes> files, unsigned mode) {
   std::vector<std::string> temporaries(files.size());  // empty: written in place at the end
   const auto remove_temporaries = [&](std::size_t from) {
@@ -149,6 +142,11 @@ sim::Status write_files_atomic(std::span<const FileBytes> files, unsigned mode) 
     }
   }
   return {};
+}
+
+sim::Status write_file_atomic(const std::string& path, std::string_view bytes, unsigned mode) {
+  const FileBytes file{path, bytes};
+  return write_files_atomic({&file, 1}, mode);
 }
 
 sim::Status sync_directory(const std::string& directory) {
