@@ -4,7 +4,6 @@
 #include <memory>
 #include <optional>
 #include <nlohmann/json.hpp>
-#include <random>
 #include <vector>
 
 #include <fmt/format.h>
@@ -15,6 +14,7 @@
 #include "drapegen/sim/drape.hpp"
 #include "drapegen/sim/logging.hpp"
 #include "drapegen/sim/ply.hpp"
+#include "drapegen/sim/xoshiro.hpp"
 #include "drapegen/storage/json_text.hpp"
 #include "parse.hpp"
 
@@ -55,8 +55,8 @@ sim::Expected<Eigen::Vector2d> parse_drift(const std::string& text, std::uint64_
     if (comma == std::string::npos) {
       const double mm = std::stod(text, &used);
       if (used != text.size() || !std::isfinite(mm) || mm < 0.0) throw std::invalid_argument("");
-      std::mt19937_64 rng(seed ^ 0x9e3779b97f4a7c15ULL);
-      const double angle = std::uniform_real_distribution<double>(0.0, 2.0 * M_PI)(rng);
+      sim::Xoshiro256 rng(seed ^ 0x9e3779b97f4a7c15ULL);
+      const double angle = 2.0 * M_PI * rng.uniform();
       return Eigen::Vector2d(Eigen::Vector2d(std::cos(angle), std::sin(angle)) * (mm * 1e-3));
     }
     std::size_t used_y = 0;

@@ -2,10 +2,10 @@
 
 #include <Eigen/Dense>
 #include <cmath>
-#include <random>
 
 #include "drapegen/sim/mesh_transfer.hpp"
 #include "drapegen/sim/ply.hpp"
+#include "drapegen/sim/xoshiro.hpp"
 
 namespace drapegen::sim {
 namespace {
@@ -17,16 +17,15 @@ double smoothstep(double t) {
 
 /// Superposes three random sine waves on the overhang; the amplitude ramps up from the platform rim.
 void add_sine_waves(std::uint64_t seed, double platform_radius, ClothMesh& mesh) {
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  Xoshiro256 rng(seed);
   struct Wave { Eigen::Vector2d k; double phase, amplitude; };
   Wave waves[3];
   for (Wave& w : waves) {
-    const double angle = 2.0 * M_PI * unit(rng);
-    const double wavelength = 0.04 + 0.11 * unit(rng);
+    const double angle = 2.0 * M_PI * rng.uniform();
+    const double wavelength = 0.04 + 0.11 * rng.uniform();
     w.k = (2.0 * M_PI / wavelength) * Eigen::Vector2d(std::cos(angle), std::sin(angle));
-    w.phase = 2.0 * M_PI * unit(rng);
-    w.amplitude = 0.004 + 0.008 * unit(rng);
+    w.phase = 2.0 * M_PI * rng.uniform();
+    w.amplitude = 0.004 + 0.008 * rng.uniform();
   }
   for (int v = 0; v < mesh.vertex_count(); ++v) {
     const Eigen::Vector2d p = mesh.positions.col(v).head<2>();
@@ -40,12 +39,11 @@ void add_sine_waves(std::uint64_t seed, double platform_radius, ClothMesh& mesh)
 /// Bends the specimen down (isometrically) over a line outside the platform: a cylindrical crease of radius
 /// `bend_radius` followed by a straight flap, at an angle of 30 to 90 degrees.
 void add_fold(std::uint64_t seed, double platform_radius, ClothMesh& mesh) {
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
-  const double direction = 2.0 * M_PI * unit(rng);
+  Xoshiro256 rng(seed);
+  const double direction = 2.0 * M_PI * rng.uniform();
   const Eigen::Vector2d n(std::cos(direction), std::sin(direction));
-  const double offset = platform_radius + 0.005 + 0.035 * unit(rng);
-  const double angle = M_PI / 6.0 + (M_PI / 3.0) * unit(rng);
+  const double offset = platform_radius + 0.005 + 0.035 * rng.uniform();
+  const double angle = M_PI / 6.0 + (M_PI / 3.0) * rng.uniform();
   const double bend_radius = 0.01;
   const double arc = angle * bend_radius;
   for (int v = 0; v < mesh.vertex_count(); ++v) {

@@ -2,21 +2,20 @@
 
 #include <algorithm>
 #include <cmath>
-#include <random>
 #include <vector>
 #include <stdexcept>
+
+#include "drapegen/sim/xoshiro.hpp"
 
 namespace drapegen::sim {
 
 namespace {
 
-double uniform_jitter(std::mt19937_64& rng, double amount) {
-  return amount * std::uniform_real_distribution<double>(-1.0, 1.0)(rng);
-}
+double uniform_jitter(Xoshiro256& rng, double amount) { return amount * (2.0 * rng.uniform() - 1.0); }
 
 /// Rows of equilateral-like triangles; odd rows are offset by half a spacing and carry an extra vertex so that the
 /// left and right borders stay straight.
-ClothMesh equilateral_specimen(const SpecimenSpec& spec, std::mt19937_64& rng) {
+ClothMesh equilateral_specimen(const SpecimenSpec& spec, Xoshiro256& rng) {
   const int nx = spec.vertices_x, ny = spec.vertices_y;
   const double hx = spec.size_x / (nx - 1), hy = spec.size_y / (ny - 1);
   std::vector<int> row_start(ny + 1, 0);
@@ -55,10 +54,9 @@ ClothMesh equilateral_specimen(const SpecimenSpec& spec, std::mt19937_64& rng) {
 }
 
 /// A grid of quads, each split along one diagonal.
-ClothMesh grid_specimen(const SpecimenSpec& spec, std::mt19937_64& rng) {
+ClothMesh grid_specimen(const SpecimenSpec& spec, Xoshiro256& rng) {
   const int nx = spec.vertices_x, ny = spec.vertices_y;
   const double hx = spec.size_x / (nx - 1), hy = spec.size_y / (ny - 1);
-  std::bernoulli_distribution coin(0.5);
   ClothMesh mesh;
   mesh.material_angle = spec.material_angle;
   mesh.rest.resize(2, nx * ny);
@@ -78,7 +76,7 @@ ClothMesh grid_specimen(const SpecimenSpec& spec, std::mt19937_64& rng) {
   for (int j = 0; j + 1 < ny; ++j) {
     for (int i = 0; i + 1 < nx; ++i) {
       const int a = j * nx + i, b = a + 1, c = a + nx, d = c + 1;
-      const bool main_diagonal = spec.triangulation == Triangulation::kRandom    ? coin(rng)
+      const bool main_diagonal = spec.triangulation == Triangulation::kRandom    ? (rng.next() >> 63) != 0
                                  : spec.triangulation == Triangulation::kUniform ? true
                                                                                  : (i + j) % 2 == 0;
       if (main_diagonal) {  // diagonal a-d
@@ -108,7 +106,7 @@ ClothMesh make_specimen(const SpecimenSpec& spec) {
   if (!(spec.jitter >= 0.0 && spec.jitter <= 0.3)) throw std::invalid_argument("specimen jitter must be in [0, 0.3]");
   // A NaN angle read as 0 downstream (every hinge the warp's): an anisotropic fabric draped as an isotropic one.
   if (!std::isfinite(spec.material_angle)) throw std::invalid_argument("specimen material angle must be finite");
-  std::mt19937_64 rng(spec.seed);
+  Xoshiro256 rng(spec.seed);
   ClothMesh mesh = spec.triangulation == Triangulation::kEquilateral ? equilateral_specimen(spec, rng)
                                                                      : grid_specimen(spec, rng);
   mesh.positions.resize(3, mesh.rest.cols());

@@ -283,10 +283,12 @@ TEST(HingeBendingAngles, CurvatureRuleIsMeshIndependentEdgeRuleIsNot) {
     // The curvature rule bends every hinge with the stiffness of the true bending direction on both meshes ...
     EXPECT_NEAR(curvature_rule[0], expected, 1e-3 * expected);
     EXPECT_NEAR(curvature_rule[1], expected, 1e-3 * expected);
-    // ... the edge rule's stiffness depends on how the mesh is triangulated.
+    // ... the edge rule's stiffness depends on how the mesh is triangulated, and off the warp it is wrong on the
+    // structured mesh (which has no random draws: +10% at 0.3 rad, +8% at pi/4). The irregular mesh's error depends
+    // on its draw (at pi/4: +11% on one, +5% on another, its random diagonals averaging out), so it is not asserted.
     EXPECT_GT(std::abs(edge_rule[1] - edge_rule[0]), 0.02 * expected);
     if (alpha > 0.0) {
-      EXPECT_GT(std::abs(edge_rule[1] - expected), 0.1 * expected);
+      EXPECT_GT(std::abs(edge_rule[0] - expected), 0.05 * expected);
     }
   }
 }

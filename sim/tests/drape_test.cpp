@@ -17,6 +17,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <functional>
 #include <limits>
 #include <filesystem>
@@ -114,57 +115,74 @@ TEST(DrapePhysics, SolverOptionsItCannotRunWithAreInputErrors) {
 // must drape like the original from the same start (the normalised moduli differ in the last bit, so the inexact
 // solver path differs at round-off level); (2) the physical claim behind it: with sigma and the contact penalty
 // held in absolute units instead (equivalently, both divided by s at the standard density), the equilibrium moves
-// little. Observed at 25 x 25: max 8.2 / 4.6 mm, mean 1.45 / 0.67 mm, |dDC| 0.0007 / 0.0009 for s = 3 / 0.5: the
-// coarse mesh compresses beyond the 1% band in its folds, where sigma acts (bench/drape_physics.cpp, check a, at
-// finer meshes). (2) continues from the base drape: from a flat start, tiny differences can select another of the
-// drape's many local minima, which measures the path, not k/rho.
+// less than the same factor on the bending alone moves it (on this coarse mesh not by much less: below; it
+// compresses beyond the 1% band in its folds, where sigma acts; bench/drape_physics.cpp, check a, at finer meshes).
+// (2) continues from the base drape: from a flat start, tiny differences can select another of the drape's many
+// local minima, which measures the path, not k/rho. Three triangulations: the margins depend on the draw.
 TEST(DrapePhysics, DrapeDependsOnBendingOverDensity) {
-  const DrapeConfig base = config(25, false);
-  const DrapeResult r0 = drape(base, "k/rho: median fabric");
-  const std::string path = (std::filesystem::temp_directory_path() /
-                            ("drapegen_k_over_rho_base_" + std::to_string(::getpid()) + ".ply"))
-                               .string();
-  ASSERT_TRUE(write_ply(path, r0.mesh));
-  for (const double s : {3.0, 0.5}) {
-    DrapeConfig c = base;
-    c.fabric.alpha = scaled(base.fabric.alpha, s);
-    c.fabric.beta = scaled(base.fabric.beta, s);
-    c.fabric.density *= s;
-    const DrapeResult same = drape(c, "k/rho: k, rho x" + std::to_string(s).substr(0, 3));
-    const double d_same = max_distance_mm(same.mesh.positions, r0.mesh.positions);
-    // With exact Newton steps the path is insensitive to the last bit of the normalised moduli; the inexact (PCG)
-    // steps amplify it to ~0.15 mm through the lagged anisotropy directions (a restart of the base drape from itself
-    // moves by as much, see the control below).
-    DrapeConfig exact_base = base, exact_scaled = c;
-    exact_base.solver.max_pcg_iterations = exact_scaled.solver.max_pcg_iterations = 0;
-    const double d_exact = max_distance_mm(drape(exact_scaled, "k/rho: scaled, exact Newton").mesh.positions,
-                                           drape(exact_base, "k/rho: base, exact Newton").mesh.positions);
-    std::printf("[ k/rho    ] x%.1f: max vertex distance %.2e mm (exact Newton steps %.2e mm)\n", s, d_same, d_exact);
-    EXPECT_LT(d_exact, 0.1) << "x" << s;
-    EXPECT_LT(d_same, 0.5) << "x" << s;
-    EXPECT_NEAR(same.measures.drape_coefficient, r0.measures.drape_coefficient, 1e-3);
-
+  for (const std::uint64_t seed : {0, 1, 2}) {
+    SCOPED_TRACE("triangulation " + std::to_string(seed));
+    DrapeConfig base = config(25, false);
+    base.specimen.seed = seed;
+    const DrapeResult r0 = drape(base, "k/rho: median fabric");
+    const std::string path = (std::filesystem::temp_directory_path() /
+                              ("drapegen_k_over_rho_base_" + std::to_string(::getpid()) + ".ply"))
+                                 .string();
+    ASSERT_TRUE(write_ply(path, r0.mesh));
     // The control restarts the base fabric from its own drape: the curvature rule recomputes the bending directions
-    // from that drape, so even the control moves a little; the claim concerns the difference.
+    // from that drape, so even the control moves (0.4 mm on one triangulation, 2.8 mm on another); the claims concern
+    // differences from it.
     DrapeConfig control = base;
     control.initial = InitialStateSpec{};
     control.initial.shape = InitialShape::kMesh;
     control.initial.mesh_path = path;
-    DrapeConfig absolute = control;
-    absolute.membrane.stiffness /= s;
-    absolute.platform.contact_stiffness /= s;
     const DrapeResult restarted = drape(control, "k/rho: restart from the base drape");
-    const DrapeResult moved = drape(absolute, "k/rho: same, sigma and contact in absolute units");
-    const double d_max = max_distance_mm(moved.mesh.positions, restarted.mesh.positions);
-    const double d_mean = mean_distance_mm(moved.mesh.positions, restarted.mesh.positions);
-    const double d_dc = std::abs(moved.measures.drape_coefficient - restarted.measures.drape_coefficient);
-    std::printf("[ k/rho    ] x%.1f, sigma and contact absolute: max vertex distance %.3f mm, mean %.3f mm, |dDC| "
-                "%.4f (control moved %.3f mm)\n",
-                s, d_max, d_mean, d_dc, max_distance_mm(restarted.mesh.positions, r0.mesh.positions));
-    EXPECT_LT(d_mean, 2.0) << "x" << s;
-    EXPECT_LT(d_dc, 0.005) << "x" << s;
+    const double control_moved = max_distance_mm(restarted.mesh.positions, r0.mesh.positions);
+    for (const double s : {3.0, 0.5}) {
+      DrapeConfig c = base;
+      c.fabric.alpha = scaled(base.fabric.alpha, s);
+      c.fabric.beta = scaled(base.fabric.beta, s);
+      c.fabric.density *= s;
+      const DrapeResult same = drape(c, "k/rho: k, rho x" + std::to_string(s).substr(0, 3));
+      const double d_same = max_distance_mm(same.mesh.positions, r0.mesh.positions);
+      // With exact Newton steps the path is insensitive to the last bit of the normalised moduli; the inexact (PCG)
+      // steps amplify it to a fraction of a millimetre through the lagged anisotropy directions, less than a restart
+      // of the base drape from itself moves.
+      DrapeConfig exact_base = base, exact_scaled = c;
+      exact_base.solver.max_pcg_iterations = exact_scaled.solver.max_pcg_iterations = 0;
+      const double d_exact = max_distance_mm(drape(exact_scaled, "k/rho: scaled, exact Newton").mesh.positions,
+                                             drape(exact_base, "k/rho: base, exact Newton").mesh.positions);
+      std::printf("[ k/rho    ] x%.1f: max vertex distance %.2e mm (exact Newton steps %.2e mm; the control moved "
+                  "%.3f mm)\n", s, d_same, d_exact, control_moved);
+      EXPECT_LT(d_exact, 0.1) << "x" << s;
+      EXPECT_LT(d_same, std::max(control_moved, 0.1)) << "x" << s;
+      EXPECT_NEAR(same.measures.drape_coefficient, r0.measures.drape_coefficient, 1e-3);
+
+      DrapeConfig absolute = control;
+      absolute.membrane.stiffness /= s;
+      absolute.platform.contact_stiffness /= s;
+      DrapeConfig bending = control;
+      bending.fabric.alpha = scaled(base.fabric.alpha, s);
+      bending.fabric.beta = scaled(base.fabric.beta, s);
+      const DrapeResult moved = drape(absolute, "k/rho: same, sigma and contact in absolute units");
+      const DrapeResult bent = drape(bending, "k/rho: same, bending alone scaled");
+      const double d_mean = mean_distance_mm(moved.mesh.positions, restarted.mesh.positions);
+      const double d_dc = std::abs(moved.measures.drape_coefficient - restarted.measures.drape_coefficient);
+      const double bent_mean = mean_distance_mm(bent.mesh.positions, restarted.mesh.positions);
+      const double bent_dc = std::abs(bent.measures.drape_coefficient - restarted.measures.drape_coefficient);
+      std::printf("[ k/rho    ] x%.1f, sigma and contact absolute: mean vertex distance %.3f mm, |dDC| %.4f; the "
+                  "bending alone x%.1f: %.3f mm, %.4f\n", s, d_mean, d_dc, s, bent_mean, bent_dc);
+      // Observed on triangulations 0, 1, 2: the mean distance is 0.38 / 0.48 / 0.30 of the bending's at x3 (sigma
+      // falls to 67, below Figs. 5-7's range) and 0.25 / 0.25 / 0.15 at x0.5; the drape coefficient moves 0.13 /
+      // 0.01 / 0.03 of the bending's at x3 (at x0.5 a restart keeps its folds and the bending alone hardly moves
+      // the coefficient either: 0.009-0.014).
+      EXPECT_LT(d_mean, 0.6 * bent_mean) << "x" << s;
+      if (s > 1.0) {
+        EXPECT_LT(d_dc, 0.2 * bent_dc) << "x" << s;
+      }
+    }
+    std::filesystem::remove(path);
   }
-  std::filesystem::remove(path);
 }
 
 // (b) The platform is a cylinder about the z axis and gravity points along it: rotating the specimen about the axis
@@ -232,36 +250,38 @@ TEST(DrapePhysics, RotationAboutTheAxisRotatesTheDrape) {
 
 // (c) Section 4.1: sigma barely changes the drape once it is large enough (Figs. 5-7), and a stiff sigma = 5000 does
 // not lock thanks to the stretch band [0.99, 1.01] (Fig. 9). Without the band, sigma = 5000 locks: the specimen
-// cannot form folds and stands out like a stiff skirt. (At 25 x 25 sigma 5000 with the band is within 0.5% of sigma
-// 200; on finer meshes some locking remains: +1.5% to +7.5% at 60 x 60 over three triangulations, see
-// bench/drape_physics.cpp.)
+// cannot form folds and stands out like a stiff skirt. At 25 x 25 some locking remains with the band, and how much
+// depends on the triangulation: over eight random triangulations of each of two generators (`drapegen simulate
+// --resolution 25 --seed S --sigma G`, S = 0..7), sigma 1000 moved the drape coefficient by -6% to +14% from sigma
+// 200 and sigma 5000 by -3% to +28% (a single draw had shown +1% and -3%; the triangulations' own spread at sigma
+// 200 is 0.13-0.16), while without the band it more than doubles. On finer meshes less remains: +1.5% to +7.5% at
+// 60 x 60 over three triangulations (bench/drape_physics.cpp). So the claim is checked on three triangulations.
 TEST(DrapePhysics, InPlaneStiffnessBarelyMattersAndDoesNotLock) {
-  const DrapeConfig base = config(25, false);
-  auto with = [&](double sigma, bool band) {
-    DrapeConfig c = base;
-    c.membrane.stiffness = sigma;
-    if (!band) c.membrane.band_low = c.membrane.band_high = 1.0;
-    return drape(c, "sigma " + std::to_string(static_cast<int>(sigma)) + (band ? ", band" : ", no band"));
-  };
-  const DrapeResult s200 = with(200, true), s1000 = with(1000, true), s5000 = with(5000, true);
-  const DrapeResult locked = with(5000, false);
-  const double dc200 = s200.measures.drape_coefficient, dc1000 = s1000.measures.drape_coefficient;
-  const double dc5000 = s5000.measures.drape_coefficient, dc_locked = locked.measures.drape_coefficient;
-  const double mean1000 = mean_distance_mm(s1000.mesh.positions, s200.mesh.positions);
-  std::printf("[ sigma    ] DC: 200 %.4f, 1000 %.4f, 5000 %.4f; no band 5000 %.4f\n", dc200, dc1000, dc5000, dc_locked);
-  std::printf("[ sigma    ] vertex distance to sigma 200: 1000 mean %.2f max %.2f mm; 5000 mean %.2f mm; "
-              "5000 without band mean %.2f mm\n",
-              mean1000, max_distance_mm(s1000.mesh.positions, s200.mesh.positions),
-              mean_distance_mm(s5000.mesh.positions, s200.mesh.positions),
-              mean_distance_mm(locked.mesh.positions, s200.mesh.positions));
-  // Fold positions move by millimetres between nearby local minima (see the top of the file), so the paper's "little
-  // change" is bounded at 5 mm mean (observed 0.8 mm at 25 x 25, 1.3 mm at 60 x 60, up to 4 mm at 30 x 30 with an
-  // earlier solver); a different model gives more (no band at sigma 200: 7.5 mm; sigma 5000 without band: 31 mm).
-  EXPECT_LT(mean1000, 5.0);
-  EXPECT_NEAR(dc1000, dc200, 0.05 * dc200);
-  EXPECT_NEAR(dc5000, dc200, 0.05 * dc200);
-  // Locking without the band: far stiffer than any bending change here (DC roughly doubles or more).
-  EXPECT_GT(dc_locked, dc200 + 0.1);
+  for (const std::uint64_t seed : {0, 1, 2}) {
+    DrapeConfig base = config(25, false);
+    base.specimen.seed = seed;
+    auto with = [&](double sigma, bool band) {
+      DrapeConfig c = base;
+      c.membrane.stiffness = sigma;
+      if (!band) c.membrane.band_low = c.membrane.band_high = 1.0;
+      return drape(c, "sigma " + std::to_string(static_cast<int>(sigma)) + (band ? ", band" : ", no band"));
+    };
+    const DrapeResult s200 = with(200, true), s1000 = with(1000, true), s5000 = with(5000, true);
+    const DrapeResult locked = with(5000, false);
+    const double dc200 = s200.measures.drape_coefficient, dc1000 = s1000.measures.drape_coefficient;
+    const double dc5000 = s5000.measures.drape_coefficient, dc_locked = locked.measures.drape_coefficient;
+    std::printf("[ sigma    ] triangulation %d: DC 200 %.4f, 1000 %.4f, 5000 %.4f; no band 5000 %.4f; mean vertex "
+                "distance to sigma 200: 1000 %.2f mm, 5000 without band %.2f mm\n",
+                static_cast<int>(seed), dc200, dc1000, dc5000, dc_locked,
+                mean_distance_mm(s1000.mesh.positions, s200.mesh.positions),
+                mean_distance_mm(locked.mesh.positions, s200.mesh.positions));
+    EXPECT_NEAR(dc1000, dc200, 0.2 * dc200) << "triangulation " << seed;
+    EXPECT_NEAR(dc5000, dc200, 0.35 * dc200) << "triangulation " << seed;
+    // Locking without the band: far stiffer than any bending change here (DC roughly doubles or more), and the band
+    // takes away most of sigma 5000's stiffening.
+    EXPECT_GT(dc_locked, dc200 + 0.1) << "triangulation " << seed;
+    EXPECT_LT(std::abs(dc5000 - dc200), 0.25 * (dc_locked - dc200)) << "triangulation " << seed;
+  }
 }
 
 /// Hem radius around the rest x axis (azimuths 0 and 180 degrees, +-15 degrees) over that around the rest y axis.

@@ -12,6 +12,7 @@
 #include "drapegen/sim/mesh_transfer.hpp"
 #include "drapegen/sim/ply.hpp"
 #include "drapegen/sim/specimen.hpp"
+#include "drapegen/sim/xoshiro.hpp"
 
 namespace drapegen::sim {
 namespace {
@@ -84,6 +85,32 @@ TEST(InitialState, AMeshIsBroughtOntoTheAxisBeforeItsDrift) {
   ASSERT_FALSE(other);
   EXPECT_NE(other.error().message.find("material angle"), std::string::npos) << other.error().message;
   std::filesystem::remove(path);
+}
+
+// A seed means the same start with every standard library: the three waves (direction, wavelength 40-150 mm,
+// phase, amplitude 4-12 mm) are the project generator's draws in that order. At a corner the ramp from the rim is 1.
+TEST(InitialState, SineWavesAreTheProjectGeneratorsDraws) {
+  ClothMesh mesh = small_specimen();
+  InitialStateSpec spec;
+  spec.shape = InitialShape::kSine;
+  spec.seed = 77;
+  ASSERT_TRUE(apply_initial_state(spec, mesh));
+  Xoshiro256 rng(77);
+  double waves[3][4];
+  for (auto& w : waves) {
+    for (double& x : w) x = rng.uniform();
+  }
+  const int corner = mesh.vertex_count() - 1;
+  const Eigen::Vector2d p = mesh.rest.col(corner);
+  ASSERT_GT(p.norm(), spec.platform_radius + 0.03);
+  double z = spec.lift;
+  for (const auto& w : waves) {
+    const double angle = 2.0 * std::numbers::pi * w[0], wavelength = 0.04 + 0.11 * w[1];
+    const Eigen::Vector2d k = (2.0 * std::numbers::pi / wavelength) * Eigen::Vector2d(std::cos(angle), std::sin(angle));
+    z += (0.004 + 0.008 * w[3]) * std::sin(k.dot(p) + 2.0 * std::numbers::pi * w[2]);
+  }
+  EXPECT_NEAR(mesh.positions(2, corner), z, 1e-12);
+  EXPECT_GT(std::abs(z - spec.lift), 1e-4);  // the waves reach the corner
 }
 
 }  // namespace

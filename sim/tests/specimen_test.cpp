@@ -2,6 +2,8 @@
 // diagonal pattern its name promises.
 #include "drapegen/sim/specimen.hpp"
 
+#include "drapegen/sim/xoshiro.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -76,6 +78,26 @@ TEST(Specimen, RejectsBadSpecs) {
                std::invalid_argument);
   EXPECT_THROW(make_specimen(SpecimenSpec{0.1, 0.1, 5, 5, 0.0, Triangulation::kUniform, 0, std::nan("")}),
                std::invalid_argument);
+}
+
+// A seed means the same specimen with every standard library: the jitter is drawn from the project's own
+// generator (the std:: distributions differ between libraries), first x then y of each interior vertex in row order.
+TEST(Specimen, JitterIsTheProjectGeneratorsDraws) {
+  SpecimenSpec spec;
+  spec.vertices_x = spec.vertices_y = 5;
+  spec.triangulation = Triangulation::kRandom;
+  spec.jitter = 0.2;
+  spec.seed = 31;
+  const ClothMesh mesh = make_specimen(spec);
+  const double h = spec.size_x / 4.0;
+  Xoshiro256 rng(31);
+  for (const int v : {6, 7}) {  // the first interior vertices: (1, 1) and (2, 1)
+    const double x = -0.5 * spec.size_x + (v % 5) * h, y = -0.5 * spec.size_y + h;
+    const double dx = 0.2 * h * (2.0 * rng.uniform() - 1.0), dy = 0.2 * h * (2.0 * rng.uniform() - 1.0);
+    EXPECT_DOUBLE_EQ(mesh.rest(0, v), x + dx);
+    EXPECT_DOUBLE_EQ(mesh.rest(1, v), y + dy);
+  }
+  EXPECT_NE(mesh.rest(0, 6), -0.5 * spec.size_x + h);  // jittered at all
 }
 
 }  // namespace
