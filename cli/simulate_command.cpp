@@ -208,7 +208,8 @@ Runner add_simulate_command(CLI::App& app) {
   app.add_flag("--json", o->json, "Print the summary as JSON");
   app.add_option("--model", o->model,
                  "Bending model: dihedral (paper Eq. 1-3, curvature per hinge), triangle (the same law on per-triangle "
-                 "curvature tensors, exact for quadratic surfaces on any mesh) or quadratic (Eq. 4, gamma = alpha/3)")
+                 "curvature tensors, exact for quadratic surfaces on any mesh without interior vertices of valence "
+                 "3) or quadratic (Eq. 4, gamma = alpha/3)")
       ->check(CLI::IsMember({"dihedral", "triangle", "quadratic"}))
       ->capture_default_str();
   app.add_option("--anisotropy", o->anisotropy, "Bending direction rule: curvature (paper) or edge (naive)")

@@ -41,8 +41,15 @@ TriangleCurvatureBending::TriangleCurvatureBending(const ClothMesh& mesh, const 
       const int a = tri[(edge + 1) % 3], b = tri[(edge + 2) % 3];
       const auto it = hinge_of.find({std::min(a, b), std::max(a, b)});
       if (it == hinge_of.end()) continue;  // a free edge
-      const int i = e.hinge_count++;
       const Hinge& g = topology.hinges[static_cast<std::size_t>(it->second)];
+      // Around an interior vertex of valence 3 two hinges of a triangle have the same wing, so both angles are of the
+      // same four vertices, whose heights have one bending mode: the second angle measures what the first does (the
+      // system would be singular). It is left out, as a free edge is; the other triangles measure it all the same.
+      const int wing = g.v2 == tri[edge] ? g.v3 : g.v2;
+      bool measured = false;
+      for (int j = 0; j < e.hinge_count; ++j) measured = measured || e.vertices[3 + j] == wing;
+      if (measured) continue;
+      const int i = e.hinge_count++;
       e.hinge[i] = g;
       const int* hv = &g.v0;
       for (int k = 0; k < 4; ++k) {

@@ -9,6 +9,7 @@
 #include <set>
 
 #include "derivative_checks.hpp"
+#include "drapegen/sim/hessian_assembler.hpp"
 #include "drapegen/sim/triangle_bending.hpp"
 
 namespace drapegen::sim {
@@ -203,6 +204,52 @@ TEST(TriangleCurvatureBending, PlaneWaveConvergesAlikeOnEveryTriangulation) {
     }
     EXPECT_LT(hi - lo, 0.02) << degrees;  // every grid alike
   }
+}
+
+// A vertex of valence 3 (here the centre of a triangle split in three, as a scanned or remeshed PLY file may have):
+// two hinges of each triangle around it share their wing, so their angles are of the same four vertices and measure
+// one bending mode; the element keeps the first (the system of both is singular: the energy was NaN) and holds every
+// vertex once (the solver's assembler refused the element that repeated the wing).
+TEST(TriangleCurvatureBending, AWingSharedByTwoHingesIsOneVertex) {
+  ClothMesh mesh;
+  mesh.rest.resize(2, 4);
+  mesh.rest << 0.0, 0.02, 0.0, 0.006,  //
+      0.0, 0.0, 0.02, 0.006;
+  mesh.triangles.resize(3, 3);
+  mesh.triangles << 3, 3, 3,  //
+      0, 1, 2,                //
+      1, 2, 0;
+  mesh.positions.resize(3, 4);
+  mesh.positions.topRows<2>() = mesh.rest;
+  mesh.positions.row(2) << 0.0, 0.001, -0.0005, 0.0015;
+  const Topology topology = build_topology(mesh);
+  ASSERT_EQ(topology.hinges.size(), 3u);
+  const TriangleCurvatureBending bending(mesh, topology, DihedralModuli{{1e-5, 2e-5, 3e-5}, {0, 0, 0}},
+                                         AnisotropyRule::kCurvature);
+  ASSERT_EQ(bending.element_count(), 3);
+  for (int e = 0; e < bending.element_count(); ++e) {
+    int vertices[6];
+    bending.element_vertices(e, vertices);
+    std::set<int> present;
+    for (const int v : vertices) {
+      if (v < 0) continue;
+      EXPECT_TRUE(present.insert(v).second) << "element " << e << " repeats vertex " << v;
+    }
+    EXPECT_EQ(present.size(), 4u) << "element " << e;  // its triangle and the one wing
+  }
+  const Eigen::MatrixXd dense_hessian = check_derivatives(bending, mesh.positions, 1e-8, 1e-5);
+  // The solver's assembler (vertex 0 held) takes the element and sums the same Hessian.
+  const std::vector<bool> fixed{true, false, false, false};
+  HessianAssembler assembler(4, fixed, {&bending});
+  Eigen::Matrix3Xd gradient = Eigen::Matrix3Xd::Zero(3, 4);
+  assembler.assemble(mesh.positions, HessianMode::kExact, gradient);
+  Eigen::MatrixXd assembled = Eigen::MatrixXd::Zero(9, 9);
+  for (int j = 0; j < assembler.dof_count(); ++j) {
+    for (int p = assembler.column_pointers()[j]; p < assembler.column_pointers()[j + 1]; ++p) {
+      assembled(assembler.row_indices()[p], j) = assembled(j, assembler.row_indices()[p]) = assembler.values()[p];
+    }
+  }
+  EXPECT_LE((assembled - dense_hessian.bottomRightCorner(9, 9)).norm(), 1e-12 * dense_hessian.norm());
 }
 
 }  // namespace

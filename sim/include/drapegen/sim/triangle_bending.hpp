@@ -1,6 +1,6 @@
 #pragma once
 // The paper's nonlinear anisotropic bending law (Eq. 1-3, 8) on per-triangle curvature tensors, a discretisation
-// that is exact for quadratic surfaces on any triangulation.
+// that is exact for quadratic surfaces on any triangulation without interior vertices of valence 3.
 //
 // To first order the three dihedral angles around a triangle are linear in a constant curvature tensor K:
 // theta_i = b_i . (K_xx, K_xy, K_yy), with b_i from the rest geometry of hinge i. Solving that 3 x 3 system gives
@@ -13,7 +13,10 @@
 // curvature per hinge instead, and on right-triangle grids picks up twist that depends on the diagonals
 // (docs/PHYSICS.md). A triangle at the border has only one or two hinges: the components of K they do not measure
 // take the values of least linear bending energy (zero moment across the free edge, its natural boundary
-// condition), so the whole specimen is one model and no hinge energy remains.
+// condition), so the whole specimen is one model and no hinge energy remains. Around an interior vertex of valence
+// 3 two hinges of each triangle share their wing, so their angles are of the same four vertices and measure one
+// bending mode: the second is left out as a free edge is, and those triangles are no longer exact (the grids and
+// lattices the specimen generator makes have no such vertex; a PLY mesh may).
 
 #include <Eigen/Core>
 #include <memory>
@@ -36,7 +39,8 @@ class TriangleCurvatureBending final : public EnergyTerm {
   [[nodiscard]] std::string_view name() const override { return "triangle bending"; }
   [[nodiscard]] int arity() const override { return 6; }
   [[nodiscard]] int element_count() const override { return static_cast<int>(elements_.size()); }
-  /// The triangle, then its wings; -1 for a border triangle's missing wings.
+  /// The triangle, then its wings; -1 for a border triangle's missing wings (and a wing left out around a vertex of
+  /// valence 3). No vertex appears twice.
   void element_vertices(int element, int* out) const override;
   /// Recomputes each triangle's bending direction (curvature rule) and its torque laws.
   double update_lagged(const Eigen::Matrix3Xd& x) override;
