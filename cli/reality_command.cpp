@@ -101,7 +101,8 @@ Runner add_reality_command(CLI::App& app) {
                  "it. A yielding specimen keeps its plastic set: placement K starts from the set placements 0..K-1 "
                  "left (K + 1 drapes)")
       ->capture_default_str();
-  app.add_option("--out", o->out, "Capture directory (capture.json, view0..3.exr, truth.json, preview.png)")
+  app.add_option("--out", o->out, "Capture directory (capture.json, view0..3.exr, truth.json, preview.png); an earlier "
+                                  "capture of drapegen reality there is replaced, any other refused")
       ->required();
   app.add_flag("!--no-noise", o->noise, "Clean depth (no sensor noise)");
   app.add_option("--measured-bending-error", o->measured_bending_error,

@@ -788,6 +788,24 @@ json_number(fitted_ln_alpha "${out}" baseline fitted_reduced 0)
 if(fitted_ln_alpha LESS 9.1928 OR fitted_ln_alpha GREATER 9.5929)
   message(FATAL_ERROR "a measured bending: the fit left its box (ln mean alpha ${fitted_ln_alpha}, box 9.193 .. 9.593)")
 endif()
+# A measured bending in SI units (1e9 times smaller) is no fabric the fit can search near: an error naming the units,
+# where it was clamped into the range and started a fit 60 times too soft.
+file(COPY ${WORK}/measured/ DESTINATION ${WORK}/measured_si)
+string(JSON si_json SET "${measured_json}" specimen measured_bending alpha "[1.4e-5, 1.2e-5, 0.98e-5]")
+string(JSON si_json SET "${si_json}" specimen measured_bending beta "[-3e-8, -2e-8, -2e-8]")
+file(WRITE ${WORK}/measured_si/capture.json "${si_json}")
+expect_failure(1 "beyond the fit's range even within its factor 1.2214: the mean alpha is off (alpha in g*mm^2/s^2"
+               diagnose --capture ${WORK}/measured_si --quick --resolution 10)
+# reality replaces only its own captures: a real tester's capture in --out is refused and left as it was.
+file(COPY ${WORK}/measured/ DESTINATION ${WORK}/tester)
+string(JSON tester_json SET "${measured_json}" source "\"lab tester 7\"")
+file(WRITE ${WORK}/tester/capture.json "${tester_json}")
+expect_failure(1 "did not write (source \"lab tester 7\"); it replaces only its own"
+               reality ${FABRIC} --resolution 14 --out ${WORK}/tester)
+file(READ ${WORK}/tester/capture.json tester_after)
+if(NOT tester_after STREQUAL tester_json)
+  message(FATAL_ERROR "a refused reality run changed the tester's capture.json")
+endif()
 small_fit_from(${WORK}/measured "drape coefficient" --ignore-measured-bending)
 string(JSON factor_type TYPE "${out}" baseline search_within_factor)
 if(NOT factor_type STREQUAL "NULL")

@@ -1,11 +1,14 @@
 #include "drapegen/diagnosis/capture.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <fmt/format.h>
 #include <fstream>
+#include <numbers>
 #include <nlohmann/json.hpp>
 #include <vector>
 
@@ -29,6 +32,17 @@ nlohmann::json matrix_json(const Eigen::MatrixXd& m) {
     rows.push_back(row);
   }
   return rows;
+}
+
+/// A file the capture lists: a relative path inside its directory (no "..", not absolute), so that a capture is
+/// one directory that can be moved or copied whole.
+sim::Status check_listed_file(const nlohmann::json& name, const std::string& what) {
+  if (!name.is_string() || name.get<std::string>().empty()) return sim::Error{what + " must be a file name"};
+  const fs::path p = name.get<std::string>();
+  if (p.is_absolute() || std::any_of(p.begin(), p.end(), [](const fs::path& part) { return part == ".."; })) {
+    return sim::Error{fmt::format("{} {} must be a path inside the capture directory", what, p.string())};
+  }
+  return {};
 }
 
 sim::Expected<Eigen::MatrixXd> matrix_from(const nlohmann::json& j, int rows, int cols, const std::string& what) {
@@ -125,7 +139,7 @@ sim::Expected<Capture> read_capture(const std::string& directory) {
       return sim::Error{fmt::format("{}: not a capture (\"format\" must be \"{}\")", where, kFormat)};
     }
     // Integers as integers: 1.5 would pass as 1 (get<int> truncates).
-    if (!j.contains("version") || !j["version"].is_number_integer() || j["version"].get<int>() != 1) {
+    if (!j.contains("version") || !j["version"].is_number_integer() || j["version"].get<std::int64_t>() != 1) {
       return sim::Error{fmt::format("{}: unsupported version (expected 1)", where)};
     }
     Capture c;
@@ -175,6 +189,7 @@ sim::Expected<Capture> read_capture(const std::string& directory) {
       if (!jv["width"].is_number_integer() || !jv["height"].is_number_integer()) {
         return sim::Error{what + ": width and height must be integers"};
       }
+      if (sim::Status st = check_listed_file(jv["depth"], what + ": depth"); !st) return st.error();
       CaptureView view;
       view.file = jv.at("depth").get<std::string>();
       for (std::size_t u = 0; u < v; ++u) {  // one file under two poses would be a view missing, unnoticed
@@ -183,12 +198,13 @@ sim::Expected<Capture> read_capture(const std::string& directory) {
                                         view.file, u)};
         }
       }
-      view.camera.intrinsics.width = jv.at("width").get<int>();
-      view.camera.intrinsics.height = jv.at("height").get<int>();
-      if (view.camera.intrinsics.width < 8 || view.camera.intrinsics.height < 8 ||
-          view.camera.intrinsics.width > 8192 || view.camera.intrinsics.height > 8192) {
+      // Compared as 64-bit integers: get<int> would wrap 2^32 + 240 to 240.
+      const std::int64_t width = jv.at("width").get<std::int64_t>(), height = jv.at("height").get<std::int64_t>();
+      if (width < 8 || height < 8 || width > 8192 || height > 8192) {
         return sim::Error{what + ": width and height must be 8 .. 8192"};
       }
+      view.camera.intrinsics.width = static_cast<int>(width);
+      view.camera.intrinsics.height = static_cast<int>(height);
       auto K = matrix_from(jv.at("K"), 3, 3, what + ".K");
       if (!K) return K.error();
       if ((*K)(2, 0) != 0.0 || (*K)(2, 1) != 0.0 || (*K)(2, 2) != 1.0)
@@ -200,6 +216,24 @@ sim::Expected<Capture> read_capture(const std::string& directory) {
       if (std::abs(K->topLeftCorner(2, 2).determinant()) < 1e-9 * (*K)(0, 0) * (*K)(1, 1)) {
         return sim::Error{what +
                           ".K: singular (its upper left 2x2 has no inverse: check the skew K[0][1] and K[1][0])"};
+      }
+      // K in pixels of this image: the principal point on it, and each axis's field of view 5 .. 170 degrees (a K
+      // normalised by the image size or in metres saw nothing of the model, scored 0 mm and read "within the floors";
+      // a huge one overflowed the renderer's single precision).
+      const double cx = (*K)(0, 2), cy = (*K)(1, 2);
+      if (!(cx >= 0.0 && cx <= static_cast<double>(width) && cy >= 0.0 && cy <= static_cast<double>(height))) {
+        return sim::Error{fmt::format("{}.K: the principal point ({:g}, {:g}) is off the {}x{} image (K is in pixels)",
+                                      what, cx, cy, width, height)};
+      }
+      constexpr double kDegree = std::numbers::pi / 180.0;
+      const auto field_of_view = [](double pixels, double focal) { return 2.0 * std::atan(0.5 * pixels / focal); };
+      const double fov_x = field_of_view(static_cast<double>(width), (*K)(0, 0));
+      const double fov_y = field_of_view(static_cast<double>(height), (*K)(1, 1));
+      if (!(fov_x >= 5.0 * kDegree && fov_x <= 170.0 * kDegree && fov_y >= 5.0 * kDegree &&
+            fov_y <= 170.0 * kDegree)) {
+        return sim::Error{fmt::format("{}.K: fields of view {:.3g} x {:.3g} degrees; a depth camera's are 5 .. 170 "
+                                      "(K is in pixels)",
+                                      what, fov_x / kDegree, fov_y / kDegree)};
       }
       view.camera.intrinsics.K = *K;
       auto T = matrix_from(jv.at("world_to_camera"), 4, 4, what + ".world_to_camera");
@@ -221,6 +255,9 @@ sim::Expected<Capture> read_capture(const std::string& directory) {
                                       what, farthest, kFarthestDepth)};
       }
       view.camera.world_to_camera.matrix() = *T;
+      if (fs::exists(dir / view.file, ec) && !fs::is_regular_file(dir / view.file, ec)) {
+        return sim::Error{fmt::format("view {}: {} is not a regular file", v, (dir / view.file).string())};
+      }
       auto depth = read_depth_exr((dir / view.file).string());
       if (!depth) return sim::Error{fmt::format("view {}: {}", v, depth.error().message)};
       view.depth = std::move(*depth);
@@ -229,6 +266,7 @@ sim::Expected<Capture> read_capture(const std::string& directory) {
       c.views.push_back(std::move(view));
     }
     if (j.contains("scan") && !j["scan"].is_null()) {
+      if (sim::Status st = check_listed_file(j["scan"], where + ": scan"); !st) return st.error();
       const std::string scan = j["scan"].get<std::string>();
       if (!fs::is_regular_file(dir / scan, ec)) return sim::Error{fmt::format("{}: scan {} not found", where, scan)};
       c.scan_mesh = scan;

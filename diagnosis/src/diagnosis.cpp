@@ -282,14 +282,27 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
   }
   if (fit_start) {
     *guess = to_reduced(*fit_start);
-    for (std::size_t k = 0; k < guess->size(); ++k) (*guess)[k] = std::clamp((*guess)[k], lo[k], hi[k]);
     if (start_box > 1.0) {  // the box narrowed to the start's neighbourhood: reduced_box
       const auto [near_lo, near_hi] = reduced_box(*guess, start_box);
       for (std::size_t k = 0; k < guess->size(); ++k) {
         lo[k] = std::max(lo[k], near_lo[k]), hi[k] = std::min(hi[k], near_hi[k]);
+        // A bending known to that precision with no bending of the search range near it is in other units (SI
+        // moduli are 1e9 times smaller), not a fabric to fit: clamped, it started a fit 60 times too soft.
+        if (!(lo[k] <= hi[k])) {
+          static constexpr const char* kCoordinate[] = {"the mean alpha", "warp over weft", "the bias's alpha",
+                                                        "the softening -beta/alpha"};
+          return sim::Error{fmt::format(
+              "the {} ({}) lies beyond the fit's range even within its factor {:g}: {} is off (alpha in "
+              "g*mm^2/s^2 and beta in g*mm^3/s^2, the paper's units?)",
+              r.initial_guess_from == "measured bending" ? "capture's measured bending" : "given start",
+              fmt::format("alpha {:g},{:g},{:g}, beta {:g},{:g},{:g}", fit_start->alpha.warp, fit_start->alpha.bias,
+                          fit_start->alpha.weft, fit_start->beta.warp, fit_start->beta.bias, fit_start->beta.weft),
+              start_box, kCoordinate[k])};
+        }
       }
       r.search_within_factor = start_box;
     }
+    for (std::size_t k = 0; k < guess->size(); ++k) (*guess)[k] = std::clamp((*guess)[k], lo[k], hi[k]);
   } else {
     guess = initial_guess(model, std::max(1, settings.guess_levels));
     if (!guess) return guess.error();

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fmt/format.h>
+#include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
 
@@ -22,6 +23,8 @@
 namespace drapegen::diagnosis {
 namespace fs = std::filesystem;
 namespace {
+
+constexpr const char* kRealitySource = "drapegen reality";  // capture.json's "source"
 
 const std::map<std::string, double>& defaults() {
   static const std::map<std::string, double> d = {{"yield", 20.0}, {"shear", 1.0},     {"curl", 200.0},
@@ -203,6 +206,19 @@ sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std
   if (spec.placement < 0 || spec.placement > kMaxPlacement) {
     return sim::Error{fmt::format("placement must be 0 .. {}", kMaxPlacement)};
   }
+  // Only a capture this generator wrote is replaced: a real tester's in the same directory would be lost.
+  if (const fs::path listed = fs::path(directory) / "capture.json"; fs::exists(listed)) {
+    std::ifstream in(listed);
+    const nlohmann::json old = nlohmann::json::parse(in, nullptr, false);
+    const std::string source = old.is_object() && old.contains("source") && old["source"].is_string()
+                                   ? old["source"].get<std::string>()
+                                   : std::string();
+    if (source != kRealitySource) {
+      return sim::Error{fmt::format("{} holds a capture that drapegen reality did not write (source \"{}\"); it "
+                                    "replaces only its own: choose another --out",
+                                    directory, source)};
+    }
+  }
   auto made = make_placement(spec, spec.placement);
   if (!made) return made.error();
   Placement& p = *made;
@@ -245,7 +261,7 @@ sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std
   const renderer::NoiseModel noise = spec.noise ? renderer::NoiseModel::kinect() : renderer::NoiseModel::none();
 
   Capture capture;
-  capture.source = "drapegen reality";
+  capture.source = kRealitySource;
   capture.specimen.size_x = config.specimen.size_x;
   capture.specimen.size_y = config.specimen.size_y;
   capture.specimen.density = spec.density;

@@ -247,6 +247,71 @@ TEST(Capture, ACameraThatIsNoneIsAClearError) {
   EXPECT_TRUE(read_capture(dir).has_value());
 }
 
+// K in other units than pixels: normalised by the image size, or in metres, it saw nothing of the model, scored 0 mm
+// and read "within the floors"; a huge one crashed the renderer (single precision). The principal point must lie on
+// the image and each field of view be 5 .. 170 degrees.
+TEST(Capture, AnIntrinsicMatrixNotInPixelsIsAClearError) {
+  const std::string dir = fresh_dir("intrinsics");
+  ASSERT_TRUE(write_capture(dir, plane_capture()).ok());
+  const nlohmann::json good = nlohmann::json::parse(std::ifstream(fs::path(dir) / "capture.json"));
+  auto with = [&](const std::function<void(nlohmann::json&)>& edit) {
+    nlohmann::json j = good;
+    edit(j);
+    std::ofstream(fs::path(dir) / "capture.json") << j.dump();
+    return read_error(dir);
+  };
+  const double width = good["views"][0]["width"].get<double>(), height = good["views"][0]["height"].get<double>();
+  const std::string normalised = with([&](nlohmann::json& j) {
+    auto& K = j["views"][2]["K"];
+    K[0][0] = K[0][0].get<double>() / width, K[1][1] = K[1][1].get<double>() / height;
+    K[0][2] = K[0][2].get<double>() / width, K[1][2] = K[1][2].get<double>() / height;
+  });
+  EXPECT_NE(normalised.find("views[2].K: fields of view"), std::string::npos) << normalised;
+  EXPECT_NE(normalised.find("(K is in pixels)"), std::string::npos) << normalised;
+  const std::string huge = with([](nlohmann::json& j) { j["views"][2]["K"][0][0] = 1e39; });
+  EXPECT_NE(huge.find("views[2].K: fields of view"), std::string::npos) << huge;
+  const std::string off = with([](nlohmann::json& j) { j["views"][0]["K"][0][2] = -1e6; });
+  EXPECT_NE(off.find("views[0].K: the principal point (-1e+06, "), std::string::npos) << off;
+  EXPECT_NE(off.find("is off the 240x180 image"), std::string::npos) << off;
+  const std::string below = with([&](nlohmann::json& j) { j["views"][1]["K"][1][2] = height + 1.0; });
+  EXPECT_NE(below.find("views[1].K: the principal point"), std::string::npos) << below;
+  std::ofstream(fs::path(dir) / "capture.json") << good.dump();
+  EXPECT_TRUE(read_capture(dir).has_value());
+}
+
+// Integers beyond 32 bits wrapped (2^32 + 240 read as 240, 2^32 + 1 as version 1); a listed file must lie inside the
+// capture directory (an absolute path or ".." read another capture's view), and be a regular file.
+TEST(Capture, WrappedIntegersAndFilesOutsideTheCaptureAreClearErrors) {
+  const std::string dir = fresh_dir("outside");
+  ASSERT_TRUE(write_capture(dir, plane_capture()).ok());
+  const nlohmann::json good = nlohmann::json::parse(std::ifstream(fs::path(dir) / "capture.json"));
+  auto with = [&](const std::function<void(nlohmann::json&)>& edit) {
+    nlohmann::json j = good;
+    edit(j);
+    std::ofstream(fs::path(dir) / "capture.json") << j.dump();
+    return read_error(dir);
+  };
+  EXPECT_NE(with([](nlohmann::json& j) { j["version"] = 4294967297LL; }).find("unsupported version"),
+            std::string::npos);
+  const std::string wide = with([](nlohmann::json& j) { j["views"][1]["width"] = 4294967296LL + 240; });
+  EXPECT_NE(wide.find("views[1]: width and height must be 8 .. 8192"), std::string::npos) << wide;
+  const std::string absolute = with([&](nlohmann::json& j) { j["views"][3]["depth"] = dir + "/view3.exr"; });
+  EXPECT_NE(absolute.find("views[3]: depth " + dir + "/view3.exr must be a path inside the capture directory"),
+            std::string::npos)
+      << absolute;
+  const std::string up = with([](nlohmann::json& j) { j["views"][0]["depth"] = "../elsewhere/view0.exr"; });
+  EXPECT_NE(up.find("must be a path inside the capture directory"), std::string::npos) << up;
+  const std::string scan = with([](nlohmann::json& j) { j["scan"] = "/etc/passwd"; });
+  EXPECT_NE(scan.find("scan /etc/passwd must be a path inside the capture directory"), std::string::npos) << scan;
+  fs::create_directory(fs::path(dir) / "folder.exr");
+  const std::string folder = with([](nlohmann::json& j) { j["views"][1]["depth"] = "folder.exr"; });
+  EXPECT_NE(folder.find("view 1: " + (fs::path(dir) / "folder.exr").string() + " is not a regular file"),
+            std::string::npos)
+      << folder;
+  std::ofstream(fs::path(dir) / "capture.json") << good.dump();
+  EXPECT_TRUE(read_capture(dir).has_value());
+}
+
 TEST(Capture, NotAnExrAndBadJson) {
   const std::string dir = fresh_dir("garbage");
   ASSERT_TRUE(write_capture(dir, plane_capture()).ok());
