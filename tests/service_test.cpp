@@ -429,6 +429,13 @@ TEST(Service, ASecondCoordinatorOnALiveOutputIsRefused) {
   EXPECT_NE(after.err().find(manifest.string() + " exists already: continue it with drapegen run --resume"),
             std::string::npos)
       << after.err();
+  // With the manifest gone, its results are files no manifest lists: a new run is refused rather than mixed with them.
+  for (const char* suffix : {"", "-wal", "-shm", "-journal"}) fs::remove(manifest.string() + suffix);
+  Process orphaned({"run", "--config", (dir / "run.toml").string()}, (dir / "orphaned").string());
+  ASSERT_EQ(orphaned.wait(30s), 1) << orphaned.err();
+  EXPECT_NE(orphaned.err().find((out / "data").string() + " holds files that no manifest lists"), std::string::npos)
+      << orphaned.err();
+  EXPECT_FALSE(fs::exists(manifest));
 }
 
 // Sends `signal` to every child of `parent` (drapegen local's workers) every `every` until it exits, at most 60 s;

@@ -881,6 +881,16 @@ sim::Expected<std::unique_ptr<Coordinator>> Coordinator::create(const std::strin
     return sim::Error{fmt::format("{} exists already: continue it with drapegen {} --resume {}", impl->manifest_path,
                                   options.command, impl->manifest_path)};
   }
+  // Files no manifest lists (an earlier run's whose manifest is gone) would sit among this run's, some under the
+  // same names as its results and some not: a data set of two runs that the manifest does not show.
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(impl->data_dir, ec)) {
+    if (!entry.is_regular_file(ec)) continue;
+    return sim::Error{fmt::format("{} holds files that no manifest lists (an earlier run's?, {} among them): move "
+                                  "them away or choose another output",
+                                  impl->data_dir, entry.path().filename().string())};
+  }
+  if (ec) return io_error(sim::Error{fmt::format("cannot list {}: {}", impl->data_dir, ec.message())});
   // Bind before planning, so a taken port fails fast and leaves no manifest behind.
   if (sim::Status s = impl->bind(options.bind_override.empty() ? config->bind : options.bind_override, ""); !s) {
     return s.error();
