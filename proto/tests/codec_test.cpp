@@ -62,6 +62,33 @@ TEST(Codec, RejectsGarbageTruncationAndEmptyBodies) {
   EXPECT_FALSE(decode(encode(empty)));
 }
 
+// A job whose spec this build refuses still names its job and attempt, so a worker can answer it as an invalid job
+// instead of leaving its lease held until it expires; nothing else does (another version, no ids, another body).
+TEST(Codec, ARefusedJobStillNamesItsJobAndAttempt) {
+  v1::Envelope e = valid_job();
+  e.mutable_job()->set_attempt(3);
+  e.mutable_job()->mutable_spec()->set_resolution(2);
+  std::string frame = encode(e);
+  ASSERT_FALSE(decode(frame));
+  const auto refused = refused_job(frame.data(), frame.size());
+  ASSERT_TRUE(refused);
+  EXPECT_EQ(refused->first, 7u);
+  EXPECT_EQ(refused->second, 3u);
+  e.set_protocol_version(2);
+  e.SerializeToString(&frame);
+  EXPECT_FALSE(refused_job(frame.data(), frame.size()));
+  e = valid_job();
+  e.mutable_job()->set_job_id(0);
+  frame = encode(e);
+  EXPECT_FALSE(refused_job(frame.data(), frame.size()));
+  v1::Envelope heartbeat;
+  heartbeat.mutable_heartbeat()->set_interval_ms(kMaxHeartbeatMs + 1);
+  frame = encode(heartbeat);
+  EXPECT_FALSE(decode(frame));
+  EXPECT_FALSE(refused_job(frame.data(), frame.size()));
+  EXPECT_FALSE(refused_job("\xff\xff garbage", 10));
+}
+
 TEST(Codec, ChecksFieldRules) {
   v1::Envelope e = valid_job();
   e.mutable_job()->mutable_spec()->mutable_parameters()->set_alpha_bias(std::nan(""));

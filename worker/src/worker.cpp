@@ -224,6 +224,17 @@ sim::Expected<WorkerEnd> run_worker(const WorkerOptions& o, const std::atomic<bo
           auto decoded = proto::decode(frame.data(), frame.size());
           if (!decoded) {
             log->warn("dropped a message from the coordinator: {}", decoded.error().message);
+            // A job this build's checks refuse (a newer coordinator's setting, say) is answered as an invalid job:
+            // dropped, its lease held on until it expired (15 minutes by default) and the next one went the same way.
+            if (auto refused = proto::refused_job(frame.data(), frame.size()); refused && current_job == 0) {
+              v1::Envelope f;
+              f.mutable_failure()->set_job_id(refused->first);
+              f.mutable_failure()->set_attempt(refused->second);
+              f.mutable_failure()->set_reason(v1::FAILURE_REASON_INVALID_JOB);
+              f.mutable_failure()->set_message("the worker refused the job: " + decoded.error().message);
+              send(std::move(f));
+              last_send = Clock::now();
+            }
             continue;
           }
           last_recv = Clock::now();

@@ -4,8 +4,10 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 
 #include "drapegen/proto/worker.pb.h"
 #include "drapegen/sim/expected.hpp"
@@ -35,8 +37,13 @@ inline constexpr std::size_t kMaxReadyText = 256;
   return decode(frame.data(), frame.size());
 }
 
+/// For a frame decode() refuses: its job id and attempt if it is nonetheless a Job of this protocol version with both
+/// nonzero (a job whose spec this build's checks refuse, which a worker answers as an invalid job); nothing
+/// otherwise.
+[[nodiscard]] std::optional<std::pair<std::uint64_t, std::uint32_t>> refused_job(const void* data, std::size_t size);
+
 /// Field rules beyond the wire format: job ids > 0, attempts >= 1, a job spec with a known mode, a positive
-/// resolution and orientation count, finite parameters, a known failure reason, ...
+/// resolution and orientation count, finite parameters, ...
 [[nodiscard]] sim::Status check(const v1::Envelope& envelope);
 
 /// The bending model a JobSpec or Metrics names: an empty field (a message from before the field existed) means the
