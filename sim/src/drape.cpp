@@ -89,8 +89,17 @@ Expected<DrapeResult> simulate_drape(const DrapeConfig& config,
 
     const std::vector<int> on_top = contact.vertices_on_top(mesh.positions, 5e-4);
     if ((config.adhesion || config.effects.friction) && on_top.empty()) {
+      // A mesh whose spacing exceeds the top's radius can miss it wholly (a 2 m specimen at 60 vertices per side).
+      const double spacing = std::max(config.specimen.size_x / (config.specimen.vertices_x - 1),
+                                      config.specimen.size_y / (config.specimen.vertices_y - 1));
+      const std::string coarse =
+          spacing > 0.5 * config.platform.radius
+              ? fmt::format(", or the mesh's {:.0f} mm spacing too coarse for the top's {:.0f} mm radius: more "
+                            "vertices per side",
+                            spacing * 1e3, config.platform.radius * 1e3)
+              : std::string();
       return Error{"no vertex of the initial state rests on the platform top (drift too large, or the initial mesh "
-                   "is not on the platform)"};
+                   "is not on the platform" + coarse + ")"};
     }
     std::vector<bool> fixed(mesh.vertex_count(), false);
     std::unique_ptr<PlatformFriction> friction;

@@ -87,6 +87,20 @@ TEST(DrapePhysics, AWeightlessDrapeIsAnInputError) {
   }
 }
 
+// A mesh too coarse to put a vertex on the top says so (a 2 m specimen at 10 vertices per side: 222 mm apart, none
+// within the 50 mm radius); the message named only the drift and the initial mesh before.
+TEST(DrapePhysics, AMeshTooCoarseForThePlatformTopSaysSo) {
+  DrapeConfig c;
+  c.specimen.size_x = c.specimen.size_y = 2.0;
+  c.specimen.vertices_x = c.specimen.vertices_y = 10;
+  const Expected<DrapeResult> r = simulate_drape(c);
+  ASSERT_FALSE(r.has_value());
+  EXPECT_NE(r.error().message.find("the mesh's 222 mm spacing too coarse for the top's 50 mm radius: more vertices "
+                                   "per side"),
+            std::string::npos)
+      << r.error().message;
+}
+
 // Solver options a solve cannot run with are refused up front, each by name (a zero max_step crept at t = 0 into
 // "stalled"; a NaN tolerance never converged).
 TEST(DrapePhysics, SolverOptionsItCannotRunWithAreInputErrors) {
