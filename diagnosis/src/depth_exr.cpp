@@ -7,6 +7,7 @@
 #include <ImfOutputFile.h>
 #include <ImfStringAttribute.h>
 
+#include <cstdint>
 #include <filesystem>
 #include <fmt/format.h>
 #include <string_view>
@@ -63,9 +64,17 @@ sim::Expected<renderer::DepthImage> read_depth_exr(const std::string& path) {
       if (count != 1) return sim::Error{fmt::format("{}: no channel 'Z' (and not a single-channel file)", path)};
     }
     const Imath::Box2i display = h.displayWindow(), data = h.dataWindow();
-    const int W = display.max.x - display.min.x + 1, H = display.max.y - display.min.y + 1;
-    const int dw = data.max.x - data.min.x + 1, dh = data.max.y - data.min.y + 1;
-    if (W <= 0 || H <= 0 || W > 16384 || H > 16384) return sim::Error{fmt::format("{}: bad image size", path)};
+    // In 64 bits: a hostile header's windows can span more than an int.
+    const auto extent = [](int lo, int hi) { return static_cast<std::int64_t>(hi) - lo + 1; };
+    const std::int64_t W64 = extent(display.min.x, display.max.x), H64 = extent(display.min.y, display.max.y);
+    const std::int64_t dw64 = extent(data.min.x, data.max.x), dh64 = extent(data.min.y, data.max.y);
+    if (W64 <= 0 || H64 <= 0 || W64 > 16384 || H64 > 16384) return sim::Error{fmt::format("{}: bad image size", path)};
+    // The data window is read whole: one far larger than any image (30000^2 floats: 3.6 GB) is refused, not allocated.
+    if (dw64 <= 0 || dh64 <= 0 || dw64 > 16384 || dh64 > 16384) {
+      return sim::Error{fmt::format("{}: bad data window ({} x {} pixels)", path, dw64, dh64)};
+    }
+    const int W = static_cast<int>(W64), H = static_cast<int>(H64), dw = static_cast<int>(dw64),
+              dh = static_cast<int>(dh64);
     std::vector<float> buffer(static_cast<std::size_t>(dw) * dh, 0.0f);
     Imf::FrameBuffer fb;
     char* base = reinterpret_cast<char*>(buffer.data()) - (static_cast<std::ptrdiff_t>(data.min.y) * dw + data.min.x) *

@@ -1,10 +1,16 @@
 #include <gtest/gtest.h>
 
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfOutputFile.h>
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <limits>
+#include <vector>
 #include <nlohmann/json.hpp>
 
 #include "drapegen/diagnosis/capture.hpp"
@@ -319,6 +325,26 @@ TEST(Capture, NotAnExrAndBadJson) {
   EXPECT_NE(read_error(dir).find("not a readable OpenEXR"), std::string::npos);
   std::ofstream(fs::path(dir) / "capture.json") << "{ broken";
   EXPECT_NE(read_error(dir).find("malformed JSON"), std::string::npos);
+}
+
+// A depth file whose data window is far larger than any image is refused before it is allocated (a 30000 x 30000
+// window on a 240 x 180 display window asked for 3.6 GB); here 20000 x 1, written for real.
+TEST(Capture, AHugeDataWindowIsRefusedNotAllocated) {
+  const std::string dir = fresh_dir("data_window");
+  ASSERT_TRUE(write_capture(dir, plane_capture()).ok());
+  const std::string path = (fs::path(dir) / "view0.exr").string();
+  {
+    Imf::Header header(Imath::Box2i({0, 0}, {239, 179}), Imath::Box2i({-10000, 0}, {9999, 0}));
+    header.channels().insert("Z", Imf::Channel(Imf::FLOAT));
+    std::vector<float> row(20000, 0.6f);
+    Imf::FrameBuffer fb;
+    fb.insert("Z", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(row.data() + 10000), sizeof(float), 0));
+    Imf::OutputFile file(path.c_str(), header);
+    file.setFrameBuffer(fb);
+    file.writePixels(1);
+  }
+  const std::string error = read_error(dir);
+  EXPECT_NE(error.find("view 0: " + path + ": bad data window (20000 x 1 pixels)"), std::string::npos) << error;
 }
 
 TEST(Capture, NoSkirtIsAClearError) {
