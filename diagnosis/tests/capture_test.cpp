@@ -52,6 +52,13 @@ std::string read_error(const std::string& dir) {
   return r ? std::string() : r.error().message;
 }
 
+/// The reader's error on the capture in `dir` with its capture.json `good` edited by `edit`.
+std::string error_with(const std::string& dir, nlohmann::json good, const std::function<void(nlohmann::json&)>& edit) {
+  edit(good);
+  std::ofstream(fs::path(dir) / "capture.json") << good.dump();
+  return read_error(dir);
+}
+
 }  // namespace
 
 TEST(Capture, RoundTrip) {
@@ -159,12 +166,7 @@ TEST(Capture, NonIntegersAndAViewsMissingKeyAreClearErrors) {
   const std::string dir = fresh_dir("fields");
   ASSERT_TRUE(write_capture(dir, plane_capture()).ok());
   const nlohmann::json good = nlohmann::json::parse(std::ifstream(fs::path(dir) / "capture.json"));
-  auto with = [&](const std::function<void(nlohmann::json&)>& edit) {
-    nlohmann::json j = good;
-    edit(j);
-    std::ofstream(fs::path(dir) / "capture.json") << j.dump();
-    return read_error(dir);
-  };
+  const auto with = [&](const std::function<void(nlohmann::json&)>& edit) { return error_with(dir, good, edit); };
   EXPECT_NE(with([](nlohmann::json& j) { j["version"] = 1.5; }).find("unsupported version"), std::string::npos);
   const std::string width =
       with([](nlohmann::json& j) { j["views"][1]["width"] = j["views"][1]["width"].get<double>() + 0.7; });
@@ -260,12 +262,7 @@ TEST(Capture, AnIntrinsicMatrixNotInPixelsIsAClearError) {
   const std::string dir = fresh_dir("intrinsics");
   ASSERT_TRUE(write_capture(dir, plane_capture()).ok());
   const nlohmann::json good = nlohmann::json::parse(std::ifstream(fs::path(dir) / "capture.json"));
-  auto with = [&](const std::function<void(nlohmann::json&)>& edit) {
-    nlohmann::json j = good;
-    edit(j);
-    std::ofstream(fs::path(dir) / "capture.json") << j.dump();
-    return read_error(dir);
-  };
+  const auto with = [&](const std::function<void(nlohmann::json&)>& edit) { return error_with(dir, good, edit); };
   const double width = good["views"][0]["width"].get<double>(), height = good["views"][0]["height"].get<double>();
   const std::string normalised = with([&](nlohmann::json& j) {
     auto& K = j["views"][2]["K"];
@@ -291,12 +288,7 @@ TEST(Capture, WrappedIntegersAndFilesOutsideTheCaptureAreClearErrors) {
   const std::string dir = fresh_dir("outside");
   ASSERT_TRUE(write_capture(dir, plane_capture()).ok());
   const nlohmann::json good = nlohmann::json::parse(std::ifstream(fs::path(dir) / "capture.json"));
-  auto with = [&](const std::function<void(nlohmann::json&)>& edit) {
-    nlohmann::json j = good;
-    edit(j);
-    std::ofstream(fs::path(dir) / "capture.json") << j.dump();
-    return read_error(dir);
-  };
+  const auto with = [&](const std::function<void(nlohmann::json&)>& edit) { return error_with(dir, good, edit); };
   EXPECT_NE(with([](nlohmann::json& j) { j["version"] = 4294967297LL; }).find("unsupported version"),
             std::string::npos);
   const std::string wide = with([](nlohmann::json& j) { j["views"][1]["width"] = 4294967296LL + 240; });

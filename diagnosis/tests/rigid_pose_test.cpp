@@ -111,10 +111,10 @@ TEST(RigidPose, SidePixelsStartBelowWhereTheSpecimenReaches) {
   EXPECT_NEAR(s.side_below, 0.15 * std::sqrt(2.0) - 0.05 + 0.01, 1e-12);
 }
 
-/// The capture with the cloth on the platform top moved `dz` along the platform axis (each top pixel's depth moved
-/// along its ray), the rest as it was: a specimen lifted off the top (dz > 0), or a top seen lower than its contact.
-/// Top pixels are those the estimator reads the top from: within its first band of the top's height.
-Capture with_top_moved(Capture capture, const RigidSurfaces& s, double dz) {
+/// Calls f(z, q, dz_dheight) for every pixel of the cloth on the platform top: within the estimator's first band of
+/// the top's height (its depth z, writable; its point q in the specimen frame; how z changes per metre of height).
+template <typename F>
+void for_each_top_pixel(Capture& capture, const RigidSurfaces& s, F&& f) {
   for (auto& view : capture.views) {
     const Eigen::Isometry3d to_specimen = view.camera.world_to_camera.inverse();
     for (int y = 0; y < view.depth.height; ++y) {
@@ -123,35 +123,33 @@ Capture with_top_moved(Capture capture, const RigidSurfaces& s, double dz) {
         if (z <= 0.0f) continue;
         const Eigen::Vector3d ray = view.camera.ray(x, y);
         const Eigen::Vector3d q = to_specimen * (static_cast<double>(z) * ray);
-        if (std::hypot(q.x(), q.y()) >= s.cylinder_radius - s.top_inset || std::abs(q.z() - s.top_height) > RigidPoseSettings{}.first_band)
+        if (std::hypot(q.x(), q.y()) >= s.cylinder_radius - s.top_inset ||
+            std::abs(q.z() - s.top_height) > RigidPoseSettings{}.first_band)
           continue;
-        z += static_cast<float>(dz / (to_specimen.linear() * ray).z());
+        f(z, q, 1.0 / (to_specimen.linear() * ray).z());
       }
     }
   }
+}
+
+/// The capture with the cloth on the platform top moved `dz` along the platform axis (each top pixel's depth moved
+/// along its ray), the rest as it was: a specimen lifted off the top (dz > 0), or a top seen lower than its contact.
+Capture with_top_moved(Capture capture, const RigidSurfaces& s, double dz) {
+  for_each_top_pixel(capture, s, [dz](float& z, const Eigen::Vector3d&, double dz_dheight) {
+    z += static_cast<float>(dz * dz_dheight);
+  });
   return capture;
 }
 
 /// m: the mean height above the top's contact offset of the pixels `with_top_moved` moves (what the recorded capture
 /// reads as its top: the cloth's own offset, sensor noise and sag near the rim included).
-double top_offset(const Capture& capture, const RigidSurfaces& s) {
+double top_offset(Capture capture, const RigidSurfaces& s) {
   double sum = 0.0;
   int count = 0;
-  for (const auto& view : capture.views) {
-    const Eigen::Isometry3d to_specimen = view.camera.world_to_camera.inverse();
-    for (int y = 0; y < view.depth.height; ++y) {
-      for (int x = 0; x < view.depth.width; ++x) {
-        const float z = view.depth.depth[static_cast<std::size_t>(y) * view.depth.width + x];
-        if (z <= 0.0f) continue;
-        const Eigen::Vector3d q = to_specimen * (static_cast<double>(z) * view.camera.ray(x, y));
-        if (std::hypot(q.x(), q.y()) >= s.cylinder_radius - s.top_inset ||
-            std::abs(q.z() - s.top_height) > RigidPoseSettings{}.first_band)
-          continue;
-        sum += q.z() - s.top_height;
-        ++count;
-      }
-    }
-  }
+  for_each_top_pixel(capture, s, [&](float&, const Eigen::Vector3d& q, double) {
+    sum += q.z() - s.top_height;
+    ++count;
+  });
   return count > 0 ? sum / count : 0.0;
 }
 

@@ -85,7 +85,9 @@ sim::Expected<v1::Envelope> decode(const void* data, std::size_t size) {
 std::optional<std::pair<std::uint64_t, std::uint32_t>> refused_job(const void* data, std::size_t size) {
   v1::Envelope envelope;
   if (size > kMaxFrameBytes || !envelope.ParseFromArray(data, static_cast<int>(size))) return std::nullopt;
-  if (envelope.protocol_version() != kProtocolVersion || envelope.body_case() != v1::Envelope::kJob) return std::nullopt;
+  if (envelope.protocol_version() != kProtocolVersion || envelope.body_case() != v1::Envelope::kJob) {
+    return std::nullopt;
+  }
   if (envelope.job().job_id() == 0 || envelope.job().attempt() == 0) return std::nullopt;
   return std::pair{envelope.job().job_id(), envelope.job().attempt()};
 }
