@@ -96,10 +96,16 @@ class WorkerPool {
     std::vector<char*> argv;
     for (auto& a : args) argv.push_back(a.data());
     argv.push_back(nullptr);
+    // The worker starts with SIGINT/SIGTERM unblocked (this process blocks them for its signal thread).
+    posix_spawnattr_t attributes;
+    posix_spawnattr_init(&attributes);
+    const sigset_t mask = child_signal_mask();
+    posix_spawnattr_setsigmask(&attributes, &mask);
+    posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSIGMASK);
     pid_t pid = 0;
-    if (const int rc = ::posix_spawn(&pid, self.c_str(), nullptr, nullptr, argv.data(), environ); rc != 0) {
-      return sim::Error{fmt::format("cannot start a worker: {}", std::strerror(rc))};
-    }
+    const int rc = ::posix_spawn(&pid, self.c_str(), nullptr, &attributes, argv.data(), environ);
+    posix_spawnattr_destroy(&attributes);
+    if (rc != 0) return sim::Error{fmt::format("cannot start a worker: {}", std::strerror(rc))};
     return pid;
   }
 

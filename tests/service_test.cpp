@@ -106,6 +106,55 @@ TEST(Service, SurvivesWorkerKills) {
   EXPECT_GE(lost, 1);
 }
 
+// A scheduler's preemption (SIGTERM to a worker) is no fault of the job's: the stopped worker says which job it
+// leaves, and the job is re-queued without costing an attempt. With one attempt per job, every job is done and no
+// failure is recorded (before: each preempted lease was a failed attempt, worker_lost, and here a failed job).
+TEST(Service, AWorkerStoppedBySigtermCostsItsJobNoAttempt) {
+  const fs::path dir = test_dir("worker_sigterm");
+  const fs::path out = dir / "run";
+  write_text(dir / "run.toml", small_config(out, 16, 2, "[retry]\nmax_attempts = 1\n"));
+  auto [coordinator, endpoint] = start_coordinator({"--config", (dir / "run.toml").string()}, out, dir / "coordinator");
+  ASSERT_FALSE(endpoint.empty()) << coordinator.err();
+  std::mt19937 rng(7);
+  std::vector<Process> workers;
+  int next = 0;
+  for (; next < 2; ++next) workers.push_back(start_worker(endpoint, dir, next));
+  int stopped = 0;
+  const auto deadline = std::chrono::steady_clock::now() + 150s;
+  while (coordinator.running() && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(150 + rng() % 250));
+    if (stopped < 8 && coordinator.running()) {
+      auto& victim = workers[rng() % workers.size()];
+      ::kill(victim.pid(), SIGTERM);
+      const int code = victim.wait(30s);
+      // 4: stopped; 0 only if the run ended (told so) just before the signal.
+      EXPECT_TRUE(code == 4 || (code == 0 && coordinator.wait(30s) == 0)) << code << ": " << victim.err();
+      ++stopped;
+      victim = start_worker(endpoint, dir, next++);
+    }
+  }
+  ASSERT_EQ(coordinator.wait(60s), 0) << coordinator.err();
+  EXPECT_GE(stopped, 3);
+  check_manifest(out / "manifest.sqlite", 2);
+  auto reader = storage::ManifestReader::open((out / "manifest.sqlite").string());
+  ASSERT_TRUE(reader);
+  int done = 0;
+  for (const auto& j : all(reader->jobs())) done += j.state == storage::JobState::kDone;
+  EXPECT_EQ(done, 32);
+  for (const auto& f : all(reader->failures())) {
+    ADD_FAILURE() << "job " << f.job_id << ": " << f.reason << ": " << f.message;
+  }
+  // The path was taken: stopped workers held leases.
+  const std::string log = coordinator.err();
+  int requeued = 0;
+  for (auto at = log.find("the attempt is not counted"); at != std::string::npos;
+       at = log.find("the attempt is not counted", at + 1)) {
+    ++requeued;
+  }
+  std::printf("[ info ] %d workers stopped, %d leases given back\n", stopped, requeued);
+  EXPECT_GE(requeued, 1);
+}
+
 struct RunSnapshot {
   std::vector<std::string> jobs;     // id, sample, slot, recipe, render seed, mode, state
   std::vector<std::string> samples;  // every parameter, exactly

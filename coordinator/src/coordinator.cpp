@@ -376,6 +376,10 @@ struct Coordinator::Impl {
         return on_result(w, e.result());
       case v1::Envelope::kFailure:
         return on_failure(w, e.failure());
+      case v1::Envelope::kLeave:
+        on_leave(w, e.leave());
+        workers.erase(it);
+        return;
       default:
         return reject(identity, fmt::format("unexpected {} from a worker", proto::body_name(e)));
     }
@@ -514,6 +518,23 @@ struct Coordinator::Impl {
     if (!slot) return;
     w.job = 0;
     record_failed_attempt(*slot, f.reason(), f.message(), w.name);
+  }
+
+  /// A worker stopped by a signal (a scheduler's preemption, say): the job it held was not finished through any fault
+  /// of the job's, so it is re-queued and its attempt not counted (nothing of it is recorded).
+  void on_leave(Worker& w, const v1::Leave& leave) {
+    log->info("worker {} left ({}; {} connected)", w.name, leave.reason().empty() ? "stopped" : leave.reason(),
+              workers.size() - 1);
+    // The Leave may name no job when the Job sent to it crossed it on the way: that attempt never started either.
+    if (w.job == 0) return;
+    JobSlot& slot = jobs[static_cast<std::size_t>(w.job - 1)];
+    w.job = 0;
+    slot.leased = false;
+    slot.worker.clear();
+    --slot.attempts;
+    ready.insert(slot.rec.id);
+    log->info("job {} (sample {} slot {}) re-queued; the attempt is not counted", slot.rec.id, slot.rec.sample,
+              slot.rec.slot);
   }
 
   /// Records a failed attempt; re-queues the job or, at the retry limit, fails it.

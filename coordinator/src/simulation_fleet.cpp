@@ -204,6 +204,18 @@ struct SimulationFleet::Impl {
         task->answer.set_value(sim::Error{fmt::format("worker {}: {}", w.name, e.failure().message())});
         return;
       }
+      case v1::Envelope::kLeave: {
+        // Stopped by a signal: its drape goes to the next worker, the attempt not counted.
+        log->info("fleet: worker {} left ({})", w.name, e.leave().reason().empty() ? "stopped" : e.leave().reason());
+        if (w.task) {
+          std::lock_guard lock(mutex);
+          --w.task->attempts;
+          queue.push_front(std::move(w.task));
+        }
+        workers.erase(it);
+        update_worker_count();
+        return;
+      }
       default:
         return reject(identity, fmt::format("unexpected {} from a worker", proto::body_name(e)));
     }

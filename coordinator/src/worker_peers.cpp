@@ -27,7 +27,8 @@ void warn_if_unlike(spdlog::logger& log, const std::string& worker, const v1::Re
 }
 
 std::optional<v1::Envelope> answer_to_stranger(const v1::Envelope& message) {
-  if (message.body_case() == v1::Envelope::kDisconnect || message.body_case() == v1::Envelope::kShutdown) {
+  if (message.body_case() == v1::Envelope::kDisconnect || message.body_case() == v1::Envelope::kShutdown ||
+      message.body_case() == v1::Envelope::kLeave) {
     return std::nullopt;
   }
   v1::Envelope d;

@@ -18,8 +18,8 @@ namespace drapegen::coordinator {
 void warn_if_unlike(spdlog::logger& log, const std::string& worker, const proto::v1::Ready& ready,
                     std::string_view self, const std::string& own_kernels, std::string_view others);
 
-/// The answer to a message from a peer that has not registered: Disconnect ("send ready"), except to a Disconnect or
-/// a Shutdown (none).
+/// The answer to a message from a peer that has not registered: Disconnect ("send ready"), except to a Disconnect, a
+/// Shutdown or a Leave (none).
 [[nodiscard]] std::optional<proto::v1::Envelope> answer_to_stranger(const proto::v1::Envelope& message);
 
 }  // namespace drapegen::coordinator

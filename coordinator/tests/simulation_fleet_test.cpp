@@ -171,6 +171,52 @@ TEST(SimulationFleet, GivesALostWorkersDrapeToTheNextAndFailsItAfterMaxAttempts)
   EXPECT_NE(lost.error().message.find("lost with 1 workers"), std::string::npos) << lost.error().message;
 }
 
+/// A worker that registers, takes one job and leaves, naming it (a worker stopped by SIGTERM).
+void take_a_job_and_leave(const std::string& endpoint, std::atomic<bool>& took) {
+  zmq::context_t context{1};
+  zmq::socket_t socket(context, zmq::socket_type::dealer);
+  socket.set(zmq::sockopt::linger, 1000);
+  socket.connect(endpoint);
+  v1::Envelope ready;
+  ready.mutable_ready()->set_worker_name("leaving");
+  ready.mutable_ready()->set_interval_ms(50);
+  socket.send(zmq::buffer(proto::encode(ready)));
+  zmq::message_t message;
+  while (socket.recv(message)) {
+    auto e = proto::decode(message.data(), message.size());
+    if (!e || e->body_case() != v1::Envelope::kJob) continue;
+    v1::Envelope leave;
+    leave.mutable_leave()->set_job_id(e->job().job_id());
+    leave.mutable_leave()->set_attempt(e->job().attempt());
+    socket.send(zmq::buffer(proto::encode(leave)));
+    break;
+  }
+  took = true;
+}
+
+// With one attempt per drape, a worker that leaves mid-drape (stopped) costs it nothing: the next worker computes it.
+TEST(SimulationFleet, GivesALeavingWorkersDrapeToTheNextWithoutCountingTheAttempt) {
+  FleetOptions once = fast_options();
+  once.max_attempts = 1;
+  auto fleet = SimulationFleet::start(once);
+  ASSERT_TRUE(fleet);
+  const std::string endpoint = (*fleet)->endpoint();
+  std::atomic<bool> took{false};
+  std::thread leaving([&] { take_a_job_and_leave(endpoint, took); });
+  ASSERT_EQ((*fleet)->wait_for_workers(1, 20.0), 1);
+  std::optional<Workers> real;
+  std::thread starter([&] {
+    while (!took) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    real.emplace(endpoint, 1);  // only after the leaving worker held the drape
+  });
+  auto drape = (*fleet)->simulate(small_drape(4));
+  starter.join();
+  leaving.join();
+  ASSERT_TRUE(drape) << drape.error().message;
+  EXPECT_EQ(drape->mesh.positions, sim::simulate_drape(small_drape(4))->mesh.positions);
+  EXPECT_EQ((*fleet)->counters().lost_attempts, 0);
+}
+
 /// A worker that registers, takes one job, and heartbeats on as if it had none (a build that cannot read the job).
 void take_a_job_and_ignore_it(const std::string& endpoint, std::atomic<bool>& took, const std::atomic<bool>& stop) {
   zmq::context_t context{1};

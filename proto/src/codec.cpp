@@ -119,6 +119,11 @@ sim::Status check(const v1::Envelope& e) {
       // Any reason passes, none or one newer than this build included: dropping the failure would leave its job
       // leased until the lease expires (the coordinator records it as "unspecified", with its number).
       return {};
+    case v1::Envelope::kLeave:
+      // Both or neither: a job is named by its id and attempt.
+      if ((e.leave().job_id() == 0) != (e.leave().attempt() == 0)) return sim::Error{"leave: job id without attempt"};
+      if (e.leave().reason().size() > kMaxReadyText) return sim::Error{"leave: reason too long"};
+      return {};
     case v1::Envelope::kDisconnect:
     case v1::Envelope::kShutdown:
       return {};
@@ -139,6 +144,7 @@ const char* body_name(const v1::Envelope& e) {
     case v1::Envelope::kFailure: return "failure";
     case v1::Envelope::kDisconnect: return "disconnect";
     case v1::Envelope::kShutdown: return "shutdown";
+    case v1::Envelope::kLeave: return "leave";
     case v1::Envelope::BODY_NOT_SET: break;
   }
   return "none";

@@ -127,6 +127,17 @@ TEST(Codec, ChecksFieldRules) {
   f.mutable_failure()->set_reason(v1::FAILURE_REASON_DIVERGED);
   EXPECT_TRUE(decode(encode(f)));
   EXPECT_STREQ(reason_name(v1::FAILURE_REASON_DIVERGED), "diverged");
+  // A Leave names a job by id and attempt, or none; its reason is bounded like a Ready's text.
+  v1::Envelope l;
+  l.mutable_leave()->set_reason("stopped");
+  EXPECT_TRUE(decode(encode(l)));
+  EXPECT_STREQ(body_name(l), "leave");
+  l.mutable_leave()->set_job_id(3);
+  EXPECT_FALSE(decode(encode(l)));
+  l.mutable_leave()->set_attempt(2);
+  EXPECT_TRUE(decode(encode(l)));
+  l.mutable_leave()->set_reason(std::string(kMaxReadyText + 1, 'x'));
+  EXPECT_FALSE(decode(encode(l)));
   // Heartbeat intervals and liveness within what `drapegen worker` accepts (beyond, they overflow int timers).
   v1::Envelope h;
   h.mutable_heartbeat()->set_interval_ms(kMaxHeartbeatMs);

@@ -31,8 +31,9 @@ enum class WorkerEnd {
 };
 
 /// Runs until the coordinator sends Shutdown, `stop` becomes true, or give_up_s passes without a coordinator (an
-/// error). A job still computing when the worker returns is abandoned (the coordinator re-queues it); callers should
-/// exit the process promptly (the computing thread cannot be interrupted).
+/// error). On `stop` it tells the coordinator it leaves (Leave), naming the job it holds, which is re-queued without
+/// costing an attempt. A job still computing when the worker returns is abandoned; callers should exit the process
+/// promptly (the computing thread cannot be interrupted).
 [[nodiscard]] sim::Expected<WorkerEnd> run_worker(const WorkerOptions& options, const std::atomic<bool>& stop);
 
 }  // namespace drapegen::worker

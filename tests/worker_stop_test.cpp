@@ -1,0 +1,84 @@
+// A worker process stopped by SIGTERM mid-job (a scheduler's preemption), against a stand-in coordinator (a ROUTER
+// socket on 127.0.0.1): it leaves, naming the job it held, and exits with 4. Before, it said nothing (the coordinator
+// found it lost by its silence and counted the attempt as failed), and a SIGTERM that came while METIS ordered the
+// Hessian ran METIS's own handler on the wrong thread and crashed the worker (SIGSEGV).
+#include <optional>
+#include <vector>
+#include <zmq.hpp>
+#include <zmq_addon.hpp>
+
+#include "drapegen/coordinator/job_message.hpp"
+#include "drapegen/coordinator/planner.hpp"
+#include "drapegen/coordinator/run_config.hpp"
+#include "drapegen/proto/codec.hpp"
+#include "service_harness.hpp"
+
+namespace drapegen::test {
+namespace {
+namespace v1 = proto::v1;
+
+/// The next message from a worker within `timeout`: its routing id and envelope.
+std::optional<std::pair<std::string, v1::Envelope>> receive(zmq::socket_t& router, std::chrono::milliseconds timeout) {
+  const auto until = std::chrono::steady_clock::now() + timeout;
+  while (std::chrono::steady_clock::now() < until) {
+    zmq::pollitem_t item{router.handle(), 0, ZMQ_POLLIN, 0};
+    zmq::poll(&item, 1, 50ms);
+    if (!(item.revents & ZMQ_POLLIN)) continue;
+    std::vector<zmq::message_t> frames;
+    if (!zmq::recv_multipart(router, std::back_inserter(frames)) || frames.size() != 2) continue;
+    auto decoded = proto::decode(frames[1].data(), frames[1].size());
+    if (decoded) return std::pair{frames[0].to_string(), std::move(*decoded)};
+  }
+  return std::nullopt;
+}
+
+TEST(WorkerProcess, StoppedMidJobItSaysWhichJobItLeaves) {
+  const fs::path dir = test_dir("worker_stop");
+  auto config = coordinator::parse_run_config("samples = 1\nresolution = 61\norientations = 1", "run.toml");
+  ASSERT_TRUE(config) << config.error().message;
+  auto plan = coordinator::plan_run(*config);
+  ASSERT_TRUE(plan) << plan.error().message;
+  auto message = coordinator::make_job_message(*config, plan->samples.front(), plan->jobs.front(), 3, "");
+  ASSERT_TRUE(message) << message.error().message;
+  message->set_job_id(7);
+
+  zmq::context_t context;
+  zmq::socket_t router(context, zmq::socket_type::router);
+  router.set(zmq::sockopt::linger, 0);
+  router.bind("tcp://127.0.0.1:*");
+  Process worker = start_worker(router.get(zmq::sockopt::last_endpoint), dir, 0);
+  auto ready = receive(router, 30s);
+  ASSERT_TRUE(ready) << worker.err();
+  ASSERT_EQ(ready->second.body_case(), v1::Envelope::kReady);
+  v1::Envelope job;
+  *job.mutable_job() = *message;
+  const std::string frame = proto::encode(job);
+  router.send(zmq::buffer(ready->first), zmq::send_flags::sndmore);
+  router.send(zmq::buffer(frame), zmq::send_flags::none);
+
+  // Computing: its heartbeat names the job (a 61x61 drape takes seconds).
+  bool computing = false;
+  const auto until = std::chrono::steady_clock::now() + 20s;
+  while (!computing && std::chrono::steady_clock::now() < until) {
+    auto m = receive(router, 1s);
+    ASSERT_FALSE(m && (m->second.body_case() == v1::Envelope::kResult ||
+                       m->second.body_case() == v1::Envelope::kFailure))
+        << "the job ended before the test could stop it";
+    computing = m && m->second.body_case() == v1::Envelope::kHeartbeat && m->second.heartbeat().job_id() == 7;
+  }
+  ASSERT_TRUE(computing) << worker.err();
+  ::kill(worker.pid(), SIGTERM);
+  std::optional<v1::Leave> leave;
+  const auto leave_until = std::chrono::steady_clock::now() + 10s;
+  while (!leave && std::chrono::steady_clock::now() < leave_until) {
+    auto m = receive(router, 1s);
+    if (m && m->second.body_case() == v1::Envelope::kLeave) leave = m->second.leave();
+  }
+  ASSERT_TRUE(leave) << "the stopped worker left without a word: " << worker.err();
+  EXPECT_EQ(leave->job_id(), 7u);
+  EXPECT_EQ(leave->attempt(), 3u);
+  EXPECT_EQ(worker.wait(10s), 4) << worker.err();
+}
+
+}  // namespace
+}  // namespace drapegen::test
