@@ -36,6 +36,7 @@ struct LocalOptions {
   std::string resume;
   std::string output;
   bool print_config = false;
+  bool retry_failed = false;
 };
 
 const Failure fail{"local"};
@@ -55,10 +56,24 @@ class WorkerPool {
   /// The pool halted the run: no worker was left (every one died with the restarts spent, or stopped).
   [[nodiscard]] bool exhausted() const { return exhausted_; }
 
+  WorkerPool(const WorkerPool&) = delete;
+  WorkerPool& operator=(const WorkerPool&) = delete;
+  /// Workers still running (a later one failed to start, or the pool was never finished) are stopped and reaped.
+  ~WorkerPool() {
+    finishing_ = true;
+    if (supervisor_.joinable()) supervisor_.join();
+    for (pid_t& pid : pids_) {
+      if (pid <= 0) continue;
+      ::kill(pid, SIGTERM);
+      ::waitpid(pid, nullptr, 0);
+      pid = -1;
+    }
+  }
+
   sim::Status start() {
     for (int k = 0; k < count_; ++k) {
       auto pid = spawn(k);
-      if (!pid) return pid.error();
+      if (!pid) return pid.error();  // the ones started are stopped when the pool goes
       pids_.push_back(*pid);
     }
     supervisor_ = std::thread([this] { supervise(); });
@@ -192,6 +207,10 @@ Runner add_local_command(CLI::App& app) {
   auto* config = app.add_option("--config", o->config, "Run configuration (TOML); default: the embedded small run");
   auto* resume = app.add_option("--resume", o->resume, "Continue the run of this manifest instead");
   config->excludes(resume);
+  app.add_flag("--retry-failed", o->retry_failed,
+               "With --resume: failed jobs are pending again, each with retry.max_attempts more attempts (their "
+               "failures stay recorded)")
+      ->needs(resume);
   app.add_option("--output", o->output, "Override the configuration's output directory (a new run only)")
       ->excludes(resume);
   app.add_flag("--print-config", o->print_config, "Print the embedded default configuration and exit");
@@ -205,6 +224,7 @@ Runner add_local_command(CLI::App& app) {
     options.bind_override = "tcp://127.0.0.1:*";  // local workers only; any free port
     options.command = "local";
     options.keyless_workers = true;
+    options.retry_failed = o->retry_failed;
     sim::Expected<std::unique_ptr<coordinator::Coordinator>> c = sim::Error{""};
     if (!o->resume.empty()) {
       c = coordinator::Coordinator::resume(o->resume, options);
@@ -227,7 +247,10 @@ Runner add_local_command(CLI::App& app) {
     }
     if (!c) return fail(c.error());
     WorkerPool pool((*c)->endpoint(), o->workers, stop);
-    if (sim::Status s = pool.start(); !s) return fail(s.error().message);
+    if (sim::Status s = pool.start(); !s) {
+      return fail(fmt::format("{} (the run is planned; continue it with drapegen local --resume {})",
+                              s.error().message, (*c)->manifest_path()));
+    }
     const auto summary = (*c)->run(pool.halt());
     pool.finish();
     if (pool.exhausted() && summary.outcome == coordinator::RunOutcome::kStopped) {

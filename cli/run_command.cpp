@@ -21,6 +21,7 @@ struct RunOptions {
   std::string server_key;
   std::string authorized_keys;
   std::string endpoint_file;
+  bool retry_failed = false;
 };
 
 const Failure fail{"run"};
@@ -60,6 +61,10 @@ Runner add_run_command(CLI::App& app) {
   auto* config = app.add_option("--config", o->config, "Run configuration (TOML; keys in docs/SERVICE.md)");
   auto* resume = app.add_option("--resume", o->resume, "Continue the run of this manifest (OUTPUT/manifest.sqlite)");
   config->excludes(resume);
+  app.add_flag("--retry-failed", o->retry_failed,
+               "With --resume: failed jobs are pending again, each with retry.max_attempts more attempts (their "
+               "failures stay recorded)")
+      ->needs(resume);
   app.add_option("--bind", o->bind, "Bind this endpoint instead of the configured/recorded one, e.g. tcp://127.0.0.1:*")
       ->check(kEndpoint);
   app.add_option("--progress", o->progress,
@@ -79,6 +84,7 @@ Runner add_run_command(CLI::App& app) {
     options.server_secret_key = o->server_key;
     options.authorized_keys = o->authorized_keys;
     options.endpoint_file = o->endpoint_file;
+    options.retry_failed = o->retry_failed;
     sim::Expected<std::unique_ptr<coordinator::Coordinator>> c = sim::Error{""};
     if (!o->config.empty()) {
       auto text = storage::read_file(o->config);

@@ -493,5 +493,55 @@ TEST(Service, AWorkerOfAnotherVersionOrOtherBlasKernelsIsWarnedAbout) {
       << coordinator.err();
 }
 
+// Jobs that failed for a cause outside them (here a broken worker: every attempt of one attempt each fails) are
+// retried by `--resume --retry-failed` with retry.max_attempts more attempts each: they complete on a healthy worker,
+// their failures stay recorded and their attempt numbers go on. Without --resume the flag is refused.
+TEST(Service, RetryFailedGivesFailedJobsMoreAttemptsOnResume) {
+  const fs::path dir = test_dir("retry_failed");
+  const fs::path out = dir / "run";
+  const fs::path manifest = out / "manifest.sqlite";
+  write_text(dir / "run.toml", small_config(out, 3, 1, "[retry]\nmax_attempts = 1\n"));
+  Process refused({"run", "--config", (dir / "run.toml").string(), "--retry-failed"}, (dir / "refused").string());
+  EXPECT_NE(refused.wait(30s), 0);
+  EXPECT_NE(refused.err().find("--retry-failed requires --resume"), std::string::npos) << refused.err();
+  EXPECT_FALSE(fs::exists(manifest));
+
+  auto [coordinator, endpoint] = start_coordinator({"--config", (dir / "run.toml").string()}, out, dir / "first");
+  ASSERT_FALSE(endpoint.empty()) << coordinator.err();
+  zmq::context_t context;
+  FakeWorker broken(context, endpoint);
+  broken.send(ready("broken"));
+  for (int k = 0; k < 3; ++k) {
+    auto job = broken.expect(v1::Envelope::kJob, 30s);
+    ASSERT_TRUE(job) << coordinator.err();
+    broken.send(failure(job->job().job_id(), job->job().attempt()));
+  }
+  ASSERT_EQ(coordinator.wait(30s), 0) << coordinator.err();  // complete: every job failed
+  {
+    auto reader = storage::ManifestReader::open(manifest.string());
+    ASSERT_TRUE(reader);
+    for (const auto& j : all(reader->jobs())) EXPECT_EQ(j.state, storage::JobState::kFailed) << j.id;
+  }
+
+  auto [resumed, resumed_endpoint] =
+      start_coordinator({"--resume", manifest.string(), "--retry-failed"}, out, dir / "resumed");
+  ASSERT_FALSE(resumed_endpoint.empty()) << resumed.err();
+  Process worker = start_worker(resumed_endpoint, dir, 1);
+  ASSERT_EQ(resumed.wait(120s), 0) << resumed.err();
+  EXPECT_NE(resumed.err().find("3 failed job(s) pending again, 1 more attempt(s) each"), std::string::npos)
+      << resumed.err();
+  check_manifest(manifest, 2);
+  auto reader = storage::ManifestReader::open(manifest.string());
+  ASSERT_TRUE(reader);
+  for (const auto& j : all(reader->jobs())) {
+    EXPECT_EQ(j.state, storage::JobState::kDone) << j.id;
+    EXPECT_EQ(j.attempts, 2) << j.id;
+    EXPECT_EQ(j.failure_reason, "") << j.id;
+  }
+  const auto failures = all(reader->failures());
+  ASSERT_EQ(failures.size(), 3u);
+  for (const auto& f : failures) EXPECT_EQ(f.attempt, 1) << f.job_id;
+}
+
 }  // namespace
 }  // namespace drapegen::test

@@ -65,6 +65,7 @@ struct Coordinator::Impl {
   struct JobSlot {
     storage::JobRecord rec;
     int attempts = 0;  // attempts started, this session included
+    int attempt_limit = 0;  // the job fails at this many attempts (retry.max_attempts; more for a retried job)
     bool leased = false;
     std::string worker;  // routing id of the lease
     double lease_started = 0.0;
@@ -215,6 +216,7 @@ struct Coordinator::Impl {
       if (rec.id != static_cast<std::int64_t>(jobs.size()) + 1) return sim::Error{"manifest: job ids not contiguous"};
       JobSlot slot;
       slot.attempts = rec.attempts;
+      slot.attempt_limit = config.max_attempts;
       slot.rec = std::move(rec);
       jobs.push_back(std::move(slot));
     }
@@ -225,6 +227,18 @@ struct Coordinator::Impl {
       }
     }
     if (sim::Status st = manifest->begin(); !st) return st;
+    if (options.retry_failed) {
+      // Each failed job gets retry.max_attempts more; its failures stay recorded, its attempt numbers go on.
+      auto retried = manifest->retry_failed();
+      if (!retried) return retried.error();
+      for (auto& slot : jobs) {
+        if (slot.rec.state != storage::JobState::kFailed) continue;
+        slot.rec.state = storage::JobState::kPending;
+        slot.rec.failure_reason.clear();
+        slot.attempt_limit = slot.attempts + config.max_attempts;
+      }
+      log->info("{} failed job(s) pending again, {} more attempt(s) each", *retried, config.max_attempts);
+    }
     for (auto& slot : jobs) {
       if (slot.rec.state == storage::JobState::kDone) ++done;
       if (slot.rec.state == storage::JobState::kFailed) ++failed;
@@ -543,7 +557,7 @@ struct Coordinator::Impl {
     slot.leased = false;
     if (!slot.worker.empty()) slot.failed_on.push_back(slot.worker);
     slot.worker.clear();
-    const bool final = slot.attempts >= config.max_attempts;
+    const bool final = slot.attempts >= slot.attempt_limit;
     storage::JobRecord rec = slot.rec;
     rec.attempts = slot.attempts;
     rec.worker = worker_name;
@@ -886,6 +900,7 @@ void setup_progress(Coordinator::Impl& impl) {
 sim::Expected<std::unique_ptr<Coordinator>> Coordinator::create(const std::string& config_text,
                                                                 const std::string& config_name,
                                                                 const CoordinatorOptions& options) {
+  if (options.retry_failed) return sim::Error{"a new run has no failed jobs to retry (retry_failed is for a resume)"};
   auto config = parse_run_config(config_text, config_name);
   if (!config) return config.error();
   auto impl = std::make_unique<Impl>();

@@ -700,6 +700,20 @@ sim::Status Manifest::update_recipe(std::int64_t job_id, const std::string& reci
   });
 }
 
+sim::Expected<std::int64_t> Manifest::retry_failed() {
+  std::int64_t changed = 0;
+  sim::Status s = impl_->atomically([&]() -> sim::Status {
+    if (sim::Status e = exec(impl_->db, "UPDATE jobs SET state = 'pending', failure_reason = '' WHERE state = 'failed'");
+        !e) {
+      return e;
+    }
+    changed = sqlite3_changes(impl_->db);
+    return {};
+  });
+  if (!s) return s.error();
+  return changed;
+}
+
 sim::Status Manifest::set_run_state(const std::string& state) {
   return impl_->atomically([&] { return impl_->run_state.reset().bind(1, state).run(); });
 }

@@ -32,6 +32,9 @@ struct CoordinatorOptions {
   /// Its workers connect without CurveZMQ keys (drapegen local's own): CurveZMQ keys in the configuration, or
   /// `security.curve = true`, would lock them out, so they are refused at start.
   bool keyless_workers = false;
+  /// Resume only: failed jobs are pending again, each with retry.max_attempts more attempts (after a cause outside
+  /// the job is fixed: a broken node, a preemption by an older worker build that counted it).
+  bool retry_failed = false;
 };
 
 enum class RunOutcome {
@@ -57,7 +60,8 @@ class Coordinator {
                                                                           const std::string& config_name,
                                                                           const CoordinatorOptions& options = {});
   /// Resumes the run of `manifest_path`: its stored configuration and plan, files not in the manifest removed,
-  /// unfinished jobs pending again; binds the recorded endpoint if it can.
+  /// unfinished jobs pending again (failed ones too with `options.retry_failed`); binds the recorded endpoint if it
+  /// can.
   [[nodiscard]] static sim::Expected<std::unique_ptr<Coordinator>> resume(const std::string& manifest_path,
                                                                           const CoordinatorOptions& options = {});
   ~Coordinator();

@@ -49,6 +49,8 @@ class Manifest {
   [[nodiscard]] sim::Status record_failure(const JobRecord& job, const FailureRecord& failure, bool final);
   /// Replaces a pending job's recipe (a kDrape job whose source failed falls back to sine or fold).
   [[nodiscard]] sim::Status update_recipe(std::int64_t job_id, const std::string& recipe_json);
+  /// Every failed job pending again (its failures kept; its attempts count on); returns how many.
+  [[nodiscard]] sim::Expected<std::int64_t> retry_failed();
   [[nodiscard]] sim::Status set_run_state(const std::string& state);
   [[nodiscard]] sim::Status set_endpoint(const std::string& endpoint);
 
