@@ -1,6 +1,8 @@
 // The distributed generation service end to end (issue 5 acceptance 1, 2, 3, 5, 6): real coordinator and worker
 // processes on 127.0.0.1 with ephemeral ports, coarse meshes.
+#include <nlohmann/json.hpp>
 #include <random>
+#include <set>
 #include <sqlite3.h>
 
 #include "service_harness.hpp"
@@ -153,6 +155,84 @@ TEST(Service, AWorkerStoppedBySigtermCostsItsJobNoAttempt) {
   }
   std::printf("[ info ] %d workers stopped, %d leases given back\n", stopped, requeued);
   EXPECT_GE(requeued, 1);
+}
+
+// A done source drape whose file is gone (removed, a disk error) no longer stops the run at every resume (exit 3):
+// the jobs that start from it fall back to their fallback recipe, as when a source fails, and the run completes.
+TEST(Service, ASourceDrapeThatCannotBeReadIsFallenBackFrom) {
+  const fs::path dir = test_dir("source_unreadable");
+  const fs::path out = dir / "run";
+  const fs::path manifest = out / "manifest.sqlite";
+  write_text(dir / "run.toml", small_config(out, 8, 2));
+  {
+    auto [coordinator, endpoint] = start_coordinator({"--config", (dir / "run.toml").string()}, out, dir / "first");
+    ASSERT_FALSE(endpoint.empty()) << coordinator.err();
+    Process worker = start_worker(endpoint, dir, 0);
+    ASSERT_EQ(coordinator.wait(120s), 0) << coordinator.err();
+  }
+  // The drape-recipe jobs made pending again (results and files forgotten), and the meshes of their sources that are
+  // not drape-recipe jobs themselves removed.
+  std::set<std::int64_t> dependents;
+  std::map<std::int64_t, std::pair<std::int64_t, std::int64_t>> source_of;  // job -> (sample, slot)
+  {
+    auto reader = storage::ManifestReader::open(manifest.string());
+    ASSERT_TRUE(reader);
+    for (const auto& j : all(reader->jobs())) {
+      const auto recipe = nlohmann::json::parse(j.recipe_json);
+      if (recipe["kind"] != "drape") continue;
+      dependents.insert(j.id);
+      source_of[j.id] = {recipe["source"]["sample"].get<std::int64_t>(), recipe["source"]["slot"].get<std::int64_t>()};
+    }
+  }
+  ASSERT_FALSE(dependents.empty()) << "the plan has no drape recipe: the test needs another seed";
+  std::set<std::int64_t> sources;  // job ids (sample * 2 + slot + 1), the dependents among them excluded
+  int expected_fallbacks = 0;
+  for (const auto& [job, source] : source_of) {
+    const std::int64_t id = source.first * 2 + source.second + 1;
+    if (dependents.count(id)) continue;
+    sources.insert(id);
+    ++expected_fallbacks;
+  }
+  ASSERT_GT(expected_fallbacks, 0);
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open(manifest.c_str(), &db), SQLITE_OK);
+  for (std::int64_t id : dependents) {
+    const std::string sql = "DELETE FROM files WHERE job_id = " + std::to_string(id) +
+                            "; DELETE FROM results WHERE job_id = " + std::to_string(id) +
+                            "; UPDATE jobs SET state = 'pending', attempts = 0 WHERE id = " + std::to_string(id);
+    ASSERT_EQ(sqlite3_exec(db, sql.c_str(), nullptr, nullptr, nullptr), SQLITE_OK) << sqlite3_errmsg(db);
+  }
+  ASSERT_EQ(sqlite3_exec(db, "UPDATE runs SET state = 'stopped'", nullptr, nullptr, nullptr), SQLITE_OK);
+  sqlite3_close(db);
+  {
+    auto reader = storage::ManifestReader::open(manifest.string());
+    ASSERT_TRUE(reader);
+    for (const auto& f : all(reader->files())) {
+      if (f.kind == "mesh" && sources.count(f.job_id)) ASSERT_TRUE(fs::remove(out / f.path)) << f.path;
+    }
+  }
+
+  Coordinator resumed = start_coordinator({"--resume", manifest.string()}, out, dir / "resumed");
+  ASSERT_FALSE(resumed.endpoint.empty()) << resumed.process.err();
+  Process worker = start_worker(resumed.endpoint, dir, 1);
+  ASSERT_EQ(resumed.process.wait(120s), 0) << resumed.process.err();  // before: 3, at every resume
+  const std::string log = resumed.process.err();
+  int fallbacks = 0;
+  for (auto at = log.find("its source drape cannot be read"); at != std::string::npos;
+       at = log.find("its source drape cannot be read", at + 1)) {
+    ++fallbacks;
+  }
+  EXPECT_EQ(fallbacks, expected_fallbacks) << log;
+  auto reader = storage::ManifestReader::open(manifest.string());
+  ASSERT_TRUE(reader);
+  int fell_back = 0;
+  for (const auto& j : all(reader->jobs())) {
+    EXPECT_EQ(j.state, storage::JobState::kDone) << j.id;
+    if (!dependents.count(j.id)) continue;
+    const auto recipe = nlohmann::json::parse(j.recipe_json);
+    fell_back += recipe["kind"] != "drape";
+  }
+  EXPECT_EQ(fell_back, expected_fallbacks);
 }
 
 struct RunSnapshot {

@@ -594,10 +594,10 @@ struct Coordinator::Impl {
   }
 
   /// A kDrape job whose source failed starts from its fallback recipe instead (recorded in the manifest).
-  sim::Status fall_back(JobSlot& slot) {
+  sim::Status fall_back(JobSlot& slot, const char* why = "failed") {
     const auto recipe = fallback_recipe(config, slot.rec.sample, slot.rec.slot);
     slot.rec.recipe_json = sampler::to_json(recipe).dump();
-    log->info("job {}: its source drape failed; falling back to a {} recipe", slot.rec.id,
+    log->info("job {}: its source drape {}; falling back to a {} recipe", slot.rec.id, why,
               sampler::to_string(recipe.kind));
     return manifest->update_recipe(slot.rec.id, slot.rec.recipe_json);
   }
@@ -639,9 +639,16 @@ struct Coordinator::Impl {
                                                                     recipe->source.slot) - 1)];
       const std::string path = data_dir + "/" + file_name(source, ".ply");
       auto bytes = storage::read_file(path);
-      if (!bytes) return sim::Error{fmt::format("the source drape: {}", bytes.error().message)};
-      if (bytes->empty()) return sim::Error{fmt::format("cannot read the source drape {}: empty file", path)};
-      source_mesh = std::move(*bytes);
+      if (bytes && !bytes->empty()) {
+        source_mesh = std::move(*bytes);
+      } else {
+        // A done source whose file is gone or unreadable (removed, a disk error): the job starts as if its source
+        // had failed, rather than the run stopping on it at every resume.
+        log->warn("job {}: its source drape {} cannot be read ({}); the data set lacks that file", slot.rec.id, path,
+                  bytes ? "empty file" : bytes.error().message);
+        if (sim::Status s = manifest->begin(); !s) return s.error();
+        if (sim::Status s = fall_back(slot, "cannot be read"); !s) return s.error();
+      }
     }
     auto job = make_job_message(config, samples[static_cast<std::size_t>(slot.rec.sample)], slot.rec, slot.attempts,
                                 std::move(source_mesh));
