@@ -386,6 +386,7 @@ std::function<v1::Envelope(const v1::Job&)> spoiled_result(const std::function<v
     v1::Envelope e = result(job.job_id(), job.attempt());
     e.mutable_result()->mutable_metrics()->set_outcome("converged");
     e.mutable_result()->mutable_metrics()->set_bending_model(job.spec().bending_model());
+    e.mutable_result()->mutable_metrics()->set_renderer(job.spec().renderer());
     e.mutable_result()->set_mesh_ply("ply");
     for (int k = 0; k < 2; ++k) e.mutable_result()->add_exr("exr");
     spoil(*e.mutable_result());
@@ -402,6 +403,17 @@ TEST(Service, ResultOfAnotherBendingModelIsRefused) {
   ASSERT_FALSE(failures.empty());
   EXPECT_NE(failures[0].message.find("dihedral (unnamed)"), std::string::npos) << failures[0].message;
   EXPECT_NE(failures[0].message.find("triangle"), std::string::npos) << failures[0].message;
+}
+
+// Likewise a worker older than the renderer field renders with OSMesa whatever the run asks.
+TEST(Service, ResultOfAnotherRendererIsRefused) {
+  const auto failures = failed_then_done(
+      "renderer_mismatch", "renderer = \"software\"\n",
+      spoiled_result([](v1::Result& r) { r.mutable_metrics()->clear_renderer(); }), "invalid_job");
+  ASSERT_FALSE(failures.empty());
+  EXPECT_NE(failures[0].message.find("rendered the views with osmesa (unnamed), the run asks for software"),
+            std::string::npos)
+      << failures[0].message;
 }
 
 // A result with one file per orientation but an empty one among them would be recorded, checksum and all, and fail

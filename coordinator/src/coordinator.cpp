@@ -458,6 +458,13 @@ struct Coordinator::Impl {
                                        "(a worker older than this run's drapegen?)",
                                        w.name, model.empty() ? "dihedral (unnamed)" : model, config.bending_model));
     }
+    // Likewise a worker older than JobSpec.renderer renders with OSMesa whatever the run asks.
+    if (const std::string& used = r.metrics().renderer(); !noop && proto::renderer_name(used) != config.renderer) {
+      return refuse_result(w, r, v1::FAILURE_REASON_INVALID_JOB,
+                           fmt::format("worker {} rendered the views with {}, the run asks for {} (a worker older than "
+                                       "this run's drapegen?)",
+                                       w.name, used.empty() ? "osmesa (unnamed)" : used, config.renderer));
+    }
     // Metrics the manifest cannot hold (its REAL columns are NOT NULL; SQLite stores NaN as NULL) make a failed
     // attempt of the job, not a storage error that would stop the run.
     const auto& metrics = r.metrics();

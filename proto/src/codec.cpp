@@ -135,6 +135,8 @@ sim::Status check(const v1::Envelope& e) {
 
 std::string_view bending_model_name(std::string_view field) { return field.empty() ? "dihedral" : field; }
 
+std::string_view renderer_name(std::string_view field) { return field.empty() ? "osmesa" : field; }
+
 const char* body_name(const v1::Envelope& e) {
   switch (e.body_case()) {
     case v1::Envelope::kReady: return "ready";

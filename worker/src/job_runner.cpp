@@ -194,7 +194,8 @@ v1::Envelope JobRunner::compute(const v1::Job& job) {
   request.noise = spec.noise() == "none" ? renderer::NoiseModel::none() : renderer::NoiseModel::kinect();
   request.seed = spec.render_seed();
   request.source = fmt::format("sample {} slot {}", spec.recipe().sample(), spec.recipe().slot());
-  const std::string renderer_name = spec.renderer().empty() ? renderer::kRendererNames.front() : spec.renderer();
+  const std::string renderer_name(proto::renderer_name(spec.renderer()));
+  metrics.set_renderer(renderer_name);
   std::unique_ptr<renderer::Renderer>& renderer = renderers_[renderer_name];
   if (!renderer) {
     auto created = renderer::make_renderer(renderer_name);

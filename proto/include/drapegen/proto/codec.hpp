@@ -49,6 +49,8 @@ inline constexpr std::size_t kMaxReadyText = 256;
 /// The bending model a JobSpec or Metrics names: an empty field (a message from before the field existed) means the
 /// paper's "dihedral"; any other value is returned as is (check() accepts "dihedral" and "triangle").
 [[nodiscard]] std::string_view bending_model_name(std::string_view field);
+/// JobSpec.renderer / Metrics.renderer as a renderer's name: empty (a message from before the field) is "osmesa".
+[[nodiscard]] std::string_view renderer_name(std::string_view field);
 
 /// The body's name ("ready", "job", ...; "none" without one), for logs.
 [[nodiscard]] const char* body_name(const v1::Envelope& envelope);
