@@ -45,6 +45,13 @@ sim::Status check_listed_file(const nlohmann::json& name, const std::string& wha
   return {};
 }
 
+/// `object[key]`, a number (`what` names the field in the error).
+sim::Expected<double> number_at(const nlohmann::json& object, const char* key, const std::string& what) {
+  if (!object.contains(key)) return sim::Error{fmt::format("{}: missing \"{}\"", what, key)};
+  if (!object[key].is_number()) return sim::Error{fmt::format("{}.{} must be a number", what, key)};
+  return object[key].get<double>();
+}
+
 sim::Expected<Eigen::MatrixXd> matrix_from(const nlohmann::json& j, int rows, int cols, const std::string& what) {
   if (!j.is_array() || static_cast<int>(j.size()) != rows) {
     return sim::Error{fmt::format("{} must be a {}x{} array of rows", what, rows, cols)};
@@ -135,7 +142,7 @@ sim::Expected<Capture> read_capture(const std::string& directory) {
   }
   const std::string where = json_path.string();
   try {
-    if (!j.is_object() || j.value("format", "") != kFormat) {
+    if (!j.is_object() || !j.contains("format") || j["format"] != kFormat) {
       return sim::Error{fmt::format("{}: not a capture (\"format\" must be \"{}\")", where, kFormat)};
     }
     // Integers as integers: 1.5 would pass as 1 (get<int> truncates).
@@ -144,18 +151,26 @@ sim::Expected<Capture> read_capture(const std::string& directory) {
     }
     Capture c;
     c.directory = directory;
-    c.source = j.value("source", "");
+    if (j.contains("source") && !j["source"].is_null()) {
+      if (!j["source"].is_string()) return sim::Error{fmt::format("{}: source must be a string", where)};
+      c.source = j["source"].get<std::string>();
+    }
     if (!j.contains("specimen") || !j["specimen"].is_object()) {
       return sim::Error{fmt::format("{}: missing \"specimen\"", where)};
     }
     const auto& s = j["specimen"];
-    const auto size = s.at("size_mm");
-    if (!size.is_array() || size.size() != 2)
-      return sim::Error{fmt::format("{}: specimen.size_mm must be [X, Y]", where)};
-    c.specimen.size_x = size[0].get<double>() * 1e-3;
-    c.specimen.size_y = size[1].get<double>() * 1e-3;
-    c.specimen.density = s.at("density_g_per_m2").get<double>();
-    c.specimen.cylinder_diameter = s.at("cylinder_diameter_mm").get<double>() * 1e-3;
+    if (!s.contains("size_mm") || !s["size_mm"].is_array() || s["size_mm"].size() != 2 ||
+        !s["size_mm"][0].is_number() || !s["size_mm"][1].is_number()) {
+      return sim::Error{fmt::format("{}: specimen.size_mm must be [X, Y] numbers", where)};
+    }
+    c.specimen.size_x = s["size_mm"][0].get<double>() * 1e-3;
+    c.specimen.size_y = s["size_mm"][1].get<double>() * 1e-3;
+    auto density = number_at(s, "density_g_per_m2", where + ": specimen");
+    if (!density) return density.error();
+    c.specimen.density = *density;
+    auto diameter = number_at(s, "cylinder_diameter_mm", where + ": specimen");
+    if (!diameter) return diameter.error();
+    c.specimen.cylinder_diameter = *diameter * 1e-3;
     if (!(c.specimen.size_x >= 0.05 && c.specimen.size_x <= 2.0 && c.specimen.size_y >= 0.05 &&
           c.specimen.size_y <= 2.0)) {
       return sim::Error{fmt::format("{}: specimen size must be 50 .. 2000 mm", where)};

@@ -173,6 +173,17 @@ TEST(Capture, NonIntegersAndAViewsMissingKeyAreClearErrors) {
   EXPECT_NE(width.find("views[1]: width and height must be integers"), std::string::npos) << width;
   const std::string pose = with([](nlohmann::json& j) { j["views"][2].erase("world_to_camera"); });
   EXPECT_NE(pose.find("views[2]: missing \"world_to_camera\""), std::string::npos) << pose;
+  // A field of the wrong type is named (before: "missing or malformed field: type must be number, but is string").
+  const std::string density = with([](nlohmann::json& j) { j["specimen"]["density_g_per_m2"] = "250"; });
+  EXPECT_NE(density.find("specimen.density_g_per_m2 must be a number"), std::string::npos) << density;
+  const std::string diameter = with([](nlohmann::json& j) { j["specimen"].erase("cylinder_diameter_mm"); });
+  EXPECT_NE(diameter.find("specimen: missing \"cylinder_diameter_mm\""), std::string::npos) << diameter;
+  const std::string size = with([](nlohmann::json& j) { j["specimen"]["size_mm"][1] = nullptr; });
+  EXPECT_NE(size.find("specimen.size_mm must be [X, Y] numbers"), std::string::npos) << size;
+  const std::string source = with([](nlohmann::json& j) { j["source"] = 5; });
+  EXPECT_NE(source.find("source must be a string"), std::string::npos) << source;
+  const std::string format = with([](nlohmann::json& j) { j["format"] = 1; });
+  EXPECT_NE(format.find("not a capture"), std::string::npos) << format;
   std::ofstream(fs::path(dir) / "capture.json") << good.dump();
   EXPECT_TRUE(read_capture(dir).has_value());
 }
