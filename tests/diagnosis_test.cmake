@@ -1,5 +1,5 @@
 # The sim-to-real diagnosis end to end on a tiny case: drapegen reality writes a capture with a strong effect, the
-# truth file is moved away, drapegen diagnose runs the whole path (fit, floors, localisation, attribution, report)
+# truth file is moved away (a decoy that cannot be read in its place), drapegen diagnose runs the whole path (fit, floors, localisation, attribution, report)
 # on a coarse mesh with few evaluations; then bad captures and bad options give one-line errors.
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
@@ -58,8 +58,10 @@ string(JSON family GET "${truth}" family)
 if(NOT family STREQUAL "sensor")
   message(FATAL_ERROR "truth family ${family}, expected sensor")
 endif()
-# The diagnosis must not need (or see) the truth.
+# The diagnosis must not need (or see) the truth. In its place a decoy: a directory named truth.json, which any read
+# of it fails on (a file decoy could only show that the verdict does not follow it); diagnose must succeed beside it.
 file(RENAME ${WORK}/capture/truth.json ${WORK}/truth.json)
+file(MAKE_DIRECTORY ${WORK}/capture/truth.json)
 
 run_ok(out diagnose --capture ${WORK}/capture --quick --resolution 10 --states 2 --evaluations 8 --refit-evaluations 4
        --json --report ${WORK}/report --jobs 1)
