@@ -1,10 +1,24 @@
 #include "drapegen/renderer/data_point.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 #include <fmt/format.h>
 
 namespace drapegen::renderer {
 
 sim::Status check_in_view(const TriangleMesh& cloth, const RigSpec& rig, const std::vector<DataPointSetup>& setups) {
+  // Inside the facets (the polygon's inscribed circle) and between the bottom and the top: the cylinder is convex, so
+  // a mesh whose vertices are all there is wholly hidden in it.
+  const double inner = rig.cylinder.radius * std::cos(M_PI / rig.cylinder.segments);
+  const bool hidden = std::all_of(cloth.vertices.begin(), cloth.vertices.end(), [&](const Eigen::Vector3f& x) {
+    return std::hypot(x.x(), x.y()) < inner && x.z() < 0.0f && x.z() > -rig.cylinder.height;
+  });
+  if (hidden && !cloth.vertices.empty()) {
+    return sim::Error{fmt::format("mesh lies inside the platform (every vertex within {:.3g} m of its axis and below "
+                                  "its top at z = 0): no camera sees it (is the drape in metres, over the platform?)",
+                                  rig.cylinder.radius)};
+  }
   const Camera camera = rig.camera();
   const double W = rig.width, H = rig.height;
   for (const auto& p : setups) {

@@ -88,6 +88,15 @@ TEST(Rig, FlatSpecimenFitsTheViewAndMillimetresDoNot) {
   const sim::Status s = check_in_view(mm, rig, plan_data_points(rig, AugmentationSpec{}, 0));
   ASSERT_FALSE(s);
   EXPECT_NE(s.error().message.find("out of the camera's view"), std::string::npos);
+  // Shrunk into the platform (before: in view, so rendered, the views holding the platform alone).
+  TriangleMesh inside = *cloth;
+  for (auto& p : inside.vertices) p = Eigen::Vector3f(0.1f * p.x(), 0.1f * p.y(), -0.05f);
+  const sim::Status hidden = check_in_view(inside, rig, plan_data_points(rig, AugmentationSpec{}, 0));
+  ASSERT_FALSE(hidden);
+  EXPECT_NE(hidden.error().message.find("mesh lies inside the platform"), std::string::npos);
+  // One vertex out of it, on the top: seen.
+  inside.vertices.front() = Eigen::Vector3f(0.0f, 0.0f, 0.001f);
+  EXPECT_TRUE(check_in_view(inside, rig, plan_data_points(rig, AugmentationSpec{}, 0)));
 }
 
 TEST(Rig, CylinderIsClosedAndOnThePlatform) {

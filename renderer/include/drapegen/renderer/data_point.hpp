@@ -22,7 +22,8 @@ struct RenderRequest {
 };
 
 /// Fails if any cloth vertex falls outside the unperturbed camera's image (or behind it) at any planned table
-/// angle: the drape does not fit the view (or is not in metres).
+/// angle: the drape does not fit the view (or is not in metres); or if every vertex lies inside the platform's
+/// cylinder, where no camera sees the cloth (the views would hold the platform alone).
 [[nodiscard]] sim::Status check_in_view(const TriangleMesh& cloth, const RigSpec& rig,
                                         const std::vector<DataPointSetup>& setups);
 
