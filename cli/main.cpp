@@ -5,6 +5,7 @@
 #include <string>
 
 #include "commands.hpp"
+#include "parse.hpp"
 #include "drapegen/build_id.hpp"
 #include "drapegen/sim/blas_kernels.hpp"
 
@@ -39,6 +40,13 @@ int main(int argc, char** argv) {
       drapegen::cli::add_stats_command);
   add("keygen", "Make a CurveZMQ key pair (coordinator or worker) for runs on non-loopback addresses",
       drapegen::cli::add_keygen_command);
+  // Integers in base 10 everywhere: CLI11 would read --seed 010 as octal 8.
+  for (CLI::App* sub : app.get_subcommands({})) {
+    for (CLI::Option* option : sub->get_options()) {
+      const std::string type = option->get_type_name();
+      if (type.rfind("INT", 0) == 0 || type.rfind("UINT", 0) == 0) option->transform(drapegen::cli::decimal_integer);
+    }
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

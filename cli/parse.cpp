@@ -1,5 +1,6 @@
 #include "parse.hpp"
 
+#include <algorithm>
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -99,6 +100,14 @@ std::ostream& summary_stream(const std::vector<std::string>& outputs) {
     }
   }
   return std::cout;
+}
+
+std::string decimal_integer(std::string text) {
+  const std::size_t sign = !text.empty() && (text[0] == '+' || text[0] == '-') ? 1 : 0;
+  const bool digits = text.size() > sign && text.find_first_not_of("0123456789", sign) == std::string::npos;
+  if (!digits) return text;
+  const std::size_t first = std::min(text.find_first_not_of('0', sign), text.size() - 1);
+  return text.substr(0, sign) + text.substr(first);
 }
 
 bool same_file(const std::string& a, const std::string& b) {

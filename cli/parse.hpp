@@ -19,6 +19,10 @@ namespace drapegen::cli {
 /// the platform top instead of adhesion). Each name at most once.
 [[nodiscard]] sim::Expected<sim::PhysicalEffects> parse_effects(const std::vector<std::string>& items);
 
+/// An integer option's text in base 10: leading zeros dropped ("010" -> "10", "-007" -> "-7"); anything else as it
+/// is. CLI11 reads integers with strtoll's base 0, where "010" is octal 8.
+[[nodiscard]] std::string decimal_integer(std::string text);
+
 /// Whether a file can be created at `path` (probes with a temporary file beside it, then removes it); a directory
 /// there is an error, not a file that can be replaced.
 [[nodiscard]] sim::Status check_writable(const std::string& path);

@@ -77,6 +77,12 @@ int run_sample(const SampleOptions& o, const sampler::VaeModel& model, const std
   recipe_options.states_per_sample = o.states;
   recipe_options.max_drift_mm = o.max_drift_mm;
   if (sim::Status s = sampler::validate(recipe_options); !s) return fail(s.error().message);
+  // An output over an input would destroy it (the model read, then replaced by a CSV).
+  if (!o.model.empty()) {
+    for (const auto& [name, path] : {std::pair{"--out", o.out}, {"--recipes", o.recipes}}) {
+      if (!path.empty() && same_file(path, o.model)) return fail(fmt::format("{} {} is the model file", name, path));
+    }
+  }
   if (sim::Status s = check_writable(o.out); !s) return fail(s.error().message, kExitIo);
   if (!o.recipes.empty()) {
     if (same_file(o.out, o.recipes)) return fail("--out and --recipes name the same file");
@@ -149,6 +155,8 @@ int run_report(const SampleOptions& o, const sampler::VaeModel& model, const std
                             data.size()));
   }
   if (!o.plot.empty()) {
+    if (same_file(o.plot, o.data)) return fail(fmt::format("--plot {} is the --data file", o.plot));
+    if (!o.model.empty() && same_file(o.plot, o.model)) return fail(fmt::format("--plot {} is the model file", o.plot));
     if (sim::Status s = check_writable(o.plot); !s) return fail(s.error().message, kExitIo);
   }
   struct Row {
@@ -259,11 +267,13 @@ Runner add_sample_command(CLI::App& app) {
   app.add_option("--seed", o->seed, "Seed of the latents and the recipes (0 is a seed like any other)")
       ->check(kSeed)
       ->capture_default_str();
-  app.add_option("--out", o->out, "Write the parameter vectors to this CSV file (paper units at 300 g/m^2)");
+  auto* out = app.add_option("--out", o->out,
+                             "Write the parameter vectors to this CSV file (paper units at 300 g/m^2)");
   app.add_option("--model", o->model,
                  "VAE model file (default: the committed sampler/models/vae3.dgvae, built into the program)");
   app.add_flag("--json", o->json, "Print the summary (or the report) as JSON");
-  app.add_option("--recipes", o->recipes, "Write the initial-state recipes, one line each, to this file");
+  auto* recipes =
+      app.add_option("--recipes", o->recipes, "Write the initial-state recipes, one line each, to this file");
   app.add_option("--states", o->states, "Initial states per parameter vector")->capture_default_str();
   app.add_option("--max-drift", o->max_drift_mm, "Largest drift of the specimen centre, mm")->capture_default_str();
   app.add_option("--range-margin", o->range_margin, "Widen the data range by this fraction per side")
@@ -271,13 +281,21 @@ Runner add_sample_command(CLI::App& app) {
   app.add_option("--duplicate-distance", o->duplicate_distance,
                  "Reject vectors closer than this to an accepted one (standardised features)")
       ->capture_default_str();
-  app.add_flag("--report", o->report, "Report the coverage of the measured fabrics instead of sampling");
-  app.add_option("--data", o->data, "--report: the measured fabrics (fabrics618.csv)")->capture_default_str();
-  app.add_option("--plot", o->plot, "--report: scatter plot PNG")->capture_default_str();
-  app.add_flag("--no-plot", o->no_plot, "--report: no scatter plot");
-  app.add_option("--plot-x", o->plot_x, "--report: feature on the plot's x axis")->capture_default_str();
-  app.add_option("--plot-y", o->plot_y, "--report: feature on the plot's y axis")->capture_default_str();
-  app.add_option("--iw-samples", o->iw_samples, "--report: importance samples per fabric")->capture_default_str();
+  auto* report = app.add_flag("--report", o->report, "Report the coverage of the measured fabrics instead of sampling");
+  // The report writes no samples, and its own options mean nothing without it: given in the wrong mode, an error
+  // rather than silently ignored.
+  out->excludes(report);
+  recipes->excludes(report);
+  app.add_option("--data", o->data, "--report: the measured fabrics (fabrics618.csv)")
+      ->capture_default_str()
+      ->needs(report);
+  app.add_option("--plot", o->plot, "--report: scatter plot PNG")->capture_default_str()->needs(report);
+  app.add_flag("--no-plot", o->no_plot, "--report: no scatter plot")->needs(report);
+  app.add_option("--plot-x", o->plot_x, "--report: feature on the plot's x axis")->capture_default_str()->needs(report);
+  app.add_option("--plot-y", o->plot_y, "--report: feature on the plot's y axis")->capture_default_str()->needs(report);
+  app.add_option("--iw-samples", o->iw_samples, "--report: importance samples per fabric")
+      ->capture_default_str()
+      ->needs(report);
   return [o] {
     if (o->no_plot) o->plot.clear();
     return run(*o);

@@ -32,6 +32,16 @@ TEST(ParseDirectional, RejectsGarbage) {
   }
 }
 
+TEST(DecimalInteger, DropsLeadingZerosOfIntegersOnly) {
+  EXPECT_EQ(decimal_integer("010"), "10");
+  EXPECT_EQ(decimal_integer("0018"), "18");
+  EXPECT_EQ(decimal_integer("000"), "0");
+  EXPECT_EQ(decimal_integer("-007"), "-7");
+  EXPECT_EQ(decimal_integer("+08"), "+8");
+  EXPECT_EQ(decimal_integer("42"), "42");
+  for (const char* other : {"", "-", "0x10", "1e3", "07a", "abc", " 07"}) EXPECT_EQ(decimal_integer(other), other);
+}
+
 TEST(CheckWritable, ReportsMissingDirectory) {
   EXPECT_TRUE(check_writable(::testing::TempDir() + "/ok.ply"));
   const auto s = check_writable("/nonexistent-dir/x.ply");
