@@ -12,6 +12,7 @@ Needs python3-torch, python3-numpy and python3-openimageio (Debian).
 import hashlib
 import math
 import os
+import stat
 import sqlite3
 import urllib.parse
 import warnings
@@ -64,8 +65,14 @@ def open_manifest(manifest):
         inside = os.path.join(manifest, "manifest.sqlite")
         hint = f"; the run's manifest is {inside}" if os.path.isfile(inside) else ""
         raise FileNotFoundError(f"{manifest}: a directory, not a manifest{hint}")
-    if not os.path.isfile(manifest):
-        raise FileNotFoundError(f"{manifest}: no such manifest")
+    try:
+        mode = os.stat(manifest).st_mode
+    except FileNotFoundError:
+        raise FileNotFoundError(f"{manifest}: no such manifest") from None
+    except OSError as e:  # a directory on the way that may not be entered, an I/O error: not "no such manifest"
+        raise PermissionError(f"{manifest}: cannot be reached ({e.strerror})") from None
+    if not stat.S_ISREG(mode):
+        raise FileNotFoundError(f"{manifest}: no such manifest (not a regular file)")
     uri = "file:" + urllib.parse.quote(manifest)
     db = None
     try:

@@ -160,7 +160,15 @@ std::string immutable_uri(const std::string& path) {
 }  // namespace
 
 sim::Expected<ManifestReader> ManifestReader::open(const std::string& path) {
-  if (!std::filesystem::is_regular_file(path)) return no_manifest_at(path);
+  {
+    std::error_code ec;
+    const auto status = std::filesystem::status(path, ec);
+    // Unreachable (a directory on the way that may not be entered, an I/O error): said as such, not as "no manifest".
+    if (ec && ec != std::errc::no_such_file_or_directory && ec != std::errc::not_a_directory) {
+      return sim::Error{fmt::format("cannot read manifest {}: {}", path, ec.message()), /*io=*/true};
+    }
+    if (!std::filesystem::is_regular_file(status)) return no_manifest_at(path);
+  }
   auto open_as = [&](const std::string& name, int flags) -> sim::Expected<std::unique_ptr<Impl>> {
     auto db = open_db(name, flags);
     if (!db) return db.error();
@@ -174,9 +182,11 @@ sim::Expected<ManifestReader> ManifestReader::open(const std::string& path) {
   auto impl = open_as(path, SQLITE_OPEN_READONLY);
   // A WAL database read where this user may not create its -shm (another user's run, a read-only mount) fails to
   // open. With no -wal beside it (the run's coordinator has closed it: every commit is in the file), the file is all
-  // there is: read it as immutable.
+  // there is: read it as immutable. An empty -wal (left by readers, or by a checkpoint another connection outlived)
+  // holds nothing either.
   std::error_code ec;
-  if (!impl && !std::filesystem::exists(path + "-wal", ec)) {
+  const auto wal_size = std::filesystem::file_size(path + "-wal", ec);
+  if (!impl && (ec || wal_size == 0)) {
     auto immutable = open_as(immutable_uri(path), SQLITE_OPEN_READONLY | SQLITE_OPEN_URI);
     if (immutable) impl = std::move(immutable);
   }
@@ -375,6 +385,13 @@ struct Manifest::Impl {
                           &insert_file, &job_failed, &job_attempt, &insert_failure, &update_recipe, &run_state,
                           &run_endpoint}) {
       *st = Statement();
+    }
+    // Every commit into the database file itself, the log emptied: closing copies the log in only when this is the
+    // last connection, and a reader open meanwhile (stats, the training stage) left the run's results in the -wal
+    // alone, so that the .sqlite copied or read without it looked empty. Best effort, a short wait for readers.
+    sqlite3_busy_timeout(db, 2000);
+    if (sqlite3_wal_checkpoint_v2(db, nullptr, SQLITE_CHECKPOINT_TRUNCATE, nullptr, nullptr) != SQLITE_OK) {
+      (void)sqlite3_wal_checkpoint_v2(db, nullptr, SQLITE_CHECKPOINT_PASSIVE, nullptr, nullptr);
     }
     sqlite3_close(db);
   }

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <optional>
 
 namespace drapegen::storage {
 namespace {
@@ -126,6 +127,49 @@ TEST_F(ManifestTest, ReadsAManifestInADirectoryItCannotWrite) {
   fs::permissions(dir_, fs::perms::owner_all);
   ASSERT_TRUE(WIFEXITED(status));
   EXPECT_EQ(WEXITSTATUS(status), 0) << "1: not read; 2: could not become nobody";
+}
+
+// A reader connected while the writer closes (drapegen stats, the training stage during a run) kept SQLite from
+// copying the log into the database file: the .sqlite alone, copied elsewhere, read as a run with nothing done.
+TEST_F(ManifestTest, ClosingPutsEveryCommitIntoTheFileThoughAReaderIsOpen) {
+  std::optional<ManifestReader> open_reader;
+  {
+    auto m = make();
+    auto r = ManifestReader::open(path_);
+    ASSERT_TRUE(r) << r.error().message;
+    open_reader.emplace(std::move(r).value());
+    ASSERT_TRUE(m.begin());
+    ASSERT_TRUE(m.set_run_state("complete"));
+    ASSERT_TRUE(m.commit());
+    ASSERT_EQ(open_reader->run()->state, "complete");
+  }  // the writer closes; the reader stays connected
+  const std::filesystem::path copy = dir_ / "copy";
+  std::filesystem::create_directories(copy);
+  std::filesystem::copy_file(path_, copy / "manifest.sqlite");  // the database file alone
+  auto copied = ManifestReader::open((copy / "manifest.sqlite").string());
+  ASSERT_TRUE(copied) << copied.error().message;
+  EXPECT_EQ(copied->run()->state, "complete");
+  std::error_code ec;
+  EXPECT_EQ(std::filesystem::file_size(path_ + "-wal", ec), 0u) << ec.message();
+}
+
+// A manifest in a directory that may not be entered is an unreadable manifest (an I/O error), not "no manifest".
+TEST_F(ManifestTest, AManifestThatCannotBeReachedIsNotCalledMissing) {
+  if (::geteuid() != 0) GTEST_SKIP() << "needs root, to read as another user (nobody)";
+  { auto m = make(); }
+  std::filesystem::permissions(dir_, std::filesystem::perms::owner_all);
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    if (::setgid(65534) != 0 || ::setuid(65534) != 0) ::_exit(2);
+    auto reader = ManifestReader::open(path_);
+    ::_exit(!reader && reader.error().io && reader.error().message.find("Permission denied") != std::string::npos ? 0
+                                                                                                                : 1);
+  }
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0) << "1: not an I/O error naming the cause; 2: could not become nobody";
 }
 
 TEST_F(ManifestTest, RecordsEachJobExactlyOnce) {
