@@ -19,13 +19,11 @@ enum ExitCode : int {
   kExitRunStopped = 5,   // drapegen worker: the coordinator stopped the run before its end (a resume wants workers)
 };
 
-/// A ZeroMQ endpoint option: tcp:// or ipc://, as the configuration's network.bind.
-inline const CLI::Validator kEndpoint(
-    [](const std::string& value) -> std::string {
-      if (value.rfind("tcp://", 0) == 0 || value.rfind("ipc://", 0) == 0) return {};
-      return "'" + value + "' is not a tcp:// or ipc:// endpoint, e.g. tcp://127.0.0.1:5555";
-    },
-    "ENDPOINT");
+/// What is wrong with a ZeroMQ endpoint ("" if nothing), as the configuration's network.bind is checked.
+[[nodiscard]] std::string endpoint_problem(const std::string& endpoint);
+
+/// A ZeroMQ endpoint option, checked as the configuration's network.bind.
+inline const CLI::Validator kEndpoint([](const std::string& value) { return endpoint_problem(value); }, "ENDPOINT");
 
 /// A 64-bit seed option: digits only, at most 2^64 - 1 (CLI11 alone wraps "-1" round and clamps larger values).
 inline const CLI::Validator kSeed(

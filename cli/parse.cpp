@@ -1,5 +1,8 @@
 #include "parse.hpp"
 
+#include "commands.hpp"
+#include "drapegen/coordinator/run_config.hpp"
+
 #include <algorithm>
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -101,6 +104,8 @@ std::ostream& summary_stream(const std::vector<std::string>& outputs) {
   }
   return std::cout;
 }
+
+std::string endpoint_problem(const std::string& endpoint) { return coordinator::endpoint_problem(endpoint); }
 
 std::string decimal_integer(std::string text) {
   const std::size_t sign = !text.empty() && (text[0] == '+' || text[0] == '-') ? 1 : 0;

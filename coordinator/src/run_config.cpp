@@ -119,6 +119,28 @@ sim::Expected<std::string> with_output(const std::string& toml_text, const std::
   return text.str();
 }
 
+std::string endpoint_problem(const std::string& endpoint) {
+  const std::string example = "e.g. tcp://127.0.0.1:5555, tcp://*:* or ipc:///tmp/drapegen.sock";
+  if (endpoint.rfind("ipc://", 0) == 0) {
+    return endpoint.size() > 6 ? "" : fmt::format("'{}' names no path ({})", endpoint, example);
+  }
+  if (endpoint.rfind("tcp://", 0) != 0) {
+    return fmt::format("'{}' is not a tcp:// or ipc:// endpoint ({})", endpoint, example);
+  }
+  const std::string rest = endpoint.substr(6);
+  const std::size_t colon = rest.rfind(':');
+  if (colon == std::string::npos || colon == 0) {
+    return fmt::format("'{}' needs a host and a port, tcp://HOST:PORT ({})", endpoint, example);
+  }
+  const std::string port = rest.substr(colon + 1);
+  if (port == "*") return "";
+  const bool digits = !port.empty() && port.size() <= 5 && port.find_first_not_of("0123456789") == std::string::npos;
+  if (!digits || std::stoi(port) < 1 || std::stoi(port) > 65535) {
+    return fmt::format("'{}': the port must be 1 .. 65535 or * (any free port)", endpoint);
+  }
+  return "";
+}
+
 sim::Expected<RunConfig> parse_run_config(const std::string& toml_text, const std::string& source_name) {
   auto parsed = parse_toml(toml_text, source_name);
   if (!parsed) return parsed.error();
@@ -163,6 +185,9 @@ sim::Expected<RunConfig> parse_run_config(const std::string& toml_text, const st
   r.integer(solver, "solver", "max_iterations", c.max_iterations, 1, 100000);
   r.real(solver, "solver", "tolerance", c.tolerance, 1e-12, 1.0);
   r.integer(solver, "solver", "coarse_start_resolution", c.coarse_start_resolution, 0, 400);
+  if (r.ok() && (c.coarse_start_resolution == 1 || c.coarse_start_resolution == 2)) {
+    r.fail("solver.coarse_start_resolution", "must be 0 (off) or at least 3");  // as drapegen simulate --coarse-start
+  }
   r.integer(solver, "solver", "max_self_intersections", c.max_self_intersections, 0, 1'000'000);
 
   const toml::table* network = r.table("network");
@@ -171,8 +196,8 @@ sim::Expected<RunConfig> parse_run_config(const std::string& toml_text, const st
   r.integer(network, "network", "heartbeat_ms", c.heartbeat_ms, 10, 600000);
   r.integer(network, "network", "liveness", c.liveness, 2, 1000);
   r.real(network, "network", "lease_s", c.lease_s, 0.1, 7 * 86400.0);
-  if (r.ok() && c.bind.rfind("tcp://", 0) != 0 && c.bind.rfind("ipc://", 0) != 0) {
-    r.fail("network.bind", "must be a tcp:// or ipc:// endpoint, e.g. tcp://127.0.0.1:5555");
+  if (const std::string problem = endpoint_problem(c.bind); r.ok() && !problem.empty()) {
+    r.fail("network.bind", problem);
   }
 
   const toml::table* security = r.table("security");

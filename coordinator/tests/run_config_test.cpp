@@ -125,7 +125,26 @@ TEST(RunConfig, NamesTheKeyOfEveryError) {
             "run.toml: bending_model: 'quadratic' is not one of dihedral, triangle");
   EXPECT_EQ(error_of("[solver]\ntolerance = \"small\""), "run.toml: solver.tolerance: must be a number");
   EXPECT_EQ(error_of("[network]\nbind = \"http://x\""),
-            "run.toml: network.bind: must be a tcp:// or ipc:// endpoint, e.g. tcp://127.0.0.1:5555");
+            "run.toml: network.bind: 'http://x' is not a tcp:// or ipc:// endpoint (e.g. tcp://127.0.0.1:5555, "
+            "tcp://*:* or ipc:///tmp/drapegen.sock)");
+  // ZeroMQ bound port 70000 as 4464 (modulo 65536) and a missing port failed only at bind, "Invalid argument".
+  for (const char* bad : {"tcp://127.0.0.1:70000", "tcp://127.0.0.1:0", "tcp://127.0.0.1:-1", "tcp://127.0.0.1:",
+                          "tcp://127.0.0.1:5x", "tcp://127.0.0.1:000005555"}) {
+    EXPECT_NE(error_of(std::string("[network]\nbind = \"") + bad + "\"").find("the port must be 1 .. 65535 or *"),
+              std::string::npos)
+        << bad;
+  }
+  EXPECT_NE(error_of("[network]\nbind = \"tcp://127.0.0.1\"").find("needs a host and a port"), std::string::npos);
+  EXPECT_NE(error_of("[network]\nbind = \"ipc://\"").find("names no path"), std::string::npos);
+  for (const char* good : {"tcp://127.0.0.1:5555", "tcp://*:*", "tcp://[::1]:65535", "ipc:///tmp/x.sock"}) {
+    auto config = parse_run_config(std::string("[network]\nbind = \"") + good + "\"", "run.toml");
+    EXPECT_TRUE(config) << good << ": " << config.error().message;
+  }
+  // 1 and 2 switched the coarse start off, silently (drapegen simulate --coarse-start refuses them).
+  for (int n : {1, 2}) {
+    EXPECT_EQ(error_of("[solver]\ncoarse_start_resolution = " + std::to_string(n)),
+              "run.toml: solver.coarse_start_resolution: must be 0 (off) or at least 3");
+  }
   EXPECT_EQ(error_of("[network]\nport = 1"), "run.toml: network.port: unknown key");
   EXPECT_EQ(error_of("[extra]\nx = 1"), "run.toml: extra: unknown section");
   EXPECT_EQ(error_of("seed = -1"), "run.toml: seed: must be a non-negative integer");

@@ -48,6 +48,10 @@ struct RunConfig {
   std::vector<std::int64_t> poison_samples;  // these samples' jobs run in poison mode (diverge)
 };
 
+/// What is wrong with a ZeroMQ endpoint to bind or connect ("" if nothing): tcp://HOST:PORT with PORT 1 .. 65535 or
+/// * (any free port), or ipc://PATH. (ZeroMQ itself took port 70000 as 4464, its value modulo 65536.)
+[[nodiscard]] std::string endpoint_problem(const std::string& endpoint);
+
 /// Parses and validates a TOML configuration. Unknown keys, wrong types and out-of-range values are errors that
 /// name the key, e.g. "run.toml: samples: must be between 1 and 10000000".
 [[nodiscard]] sim::Expected<RunConfig> parse_run_config(const std::string& toml_text, const std::string& source_name);
