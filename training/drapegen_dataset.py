@@ -122,22 +122,45 @@ class DrapeDataset(Dataset):
                 raise ValueError(f"{self.manifest}: manifest schema version {row[0]}, this reader reads 1 and 2")
             self.run_state = state[0]
             self.read_immutable = immutable  # read as a finished file (its directory not writable here)
-            rows = db.execute(
-                "SELECT j.id, j.sample, j.slot, f.idx, f.path, f.sha256, s.alpha_warp, s.alpha_bias, s.alpha_weft, "
-                "s.beta_warp, s.beta_bias, s.beta_weft, s.density "
-                "FROM jobs j JOIN files f ON f.job_id = j.id AND f.kind = 'exr' "
-                "JOIN samples s ON s.run_id = j.run_id AND s.sample = j.sample "
-                "WHERE j.state = 'done' ORDER BY j.id, f.idx").fetchall()
+            # Streamed into flat arrays: a run of the default size has 576,000 items, which as Python objects took
+            # about 1 GB, copied into every DataLoader worker as reference counts touched their pages. Features are
+            # per sample, paths fixed-width bytes, checksums read only when they are verified.
+            where = ("FROM jobs j JOIN files f ON f.job_id = j.id AND f.kind = 'exr' WHERE j.state = 'done'")
+            count = db.execute("SELECT count(*) " + where).fetchone()[0]
+            width = db.execute("SELECT coalesce(max(length(CAST(f.path AS BLOB))), 1) " + where).fetchone()[0]
+            self.jobs = np.empty(count, dtype=np.int64)
+            self.samples = np.empty(count, dtype=np.int64)
+            self.slots = np.empty(count, dtype=np.int32)
+            self.orientations = np.empty(count, dtype=np.int32)
+            self.paths = np.empty(count, dtype=f"S{width}")
+            self.checksums = np.empty(count, dtype="S64") if verify_checksums else None
+            columns = "j.id, j.sample, j.slot, f.idx, f.path" + (", f.sha256" if verify_checksums else "")
+            cursor = db.execute(f"SELECT {columns} {where} ORDER BY j.id, f.idx")
+            i = 0
+            while True:
+                chunk = cursor.fetchmany(65536)
+                if not chunk:
+                    break
+                for row in chunk:
+                    if i == count:  # (a writer's commit between the two reads cannot add rows to one snapshot)
+                        break
+                    self.jobs[i], self.samples[i], self.slots[i], self.orientations[i] = row[:4]
+                    self.paths[i] = row[4].encode()
+                    if verify_checksums:
+                        self.checksums[i] = row[5].encode()
+                    i += 1
+            sample_rows = db.execute("SELECT sample, alpha_warp, alpha_bias, alpha_weft, beta_warp, beta_bias, "
+                                     "beta_weft, density FROM samples ORDER BY sample").fetchall()
         finally:
             db.close()
         if self.run_state != "complete":
             warnings.warn(f"{self.manifest}: the run is {self.run_state}: the dataset holds the jobs done so far "
                           "(and, by default, their mean and std)", stacklevel=2)
-        self.items = []
-        for job, sample, slot, idx, path, sha, aw, ab, af, bw, bb, bf, density in rows:
-            self.items.append({"job": job, "sample": sample, "slot": slot, "orientation": idx, "path": path,
-                               "sha256": sha, "features": features((aw, ab, af, bw, bb, bf), density)})
-        raw = np.array([it["features"] for it in self.items], dtype=np.float64).reshape(-1, len(FEATURES))
+        sample_ids = np.array([r[0] for r in sample_rows], dtype=np.int64)
+        table = np.array([features(r[1:7], r[7]) for r in sample_rows], dtype=np.float64).reshape(-1, len(FEATURES))
+        self.sample_row = np.searchsorted(sample_ids, self.samples)  # each item's row of `table`
+        self.sample_features = table
+        raw = table[self.sample_row] if len(self.samples) else np.zeros((0, len(FEATURES)))
         self.mean = np.asarray(mean, dtype=np.float64) if mean is not None else (
             raw.mean(axis=0) if len(raw) else np.zeros(len(FEATURES)))
         if std is not None:
@@ -147,18 +170,24 @@ class DrapeDataset(Dataset):
             self.std[self.std == 0] = 1.0
 
     def __len__(self):
-        return len(self.items)
+        return len(self.jobs)
+
+    def item(self, i):
+        """What item `i` is: its job, sample, slot, orientation, EXR path (relative to the manifest) and features."""
+        return {"job": int(self.jobs[i]), "sample": int(self.samples[i]), "slot": int(self.slots[i]),
+                "orientation": int(self.orientations[i]), "path": self.paths[i].decode(),
+                "features": self.sample_features[self.sample_row[i]].tolist()}
 
     def __getitem__(self, i):
-        it = self.items[i]
-        path = os.path.join(self.root, it["path"])
+        path = os.path.join(self.root, self.paths[i].decode())
         if self.verify:
             with open(path, "rb") as f:
                 digest = hashlib.sha256(f.read()).hexdigest()
-            if digest != it["sha256"]:
-                raise IOError(f"{path}: checksum {digest} does not match the manifest's {it['sha256']}")
+            expected = self.checksums[i].decode()
+            if digest != expected:
+                raise IOError(f"{path}: checksum {digest} does not match the manifest's {expected}")
         views = torch.from_numpy(read_views(path))
-        target = torch.tensor((np.asarray(it["features"]) - self.mean) / self.std, dtype=torch.float32)
+        target = torch.tensor((self.sample_features[self.sample_row[i]] - self.mean) / self.std, dtype=torch.float32)
         return views, target
 
     def denormalise(self, target):

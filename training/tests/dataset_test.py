@@ -58,7 +58,7 @@ assert tuple(target.shape) == (6,)
 targets = torch.stack([ds[i][1] for i in range(len(ds))]).numpy()
 assert np.allclose(targets.mean(axis=0), 0.0, atol=1e-5), targets.mean(axis=0)
 row = db.execute("SELECT alpha_warp, alpha_bias, alpha_weft, beta_warp, beta_bias, beta_weft, density "
-                 "FROM samples WHERE sample = ?", (ds.items[0]["sample"],)).fetchone()
+                 "FROM samples WHERE sample = ?", (ds.item(0)["sample"],)).fetchone()
 assert np.allclose(ds.denormalise(target.numpy()), features(row[:6], row[6]), atol=1e-5)
 # The feature map is the sampler's, sign(k) ln|k| at 300 g/m^2, also where |k| < 1 (ln|k| < 0).
 assert np.allclose(features([0.5, -0.5, 2.0, -2.0, 600.0, 1.0], 300.0),
@@ -69,7 +69,7 @@ db.close()  # the last connection: no log or shared-memory file left beside the 
 # Two orientations of one drape differ (other table angles), the same item read twice does not.
 a, _ = ds[0]
 b, _ = ds[1]
-assert ds.items[0]["job"] == ds.items[1]["job"] and not torch.equal(a, b)
+assert ds.item(0)["job"] == ds.item(1)["job"] and not torch.equal(a, b)
 assert torch.equal(a, ds[0][0])
 
 loader = torch.utils.data.DataLoader(ds, batch_size=4, shuffle=False)
