@@ -160,6 +160,14 @@ sim::Expected<RunConfig> parse_run_config(const std::string& toml_text, const st
   }
   r.integer(&root, "", "samples", c.samples, 1, 10'000'000);
   r.integer(&root, "", "states_per_sample", c.states_per_sample, 1, 64);
+  // The plan is built in memory before the manifest is written: 10^7 x 64 jobs would have needed hundreds of GB
+  // and ended in "out of memory" without naming the keys.
+  if (constexpr std::int64_t kMaxJobs = 2'000'000;
+      r.ok() && static_cast<std::int64_t>(c.samples) * c.states_per_sample > kMaxJobs) {
+    r.fail("samples", fmt::format("samples x states_per_sample is {} jobs; at most {} in one run (the plan is built "
+                                  "in memory: split the run, e.g. by seed)",
+                                  static_cast<std::int64_t>(c.samples) * c.states_per_sample, kMaxJobs));
+  }
   r.integer(&root, "", "orientations", c.orientations, 1, 360);
   r.integer(&root, "", "resolution", c.resolution, 5, 400);
   r.text(&root, "", "noise", c.noise, {"kinect", "none"});

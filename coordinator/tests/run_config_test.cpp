@@ -119,6 +119,10 @@ poison_samples = [1, 2]
 TEST(RunConfig, NamesTheKeyOfEveryError) {
   EXPECT_EQ(error_of("samples = 0"), "run.toml: samples: must be between 1 and 10000000");
   EXPECT_EQ(error_of("sampels = 3"), "run.toml: sampels: unknown key");
+  EXPECT_EQ(error_of("samples = 10000000\nstates_per_sample = 64"),
+            "run.toml: samples: samples x states_per_sample is 640000000 jobs; at most 2000000 in one run (the plan "
+            "is built in memory: split the run, e.g. by seed)");
+  EXPECT_TRUE(parse_run_config("samples = 250000\nstates_per_sample = 8", "run.toml"));
   EXPECT_EQ(error_of("noise = \"loud\""), "run.toml: noise: 'loud' is not one of kinect, none");
   EXPECT_EQ(error_of("renderer = \"gpu\""), "run.toml: renderer: 'gpu' is not one of osmesa, software");
   EXPECT_EQ(error_of("bending_model = \"quadratic\""),
