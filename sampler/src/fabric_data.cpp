@@ -1,5 +1,7 @@
 #include "drapegen/sampler/fabric_data.hpp"
 
+#include <cerrno>
+#include <cstring>
 #include <array>
 #include <charconv>
 #include <cmath>
@@ -41,7 +43,7 @@ bool is_header(std::string_view line) {
 
 sim::Expected<std::vector<MeasuredFabric>> read_fabric_csv(const std::string& path) {
   std::ifstream in(path);
-  if (!in) return sim::Error{"cannot open fabric data '" + path + "'"};
+  if (!in) return sim::Error{"cannot open fabric data '" + path + "': " + std::strerror(errno)};
   std::string line;
   if (!std::getline(in, line)) return sim::Error{"fabric data '" + path + "' is empty or unreadable"};
   if (!is_header(line)) {

@@ -189,6 +189,12 @@ sim::Expected<ManifestReader> ManifestReader::open(const std::string& path) {
   if (!impl && (ec || wal_size == 0)) {
     auto immutable = open_as(immutable_uri(path), SQLITE_OPEN_READONLY | SQLITE_OPEN_URI);
     if (immutable) impl = std::move(immutable);
+  } else if (!impl && ::access(directory_of(path).c_str(), W_OK) != 0) {
+    return sim::Error{fmt::format("cannot read manifest {}: the run is live or was not closed (its log {}-wal holds "
+                                  "commits), and this process cannot write its directory, which reading it then "
+                                  "needs; read it where it can, or once the run has ended (or resume it to an end)",
+                                  path, path),
+                      /*io=*/true};
   }
   if (!impl) return impl.error();
   return ManifestReader(std::move(*impl), directory_of(path));
@@ -199,7 +205,9 @@ sim::Expected<RunRecord> ManifestReader::run() const {
                "SELECT id, created_at, seed, config_toml, code_version, total_jobs, state, endpoint FROM runs "
                "ORDER BY id LIMIT 1");
   if (!st.ok()) return sim::Error{"manifest: " + st.prepare_error()};
-  if (st.step() != SQLITE_ROW) return sim::Error{"manifest: no run"};
+  if (st.step() != SQLITE_ROW) {
+    return sim::Error{fmt::format("manifest in {}: no run recorded (not a manifest drapegen wrote whole?)", directory_)};
+  }
   RunRecord r;
   r.id = st.int64(0);
   r.created_at = st.real(1);

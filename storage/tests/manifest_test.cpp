@@ -172,6 +172,38 @@ TEST_F(ManifestTest, AManifestThatCannotBeReachedIsNotCalledMissing) {
   EXPECT_EQ(WEXITSTATUS(status), 0) << "1: not an I/O error naming the cause; 2: could not become nobody";
 }
 
+// A log that holds commits, in a directory this user cannot write (a live or killed run's copy): SQLite cannot read
+// it and said only "unable to open database file"; the reader says why.
+TEST_F(ManifestTest, ALogItCannotReadIsExplained) {
+  if (::geteuid() != 0) GTEST_SKIP() << "needs root, to read as another user (nobody)";
+  namespace fs = std::filesystem;
+  const fs::path copy = dir_ / "copy";
+  {
+    auto m = make();
+    ASSERT_TRUE(m.begin());
+    ASSERT_TRUE(m.set_run_state("stopped"));
+    ASSERT_TRUE(m.commit());
+    fs::create_directories(copy);
+    fs::copy_file(path_, copy / "manifest.sqlite");
+    fs::copy_file(path_ + "-wal", copy / "manifest.sqlite-wal");  // the log, not its shared-memory file
+  }
+  ASSERT_GT(fs::file_size(copy / "manifest.sqlite-wal"), 0u);
+  fs::permissions(dir_, fs::perms::owner_all | fs::perms::others_read | fs::perms::others_exec);
+  fs::permissions(copy, fs::perms::owner_all | fs::perms::others_read | fs::perms::others_exec);
+  const std::string path = (copy / "manifest.sqlite").string();
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    if (::setgid(65534) != 0 || ::setuid(65534) != 0) ::_exit(2);
+    auto reader = ManifestReader::open(path);
+    ::_exit(!reader && reader.error().message.find("the run is live or was not closed") != std::string::npos ? 0 : 1);
+  }
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0) << "1: not explained; 2: could not become nobody";
+}
+
 TEST_F(ManifestTest, RecordsEachJobExactlyOnce) {
   auto m = make();
   JobRecord job;
