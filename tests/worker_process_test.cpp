@@ -1,7 +1,8 @@
-// A worker process stopped by SIGTERM mid-job (a scheduler's preemption), against a stand-in coordinator (a ROUTER
-// socket on 127.0.0.1): it leaves, naming the job it held, and exits with 4. Before, it said nothing (the coordinator
-// found it lost by its silence and counted the attempt as failed), and a SIGTERM that came while METIS ordered the
-// Hessian ran METIS's own handler on the wrong thread and crashed the worker (SIGSEGV).
+// A worker process against a stand-in coordinator (a ROUTER socket on 127.0.0.1). A job this build's checks refuse is
+// answered as an invalid job at once, where it was dropped and its lease held until it expired. Stopped by SIGTERM
+// mid-job (a scheduler's preemption), it leaves, naming the job it held, and exits with 4. Before, it said nothing
+// (the coordinator found it lost by its silence and counted the attempt as failed), and a SIGTERM that came while
+// METIS ordered the Hessian ran METIS's own handler on the wrong thread and crashed the worker (SIGSEGV).
 #include <optional>
 #include <vector>
 #include <zmq.hpp>
@@ -32,6 +33,46 @@ std::optional<std::pair<std::string, v1::Envelope>> receive(zmq::socket_t& route
   return std::nullopt;
 }
 
+void send(zmq::socket_t& router, const std::string& identity, v1::Envelope e) {
+  const std::string frame = proto::encode(std::move(e));
+  router.send(zmq::buffer(identity), zmq::send_flags::sndmore);
+  router.send(zmq::buffer(frame), zmq::send_flags::none);
+}
+
+TEST(WorkerProcess, AJobItsChecksRefuseIsAnsweredAsAnInvalidJob) {
+  const fs::path dir = test_dir("worker_refuses");
+  zmq::context_t context;
+  zmq::socket_t router(context, zmq::socket_type::router);
+  router.set(zmq::sockopt::linger, 0);
+  router.bind("tcp://127.0.0.1:*");
+  Process worker = start_worker(router.get(zmq::sockopt::last_endpoint), dir, 0);
+  auto ready = receive(router, 30s);
+  ASSERT_TRUE(ready) << worker.err();
+  ASSERT_EQ(ready->second.body_case(), v1::Envelope::kReady);
+  v1::Envelope job;  // a resolution of 2: below every build's minimum, as a newer coordinator's new value would be
+  job.mutable_job()->set_job_id(41);
+  job.mutable_job()->set_attempt(2);
+  job.mutable_job()->set_lease_ms(60000);
+  job.mutable_job()->mutable_spec()->set_mode(v1::JOB_MODE_DRAPE);
+  job.mutable_job()->mutable_spec()->set_resolution(2);
+  send(router, ready->first, job);
+  std::optional<v1::Failure> failure;
+  const auto until = std::chrono::steady_clock::now() + 10s;
+  while (!failure && std::chrono::steady_clock::now() < until) {
+    auto message = receive(router, 1s);
+    if (message && message->second.body_case() == v1::Envelope::kFailure) failure = message->second.failure();
+  }
+  ASSERT_TRUE(failure) << "no answer to the refused job: " << worker.err();
+  EXPECT_EQ(failure->job_id(), 41u);
+  EXPECT_EQ(failure->attempt(), 2u);
+  EXPECT_EQ(failure->reason(), v1::FAILURE_REASON_INVALID_JOB);
+  EXPECT_NE(failure->message().find("the worker refused the job: "), std::string::npos) << failure->message();
+  v1::Envelope shutdown;
+  shutdown.mutable_shutdown()->set_reason("test over");
+  send(router, ready->first, shutdown);
+  EXPECT_EQ(worker.wait(10s), 0) << worker.err();
+}
+
 TEST(WorkerProcess, StoppedMidJobItSaysWhichJobItLeaves) {
   const fs::path dir = test_dir("worker_stop");
   auto config = coordinator::parse_run_config("samples = 1\nresolution = 61\norientations = 1", "run.toml");
@@ -52,9 +93,7 @@ TEST(WorkerProcess, StoppedMidJobItSaysWhichJobItLeaves) {
   ASSERT_EQ(ready->second.body_case(), v1::Envelope::kReady);
   v1::Envelope job;
   *job.mutable_job() = *message;
-  const std::string frame = proto::encode(job);
-  router.send(zmq::buffer(ready->first), zmq::send_flags::sndmore);
-  router.send(zmq::buffer(frame), zmq::send_flags::none);
+  send(router, ready->first, job);
 
   // Computing: its heartbeat names the job (a 61x61 drape takes seconds).
   bool computing = false;
