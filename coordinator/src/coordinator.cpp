@@ -917,6 +917,7 @@ sim::Expected<std::unique_ptr<Coordinator>> Coordinator::create(const std::strin
   if (options.retry_failed) return sim::Error{"a new run has no failed jobs to retry (retry_failed is for a resume)"};
   auto config = parse_run_config(config_text, config_name);
   if (!config) return config.error();
+  if (sim::Status s = check_new_run(*config, config_name); !s) return s.error();
   auto impl = std::make_unique<Impl>();
   impl->config = *config;
   impl->options = options;

@@ -141,6 +141,25 @@ std::string endpoint_problem(const std::string& endpoint) {
   return "";
 }
 
+sim::Status check_new_run(const RunConfig& c, const std::string& source_name) {
+  const auto fail = [&](const char* key, const std::string& message) {
+    return sim::Error{fmt::format("{}: {}: {}", source_name, key, message)};
+  };
+  // The plan is built in memory before the manifest is written: 10^7 x 64 jobs would have needed hundreds of GB and
+  // ended in "out of memory" without naming the keys.
+  constexpr std::int64_t kMaxJobs = 2'000'000;
+  if (const std::int64_t jobs = static_cast<std::int64_t>(c.samples) * c.states_per_sample; jobs > kMaxJobs) {
+    return fail("samples", fmt::format("samples x states_per_sample is {} jobs; at most {} in one run (the plan is "
+                                       "built in memory: split the run, e.g. by seed)",
+                                       jobs, kMaxJobs));
+  }
+  if (c.coarse_start_resolution == 1 || c.coarse_start_resolution == 2) {
+    return fail("solver.coarse_start_resolution", "must be 0 (off) or at least 3");  // as simulate --coarse-start
+  }
+  if (const std::string problem = endpoint_problem(c.bind); !problem.empty()) return fail("network.bind", problem);
+  return {};
+}
+
 sim::Expected<RunConfig> parse_run_config(const std::string& toml_text, const std::string& source_name) {
   auto parsed = parse_toml(toml_text, source_name);
   if (!parsed) return parsed.error();
@@ -160,14 +179,6 @@ sim::Expected<RunConfig> parse_run_config(const std::string& toml_text, const st
   }
   r.integer(&root, "", "samples", c.samples, 1, 10'000'000);
   r.integer(&root, "", "states_per_sample", c.states_per_sample, 1, 64);
-  // The plan is built in memory before the manifest is written: 10^7 x 64 jobs would have needed hundreds of GB
-  // and ended in "out of memory" without naming the keys.
-  if (constexpr std::int64_t kMaxJobs = 2'000'000;
-      r.ok() && static_cast<std::int64_t>(c.samples) * c.states_per_sample > kMaxJobs) {
-    r.fail("samples", fmt::format("samples x states_per_sample is {} jobs; at most {} in one run (the plan is built "
-                                  "in memory: split the run, e.g. by seed)",
-                                  static_cast<std::int64_t>(c.samples) * c.states_per_sample, kMaxJobs));
-  }
   r.integer(&root, "", "orientations", c.orientations, 1, 360);
   r.integer(&root, "", "resolution", c.resolution, 5, 400);
   r.text(&root, "", "noise", c.noise, {"kinect", "none"});
@@ -193,9 +204,6 @@ sim::Expected<RunConfig> parse_run_config(const std::string& toml_text, const st
   r.integer(solver, "solver", "max_iterations", c.max_iterations, 1, 100000);
   r.real(solver, "solver", "tolerance", c.tolerance, 1e-12, 1.0);
   r.integer(solver, "solver", "coarse_start_resolution", c.coarse_start_resolution, 0, 400);
-  if (r.ok() && (c.coarse_start_resolution == 1 || c.coarse_start_resolution == 2)) {
-    r.fail("solver.coarse_start_resolution", "must be 0 (off) or at least 3");  // as drapegen simulate --coarse-start
-  }
   r.integer(solver, "solver", "max_self_intersections", c.max_self_intersections, 0, 1'000'000);
 
   const toml::table* network = r.table("network");
@@ -204,8 +212,8 @@ sim::Expected<RunConfig> parse_run_config(const std::string& toml_text, const st
   r.integer(network, "network", "heartbeat_ms", c.heartbeat_ms, 10, 600000);
   r.integer(network, "network", "liveness", c.liveness, 2, 1000);
   r.real(network, "network", "lease_s", c.lease_s, 0.1, 7 * 86400.0);
-  if (const std::string problem = endpoint_problem(c.bind); r.ok() && !problem.empty()) {
-    r.fail("network.bind", problem);
+  if (r.ok() && c.bind.rfind("tcp://", 0) != 0 && c.bind.rfind("ipc://", 0) != 0) {
+    r.fail("network.bind", "must be a tcp:// or ipc:// endpoint, e.g. tcp://127.0.0.1:5555");
   }
 
   const toml::table* security = r.table("security");

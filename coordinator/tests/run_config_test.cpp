@@ -6,6 +6,14 @@
 namespace drapegen::coordinator {
 namespace {
 
+/// The error of `text` as a new run's configuration ("" if none).
+std::string new_run_error_of(const std::string& text) {
+  auto config = parse_run_config(text, "run.toml");
+  if (!config) return config.error().message;
+  const sim::Status s = check_new_run(*config, "run.toml");
+  return s ? std::string() : s.error().message;
+}
+
 std::string error_of(const std::string& text) {
   auto c = parse_run_config(text, "run.toml");
   return c ? std::string() : c.error().message;
@@ -119,42 +127,51 @@ poison_samples = [1, 2]
 TEST(RunConfig, NamesTheKeyOfEveryError) {
   EXPECT_EQ(error_of("samples = 0"), "run.toml: samples: must be between 1 and 10000000");
   EXPECT_EQ(error_of("sampels = 3"), "run.toml: sampels: unknown key");
-  EXPECT_EQ(error_of("samples = 10000000\nstates_per_sample = 64"),
-            "run.toml: samples: samples x states_per_sample is 640000000 jobs; at most 2000000 in one run (the plan "
-            "is built in memory: split the run, e.g. by seed)");
-  EXPECT_TRUE(parse_run_config("samples = 250000\nstates_per_sample = 8", "run.toml"));
+
   EXPECT_EQ(error_of("noise = \"loud\""), "run.toml: noise: 'loud' is not one of kinect, none");
   EXPECT_EQ(error_of("renderer = \"gpu\""), "run.toml: renderer: 'gpu' is not one of osmesa, software");
   EXPECT_EQ(error_of("bending_model = \"quadratic\""),
             "run.toml: bending_model: 'quadratic' is not one of dihedral, triangle");
   EXPECT_EQ(error_of("[solver]\ntolerance = \"small\""), "run.toml: solver.tolerance: must be a number");
   EXPECT_EQ(error_of("[network]\nbind = \"http://x\""),
-            "run.toml: network.bind: 'http://x' is not a tcp:// or ipc:// endpoint (e.g. tcp://127.0.0.1:5555, "
-            "tcp://*:* or ipc:///tmp/drapegen.sock)");
-  // ZeroMQ bound port 70000 as 4464 (modulo 65536) and a missing port failed only at bind, "Invalid argument".
-  for (const char* bad : {"tcp://127.0.0.1:70000", "tcp://127.0.0.1:0", "tcp://127.0.0.1:-1", "tcp://127.0.0.1:",
-                          "tcp://127.0.0.1:5x", "tcp://127.0.0.1:000005555"}) {
-    EXPECT_NE(error_of(std::string("[network]\nbind = \"") + bad + "\"").find("the port must be 1 .. 65535 or *"),
-              std::string::npos)
-        << bad;
-  }
-  EXPECT_NE(error_of("[network]\nbind = \"tcp://127.0.0.1\"").find("needs a host and a port"), std::string::npos);
-  EXPECT_NE(error_of("[network]\nbind = \"ipc://\"").find("names no path"), std::string::npos);
-  for (const char* good : {"tcp://127.0.0.1:5555", "tcp://*:*", "tcp://[::1]:65535", "ipc:///tmp/x.sock"}) {
-    auto config = parse_run_config(std::string("[network]\nbind = \"") + good + "\"", "run.toml");
-    EXPECT_TRUE(config) << good << ": " << config.error().message;
-  }
-  // 1 and 2 switched the coarse start off, silently (drapegen simulate --coarse-start refuses them).
-  for (int n : {1, 2}) {
-    EXPECT_EQ(error_of("[solver]\ncoarse_start_resolution = " + std::to_string(n)),
-              "run.toml: solver.coarse_start_resolution: must be 0 (off) or at least 3");
-  }
+            "run.toml: network.bind: must be a tcp:// or ipc:// endpoint, e.g. tcp://127.0.0.1:5555");
   EXPECT_EQ(error_of("[network]\nport = 1"), "run.toml: network.port: unknown key");
   EXPECT_EQ(error_of("[extra]\nx = 1"), "run.toml: extra: unknown section");
   EXPECT_EQ(error_of("seed = -1"), "run.toml: seed: must be a non-negative integer");
   EXPECT_EQ(error_of("[testing]\npoison_samples = [\"a\"]"),
             "run.toml: testing.poison_samples: must hold non-negative integers");
   EXPECT_NE(error_of("seed = = 1").find("run.toml:1:"), std::string::npos);
+}
+
+// What a new run must also pass, and a stored configuration (an earlier build's run, resumed) need not: it was
+// planned already, so the job cap means nothing to it, and refusing it would leave the run impossible to resume.
+TEST(RunConfig, ANewRunIsCheckedFurtherThanAStoredOne) {
+  const std::string big = "samples = 10000000\nstates_per_sample = 64";
+  EXPECT_EQ(new_run_error_of(big),
+            "run.toml: samples: samples x states_per_sample is 640000000 jobs; at most 2000000 in one run (the plan "
+            "is built in memory: split the run, e.g. by seed)");
+  EXPECT_EQ(error_of(big), "");
+  EXPECT_EQ(new_run_error_of("samples = 250000\nstates_per_sample = 8"), "");
+  // ZeroMQ bound port 70000 as 4464 (modulo 65536) and a missing port failed only at bind, "Invalid argument".
+  for (const char* bad : {"tcp://127.0.0.1:70000", "tcp://127.0.0.1:0", "tcp://127.0.0.1:-1", "tcp://127.0.0.1:",
+                          "tcp://127.0.0.1:5x", "tcp://127.0.0.1:000005555"}) {
+    const std::string toml = std::string("[network]\nbind = \"") + bad + "\"";
+    EXPECT_NE(new_run_error_of(toml).find("network.bind: '"), std::string::npos) << bad;
+    EXPECT_NE(new_run_error_of(toml).find("the port must be 1 .. 65535 or *"), std::string::npos) << bad;
+    EXPECT_EQ(error_of(toml), "") << bad;
+  }
+  EXPECT_NE(new_run_error_of("[network]\nbind = \"tcp://127.0.0.1\"").find("needs a host and a port"),
+            std::string::npos);
+  EXPECT_NE(new_run_error_of("[network]\nbind = \"ipc://\"").find("names no path"), std::string::npos);
+  for (const char* good : {"tcp://127.0.0.1:5555", "tcp://*:*", "tcp://[::1]:65535", "ipc:///tmp/x.sock"}) {
+    EXPECT_EQ(new_run_error_of(std::string("[network]\nbind = \"") + good + "\""), "") << good;
+  }
+  // 1 and 2 switched the coarse start off, silently (drapegen simulate --coarse-start refuses them).
+  for (int n : {1, 2}) {
+    const std::string toml = "[solver]\ncoarse_start_resolution = " + std::to_string(n);
+    EXPECT_EQ(new_run_error_of(toml), "run.toml: solver.coarse_start_resolution: must be 0 (off) or at least 3");
+    EXPECT_EQ(error_of(toml), "");
+  }
 }
 
 TEST(RunConfig, TakesAnyOutputDirectoryAsAnOverride) {

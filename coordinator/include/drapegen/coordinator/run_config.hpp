@@ -56,6 +56,11 @@ struct RunConfig {
 /// name the key, e.g. "run.toml: samples: must be between 1 and 10000000".
 [[nodiscard]] sim::Expected<RunConfig> parse_run_config(const std::string& toml_text, const std::string& source_name);
 
+/// The checks a new run's configuration must also pass (not a stored one that an earlier build planned, which a resume
+/// reads back): at most 2,000,000 jobs (the plan is built in memory), a coarse start of 0 or at least 3, a bind
+/// endpoint with a valid port. Errors name the key, as parse_run_config's.
+[[nodiscard]] sim::Status check_new_run(const RunConfig& config, const std::string& source_name);
+
 /// The configuration with its top-level `output` set to `output` (any characters; the file's own, if any, replaced),
 /// as TOML text again (comments and layout are not kept). Errors: the text does not parse.
 [[nodiscard]] sim::Expected<std::string> with_output(const std::string& toml_text, const std::string& source_name,
