@@ -40,11 +40,18 @@ int main(int argc, char** argv) {
       drapegen::cli::add_stats_command);
   add("keygen", "Make a CurveZMQ key pair (coordinator or worker) for runs on non-loopback addresses",
       drapegen::cli::add_keygen_command);
-  // Integers in base 10 everywhere: CLI11 would read --seed 010 as octal 8.
+  // Integers in base 10 everywhere: CLI11 would read --seed 010 as octal 8, 0x10 as 16 and 0b11 as 3.
+  const CLI::Validator decimal(
+      [](std::string& text) {
+        if (!drapegen::cli::is_decimal_integer(text)) return "'" + text + "' is not a decimal integer";
+        text = drapegen::cli::decimal_integer(text);
+        return std::string();
+      },
+      "");
   for (CLI::App* sub : app.get_subcommands({})) {
     for (CLI::Option* option : sub->get_options()) {
       const std::string type = option->get_type_name();
-      if (type.rfind("INT", 0) == 0 || type.rfind("UINT", 0) == 0) option->transform(drapegen::cli::decimal_integer);
+      if (type.rfind("INT", 0) == 0 || type.rfind("UINT", 0) == 0) option->transform(decimal);
     }
   }
   try {

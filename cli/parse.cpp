@@ -107,6 +107,11 @@ std::ostream& summary_stream(const std::vector<std::string>& outputs) {
 
 std::string endpoint_problem(const std::string& endpoint) { return coordinator::endpoint_problem(endpoint); }
 
+bool is_decimal_integer(const std::string& text) {
+  const std::size_t sign = !text.empty() && (text[0] == '+' || text[0] == '-') ? 1 : 0;
+  return text.size() > sign && text.find_first_not_of("0123456789", sign) == std::string::npos;
+}
+
 std::string decimal_integer(std::string text) {
   const std::size_t sign = !text.empty() && (text[0] == '+' || text[0] == '-') ? 1 : 0;
   const bool digits = text.size() > sign && text.find_first_not_of("0123456789", sign) == std::string::npos;

@@ -22,6 +22,8 @@ namespace drapegen::cli {
 /// An integer option's text in base 10: leading zeros dropped ("010" -> "10", "-007" -> "-7"); anything else as it
 /// is. CLI11 reads integers with strtoll's base 0, where "010" is octal 8.
 [[nodiscard]] std::string decimal_integer(std::string text);
+/// Whether `text` is an optional sign and decimal digits (no 0x, 0b or 0o prefix, no spaces).
+[[nodiscard]] bool is_decimal_integer(const std::string& text);
 
 /// Whether a file can be created at `path` (probes with a temporary file beside it, then removes it); a directory
 /// there is an error, not a file that can be replaced.

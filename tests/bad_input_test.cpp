@@ -555,5 +555,89 @@ TEST(Service, RetryFailedGivesFailedJobsMoreAttemptsOnResume) {
   for (const auto& f : failures) EXPECT_EQ(f.attempt, 1) << f.job_id;
 }
 
+// The retried job's extra attempts survive a resume: max_attempts 3, failed at 3; retried, failed at 4 and stopped;
+// resumed without the flag it still has attempts 5 and 6 (it had max_attempts only, 3, and failed at 5 before).
+TEST(Service, ARetriedJobKeepsItsExtraAttemptsAcrossAResume) {
+  const fs::path dir = test_dir("retry_budget");
+  const fs::path out = dir / "run";
+  const fs::path manifest = out / "manifest.sqlite";
+  write_text(dir / "run.toml", small_config(out, 1, 1, "[retry]\nmax_attempts = 3\n"));
+  zmq::context_t context;
+  // A session served by a worker that fails `fails` attempts; then the run is stopped (SIGTERM), or ends with the job
+  // failed (3 failures), or a real worker completes it.
+  const auto session = [&](const std::vector<std::string>& args, const std::string& name, int fails, bool stop) {
+    auto [coordinator, endpoint] = start_coordinator(args, out, dir / name);
+    ASSERT_FALSE(endpoint.empty()) << coordinator.err();
+    FakeWorker broken(context, endpoint);
+    broken.send(ready("broken"));
+    for (int k = 0; k < fails; ++k) {
+      auto job = broken.expect(v1::Envelope::kJob, 30s);
+      ASSERT_TRUE(job) << coordinator.err();
+      broken.send(failure(job->job().job_id(), job->job().attempt()));
+    }
+    if (stop) {
+      const auto until = std::chrono::steady_clock::now() + 10s;  // the last failure recorded, then stop
+      while (std::chrono::steady_clock::now() < until) {
+        auto reader = storage::ManifestReader::open(manifest.string());
+        if (reader && reader->failures() && static_cast<int>(reader->failures()->size()) >= 4) break;
+        std::this_thread::sleep_for(20ms);
+      }
+      ::kill(coordinator.pid(), SIGTERM);
+      ASSERT_EQ(coordinator.wait(30s), 4) << coordinator.err();
+      return;
+    }
+    if (fails == 3) {
+      ASSERT_EQ(coordinator.wait(30s), 0) << coordinator.err();  // the job failed: the run is complete
+      return;
+    }
+    v1::Envelope leave;  // the broken worker goes (else the job, failed by it, is leased to it again: no other)
+    leave.mutable_leave()->set_reason("test");
+    broken.send(leave);
+    Process worker = start_worker(endpoint, dir, 1);
+    ASSERT_EQ(coordinator.wait(120s), 0) << coordinator.err();
+  };
+  session({"--config", (dir / "run.toml").string()}, "first", 3, false);
+  session({"--resume", manifest.string(), "--retry-failed"}, "retried", 1, true);
+  session({"--resume", manifest.string()}, "resumed", 1, false);
+  auto reader = storage::ManifestReader::open(manifest.string());
+  ASSERT_TRUE(reader);
+  const auto jobs = all(reader->jobs());
+  ASSERT_EQ(jobs.size(), 1u);
+  EXPECT_EQ(jobs[0].state, storage::JobState::kDone);
+  EXPECT_EQ(jobs[0].attempts, 6);
+  EXPECT_EQ(all(reader->failures()).size(), 5u);
+}
+
+// A worker that leaves (stopped) gives its job back without costing an attempt, but only three times per job: a job
+// that outlasts every worker's time limit (a scheduler's --time shorter than the lease) would go round for ever. The
+// fourth leave is a lost worker's failed attempt, and with one attempt per job the job fails.
+TEST(Service, AJobIsForgivenThreeLeavesNotMore) {
+  const fs::path dir = test_dir("leaves");
+  const fs::path out = dir / "run";
+  write_text(dir / "run.toml", small_config(out, 1, 1, "[retry]\nmax_attempts = 1\n"));
+  auto [coordinator, endpoint] = start_coordinator({"--config", (dir / "run.toml").string()}, out, dir / "coordinator");
+  ASSERT_FALSE(endpoint.empty()) << coordinator.err();
+  zmq::context_t context;
+  for (int k = 0; k < 4; ++k) {
+    FakeWorker leaving(context, endpoint);
+    leaving.send(ready("leaving" + std::to_string(k)));
+    auto job = leaving.expect(v1::Envelope::kJob, 30s);
+    ASSERT_TRUE(job) << k << ": " << coordinator.err();
+    EXPECT_EQ(job->job().attempt(), 1u) << k;  // given back: the same attempt again
+    v1::Envelope leave;
+    leave.mutable_leave()->set_job_id(job->job().job_id());
+    leave.mutable_leave()->set_attempt(job->job().attempt());
+    leaving.send(leave);
+  }
+  ASSERT_EQ(coordinator.wait(30s), 0) << coordinator.err();  // the job failed: the run is complete
+  auto reader = storage::ManifestReader::open((out / "manifest.sqlite").string());
+  ASSERT_TRUE(reader);
+  const auto failures = all(reader->failures());
+  ASSERT_EQ(failures.size(), 1u);
+  EXPECT_EQ(failures[0].reason, "worker_lost");
+  EXPECT_NE(failures[0].message.find("stopped while computing it, again"), std::string::npos) << failures[0].message;
+  EXPECT_EQ(all(reader->jobs())[0].state, storage::JobState::kFailed);
+}
+
 }  // namespace
 }  // namespace drapegen::test

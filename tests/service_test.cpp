@@ -133,6 +133,13 @@ TEST(Service, AWorkerStoppedBySigtermCostsItsJobNoAttempt) {
       EXPECT_TRUE(code == 4 || (code == 0 && coordinator.wait(30s) == 0)) << code << ": " << victim.err();
       ++stopped;
       victim = start_worker(endpoint, dir, next++);
+      // Not stopped before it has its signal thread (else SIGTERM's default action kills it, as a scheduler's would
+      // before the program starts): once it has connected it has.
+      const auto until = std::chrono::steady_clock::now() + 10s;
+      while (victim.err().find("connected to") == std::string::npos && victim.running() && coordinator.running() &&
+             std::chrono::steady_clock::now() < until) {
+        std::this_thread::sleep_for(10ms);
+      }
     }
   }
   ASSERT_EQ(coordinator.wait(60s), 0) << coordinator.err();

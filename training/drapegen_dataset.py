@@ -126,6 +126,7 @@ class DrapeDataset(Dataset):
             # about 1 GB, copied into every DataLoader worker as reference counts touched their pages. Features are
             # per sample, paths fixed-width bytes, checksums read only when they are verified.
             where = ("FROM jobs j JOIN files f ON f.job_id = j.id AND f.kind = 'exr' WHERE j.state = 'done'")
+            db.execute("BEGIN")  # one snapshot for the count, the width, the rows and the samples (a live run commits)
             count = db.execute("SELECT count(*) " + where).fetchone()[0]
             width = db.execute("SELECT coalesce(max(length(CAST(f.path AS BLOB))), 1) " + where).fetchone()[0]
             self.jobs = np.empty(count, dtype=np.int64)
@@ -142,8 +143,6 @@ class DrapeDataset(Dataset):
                 if not chunk:
                     break
                 for row in chunk:
-                    if i == count:  # (a writer's commit between the two reads cannot add rows to one snapshot)
-                        break
                     self.jobs[i], self.samples[i], self.slots[i], self.orientations[i] = row[:4]
                     self.paths[i] = row[4].encode()
                     if verify_checksums:
@@ -151,6 +150,7 @@ class DrapeDataset(Dataset):
                     i += 1
             sample_rows = db.execute("SELECT sample, alpha_warp, alpha_bias, alpha_weft, beta_warp, beta_bias, "
                                      "beta_weft, density FROM samples ORDER BY sample").fetchall()
+            db.execute("COMMIT")
         finally:
             db.close()
         if self.run_state != "complete":

@@ -39,7 +39,11 @@ TEST(DecimalInteger, DropsLeadingZerosOfIntegersOnly) {
   EXPECT_EQ(decimal_integer("-007"), "-7");
   EXPECT_EQ(decimal_integer("+08"), "+8");
   EXPECT_EQ(decimal_integer("42"), "42");
-  for (const char* other : {"", "-", "0x10", "1e3", "07a", "abc", " 07"}) EXPECT_EQ(decimal_integer(other), other);
+  for (const char* other : {"", "-", "0x10", "1e3", "07a", "abc", " 07"}) {
+    EXPECT_EQ(decimal_integer(other), other);
+    EXPECT_FALSE(is_decimal_integer(other)) << other;
+  }
+  for (const char* integer : {"0", "010", "-7", "+8", "18446744073709551615"}) EXPECT_TRUE(is_decimal_integer(integer));
 }
 
 TEST(CheckWritable, ReportsMissingDirectory) {

@@ -66,6 +66,7 @@ struct Coordinator::Impl {
     storage::JobRecord rec;
     int attempts = 0;  // attempts started, this session included
     int attempt_limit = 0;  // the job fails at this many attempts (retry.max_attempts; more for a retried job)
+    int forgiven_leaves = 0;  // attempts given back by workers that left (stopped), this session
     bool leased = false;
     std::string worker;  // routing id of the lease
     double lease_started = 0.0;
@@ -73,6 +74,7 @@ struct Coordinator::Impl {
     std::int64_t waiting_on = 0;  // source job of a drape recipe, while it is pending
     std::vector<std::string> failed_on;  // routing ids of the workers whose attempts failed, this session
   };
+  static constexpr int kForgivenLeaves = 3;  // attempts per job given back by leaving workers, per session
   struct Worker {
     std::string identity;
     std::string name;
@@ -216,7 +218,9 @@ struct Coordinator::Impl {
       if (rec.id != static_cast<std::int64_t>(jobs.size()) + 1) return sim::Error{"manifest: job ids not contiguous"};
       JobSlot slot;
       slot.attempts = rec.attempts;
-      slot.attempt_limit = config.max_attempts;
+      // max_attempts, or for a job --retry-failed made pending again (its attempts a multiple of max_attempts when it
+      // failed) max_attempts more: the next multiple above the attempts it has had, so the budget survives a resume.
+      slot.attempt_limit = (rec.attempts / config.max_attempts + 1) * config.max_attempts;
       slot.rec = std::move(rec);
       jobs.push_back(std::move(slot));
     }
@@ -235,7 +239,6 @@ struct Coordinator::Impl {
         if (slot.rec.state != storage::JobState::kFailed) continue;
         slot.rec.state = storage::JobState::kPending;
         slot.rec.failure_reason.clear();
-        slot.attempt_limit = slot.attempts + config.max_attempts;
       }
       log->info("{} failed job(s) pending again, {} more attempt(s) each", *retried, config.max_attempts);
     }
@@ -549,6 +552,12 @@ struct Coordinator::Impl {
     // The Leave may name no job when the Job sent to it crossed it on the way: that attempt never started either.
     if (w.job == 0) return;
     JobSlot& slot = jobs[static_cast<std::size_t>(w.job - 1)];
+    // Forgiven a few times only: a job that outlasts every worker's time limit (a scheduler's --time shorter than the
+    // lease) would otherwise be given back for ever and never fail.
+    if (slot.forgiven_leaves >= kForgivenLeaves) {
+      return lose_worker(w, "stopped while computing it, again");
+    }
+    ++slot.forgiven_leaves;
     w.job = 0;
     slot.leased = false;
     slot.worker.clear();

@@ -32,6 +32,7 @@ struct Task {
   std::uint64_t id = 0;
   v1::Simulation simulation;
   int attempts = 0;  // started
+  int forgiven_leaves = 0;  // attempts given back by workers that left (stopped)
   Clock::time_point queued;
   std::promise<sim::Expected<sim::DrapeResult>> answer;
 };
@@ -39,6 +40,7 @@ struct Task {
 }  // namespace
 
 struct SimulationFleet::Impl {
+  static constexpr int kForgivenLeaves = 3;  // attempts per drape given back by leaving workers
   struct Worker {
     std::string identity, name;
     Clock::time_point last_seen, last_sent;
@@ -205,10 +207,14 @@ struct SimulationFleet::Impl {
         return;
       }
       case v1::Envelope::kLeave: {
-        // Stopped by a signal: its drape goes to the next worker, the attempt not counted.
+        // Stopped by a signal: its drape goes to the next worker, the attempt not counted (a few times: a drape that
+        // outlasts every worker's time limit would otherwise go round for ever).
         log->info("fleet: worker {} left ({})", w.name, e.leave().reason().empty() ? "stopped" : e.leave().reason());
-        if (w.task) {
+        if (w.task && w.task->forgiven_leaves >= kForgivenLeaves) {
+          lose(w, "stopped while computing it, again");
+        } else if (w.task) {
           std::lock_guard lock(mutex);
+          ++w.task->forgiven_leaves;
           --w.task->attempts;
           queue.push_front(std::move(w.task));
         }

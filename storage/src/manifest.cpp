@@ -383,6 +383,7 @@ struct Manifest::Impl {
   std::string path;
   int schema_version = kSchemaVersion;
   bool in_transaction = false;
+  bool wrote = false;  // a write group was begun (a resume refused before it, on a live run's lock, writes nothing)
   Statement begin, commit, rollback, savepoint, release, rollback_to;
   Statement job_done, insert_result, insert_file, job_failed, job_attempt, insert_failure, update_recipe;
   Statement run_state, run_endpoint;
@@ -397,8 +398,10 @@ struct Manifest::Impl {
     // Every commit into the database file itself, the log emptied: closing copies the log in only when this is the
     // last connection, and a reader open meanwhile (stats, the training stage) left the run's results in the -wal
     // alone, so that the .sqlite copied or read without it looked empty. Best effort, a short wait for readers.
+    // Only by a connection that wrote: one that opened a live run's manifest and was refused its lock must not hold
+    // up that run's commits.
     sqlite3_busy_timeout(db, 2000);
-    if (sqlite3_wal_checkpoint_v2(db, nullptr, SQLITE_CHECKPOINT_TRUNCATE, nullptr, nullptr) != SQLITE_OK) {
+    if (wrote && sqlite3_wal_checkpoint_v2(db, nullptr, SQLITE_CHECKPOINT_TRUNCATE, nullptr, nullptr) != SQLITE_OK) {
       (void)sqlite3_wal_checkpoint_v2(db, nullptr, SQLITE_CHECKPOINT_PASSIVE, nullptr, nullptr);
     }
     sqlite3_close(db);
@@ -613,6 +616,7 @@ sim::Status Manifest::begin() {
   if (impl_->in_transaction) return {};
   if (sim::Status s = impl_->begin.run(); !s) return s;
   impl_->in_transaction = true;
+  impl_->wrote = true;
   return {};
 }
 

@@ -319,15 +319,14 @@ sim::Expected<WorkerEnd> run_worker(const WorkerOptions& o, const std::atomic<bo
       }
     }
     if (stop.load()) {
-      // Said, so that the job in hand is re-queued at once without costing an attempt, and no other is sent here.
-      if (connected) {
-        v1::Envelope leave;
-        leave.mutable_leave()->set_job_id(static_cast<std::uint64_t>(current_job));
-        leave.mutable_leave()->set_attempt(current_job != 0 ? current_attempt : 0);
-        leave.mutable_leave()->set_reason("stopped");
-        socket.set(zmq::sockopt::linger, 1000);  // sent before the socket closes, if the coordinator is there
-        send(std::move(leave));
-      }
+      // Said, so that the job in hand is re-queued at once without costing an attempt, and no other is sent here
+      // (also before anything was heard on this socket: the coordinator may have leased a job on our Ready already).
+      v1::Envelope leave;
+      leave.mutable_leave()->set_job_id(static_cast<std::uint64_t>(current_job));
+      leave.mutable_leave()->set_attempt(current_job != 0 ? current_attempt : 0);
+      leave.mutable_leave()->set_reason("stopped");
+      socket.set(zmq::sockopt::linger, connected ? 1000 : 200);  // sent before the socket closes, if anyone is there
+      send(std::move(leave));
       break;
     }
     // The job in flight (if any) belonged to this connection.
