@@ -2,7 +2,8 @@
 // SIGINT/SIGTERM as a stop flag for the service commands. The signals are blocked in every thread and taken by one
 // thread of their own (sigwait), so no handler ever runs on a computing thread: METIS, which CHOLMOD orders with,
 // installs its own SIGTERM handler while it runs (a longjmp into its own stack), and a SIGTERM delivered then crashed
-// the worker (SIGSEGV) instead of stopping it. The service loops poll with timeouts of at most 100 ms.
+// the worker (SIGSEGV) instead of stopping it. A handler that sets the same flag covers threads started before the
+// mask was set (a threaded BLAS's pool). The service loops poll with timeouts of at most 100 ms.
 
 #include <atomic>
 #include <signal.h>
