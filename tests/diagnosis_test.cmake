@@ -1,6 +1,7 @@
 # The sim-to-real diagnosis end to end on a tiny case: drapegen reality writes a capture with a strong effect, the
-# truth file is moved away (a decoy that cannot be read in its place), drapegen diagnose runs the whole path (fit, floors, localisation, attribution, report)
-# on a coarse mesh with few evaluations; then bad captures and bad options give one-line errors.
+# truth file is moved away (a decoy that cannot be read in its place), drapegen diagnose runs the whole path (fit,
+# floors, localisation, attribution, report) on a coarse mesh with few evaluations; then bad captures and bad options
+# give one-line errors.
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
 

@@ -33,6 +33,17 @@ std::optional<std::pair<std::string, v1::Envelope>> receive(zmq::socket_t& route
   return std::nullopt;
 }
 
+/// The next message of `kind` from a worker within `timeout` (others skipped).
+std::optional<v1::Envelope> receive_kind(zmq::socket_t& router, v1::Envelope::BodyCase kind,
+                                         std::chrono::milliseconds timeout) {
+  const auto until = std::chrono::steady_clock::now() + timeout;
+  while (std::chrono::steady_clock::now() < until) {
+    auto message = receive(router, 1s);
+    if (message && message->second.body_case() == kind) return std::move(message->second);
+  }
+  return std::nullopt;
+}
+
 void send(zmq::socket_t& router, const std::string& identity, v1::Envelope e) {
   const std::string frame = proto::encode(std::move(e));
   router.send(zmq::buffer(identity), zmq::send_flags::sndmore);
@@ -56,17 +67,13 @@ TEST(WorkerProcess, AJobItsChecksRefuseIsAnsweredAsAnInvalidJob) {
   job.mutable_job()->mutable_spec()->set_mode(v1::JOB_MODE_DRAPE);
   job.mutable_job()->mutable_spec()->set_resolution(2);
   send(router, ready->first, job);
-  std::optional<v1::Failure> failure;
-  const auto until = std::chrono::steady_clock::now() + 10s;
-  while (!failure && std::chrono::steady_clock::now() < until) {
-    auto message = receive(router, 1s);
-    if (message && message->second.body_case() == v1::Envelope::kFailure) failure = message->second.failure();
-  }
-  ASSERT_TRUE(failure) << "no answer to the refused job: " << worker.err();
-  EXPECT_EQ(failure->job_id(), 41u);
-  EXPECT_EQ(failure->attempt(), 2u);
-  EXPECT_EQ(failure->reason(), v1::FAILURE_REASON_INVALID_JOB);
-  EXPECT_NE(failure->message().find("the worker refused the job: "), std::string::npos) << failure->message();
+  const auto answer = receive_kind(router, v1::Envelope::kFailure, 10s);
+  ASSERT_TRUE(answer) << "no answer to the refused job: " << worker.err();
+  const v1::Failure& failure = answer->failure();
+  EXPECT_EQ(failure.job_id(), 41u);
+  EXPECT_EQ(failure.attempt(), 2u);
+  EXPECT_EQ(failure.reason(), v1::FAILURE_REASON_INVALID_JOB);
+  EXPECT_NE(failure.message().find("the worker refused the job: "), std::string::npos) << failure.message();
   v1::Envelope shutdown;
   shutdown.mutable_shutdown()->set_reason("test over");
   send(router, ready->first, shutdown);
@@ -107,15 +114,10 @@ TEST(WorkerProcess, StoppedMidJobItSaysWhichJobItLeaves) {
   }
   ASSERT_TRUE(computing) << worker.err();
   ::kill(worker.pid(), SIGTERM);
-  std::optional<v1::Leave> leave;
-  const auto leave_until = std::chrono::steady_clock::now() + 10s;
-  while (!leave && std::chrono::steady_clock::now() < leave_until) {
-    auto m = receive(router, 1s);
-    if (m && m->second.body_case() == v1::Envelope::kLeave) leave = m->second.leave();
-  }
+  const auto leave = receive_kind(router, v1::Envelope::kLeave, 10s);
   ASSERT_TRUE(leave) << "the stopped worker left without a word: " << worker.err();
-  EXPECT_EQ(leave->job_id(), 7u);
-  EXPECT_EQ(leave->attempt(), 3u);
+  EXPECT_EQ(leave->leave().job_id(), 7u);
+  EXPECT_EQ(leave->leave().attempt(), 3u);
   EXPECT_EQ(worker.wait(10s), 4) << worker.err();
 }
 

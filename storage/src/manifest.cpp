@@ -206,7 +206,8 @@ sim::Expected<RunRecord> ManifestReader::run() const {
                "ORDER BY id LIMIT 1");
   if (!st.ok()) return sim::Error{"manifest: " + st.prepare_error()};
   if (st.step() != SQLITE_ROW) {
-    return sim::Error{fmt::format("manifest in {}: no run recorded (not a manifest drapegen wrote whole?)", directory_)};
+    return sim::Error{
+        fmt::format("manifest in {}: no run recorded (not a manifest drapegen wrote whole?)", directory_)};
   }
   RunRecord r;
   r.id = st.int64(0);
@@ -732,10 +733,8 @@ sim::Status Manifest::update_recipe(std::int64_t job_id, const std::string& reci
 sim::Expected<std::int64_t> Manifest::retry_failed() {
   std::int64_t changed = 0;
   sim::Status s = impl_->atomically([&]() -> sim::Status {
-    if (sim::Status e = exec(impl_->db, "UPDATE jobs SET state = 'pending', failure_reason = '' WHERE state = 'failed'");
-        !e) {
-      return e;
-    }
+    constexpr const char* kRetry = "UPDATE jobs SET state = 'pending', failure_reason = '' WHERE state = 'failed'";
+    if (sim::Status e = exec(impl_->db, kRetry); !e) return e;
     changed = sqlite3_changes(impl_->db);
     return {};
   });
