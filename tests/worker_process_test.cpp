@@ -50,23 +50,37 @@ void send(zmq::socket_t& router, const std::string& identity, v1::Envelope e) {
   router.send(zmq::buffer(frame), zmq::send_flags::none);
 }
 
-TEST(WorkerProcess, AJobItsChecksRefuseIsAnsweredAsAnInvalidJob) {
-  const fs::path dir = test_dir("worker_refuses");
-  zmq::context_t context;
-  zmq::socket_t router(context, zmq::socket_type::router);
-  router.set(zmq::sockopt::linger, 0);
-  router.bind("tcp://127.0.0.1:*");
-  Process worker = start_worker(router.get(zmq::sockopt::last_endpoint), dir, 0);
-  auto ready = receive(router, 30s);
-  ASSERT_TRUE(ready) << worker.err();
-  ASSERT_EQ(ready->second.body_case(), v1::Envelope::kReady);
+/// A stand-in coordinator's ROUTER socket and a worker process registered with it.
+class WorkerProcess : public ::testing::Test {
+ protected:
+  /// Starts the worker (logs in test_dir(name)); its routing id once it has sent Ready.
+  void start(const std::string& name) {
+    router_.set(zmq::sockopt::linger, 0);
+    router_.bind("tcp://127.0.0.1:*");
+    worker_ = start_worker(router_.get(zmq::sockopt::last_endpoint), test_dir(name), 0);
+    auto ready = receive(router_, 30s);
+    ASSERT_TRUE(ready) << worker_.err();
+    ASSERT_EQ(ready->second.body_case(), v1::Envelope::kReady);
+    identity_ = ready->first;
+  }
+
+  zmq::context_t context_;
+  zmq::socket_t router_{context_, zmq::socket_type::router};
+  Process worker_;
+  std::string identity_;
+};
+
+TEST_F(WorkerProcess, AJobItsChecksRefuseIsAnsweredAsAnInvalidJob) {
+  ASSERT_NO_FATAL_FAILURE(start("worker_refuses"));
+  zmq::socket_t& router = router_;
+  Process& worker = worker_;
   v1::Envelope job;  // a resolution of 2: below every build's minimum, as a newer coordinator's new value would be
   job.mutable_job()->set_job_id(41);
   job.mutable_job()->set_attempt(2);
   job.mutable_job()->set_lease_ms(60000);
   job.mutable_job()->mutable_spec()->set_mode(v1::JOB_MODE_DRAPE);
   job.mutable_job()->mutable_spec()->set_resolution(2);
-  send(router, ready->first, job);
+  send(router, identity_, job);
   const auto answer = receive_kind(router, v1::Envelope::kFailure, 10s);
   ASSERT_TRUE(answer) << "no answer to the refused job: " << worker.err();
   const v1::Failure& failure = answer->failure();
@@ -76,12 +90,11 @@ TEST(WorkerProcess, AJobItsChecksRefuseIsAnsweredAsAnInvalidJob) {
   EXPECT_NE(failure.message().find("the worker refused the job: "), std::string::npos) << failure.message();
   v1::Envelope shutdown;
   shutdown.mutable_shutdown()->set_reason("test over");
-  send(router, ready->first, shutdown);
+  send(router, identity_, shutdown);
   EXPECT_EQ(worker.wait(10s), 0) << worker.err();
 }
 
-TEST(WorkerProcess, StoppedMidJobItSaysWhichJobItLeaves) {
-  const fs::path dir = test_dir("worker_stop");
+TEST_F(WorkerProcess, StoppedMidJobItSaysWhichJobItLeaves) {
   auto config = coordinator::parse_run_config("samples = 1\nresolution = 61\norientations = 1", "run.toml");
   ASSERT_TRUE(config) << config.error().message;
   auto plan = coordinator::plan_run(*config);
@@ -90,17 +103,12 @@ TEST(WorkerProcess, StoppedMidJobItSaysWhichJobItLeaves) {
   ASSERT_TRUE(message) << message.error().message;
   message->set_job_id(7);
 
-  zmq::context_t context;
-  zmq::socket_t router(context, zmq::socket_type::router);
-  router.set(zmq::sockopt::linger, 0);
-  router.bind("tcp://127.0.0.1:*");
-  Process worker = start_worker(router.get(zmq::sockopt::last_endpoint), dir, 0);
-  auto ready = receive(router, 30s);
-  ASSERT_TRUE(ready) << worker.err();
-  ASSERT_EQ(ready->second.body_case(), v1::Envelope::kReady);
+  ASSERT_NO_FATAL_FAILURE(start("worker_stop"));
+  zmq::socket_t& router = router_;
+  Process& worker = worker_;
   v1::Envelope job;
   *job.mutable_job() = *message;
-  send(router, ready->first, job);
+  send(router, identity_, job);
 
   // Computing: its heartbeat names the job (a 61x61 drape takes seconds).
   bool computing = false;
