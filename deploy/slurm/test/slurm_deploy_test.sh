@@ -106,6 +106,16 @@ unnamed=$(sqlite3 "$manifest" "SELECT count(*) FROM jobs WHERE state = 'done' AN
 workers=$(sqlite3 "$manifest" "SELECT count(DISTINCT worker) FROM jobs WHERE state = 'done'")
 { [ "$workers" -ge 1 ] && [ "$workers" -le "$cpus" ]; } || fail "the manifest names $workers workers ($cpus started)"
 
+# --resume MANIFEST --retry-failed through the script: one job made failed (its result forgotten; its files, now
+# listed nowhere, the resume removes) is computed again.
+sqlite3 "$manifest" "DELETE FROM files WHERE job_id = 1; DELETE FROM results WHERE job_id = 1;
+  UPDATE jobs SET state = 'failed', failure_reason = 'worker_lost' WHERE id = 1"
+DRAPEGEN=$DRAPEGEN DRAPEGEN_BIND=127.0.0.1 DRAPEGEN_HOST=127.0.0.1 DRAPEGEN_GIVE_UP=60 \
+  sbatch --wait --ntasks="$cpus" --cpus-per-task=1 --time=10 --output="$WORK/run/retry.out" \
+  --export=ALL "$SCRIPT" --resume "$manifest" --retry-failed || { cat retry.out >&2; fail "sbatch retry job failed"; }
+grep -q "1 failed job(s) pending again" retry.out || { cat retry.out >&2; fail "--retry-failed did not reach the run"; }
+grep -q "run complete: 6 done, 0 failed of 6 jobs" retry.out || { cat retry.out >&2; fail "the retried job not done"; }
+
 # A gap diagnosis whose drapes the job's workers compute (`diagnose`): its report is the local one but its seconds.
 mkdir -p "$WORK/diagnose"
 cd "$WORK/diagnose"
@@ -123,4 +133,5 @@ grep -q "fleet: [0-9]* drapes on $cpus worker(s)" job.out || { cat job.out >&2; 
 varying='seconds"|simulations_main_thread'
 diff <(grep -Ev "$varying" local.json) <(grep -Ev "$varying" report/report.json) > /dev/null \
   || fail "the report on the fleet differs from the local one ($WORK/diagnose)"
-echo "slurm_deploy_test: ok (sbatch --ntasks=$cpus; 6 jobs done by $workers worker(s); a diagnosis on $cpus workers)"
+echo "slurm_deploy_test: ok (sbatch --ntasks=$cpus; 6 jobs done by $workers worker(s); a failed one retried by a" \
+  "resume; a diagnosis on $cpus workers)"
