@@ -113,9 +113,8 @@ bool is_decimal_integer(const std::string& text) {
 }
 
 std::string decimal_integer(std::string text) {
-  const std::size_t sign = !text.empty() && (text[0] == '+' || text[0] == '-') ? 1 : 0;
-  const bool digits = text.size() > sign && text.find_first_not_of("0123456789", sign) == std::string::npos;
-  if (!digits) return text;
+  if (!is_decimal_integer(text)) return text;
+  const std::size_t sign = text[0] == '+' || text[0] == '-' ? 1 : 0;
   const std::size_t first = std::min(text.find_first_not_of('0', sign), text.size() - 1);
   return text.substr(0, sign) + text.substr(first);
 }

@@ -38,9 +38,7 @@ const std::atomic<bool>& install_stop_signals() {
     std::thread([set] {
       for (;;) {
         int sig = 0;
-        if (sigwait(&set, &sig) != 0) continue;
-        g_signal.store(sig);
-        g_stop.store(true);
+        if (sigwait(&set, &sig) == 0) on_signal(sig);
       }
     }).detach();
     return true;

@@ -135,7 +135,7 @@ std::string endpoint_problem(const std::string& endpoint) {
   const std::string port = rest.substr(colon + 1);
   if (port == "*") return "";
   const bool digits = !port.empty() && port.size() <= 5 && port.find_first_not_of("0123456789") == std::string::npos;
-  if (!digits || std::stoi(port) < 1 || std::stoi(port) > 65535) {
+  if (const int number = digits ? std::stoi(port) : 0; number < 1 || number > 65535) {
     return fmt::format("'{}': the port must be 1 .. 65535 or * (any free port)", endpoint);
   }
   return "";
