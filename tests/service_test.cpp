@@ -215,7 +215,9 @@ TEST(Service, ASourceDrapeThatCannotBeReadIsFallenBackFrom) {
     auto reader = storage::ManifestReader::open(manifest.string());
     ASSERT_TRUE(reader);
     for (const auto& f : all(reader->files())) {
-      if (f.kind == "mesh" && sources.count(f.job_id)) ASSERT_TRUE(fs::remove(out / f.path)) << f.path;
+      if (f.kind == "mesh" && sources.count(f.job_id)) {
+        ASSERT_TRUE(fs::remove(out / f.path)) << f.path;
+      }
     }
   }
 

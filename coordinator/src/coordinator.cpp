@@ -288,10 +288,12 @@ struct Coordinator::Impl {
   /// Removes files in data/ that the manifest does not list (results of a transaction that never committed) and
   /// stray temporary files.
   sim::Status remove_orphans() {
-    auto files = manifest->reader().files();
-    if (!files) return files.error();
     std::unordered_set<std::string> known;
-    for (const auto& f : *files) known.insert(fs::path(f.path).filename().string());
+    if (sim::Status s = manifest->reader().for_each_file(
+            [&](const storage::FileRecord& f) { known.insert(fs::path(f.path).filename().string()); });
+        !s) {
+      return s;
+    }
     int removed = 0;
     std::error_code ec;
     for (const auto& entry : fs::directory_iterator(data_dir, ec)) {

@@ -22,26 +22,26 @@ struct Data {
   std::vector<std::vector<double>> run_features, measured_features;  // [feature][value]
 };
 
-double quantile(std::vector<double> v, double q) {
-  if (v.empty()) return std::nan("");
-  std::sort(v.begin(), v.end());
-  const double pos = q * static_cast<double>(v.size() - 1);
+/// The q-quantile of `sorted` (ascending, not empty), linear between neighbours.
+double quantile(const std::vector<double>& sorted, double q) {
+  const double pos = q * static_cast<double>(sorted.size() - 1);
   const auto lo = static_cast<std::size_t>(std::floor(pos));
-  const auto hi = std::min(lo + 1, v.size() - 1);
-  return v[lo] + (pos - static_cast<double>(lo)) * (v[hi] - v[lo]);
+  const auto hi = std::min(lo + 1, sorted.size() - 1);
+  return sorted[lo] + (pos - static_cast<double>(lo)) * (sorted[hi] - sorted[lo]);
 }
 
-nlohmann::json summary(const std::vector<double>& v) {
+nlohmann::json summary(std::vector<double> v) {
   if (v.empty()) return {{"count", 0}};
+  std::sort(v.begin(), v.end());
   double sum = 0.0;
   for (double x : v) sum += x;
   return {{"count", v.size()},
-          {"min", quantile(v, 0.0)},
+          {"min", v.front()},
           {"p05", quantile(v, 0.05)},
           {"median", quantile(v, 0.5)},
           {"mean", sum / static_cast<double>(v.size())},
           {"p95", quantile(v, 0.95)},
-          {"max", quantile(v, 1.0)}};
+          {"max", v.back()}};
 }
 
 std::string default_fabrics() { return sampler::default_fabric_data_path(); }
@@ -49,21 +49,12 @@ std::string default_fabrics() { return sampler::default_fabric_data_path(); }
 sim::Expected<Data> gather(const std::string& manifest_path, const StatsOptions& options) {
   auto reader = storage::ManifestReader::open(manifest_path);
   if (!reader) return reader.error();
-  // One read transaction: a run in progress commits meanwhile, and the figures must all be of one commit.
-  auto snapshot = reader->snapshot();
-  if (!snapshot) return snapshot.error();
-  const auto& [run, samples, jobs, results, files, failures] = *snapshot;
 
+  // Every table is read a row at a time and only what the figures need is kept (a run's manifest can hold millions
+  // of file rows), all in one read transaction: a run in progress commits meanwhile, and the figures must all be of
+  // one commit.
   Data d;
-  nlohmann::json& s = d.stats;
-  s["manifest"] = manifest_path;
-  s["run"] = {{"seed", run.seed}, {"state", run.state}, {"code_version", run.code_version},
-              {"total_jobs", run.total_jobs}, {"samples", samples.size()}};
-  // The stored configuration was validated when the run was planned; one that no longer parses (a manifest of
-  // another version) leaves the model unnamed rather than guessed.
-  const auto config = parse_run_config(run.config_toml, manifest_path);
-  s["run"]["bending_model"] = config ? config->bending_model : std::string("unknown");
-
+  storage::RunRecord run;
   std::map<std::string, std::int64_t> by_state, by_reason, attempts_by_reason;
   for (const auto& state : {"pending", "done", "failed"}) by_state[state] = 0;
   struct WorkerStats {
@@ -73,23 +64,79 @@ sim::Expected<Data> gather(const std::string& manifest_path, const StatsOptions&
   std::map<std::string, WorkerStats> workers;
   double first_start = 1e300, last_finish = 0.0;
   std::vector<std::pair<double, double>> attempts;  // the recorded attempts' [start, end]
-  for (const auto& j : jobs) {
-    ++by_state[std::string(storage::to_string(j.state))];
-    if (j.state == storage::JobState::kFailed) ++by_reason[j.failure_reason];
-    if (j.state == storage::JobState::kPending || !(j.finished_at >= j.started_at) || j.started_at <= 0.0) continue;
-    // A failed job's last attempt counts as busy time too (often the longest: a solve to its iteration limit);
-    // earlier failed attempts are not timed in the manifest (a failure row has its end only).
-    const double seconds = j.finished_at - j.started_at;
-    auto& w = workers[j.worker];
-    w.busy += seconds;
-    attempts.emplace_back(j.started_at, j.finished_at);
-    if (j.state == storage::JobState::kDone) {
-      d.seconds.push_back(seconds);
-      ++w.jobs;
-      first_start = std::min(first_start, j.started_at);
-      last_finish = std::max(last_finish, j.finished_at);
+  std::vector<double> iterations;
+  std::int64_t failed_attempts = 0, files = 0, bytes = 0, mesh_bytes = 0, exr_bytes = 0;
+  d.run_features.assign(sampler::kFeatureCount, {});
+
+  const sim::Status read = reader->in_one_snapshot([&]() -> sim::Status {
+    auto run_record = reader->run();
+    if (!run_record) return run_record.error();
+    run = std::move(run_record).value();
+    // Parameters in the sampler's feature space (sign(k) ln|k| at 300 g/m^2), to set against the measured fabrics.
+    if (sim::Status s = reader->for_each_sample([&](const storage::SampleRecord& smp) {
+          const sampler::ParameterVector v{{smp.alpha[0], smp.alpha[1], smp.alpha[2]},
+                                           {smp.beta[0], smp.beta[1], smp.beta[2]}};
+          const auto f = sampler::to_features(sampler::normalise_density(v, smp.density_g_per_m2));
+          for (int i = 0; i < sampler::kFeatureCount; ++i) d.run_features[i].push_back(f[i]);
+        });
+        !s) {
+      return s;
     }
-  }
+    if (sim::Status s = reader->for_each_job([&](const storage::JobRecord& j) {
+          ++by_state[std::string(storage::to_string(j.state))];
+          if (j.state == storage::JobState::kFailed) ++by_reason[j.failure_reason];
+          if (j.state == storage::JobState::kPending || !(j.finished_at >= j.started_at) || j.started_at <= 0.0) {
+            return;
+          }
+          // A failed job's last attempt counts as busy time too (often the longest: a solve to its iteration
+          // limit); earlier failed attempts are not timed in the manifest (a failure row has its end only).
+          const double seconds = j.finished_at - j.started_at;
+          auto& w = workers[j.worker];
+          w.busy += seconds;
+          attempts.emplace_back(j.started_at, j.finished_at);
+          if (j.state == storage::JobState::kDone) {
+            d.seconds.push_back(seconds);
+            ++w.jobs;
+            first_start = std::min(first_start, j.started_at);
+            last_finish = std::max(last_finish, j.finished_at);
+          }
+        });
+        !s) {
+      return s;
+    }
+    if (sim::Status s = reader->for_each_result([&](const storage::ResultRecord& r) {
+          if (r.outcome == "noop") return;
+          d.dc.push_back(r.drape_coefficient);
+          d.folds.push_back(r.folds);
+          iterations.push_back(r.iterations);
+        });
+        !s) {
+      return s;
+    }
+    if (sim::Status s = reader->for_each_file([&](const storage::FileRecord& f) {
+          ++files;
+          bytes += f.bytes;
+          (f.kind == "mesh" ? mesh_bytes : exr_bytes) += f.bytes;
+        });
+        !s) {
+      return s;
+    }
+    return reader->for_each_failure([&](const storage::FailureRecord& f) {
+      ++attempts_by_reason[f.reason];
+      ++failed_attempts;
+    });
+  });
+  if (!read) return read.error();
+
+  nlohmann::json& s = d.stats;
+  s["manifest"] = manifest_path;
+  s["run"] = {{"seed", run.seed}, {"state", run.state}, {"code_version", run.code_version},
+              {"total_jobs", run.total_jobs}, {"samples", d.run_features[0].size()}};
+  // The stored configuration was validated when the run was planned; one that no longer parses (a manifest of
+  // another version) leaves the model unnamed rather than guessed.
+  const auto config = parse_run_config(run.config_toml, manifest_path);
+  s["run"]["bending_model"] = config ? config->bending_model : std::string("unknown");
+
   // Time with an attempt in flight: the union of the attempts' spans. A run stopped and resumed later does not count
   // the time between (the first lease to the last result did).
   std::sort(attempts.begin(), attempts.end());
@@ -99,9 +146,8 @@ sim::Expected<Data> gather(const std::string& manifest_path, const StatsOptions&
     active += end - std::max(start, covered_to);
     covered_to = end;
   }
-  for (const auto& f : failures) ++attempts_by_reason[f.reason];
   s["jobs"] = {{"by_state", by_state}, {"failed_by_reason", by_reason},
-               {"failed_attempts_by_reason", attempts_by_reason}, {"failed_attempts", failures.size()}};
+               {"failed_attempts_by_reason", attempts_by_reason}, {"failed_attempts", failed_attempts}};
 
   const double wall = last_finish > first_start ? last_finish - first_start : 0.0;
   nlohmann::json per_worker = nlohmann::json::object();
@@ -116,41 +162,19 @@ sim::Expected<Data> gather(const std::string& manifest_path, const StatsOptions&
                      {"jobs_per_hour", active > 0 ? 3600.0 * static_cast<double>(done) / active : 0.0},
                      {"per_worker", per_worker}};
   s["seconds_per_job"] = summary(d.seconds);
-
-  for (const auto& r : results) {
-    if (r.outcome == "noop") continue;
-    d.dc.push_back(r.drape_coefficient);
-    d.folds.push_back(r.folds);
-  }
   s["drape_coefficient"] = summary(d.dc);
   s["folds"] = summary(d.folds);
-  std::vector<double> iterations;
-  for (const auto& r : results) {
-    if (r.outcome != "noop") iterations.push_back(r.iterations);
-  }
   s["newton_iterations"] = summary(iterations);
 
-  std::int64_t bytes = 0, mesh_bytes = 0, exr_bytes = 0;
-  for (const auto& f : files) {
-    bytes += f.bytes;
-    (f.kind == "mesh" ? mesh_bytes : exr_bytes) += f.bytes;
-  }
   std::error_code ec;
   std::int64_t manifest_bytes = 0;
   for (const char* suffix : {"", "-wal"}) {
     const auto size = std::filesystem::file_size(manifest_path + suffix, ec);
     if (!ec) manifest_bytes += static_cast<std::int64_t>(size);
   }
-  s["storage"] = {{"files", files.size()}, {"bytes", bytes}, {"mesh_bytes", mesh_bytes},
+  s["storage"] = {{"files", files}, {"bytes", bytes}, {"mesh_bytes", mesh_bytes},
                   {"exr_bytes", exr_bytes}, {"manifest_bytes", manifest_bytes}};
 
-  // Parameters in the sampler's feature space (sign(k) ln|k| at 300 g/m^2) against the measured fabrics.
-  d.run_features.assign(sampler::kFeatureCount, {});
-  for (const auto& smp : samples) {
-    sampler::ParameterVector v{{smp.alpha[0], smp.alpha[1], smp.alpha[2]}, {smp.beta[0], smp.beta[1], smp.beta[2]}};
-    const auto f = sampler::to_features(sampler::normalise_density(v, smp.density_g_per_m2));
-    for (int i = 0; i < sampler::kFeatureCount; ++i) d.run_features[i].push_back(f[i]);
-  }
   const std::string csv = options.fabrics_csv.empty() ? default_fabrics() : options.fabrics_csv;
   nlohmann::json params = nlohmann::json::object();
   auto fabrics = csv.empty() ? sim::Expected<std::vector<sampler::MeasuredFabric>>(sim::Error{"no fabric data"})

@@ -221,36 +221,50 @@ sim::Expected<RunRecord> ManifestReader::run() const {
   return r;
 }
 
-sim::Expected<std::vector<SampleRecord>> ManifestReader::samples() const {
+namespace {
+
+/// Steps `st` to its end, handing each row to `row`; `what` names the table in an error.
+template <class Read>
+sim::Status each_row(sqlite3* db, Statement& st, const char* what, Read&& row) {
+  if (!st.ok()) return sim::Error{"manifest: " + st.prepare_error()};
+  int rc;
+  while ((rc = st.step()) == SQLITE_ROW) row();
+  if (rc != SQLITE_DONE) return sqlite_error(db, fmt::format("reading {}", what));
+  return {};
+}
+
+/// A table's rows as a vector, through its visitor.
+template <class Row, class ForEach>
+sim::Expected<std::vector<Row>> collect(ForEach&& for_each) {
+  std::vector<Row> out;
+  if (sim::Status s = for_each([&](const Row& row) { out.push_back(row); }); !s) return s.error();
+  return out;
+}
+
+}  // namespace
+
+sim::Status ManifestReader::for_each_sample(const Visitor<SampleRecord>& visit) const {
   Statement st(impl_->db,
                "SELECT sample, alpha_warp, alpha_bias, alpha_weft, beta_warp, beta_bias, beta_weft, density "
                "FROM samples ORDER BY sample");
-  if (!st.ok()) return sim::Error{"manifest: " + st.prepare_error()};
-  std::vector<SampleRecord> out;
-  int rc;
-  while ((rc = st.step()) == SQLITE_ROW) {
-    SampleRecord s;
+  SampleRecord s;
+  return each_row(impl_->db, st, "samples", [&] {
     s.sample = st.int64(0);
     for (int i = 0; i < 3; ++i) {
       s.alpha[i] = st.real(1 + i);
       s.beta[i] = st.real(4 + i);
     }
     s.density_g_per_m2 = st.real(7);
-    out.push_back(s);
-  }
-  if (rc != SQLITE_DONE) return sqlite_error(impl_->db, "reading samples").error();
-  return out;
+    visit(s);
+  });
 }
 
-sim::Expected<std::vector<JobRecord>> ManifestReader::jobs() const {
+sim::Status ManifestReader::for_each_job(const Visitor<JobRecord>& visit) const {
   Statement st(impl_->db,
                "SELECT id, sample, slot, recipe, render_seed, mode, state, attempts, worker, failure_reason, "
                "coalesce(started_at, 0), coalesce(finished_at, 0) FROM jobs ORDER BY id");
-  if (!st.ok()) return sim::Error{"manifest: " + st.prepare_error()};
-  std::vector<JobRecord> out;
-  int rc;
-  while ((rc = st.step()) == SQLITE_ROW) {
-    JobRecord j;
+  JobRecord j;
+  return each_row(impl_->db, st, "jobs", [&] {
     j.id = st.int64(0);
     j.sample = st.int64(1);
     j.slot = static_cast<int>(st.int64(2));
@@ -263,21 +277,16 @@ sim::Expected<std::vector<JobRecord>> ManifestReader::jobs() const {
     j.failure_reason = st.text(9);
     j.started_at = st.real(10);
     j.finished_at = st.real(11);
-    out.push_back(std::move(j));
-  }
-  if (rc != SQLITE_DONE) return sqlite_error(impl_->db, "reading jobs").error();
-  return out;
+    visit(j);
+  });
 }
 
-sim::Expected<std::vector<ResultRecord>> ManifestReader::results() const {
+sim::Status ManifestReader::for_each_result(const Visitor<ResultRecord>& visit) const {
   Statement st(impl_->db,
                "SELECT job_id, outcome, iterations, coarse_iterations, residual, energy, drape_coefficient, folds, "
                "self_intersections, sim_seconds, render_seconds, bytes FROM results ORDER BY job_id");
-  if (!st.ok()) return sim::Error{"manifest: " + st.prepare_error()};
-  std::vector<ResultRecord> out;
-  int rc;
-  while ((rc = st.step()) == SQLITE_ROW) {
-    ResultRecord r;
+  ResultRecord r;
+  return each_row(impl_->db, st, "results", [&] {
     r.job_id = st.int64(0);
     r.outcome = st.text(1);
     r.iterations = static_cast<int>(st.int64(2));
@@ -290,59 +299,69 @@ sim::Expected<std::vector<ResultRecord>> ManifestReader::results() const {
     r.sim_seconds = st.real(9);
     r.render_seconds = st.real(10);
     r.bytes = st.int64(11);
-    out.push_back(std::move(r));
-  }
-  if (rc != SQLITE_DONE) return sqlite_error(impl_->db, "reading results").error();
-  return out;
+    visit(r);
+  });
 }
 
-sim::Expected<std::vector<FileRecord>> ManifestReader::files() const {
+sim::Status ManifestReader::for_each_file(const Visitor<FileRecord>& visit) const {
   Statement st(impl_->db, "SELECT job_id, kind, idx, path, sha256, bytes FROM files ORDER BY job_id, kind, idx");
-  if (!st.ok()) return sim::Error{"manifest: " + st.prepare_error()};
-  std::vector<FileRecord> out;
-  int rc;
-  while ((rc = st.step()) == SQLITE_ROW) {
-    FileRecord f;
+  FileRecord f;
+  return each_row(impl_->db, st, "files", [&] {
     f.job_id = st.int64(0);
     f.kind = st.text(1);
     f.index = static_cast<int>(st.int64(2));
     f.path = st.text(3);
     f.sha256 = st.text(4);
     f.bytes = st.int64(5);
-    out.push_back(std::move(f));
-  }
-  if (rc != SQLITE_DONE) return sqlite_error(impl_->db, "reading files").error();
-  return out;
+    visit(f);
+  });
 }
 
-sim::Expected<std::vector<FailureRecord>> ManifestReader::failures() const {
+sim::Status ManifestReader::for_each_failure(const Visitor<FailureRecord>& visit) const {
   Statement st(impl_->db, "SELECT job_id, attempt, reason, message, worker, at FROM failures ORDER BY id");
-  if (!st.ok()) return sim::Error{"manifest: " + st.prepare_error()};
-  std::vector<FailureRecord> out;
-  int rc;
-  while ((rc = st.step()) == SQLITE_ROW) {
-    FailureRecord f;
+  FailureRecord f;
+  return each_row(impl_->db, st, "failures", [&] {
     f.job_id = st.int64(0);
     f.attempt = static_cast<int>(st.int64(1));
     f.reason = st.text(2);
     f.message = st.text(3);
     f.worker = st.text(4);
     f.at = st.real(5);
-    out.push_back(std::move(f));
-  }
-  if (rc != SQLITE_DONE) return sqlite_error(impl_->db, "reading failures").error();
-  return out;
+    visit(f);
+  });
 }
 
-sim::Expected<ManifestSnapshot> ManifestReader::snapshot() const {
+sim::Expected<std::vector<SampleRecord>> ManifestReader::samples() const {
+  return collect<SampleRecord>([&](const auto& visit) { return for_each_sample(visit); });
+}
+sim::Expected<std::vector<JobRecord>> ManifestReader::jobs() const {
+  return collect<JobRecord>([&](const auto& visit) { return for_each_job(visit); });
+}
+sim::Expected<std::vector<ResultRecord>> ManifestReader::results() const {
+  return collect<ResultRecord>([&](const auto& visit) { return for_each_result(visit); });
+}
+sim::Expected<std::vector<FileRecord>> ManifestReader::files() const {
+  return collect<FileRecord>([&](const auto& visit) { return for_each_file(visit); });
+}
+sim::Expected<std::vector<FailureRecord>> ManifestReader::failures() const {
+  return collect<FailureRecord>([&](const auto& visit) { return for_each_failure(visit); });
+}
+
+sim::Status ManifestReader::in_one_snapshot(const std::function<sim::Status()>& read) const {
   // A reader on its own connection reads in one transaction; the writer's view (Manifest::reader) shares the
   // writer's connection, which sees its own state whole.
   const bool transaction = impl_->owns;
   if (transaction) {
-    if (sim::Status s = exec(impl_->db, "BEGIN"); !s) return s.error();
+    if (sim::Status s = exec(impl_->db, "BEGIN"); !s) return s;
   }
-  auto read = [&]() -> sim::Expected<ManifestSnapshot> {
-    ManifestSnapshot snap;
+  sim::Status status = read();
+  if (transaction) (void)exec(impl_->db, "COMMIT");  // a read transaction: nothing to keep or lose
+  return status;
+}
+
+sim::Expected<ManifestSnapshot> ManifestReader::snapshot() const {
+  ManifestSnapshot snap;
+  const sim::Status status = in_one_snapshot([&]() -> sim::Status {
     auto run_record = run();
     if (!run_record) return run_record.error();
     snap.run = std::move(run_record).value();
@@ -351,15 +370,13 @@ sim::Expected<ManifestSnapshot> ManifestReader::snapshot() const {
       into = std::move(got).value();
       return {};
     };
-    if (sim::Status s = take(samples(), snap.samples); !s) return s.error();
-    if (sim::Status s = take(jobs(), snap.jobs); !s) return s.error();
-    if (sim::Status s = take(results(), snap.results); !s) return s.error();
-    if (sim::Status s = take(files(), snap.files); !s) return s.error();
-    if (sim::Status s = take(failures(), snap.failures); !s) return s.error();
-    return snap;
-  };
-  auto snap = read();
-  if (transaction) (void)exec(impl_->db, "COMMIT");  // a read transaction: nothing to keep or lose
+    if (sim::Status s = take(samples(), snap.samples); !s) return s;
+    if (sim::Status s = take(jobs(), snap.jobs); !s) return s;
+    if (sim::Status s = take(results(), snap.results); !s) return s;
+    if (sim::Status s = take(files(), snap.files); !s) return s;
+    return take(failures(), snap.failures);
+  });
+  if (!status) return status.error();
   return snap;
 }
 

@@ -1,5 +1,6 @@
 #include "drapegen/storage/manifest.hpp"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <sqlite3.h>
 #include <sys/wait.h>
@@ -331,8 +332,8 @@ TEST_F(ManifestTest, AVersion1ManifestIsReadAndUpgradedOnResume) {
 }
 
 // What a snapshot sees (the last commit; the writer's own pass on its connection) and that its read transaction ends
-// (a reader left in one would never see another commit). That no commit lands between its table reads is SQLite's
-// isolation of one read transaction, which a single-threaded test cannot interleave.
+// (a reader left in one would never see another commit). A commit between its table reads:
+// OneSnapshotIsNotMovedByACommitWithinIt.
 TEST_F(ManifestTest, SnapshotsSeeTheLastCommitAndLetTheNextOneIn) {
   auto m = make();
   auto reader = ManifestReader::open(path_);
@@ -361,6 +362,58 @@ TEST_F(ManifestTest, SnapshotsSeeTheLastCommitAndLetTheNextOneIn) {
   EXPECT_EQ(after->files.size(), 1u);
   EXPECT_EQ(after->jobs[0].state, JobState::kDone);
   EXPECT_TRUE(after->failures.empty());
+}
+
+// A commit that lands while a reader is inside one snapshot: the reader's later queries still see the commit before
+// it (a reader outside one sees it at once), and the snapshot's transaction ends with it, error or not.
+TEST_F(ManifestTest, OneSnapshotIsNotMovedByACommitWithinIt) {
+  auto m = make();
+  auto reader = ManifestReader::open(path_);
+  ASSERT_TRUE(reader);
+  auto count_done = [&] {
+    int done = 0;
+    EXPECT_TRUE(reader->for_each_job([&](const JobRecord& j) { done += j.state == JobState::kDone; }));
+    return done;
+  };
+  auto count_files = [&] {
+    int files = 0;
+    EXPECT_TRUE(reader->for_each_file([&](const FileRecord&) { ++files; }));
+    return files;
+  };
+  auto record = [&](std::int64_t id) {
+    JobRecord job;
+    job.id = id;
+    job.attempts = 1;
+    ASSERT_TRUE(m.begin());
+    ASSERT_TRUE(m.record_result(job, ResultRecord{}, {{0, "mesh", 0, fmt::format("data/{}.ply", id), "00", 10}}));
+  };
+
+  record(1);
+  ASSERT_TRUE(reader->in_one_snapshot([&]() -> sim::Status {
+    EXPECT_EQ(count_done(), 0);
+    EXPECT_TRUE(m.commit());
+    EXPECT_EQ(count_files(), 0);  // the commit is after this snapshot
+    EXPECT_EQ(count_done(), 0);
+    return {};
+  }));
+  EXPECT_EQ(count_files(), 1);  // and the next read sees it
+
+  // Outside a snapshot each query sees the last commit: the same reads disagree.
+  record(2);
+  EXPECT_EQ(count_done(), 1);
+  ASSERT_TRUE(m.commit());
+  EXPECT_EQ(count_files(), 2);
+
+  // An error from within is returned, and the transaction still ends.
+  record(3);
+  const sim::Status failed = reader->in_one_snapshot([&]() -> sim::Status {
+    EXPECT_EQ(count_done(), 2);
+    return sim::Error{"stop here"};
+  });
+  ASSERT_FALSE(failed);
+  EXPECT_EQ(failed.error().message, "stop here");
+  ASSERT_TRUE(m.commit());
+  EXPECT_EQ(count_done(), 3);
 }
 
 TEST_F(ManifestTest, UncommittedGroupsVanish) {

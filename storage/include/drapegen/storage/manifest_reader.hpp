@@ -3,6 +3,7 @@
 // (any number of readers may run while the coordinator writes; WAL gives each query, and each snapshot(), a consistent
 // view of one commit).
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -33,6 +34,20 @@ class ManifestReader {
   ~ManifestReader();
 
   [[nodiscard]] sim::Expected<RunRecord> run() const;
+
+  /// Each row of a table, one at a time and in the order the vectors below hold them, none kept: a reader of a large
+  /// run's manifest (millions of file rows) needs memory for what it keeps of them only.
+  template <class Row>
+  using Visitor = std::function<void(const Row&)>;
+  [[nodiscard]] sim::Status for_each_sample(const Visitor<SampleRecord>& visit) const;
+  [[nodiscard]] sim::Status for_each_job(const Visitor<JobRecord>& visit) const;
+  [[nodiscard]] sim::Status for_each_result(const Visitor<ResultRecord>& visit) const;
+  [[nodiscard]] sim::Status for_each_file(const Visitor<FileRecord>& visit) const;
+  [[nodiscard]] sim::Status for_each_failure(const Visitor<FailureRecord>& visit) const;
+  /// Runs `read` (calls of this reader) in one read transaction: every query in it sees the same commit, however
+  /// many a coordinator makes meanwhile. What `read` returns is returned.
+  [[nodiscard]] sim::Status in_one_snapshot(const std::function<sim::Status()>& read) const;
+
   [[nodiscard]] sim::Expected<std::vector<SampleRecord>> samples() const;
   [[nodiscard]] sim::Expected<std::vector<JobRecord>> jobs() const;
   [[nodiscard]] sim::Expected<std::vector<ResultRecord>> results() const;
