@@ -110,6 +110,9 @@ class DrapeDataset(Dataset):
         self.verify = verify_checksums
         db, immutable = open_manifest(self.manifest)
         try:
+            # One snapshot for everything read here, the run's state too (a live run commits meanwhile; one
+            # completing between the reads would leave the warning below about rows it does not describe).
+            db.execute("BEGIN")
             try:
                 row = db.execute("SELECT value FROM meta WHERE key = 'schema_version'").fetchone()
                 state = db.execute("SELECT state FROM runs ORDER BY id LIMIT 1").fetchone()
@@ -126,7 +129,6 @@ class DrapeDataset(Dataset):
             # about 1 GB, copied into every DataLoader worker as reference counts touched their pages. Features are
             # per sample, paths fixed-width bytes, checksums read only when they are verified.
             where = ("FROM jobs j JOIN files f ON f.job_id = j.id AND f.kind = 'exr' WHERE j.state = 'done'")
-            db.execute("BEGIN")  # one snapshot for the count, the width, the rows and the samples (a live run commits)
             count = db.execute("SELECT count(*) " + where).fetchone()[0]
             width = db.execute("SELECT coalesce(max(length(CAST(f.path AS BLOB))), 1) " + where).fetchone()[0]
             self.jobs = np.empty(count, dtype=np.int64)
