@@ -163,7 +163,9 @@ ViewComparison compare_view(const ViewFeatures& captured, const renderer::DepthI
   c.silhouette = either_w > 0.0 ? mismatch_w / either_w : 1.0;
   c.fold_rms_deg = fold_w > 0.0 ? std::sqrt(fold_sq / fold_w) : 0.0;
   c.stable_pixels = stable_n;
-  c.stable_rms = stable_n > 0 ? std::sqrt(stable_sq / stable_n) : 0.0;
+  // No pixel where both see the rigid surfaces (a camera whose stated pose misses the platform, a model that does not
+  // cover it): the disagreement is as large as a pixel's can be, not none.
+  c.stable_rms = stable_n > 0 ? std::sqrt(stable_sq / stable_n) : weights.truncation;
   const double pixel = c.depth_rms + weights.silhouette * c.silhouette + weights.fold * c.fold_rms_deg;
   c.score = captured.weighted ? weights.stable * c.stable_rms + weights.pixel * pixel : pixel;
   return c;

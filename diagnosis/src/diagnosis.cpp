@@ -417,6 +417,13 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
         r.validated_held_out ? &r.validated_held_out->best : nullptr);
   }
   const ScoredDrape& gap = r.gap_drape();
+  for (std::size_t v = 0; v < gap.views.size(); ++v) {
+    if (gap.views[v].stable_pixels > 0) continue;
+    sim::logger()->warn("view {}: no pixel where both the capture and the fitted drape see the platform top or the "
+                        "bare cylinder (is the view's world_to_camera in capture.json right?): its stable term counts "
+                        "the most a pixel can, {:.0f} mm",
+                        v, gap.views[v].stable_rms * 1e3);
+  }
   r.gap_all = gap.all_score;
   r.gap_fit = gap.fit_score;
   r.gap_held_out = gap.held_out_score;

@@ -45,3 +45,32 @@ TEST(DepthMetric, OffsetSilhouetteAndFolds) {
     for (int u = 20; u < 100; ++u) flat.at(u, v) = 0.7f;
   EXPECT_GT(compare_view(f, flat).fold_rms_deg, 10.0);
 }
+
+// With the pose, the stable term is over the pixels where both see the platform top or the bare cylinder. A model
+// that sees none of them where the capture does (its camera stated wrong, or the drape elsewhere) disagrees as much
+// as a pixel can: the stable term is the truncation, not 0 (it was 0, and such a view lowered the gap).
+TEST(DepthMetric, AViewWhereNoRigidSurfaceIsSeenByBothCostsTheTruncation) {
+  const auto camera = renderer::Camera::look_at(intr(), {0.0, 0.0, 0.7}, {0.0, 0.0, 0.0}, Eigen::Vector3d::UnitY());
+  // Looking straight down from 0.7 m: the platform top (z = 0) at camera depth 0.7, a skirt 10 cm below it, 7 cm or
+  // more from the axis.
+  auto scene = [&](bool top_seen) {
+    renderer::DepthImage d(120, 90);
+    for (int v = 0; v < 90; ++v) {
+      for (int u = 0; u < 120; ++u) {
+        const Eigen::Vector3d top = 0.7 * camera.ray(u, v), skirt = 0.8 * camera.ray(u, v);
+        if (std::hypot(top.x(), top.y()) < 0.04 && top_seen) d.at(u, v) = 0.7f;
+        if (std::hypot(skirt.x(), skirt.y()) > 0.07) d.at(u, v) = 0.8f;  // clear of the cylinder's side
+      }
+    }
+    return d;
+  };
+  const MetricWeights weights;
+  const auto captured = view_features(scene(true), camera, weights);
+  const auto same = compare_view(captured, scene(true), weights);
+  EXPECT_GT(same.stable_pixels, 100);
+  EXPECT_NEAR(same.stable_rms, 0.0, 1e-9);
+  const auto missed = compare_view(captured, scene(false), weights);
+  EXPECT_EQ(missed.stable_pixels, 0);
+  EXPECT_DOUBLE_EQ(missed.stable_rms, weights.truncation);
+  EXPECT_GT(missed.score, same.score + weights.stable * weights.truncation);
+}
