@@ -8,7 +8,9 @@
 #include <filesystem>
 #include <fmt/format.h>
 #include <fstream>
+#include <initializer_list>
 #include <numbers>
+#include <string_view>
 #include <nlohmann/json.hpp>
 #include <vector>
 
@@ -70,8 +72,22 @@ sim::Expected<Eigen::MatrixXd> matrix_from(const nlohmann::json& j, int rows, in
   return m;
 }
 
+/// A key of `object` this format does not define (a misspelt optional field would otherwise be dropped unseen):
+/// an error naming it and what `where` takes.
+sim::Status known_keys_only(const nlohmann::json& object, std::initializer_list<std::string_view> known,
+                            const std::string& where) {
+  for (const auto& [key, value] : object.items()) {
+    if (std::find(known.begin(), known.end(), key) != known.end()) continue;
+    std::string names;
+    for (const auto name : known) names += fmt::format("{}\"{}\"", names.empty() ? "" : ", ", name);
+    return sim::Error{fmt::format("{}: unknown field \"{}\" (it takes {})", where, key, names)};
+  }
+  return {};
+}
+
 sim::Expected<MeasuredBending> measured_bending_from(const nlohmann::json& j, const std::string& where) {
   if (!j.is_object()) return sim::Error{where + " must be an object"};
+  if (sim::Status st = known_keys_only(j, {"alpha", "beta", "within_factor", "method"}, where); !st) return st.error();
   if (!j.contains("alpha") || !j.contains("beta") || !j.contains("within_factor")) {
     return sim::Error{where + " needs \"alpha\", \"beta\" and \"within_factor\""};
   }
@@ -147,7 +163,14 @@ sim::Expected<Capture> read_capture(const std::string& directory) {
     }
     // Integers as integers: 1.5 would pass as 1 (get<int> truncates).
     if (!j.contains("version") || !j["version"].is_number_integer() || j["version"].get<std::int64_t>() != 1) {
-      return sim::Error{fmt::format("{}: unsupported version (expected 1)", where)};
+      return sim::Error{fmt::format("{}: unsupported version {} (this build reads the integer 1)", where,
+                                    j.contains("version") ? j["version"].dump() : std::string("(none)"))};
+    }
+    // "notes": the tester's own metadata, any JSON, not read.
+    if (sim::Status st = known_keys_only(j, {"format", "version", "source", "specimen", "views", "scan", "notes"},
+                                         where);
+        !st) {
+      return st.error();
     }
     Capture c;
     c.directory = directory;
@@ -159,6 +182,11 @@ sim::Expected<Capture> read_capture(const std::string& directory) {
       return sim::Error{fmt::format("{}: missing \"specimen\"", where)};
     }
     const auto& s = j["specimen"];
+    if (sim::Status st = known_keys_only(
+            s, {"size_mm", "density_g_per_m2", "cylinder_diameter_mm", "measured_bending"}, where + ": specimen");
+        !st) {
+      return st.error();
+    }
     if (!s.contains("size_mm") || !s["size_mm"].is_array() || s["size_mm"].size() != 2 ||
         !s["size_mm"][0].is_number() || !s["size_mm"][1].is_number()) {
       return sim::Error{fmt::format("{}: specimen.size_mm must be [X, Y] numbers", where)};
@@ -189,7 +217,10 @@ sim::Expected<Capture> read_capture(const std::string& directory) {
       if (!measured) return measured.error();
       c.specimen.measured_bending = std::move(*measured);
     }
-    if (!j.contains("views") || !j["views"].is_array()) return sim::Error{fmt::format("{}: missing \"views\"", where)};
+    if (!j.contains("views")) return sim::Error{fmt::format("{}: missing \"views\"", where)};
+    if (!j["views"].is_array()) {
+      return sim::Error{fmt::format("{}: \"views\" must be an array of {} views", where, kCaptureViews)};
+    }
     const auto& views = j["views"];
     if (static_cast<int>(views.size()) != kCaptureViews) {
       return sim::Error{fmt::format("{}: {} views listed, the tester takes {}", where, views.size(), kCaptureViews)};
@@ -198,6 +229,9 @@ sim::Expected<Capture> read_capture(const std::string& directory) {
       const auto& jv = views[v];
       const std::string what = fmt::format("{}: views[{}]", where, v);
       if (!jv.is_object()) return sim::Error{what + ": not an object"};
+      if (sim::Status st = known_keys_only(jv, {"depth", "width", "height", "K", "world_to_camera"}, what); !st) {
+        return st.error();
+      }
       for (const char* key : {"depth", "width", "height", "K", "world_to_camera"}) {
         if (!jv.contains(key)) return sim::Error{fmt::format("{}: missing \"{}\"", what, key)};
       }

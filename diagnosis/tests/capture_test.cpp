@@ -188,6 +188,37 @@ TEST(Capture, NonIntegersAndAViewsMissingKeyAreClearErrors) {
   EXPECT_TRUE(read_capture(dir).has_value());
 }
 
+// A field this format does not define is refused, named with where it sits: a misspelt optional field
+// ("measured_bendng") was dropped unseen and the diagnosis ran without it. "notes" holds a tester's own metadata.
+TEST(Capture, AnUnknownFieldIsNamedNotDropped) {
+  const std::string dir = fresh_dir("unknown");
+  ASSERT_TRUE(write_capture(dir, plane_capture()).ok());
+  const nlohmann::json good = nlohmann::json::parse(std::ifstream(fs::path(dir) / "capture.json"));
+  const auto with = [&](const std::function<void(nlohmann::json&)>& edit) { return error_with(dir, good, edit); };
+  const std::string specimen = with([](nlohmann::json& j) {
+    j["specimen"]["measured_bendng"] = {{"alpha", {1e4, 1e4, 1e4}}, {"beta", {-1e4, -1e4, -1e4}}};
+  });
+  EXPECT_NE(specimen.find("specimen: unknown field \"measured_bendng\" (it takes \"size_mm\""), std::string::npos)
+      << specimen;
+  const std::string top = with([](nlohmann::json& j) { j["sacn"] = "scan.ply"; });
+  EXPECT_NE(top.find("capture.json: unknown field \"sacn\""), std::string::npos) << top;
+  const std::string view = with([](nlohmann::json& j) { j["views"][3]["k"] = j["views"][3]["K"]; });
+  EXPECT_NE(view.find("views[3]: unknown field \"k\""), std::string::npos) << view;
+  const std::string measured = with([](nlohmann::json& j) {
+    j["specimen"]["measured_bending"] = {
+        {"alpha", {1e4, 1e4, 1e4}}, {"beta", {-1e4, -1e4, -1e4}}, {"within_factor", 1.2}, {"metod", "cantilever"}};
+  });
+  EXPECT_NE(measured.find("measured_bending: unknown field \"metod\""), std::string::npos) << measured;
+  const std::string version = with([](nlohmann::json& j) { j["version"] = 2; });
+  EXPECT_NE(version.find("unsupported version 2 (this build reads the integer 1)"), std::string::npos) << version;
+  const std::string views = with([](nlohmann::json& j) { j["views"] = nlohmann::json::object(); });
+  EXPECT_NE(views.find("\"views\" must be an array of 4 views"), std::string::npos) << views;
+  nlohmann::json noted = good;
+  noted["notes"] = {{"operator", "A. B."}, {"room_temperature_c", 21.5}};
+  std::ofstream(fs::path(dir) / "capture.json") << noted.dump();
+  EXPECT_TRUE(read_capture(dir).has_value());
+}
+
 TEST(Capture, WrongSize) {
   const std::string dir = fresh_dir("size");
   Capture c = plane_capture();
