@@ -1,6 +1,7 @@
 // drapegen diagnose: where the sim-to-real gap of a capture lies and which unmodelled effect explains it (issue 6).
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -119,7 +120,8 @@ int run_diagnose(const DiagnoseOptions& o) {
   }
   std::vector<diagnosis::Effect> candidates;
   for (const auto& name : o.candidates) {
-    const auto effect = diagnosis::parse_effect(name);
+    // `drapegen reality`'s name of the misalignment effect, taken here too.
+    const auto effect = diagnosis::parse_effect(name == "misalign" ? "misalignment" : name);
     if (!effect) return fail(fmt::format("--candidates: unknown effect '{}' (yield, shear, curl, friction, "
                                          "misalignment, sensor)", name));
     if (std::find(candidates.begin(), candidates.end(), *effect) != candidates.end()) {
@@ -142,6 +144,13 @@ int run_diagnose(const DiagnoseOptions& o) {
     *into = std::move(*read);
   }
   if (!o.report.empty()) {
+    // Not into a capture: a capture made again there (drapegen reality --out) would sit beside the old report.
+    std::error_code ec;
+    if (std::filesystem::exists(std::filesystem::path(o.report) / "capture.json", ec)) {
+      return fail(fmt::format("--report {}: a capture's directory (it holds capture.json); write the report to "
+                              "another directory",
+                              o.report));
+    }
     if (sim::Status s = prepare_output_directory(o.report, "report.json"); !s) return fail(s.error().message, kExitIo);
   }
   diagnosis::DiagnosisSettings settings = o.fine    ? diagnosis::DiagnosisSettings::fine()
@@ -260,6 +269,8 @@ int run_diagnose(const DiagnoseOptions& o) {
 
 Runner add_diagnose_command(CLI::App& app) {
   auto o = std::make_shared<DiagnoseOptions>();
+  app.footer("Exit codes: 0 diagnosed (whatever the verdict); 1 bad input, a bad capture included (one line on "
+             "stderr says why, docs/CAPTURE.md); 3 the report (--report, --fleet-endpoint-file) could not be written.");
   app.add_option("--capture", o->capture, "Capture directory (docs/CAPTURE.md)")->required();
   app.add_option("--held-out-capture", o->held_out,
                  "Another capture of the same specimen (another placement), used in no fit: every candidate is "
@@ -269,7 +280,10 @@ Runner add_diagnose_command(CLI::App& app) {
                  "candidate refit (the mean of both captures' fit scores; a yielding candidate is laid again on it "
                  "with the plastic set its drape on the capture left) and in the gate (the mean of both captures' "
                  "terms); not in the baseline fit");
-  app.add_option("--report", o->report, "Write report.json, report.md, views.png and the residual PNGs here");
+  app.add_option("--report", o->report,
+                 "Write report.json, report.md, views.png and the residual PNGs into this directory (created; not a "
+                 "capture's)")
+      ->check([](const std::string& dir) { return dir.empty() ? std::string("--report needs a directory") : ""; });
   app.add_flag("--json", o->json, "Print the result as JSON");
   auto* quick = app.add_flag("--quick", o->quick, "Small budgets (16x16 mesh, 2 initial states, fewer evaluations)");
   app.add_flag("--fine", o->fine,
@@ -421,8 +435,16 @@ Runner add_diagnose_command(CLI::App& app) {
                  "A candidate is confirmed when its score on the held-out view or capture is at most (1 + this) "
                  "times the reference's (0: not worse at all; docs/DIAGNOSIS_RESULTS.md, \"Session 23\")")
       ->capture_default_str();
-  app.add_flag("--gap-only", o->gap_only,
-               "Stop after the gap, floors and localisation (verdict \"not attributed\" above the floors)");
+  CLI::Option* gap_only = app.add_flag(
+      "--gap-only", o->gap_only,
+      "Stop after the gap, floors and localisation (verdict \"not attributed\" above the floors); the attribution's "
+      "options are refused with it");
+  // What only the attribution reads would be ignored: refused instead.
+  for (const char* name : {"--candidates", "--ablation", "--sensor-bending", "--free-sensor", "--tie-margin",
+                           "--held-out-tolerance", "--refit-evaluations", "--sensor-evaluations", "--common-bending",
+                           "--refit-scan", "--yield-trade", "--shear-trade", "--drift-scan"}) {
+    gap_only->excludes(app.get_option(name));
+  }
   app.add_flag("-v,--verbose", o->verbose, "Log every simulation of the fit and the refits on stderr (by default: "
                                            "each stage's end)");
   app.add_flag("-q,--quiet", o->quiet, "Log only warnings and errors on stderr")->excludes("--verbose");

@@ -82,6 +82,8 @@ int run_reality(const RealityOptions& o) {
 
 Runner add_reality_command(CLI::App& app) {
   auto o = std::make_shared<RealityOptions>();
+  app.footer("Exit codes: 0 written; 1 bad input (one line on stderr says why); 2 written, but a drape did not "
+             "converge (truth.json's \"converged\" says which); 3 an output could not be written.");
   app.add_option(
       "--effect", o->effects,
       "NAME[=STRENGTH], repeatable: yield=K (1/m), shear=G (kg/s^2), curl=K[,W] (1/m over W mm, default 30), "

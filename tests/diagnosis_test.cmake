@@ -251,6 +251,14 @@ string(JSON ncand LENGTH "${out}" attribution candidates)
 if(NOT verdict STREQUAL "not attributed" OR ran OR NOT ncand EQUAL 0)
   message(FATAL_ERROR "--gap-only: verdict '${verdict}', attribution ran ${ran}, ${ncand} candidates")
 endif()
+# The budgets it ran with are in the report (a small run's figures are not a full run's).
+json_number(res "${out}" settings resolution)
+json_number(states "${out}" settings initial_states)
+json_number(evals "${out}" settings max_baseline_evaluations)
+json_boolean(attributing "${out}" settings attribution)
+if(NOT res EQUAL 10 OR NOT states EQUAL 2 OR NOT evals EQUAL 8 OR attributing)
+  message(FATAL_ERROR "settings: resolution ${res}, states ${states}, evaluations ${evals}, attribution ${attributing}")
+endif()
 json_number(starts "${out}" baseline start_evaluations)
 json_number(guess_only_score "${out}" baseline fit_score_mm)
 if(NOT starts EQUAL 0)
@@ -562,10 +570,11 @@ endif()
 expect_failure(1 "--drift-scan (4) must leave" diagnose --capture ${WORK}/capture --refit-evaluations 6 --drift-scan 4)
 # A refit budget too small for any scan is valid where no scan is asked for (before, a scan of 0 had to leave it 3).
 run_ok(small diagnose --capture ${WORK}/capture --quick --resolution 6 --states 1 --evaluations 2 --refit-evaluations 2
-       --gap-only --json)
+       --candidates yield --json)
 json_boolean(small_ran "${small}" attribution ran)
-if(small_ran)
-  message(FATAL_ERROR "--gap-only with --refit-evaluations 2: the attribution ran")
+string(JSON small_effect GET "${small}" attribution candidates 0 effect)
+if(NOT small_ran OR NOT small_effect STREQUAL "yield")
+  message(FATAL_ERROR "--refit-evaluations 2 --candidates yield: attribution ran ${small_ran}, first ${small_effect}")
 endif()
 expect_failure(1 "--drift-scan must be" diagnose --capture ${WORK}/capture --drift-scan -3)
 # Each option is either unset (the settings' value) or checked: no value of it means "the default".
@@ -1214,6 +1223,11 @@ expect_failure(1 "the capture itself" diagnose --capture ${WORK}/capture --held-
 expect_failure(1 "second capture ${WORK}/heavier: another specimen" diagnose --capture ${WORK}/capture
                --second-capture ${WORK}/heavier)
 expect_failure(1 "unknown effect" reality ${FABRIC} --effect gravity=2 --out ${WORK}/bad)
+expect_failure(1 "bias=0 changes nothing" reality ${FABRIC} --effect bias=0 --out ${WORK}/bad)
+expect_failure(1 "a capture's directory (it holds capture.json)" diagnose --capture ${WORK}/capture
+               --report ${WORK}/capture)
+expect_failure(1 "--candidates excludes --gap-only" diagnose --capture ${WORK}/capture --gap-only --candidates yield)
+expect_failure(1 "'misalign' given twice" diagnose --capture ${WORK}/capture --candidates misalignment,misalign)
 expect_failure(1 "given twice" reality ${FABRIC} --effect curl=10 --effect curl=20 --out ${WORK}/bad)
 expect_failure(1 "fewer than two vertex spacings" reality ${FABRIC} --effect curl=200,10 --resolution 14
                --out ${WORK}/bad)

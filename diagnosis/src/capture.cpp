@@ -147,7 +147,10 @@ sim::Expected<Capture> read_capture(const std::string& directory) {
   const fs::path json_path = dir / "capture.json";
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) return sim::Error{fmt::format("{}: not a directory", directory)};
-  if (!fs::is_regular_file(json_path, ec)) return sim::Error{fmt::format("{}: no such file", json_path.string())};
+  if (!fs::is_regular_file(json_path, ec)) {
+    return sim::Error{fmt::format("{}: {}", json_path.string(),
+                                  fs::exists(json_path, ec) ? "not a regular file" : "no such file")};
+  }
   nlohmann::json j;
   std::ifstream in(json_path);
   if (!in) return sim::Error{fmt::format("{}: cannot read: {}", json_path.string(), std::strerror(errno))};

@@ -260,6 +260,8 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
   };
   set_threads(settings.attribution.jobs);
   DiagnosisResult r;
+  r.budgets = {settings.fit.resolution, settings.fit.initial_states, settings.baseline_optimiser.max_evaluations,
+               settings.attribute};
   // 0. The camera from the rigid surfaces (no simulation): the sensor candidate's start.
   if (auto pose = estimate_rigid_pose(capture, RigidSurfaces::for_specimen(capture.specimen))) {
     r.rigid_pose = *pose;
@@ -698,6 +700,10 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                       {"confidence", r.attribution.confidence},
                       {"candidates", candidates}};
   j["shrinkage"] = r.attribution.candidates.empty() ? 0.0 : r.attribution.candidates[0].shrinkage;
+  j["settings"] = {{"resolution", r.budgets.resolution},
+                   {"initial_states", r.budgets.initial_states},
+                   {"max_baseline_evaluations", r.budgets.max_baseline_evaluations},
+                   {"attribution", r.budgets.attribution}};
   j["runtime"] = {{"seconds", r.seconds},
                   {"cpu_seconds", r.cpu_seconds},
                   {"jobs", r.jobs},

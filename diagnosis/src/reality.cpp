@@ -67,6 +67,7 @@ sim::Expected<RealityEffect> parse_reality_effect(const std::string& text) {
       return sim::Error{fmt::format("--effect {}: one value expected (only curl=K,W takes two)", e.name)};
     }
     auto number = [&](const std::string& s, double& out) {
+      if (s.find_first_of("xX") != std::string::npos) return false;  // decimal only (stod reads 0x10 as 16)
       try {
         std::size_t used = 0;
         out = std::stod(s, &used);
@@ -84,6 +85,10 @@ sim::Expected<RealityEffect> parse_reality_effect(const std::string& text) {
         return sim::Error{fmt::format("--effect curl: the band width '{}' must be a number of mm in (0, 150]", w)};
       }
     }
+  }
+  // Zero is no effect at all: its capture would be a control whose truth names a family.
+  if (e.strength == 0.0) {
+    return sim::Error{fmt::format("--effect {}=0 changes nothing (a control is a capture without --effect)", e.name)};
   }
   const bool positive = e.name == "yield" || e.name == "shear" || e.name == "friction";
   if (positive && !(e.strength > 0.0)) return sim::Error{fmt::format("--effect {}: must be positive", e.name)};

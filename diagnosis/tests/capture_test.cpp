@@ -153,6 +153,9 @@ TEST(Capture, MissingJsonAndWrongViewCount) {
   const std::string dir = fresh_dir("count");
   fs::create_directories(dir);
   EXPECT_NE(read_error(dir).find("capture.json: no such file"), std::string::npos);
+  fs::create_directories(fs::path(dir) / "capture.json");
+  EXPECT_NE(read_error(dir).find("capture.json: not a regular file"), std::string::npos) << read_error(dir);
+  fs::remove(fs::path(dir) / "capture.json");
   ASSERT_TRUE(write_capture(dir, plane_capture()).ok());
   nlohmann::json j = nlohmann::json::parse(std::ifstream(fs::path(dir) / "capture.json"));
   j["views"].erase(3);

@@ -160,5 +160,22 @@ TEST(Reality, RejectsANegativePlacement) {
   EXPECT_FALSE(generate_reality(spec, (fs::temp_directory_path() / "drapegen_reality_bad").string()).has_value());
 }
 
+// An effect of strength 0 is no effect (its capture a control whose truth names a family) and is refused for every
+// effect, as a strength in another base is (stod read bias=0x10 as 16 mm); a signed effect keeps its sign.
+TEST(Reality, AnEffectOfStrengthZeroOrNotDecimalIsRefused) {
+  for (const char* name : {"yield", "shear", "curl", "friction", "misalign", "pose", "bias", "multipath"}) {
+    const auto zero = parse_reality_effect(std::string(name) + "=0");
+    ASSERT_FALSE(zero) << name;
+    EXPECT_NE(zero.error().message.find("=0 changes nothing"), std::string::npos) << zero.error().message;
+  }
+  const auto hex = parse_reality_effect("bias=0x10");
+  ASSERT_FALSE(hex);
+  EXPECT_NE(hex.error().message.find("'0x10' is not a number"), std::string::npos) << hex.error().message;
+  const auto negative = parse_reality_effect("bias=-4");
+  ASSERT_TRUE(negative) << negative.error().message;
+  EXPECT_DOUBLE_EQ(negative->strength, -4.0);
+  EXPECT_DOUBLE_EQ(parse_reality_effect("curl=-150")->strength, -150.0);
+}
+
 }  // namespace
 }  // namespace drapegen::diagnosis

@@ -78,6 +78,13 @@ struct DiagnosisSettings {
 };
 
 struct DiagnosisResult {
+  /// The budgets it ran with (report.json "settings"): a --quick run's figures are not a full run's.
+  struct Budgets {
+    int resolution = 0;                // vertices per side of the fitting mesh
+    int initial_states = 0;            // of the fit
+    int max_baseline_evaluations = 0;  // per simplex of the baseline fit
+    bool attribution = true;           // false: gap, floors and localisation only
+  } budgets;
   BendingParameters initial_guess;  // the drape-coefficient guess, or the given start (clamped to the box)
   /// Where the initial guess came from: "drape coefficient", "given start" (DiagnosisSettings::start) or
   /// "measured bending" (the capture's).
