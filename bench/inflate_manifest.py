@@ -5,7 +5,9 @@ training stage's index) at a run's real size without computing its drapes.
 Copies SOURCE to DEST and appends COPIES - 1 copies of its samples, jobs, results, files and failures, each with
 fresh ids and file paths (the files themselves are not copied: the rows name files that do not exist). The run's
 total_jobs is set to the new count. The schema, meta and run rows are the source's own, so the result is whatever
-manifest version wrote SOURCE.
+manifest version wrote SOURCE. The copies keep the source's times (leases, results, failures), so the time figures
+of `drapegen stats` on the result (jobs per hour, busy seconds) are meaningless; its counts, distributions and its
+own memory and time are what it is for.
 
   bench/inflate_manifest.py out/local-run/manifest.sqlite /tmp/big/manifest.sqlite --copies 1200
 """

@@ -123,7 +123,7 @@ int run_diagnose(const DiagnoseOptions& o) {
     // `drapegen reality`'s name of the misalignment effect, taken here too.
     const auto effect = diagnosis::parse_effect(name == "misalign" ? "misalignment" : name);
     if (!effect) return fail(fmt::format("--candidates: unknown effect '{}' (yield, shear, curl, friction, "
-                                         "misalignment, sensor)", name));
+                                         "misalignment or misalign, sensor)", name));
     if (std::find(candidates.begin(), candidates.end(), *effect) != candidates.end()) {
       return fail(fmt::format("--candidates: '{}' given twice", name));
     }
@@ -269,8 +269,9 @@ int run_diagnose(const DiagnoseOptions& o) {
 
 Runner add_diagnose_command(CLI::App& app) {
   auto o = std::make_shared<DiagnoseOptions>();
-  app.footer("Exit codes: 0 diagnosed (whatever the verdict); 1 bad input, a bad capture included (one line on "
-             "stderr says why, docs/CAPTURE.md); 3 the report (--report, --fleet-endpoint-file) could not be written.");
+  app.footer("Exit codes: 0 diagnosed (whatever the verdict); 1 bad input, a bad capture included (docs/CAPTURE.md), "
+             "or a diagnosis that could not finish (a simulation's error, a fleet without workers): one line on "
+             "stderr says why; 3 the report (--report, --fleet-endpoint-file) could not be written.");
   app.add_option("--capture", o->capture, "Capture directory (docs/CAPTURE.md)")->required();
   app.add_option("--held-out-capture", o->held_out,
                  "Another capture of the same specimen (another placement), used in no fit: every candidate is "
@@ -387,7 +388,7 @@ Runner add_diagnose_command(CLI::App& app) {
                              diagnosis::AttributionSettings{}.drift_scan_levels));
   app.add_option("--candidates", o->candidates,
                  "The candidate effects to refit, comma-separated (default: yield, shear, curl, friction, "
-                 "misalignment, sensor)")
+                 "misalignment, sensor; misalign for misalignment as drapegen reality names it)")
       ->delimiter(',');
   app.add_option(
       "--jobs", o->jobs,

@@ -126,21 +126,25 @@ ViewComparison compare_view(const ViewFeatures& captured, const renderer::DepthI
   const ViewFeatures m = view_features(model, captured.intrinsics, weights);
   const float T = static_cast<float>(weights.truncation);
   double sum_sq = 0.0, fold_sq = 0.0, both_w = 0.0, either_w = 0.0, mismatch_w = 0.0, fold_w = 0.0, stable_sq = 0.0;
-  int both = 0, stable_n = 0;
+  int both = 0, stable_n = 0, captured_stable = 0;
   const int W = cd.width;
   for (std::size_t i = 0; i < N; ++i) {
     const float a = cd.depth[i], b = model.depth[i];
     const bool ha = a > 0.0f, hb = b > 0.0f;
     if (!ha && !hb) continue;
-    const double w = pixel_weight(captured, static_cast<int>(i % W), static_cast<int>(i / W), ha ? a : b, weights);
+    const int u = static_cast<int>(i % W), v = static_cast<int>(i / W);
+    const bool rigid = ha && stable_pixel(captured, u, v, a, weights);  // the capture sees a rigid surface here
+    captured_stable += rigid;
+    const double w = !captured.weighted ? 1.0
+                     : ha               ? (rigid ? 1.0 : weights.variable_weight)
+                                        : pixel_weight(captured, u, v, b, weights);
     either_w += w;
     if (ha && hb) {
       const float d = std::clamp(a - b, -T, T);
       sum_sq += w * d * d;
       both_w += w;
       ++both;
-      const int u = static_cast<int>(i % W), v = static_cast<int>(i / W);
-      if (captured.weighted && stable_pixel(captured, u, v, a, weights) && stable_pixel(captured, u, v, b, weights)) {
+      if (rigid && stable_pixel(captured, u, v, b, weights)) {
         stable_sq += static_cast<double>(d) * d;
         ++stable_n;
       }
@@ -163,9 +167,11 @@ ViewComparison compare_view(const ViewFeatures& captured, const renderer::DepthI
   c.silhouette = either_w > 0.0 ? mismatch_w / either_w : 1.0;
   c.fold_rms_deg = fold_w > 0.0 ? std::sqrt(fold_sq / fold_w) : 0.0;
   c.stable_pixels = stable_n;
-  // No pixel where both see the rigid surfaces (a camera whose stated pose misses the platform, a model that does not
-  // cover it): the disagreement is as large as a pixel's can be, not none.
-  c.stable_rms = stable_n > 0 ? std::sqrt(stable_sq / stable_n) : weights.truncation;
+  c.captured_stable_pixels = captured_stable;
+  // The capture sees rigid surfaces but no pixel of them is one the model sees as rigid too (a camera whose stated
+  // pose misses the platform, a model that does not cover it): the disagreement is as large as a pixel's can be, not
+  // none. A view whose capture sees none has no stable term (ForwardModel leaves it out of the mean).
+  c.stable_rms = stable_n > 0 ? std::sqrt(stable_sq / stable_n) : captured_stable > 0 ? weights.truncation : 0.0;
   const double pixel = c.depth_rms + weights.silhouette * c.silhouette + weights.fold * c.fold_rms_deg;
   c.score = captured.weighted ? weights.stable * c.stable_rms + weights.pixel * pixel : pixel;
   return c;

@@ -420,7 +420,7 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
   }
   const ScoredDrape& gap = r.gap_drape();
   for (std::size_t v = 0; v < gap.views.size(); ++v) {
-    if (gap.views[v].stable_pixels > 0) continue;
+    if (gap.views[v].stable_pixels > 0 || gap.views[v].captured_stable_pixels == 0) continue;
     sim::logger()->warn("view {}: no pixel where both the capture and the fitted drape see the platform top or the "
                         "bare cylinder (is the view's world_to_camera in capture.json right?): its stable term counts "
                         "the most a pixel can, {:.0f} mm",

@@ -223,9 +223,11 @@ sim::Expected<ScoredDrape> ForwardModel::score(const sim::ClothMesh& mesh, const
   d.shape_all = feature_distance(target.shape.all, d.shape.all, scales);
   double fit = 0.0, held = 0.0, all = 0.0;
   int nf = 0, nh = 0;
+  int na = 0;
   for (std::size_t v = 0; v < d.views.size(); ++v) {
+    if (d.views[v].captured_stable_pixels == 0) continue;  // the capture sees no rigid surface there: no stable term
     const double s = d.views[v].stable_rms;
-    all += s;
+    all += s, ++na;
     if (is_fit_view_[v]) {
       fit += s, ++nf;
     } else {
@@ -234,7 +236,7 @@ sim::Expected<ScoredDrape> ForwardModel::score(const sim::ClothMesh& mesh, const
   }
   d.stable_fit = nf > 0 ? fit / nf : 0.0;
   d.stable_held_out = nh > 0 ? held / nh : 0.0;
-  d.stable_all = d.views.empty() ? 0.0 : all / static_cast<double>(d.views.size());
+  d.stable_all = na > 0 ? all / na : 0.0;
   const double w = settings_.weights.shape;
   d.fit_score = d.stable_fit + w * d.shape_fit;
   d.held_out_score = d.stable_held_out + w * d.shape_held_out;

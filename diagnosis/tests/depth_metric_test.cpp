@@ -48,7 +48,8 @@ TEST(DepthMetric, OffsetSilhouetteAndFolds) {
 
 // With the pose, the stable term is over the pixels where both see the platform top or the bare cylinder. A model
 // that sees none of them where the capture does (its camera stated wrong, or the drape elsewhere) disagrees as much
-// as a pixel can: the stable term is the truncation, not 0 (it was 0, and such a view lowered the gap).
+// as a pixel can: the stable term is the truncation, not 0 (it was 0, and such a view lowered the gap). A capture
+// that sees none has no stable term in that view.
 TEST(DepthMetric, AViewWhereNoRigidSurfaceIsSeenByBothCostsTheTruncation) {
   const auto camera = renderer::Camera::look_at(intr(), {0.0, 0.0, 0.7}, {0.0, 0.0, 0.0}, Eigen::Vector3d::UnitY());
   // Looking straight down from 0.7 m: the platform top (z = 0) at camera depth 0.7, a skirt 10 cm below it, 7 cm or
@@ -73,4 +74,11 @@ TEST(DepthMetric, AViewWhereNoRigidSurfaceIsSeenByBothCostsTheTruncation) {
   EXPECT_EQ(missed.stable_pixels, 0);
   EXPECT_DOUBLE_EQ(missed.stable_rms, weights.truncation);
   EXPECT_GT(missed.score, same.score + weights.stable * weights.truncation);
+  EXPECT_GT(missed.captured_stable_pixels, 100);
+  // A capture that sees no rigid surface in this view has no stable term there (ForwardModel leaves it out of the
+  // mean): not the truncation, which would add the same constant to every score and floor.
+  const auto bare = view_features(scene(false), camera, weights);
+  const auto none = compare_view(bare, scene(true), weights);
+  EXPECT_EQ(none.captured_stable_pixels, 0);
+  EXPECT_DOUBLE_EQ(none.stable_rms, 0.0);
 }

@@ -349,14 +349,21 @@ sim::Expected<std::vector<FailureRecord>> ManifestReader::failures() const {
 
 sim::Status ManifestReader::in_one_snapshot(const std::function<sim::Status()>& read) const {
   // A reader on its own connection reads in one transaction; the writer's view (Manifest::reader) shares the
-  // writer's connection, which sees its own state whole.
-  const bool transaction = impl_->owns;
+  // writer's connection, which sees its own state whole. Inside a snapshot already (nested), that one holds.
+  const bool transaction = impl_->owns && sqlite3_get_autocommit(impl_->db) != 0;
   if (transaction) {
     if (sim::Status s = exec(impl_->db, "BEGIN"); !s) return s;
   }
-  sim::Status status = read();
-  if (transaction) (void)exec(impl_->db, "COMMIT");  // a read transaction: nothing to keep or lose
-  return status;
+  // Ended however `read` ends, a throw included: a read transaction left open would pin this reader to its commit
+  // and keep the writer's log from being checkpointed.
+  struct End {
+    sqlite3* db;
+    bool active;
+    ~End() {
+      if (active) (void)exec(db, "COMMIT");  // a read transaction: nothing to keep or lose
+    }
+  } end{impl_->db, transaction};
+  return read();
 }
 
 sim::Expected<ManifestSnapshot> ManifestReader::snapshot() const {

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <iterator>
 #include <optional>
+#include <stdexcept>
 
 namespace drapegen::storage {
 namespace {
@@ -414,6 +415,22 @@ TEST_F(ManifestTest, OneSnapshotIsNotMovedByACommitWithinIt) {
   EXPECT_EQ(failed.error().message, "stop here");
   ASSERT_TRUE(m.commit());
   EXPECT_EQ(count_done(), 3);
+
+  // A visitor that throws: the transaction ends with it, and the reader sees later commits.
+  record(4);
+  EXPECT_THROW((void)reader->in_one_snapshot([&]() -> sim::Status {
+    return reader->for_each_job([](const JobRecord&) { throw std::runtime_error("visitor failed"); });
+  }),
+               std::runtime_error);
+  ASSERT_TRUE(m.commit());
+  EXPECT_EQ(count_done(), 4);
+
+  // Nested: the inner snapshot reads in the outer one (it was "cannot start a transaction within a transaction").
+  ASSERT_TRUE(reader->in_one_snapshot([&]() -> sim::Status {
+    auto inner = reader->snapshot();
+    EXPECT_TRUE(inner) << inner.error().message;
+    return {};
+  }));
 }
 
 TEST_F(ManifestTest, UncommittedGroupsVanish) {

@@ -55,10 +55,12 @@ struct ViewComparison {
   double silhouette = 0.0;    // weighted |A xor B| / |A or B|
   double fold_rms_deg = 0.0;  // RMS angle between normals on the fold mask where both return
   /// m: truncated RMS over the pixels where both the capture and the model see the platform top or the bare
-  /// cylinder side (geometry that does not depend on which stable drape formed); the truncation where there is no
-  /// such pixel (with a pose: the stated camera, or the model, misses the rigid surfaces the other sees).
+  /// cylinder side (geometry that does not depend on which stable drape formed); the truncation where the capture
+  /// sees such pixels but none of them is one the model sees so too (the stated camera, or the model, misses them);
+  /// 0 where the capture sees none (no stable term: left out of ForwardModel's mean).
   double stable_rms = 0.0;
-  int stable_pixels = 0;
+  int stable_pixels = 0;           // where both see the rigid surfaces
+  int captured_stable_pixels = 0;  // where the capture does (with a pose; 0 without)
   double score = 0.0;         // m: w_stable stable_rms + w_pixel (depth_rms + w_s silhouette + w_f fold_rms_deg)
   int overlap = 0;            // pixels where both return
   /// Per pixel: captured - model clamped to +-truncation where both return; +truncation where only the capture

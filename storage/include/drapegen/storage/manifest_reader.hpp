@@ -45,7 +45,9 @@ class ManifestReader {
   [[nodiscard]] sim::Status for_each_file(const Visitor<FileRecord>& visit) const;
   [[nodiscard]] sim::Status for_each_failure(const Visitor<FailureRecord>& visit) const;
   /// Runs `read` (calls of this reader) in one read transaction: every query in it sees the same commit, however
-  /// many a coordinator makes meanwhile. What `read` returns is returned.
+  /// many a coordinator makes meanwhile (the writer's own view, Manifest::reader, sees the writer's state, its pass
+  /// included). What `read` returns is returned; the transaction ends however `read` ends, by an exception too. A
+  /// snapshot within one (snapshot(), in_one_snapshot) reads in the outer one.
   [[nodiscard]] sim::Status in_one_snapshot(const std::function<sim::Status()>& read) const;
 
   [[nodiscard]] sim::Expected<std::vector<SampleRecord>> samples() const;
