@@ -1220,6 +1220,9 @@ file(WRITE ${WORK}/heavier/capture.json "${facts}")
 expect_failure(1 "another specimen" diagnose --capture ${WORK}/capture --held-out-capture ${WORK}/heavier)
 expect_failure(1 "held-out capture: " diagnose --capture ${WORK}/capture --held-out-capture ${WORK}/does_not_exist)
 expect_failure(1 "the capture itself" diagnose --capture ${WORK}/capture --held-out-capture ${WORK}/capture/.)
+file(COPY ${WORK}/capture/ DESTINATION ${WORK}/capture_copy)
+expect_failure(1 "the same depth in every view as the capture" diagnose --capture ${WORK}/capture
+               --held-out-capture ${WORK}/capture_copy)
 expect_failure(1 "second capture ${WORK}/heavier: another specimen" diagnose --capture ${WORK}/capture
                --second-capture ${WORK}/heavier)
 expect_failure(1 "unknown effect" reality ${FABRIC} --effect gravity=2 --out ${WORK}/bad)

@@ -291,8 +291,12 @@ sim::Expected<Capture> read_capture(const std::string& directory) {
       auto T = matrix_from(jv.at("world_to_camera"), 4, 4, what + ".world_to_camera");
       if (!T) return T.error();
       const Eigen::Matrix3d R = T->topLeftCorner(3, 3);
-      if ((R.transpose() * R - Eigen::Matrix3d::Identity()).norm() > 1e-4 || R.determinant() < 0.0) {
+      if ((R.transpose() * R - Eigen::Matrix3d::Identity()).norm() > 1e-4) {
         return sim::Error{what + ".world_to_camera: not a rigid transform (rotation part not orthonormal)"};
+      }
+      if (R.determinant() < 0.0) {
+        return sim::Error{what + ".world_to_camera: not a rigid transform (a reflection: the rotation part's "
+                                 "determinant is -1; a left-handed frame?)"};
       }
       if (T->row(3) != Eigen::RowVector4d(0.0, 0.0, 0.0, 1.0)) {
         return sim::Error{what + ".world_to_camera: not a rigid transform (last row must be 0 0 0 1)"};

@@ -290,6 +290,14 @@ TEST(Capture, ACameraThatIsNoneIsAClearError) {
   singular["views"][1]["K"][1][0] = good["views"][1]["K"][1][1];
   std::ofstream(fs::path(dir) / "capture.json") << singular.dump();
   EXPECT_NE(read_error(dir).find("views[1].K: singular"), std::string::npos) << read_error(dir);
+  // A mirrored pose (a row of the rotation negated: orthonormal, determinant -1) is named as a reflection.
+  nlohmann::json mirrored = good;
+  for (int k = 0; k < 4; ++k) {
+    mirrored["views"][1]["world_to_camera"][0][k] = -good["views"][1]["world_to_camera"][0][k].get<double>();
+  }
+  std::ofstream(fs::path(dir) / "capture.json") << mirrored.dump();
+  EXPECT_NE(read_error(dir).find("world_to_camera: not a rigid transform (a reflection"), std::string::npos)
+      << read_error(dir);
   // One depth file under two poses: a view missing, which the view count alone does not show.
   nlohmann::json twice = good;
   twice["views"][2]["depth"] = good["views"][0]["depth"];
