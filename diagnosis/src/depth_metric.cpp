@@ -135,9 +135,7 @@ ViewComparison compare_view(const ViewFeatures& captured, const renderer::DepthI
     const int u = static_cast<int>(i % W), v = static_cast<int>(i / W);
     const bool rigid = ha && stable_pixel(captured, u, v, a, weights);  // the capture sees a rigid surface here
     captured_stable += rigid;
-    const double w = !captured.weighted ? 1.0
-                     : ha               ? (rigid ? 1.0 : weights.variable_weight)
-                                        : pixel_weight(captured, u, v, b, weights);
+    const double w = rigid ? 1.0 : pixel_weight(captured, u, v, ha ? a : b, weights);
     either_w += w;
     if (ha && hb) {
       const float d = std::clamp(a - b, -T, T);
