@@ -87,6 +87,9 @@ Expected<InitialStateSpec> parse_initial_state(const std::string& text) {
 
 Status apply_initial_state(const InitialStateSpec& spec, ClothMesh& mesh) {
   if (!spec.drift.allFinite() || !std::isfinite(spec.rotation)) return Error{"drift and rotation must be finite"};
+  if (spec.shape == InitialShape::kMesh && spec.face_down) {
+    return Error{"a mesh initial state lies as its file does: it cannot also be laid face down"};
+  }
   if (spec.shape == InitialShape::kMesh) {
     Expected<ClothMesh> loaded = read_ply(spec.mesh_path);
     if (!loaded) return loaded.error();
@@ -118,6 +121,7 @@ Status apply_initial_state(const InitialStateSpec& spec, ClothMesh& mesh) {
     mesh.positions.row(2).setConstant(spec.lift);
     if (spec.shape == InitialShape::kSine) add_sine_waves(spec.seed, spec.platform_radius, mesh);
     if (spec.shape == InitialShape::kFold) add_fold(spec.seed, spec.platform_radius, mesh);
+    if (spec.face_down) mesh.positions.row(1) *= -1.0;
   }
   const Eigen::Matrix3d rotation = Eigen::AngleAxisd(spec.rotation, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   mesh.positions = rotation * mesh.positions;

@@ -437,6 +437,48 @@ TEST(Effects, ALoadStepThatDivergesEndsTheDrapeWithItsReport) {
   EXPECT_EQ(cut->report.message.rfind("load step 1 of 2: ", 0), 0u) << cut->report.message;
 }
 
+TEST(Effects, ASpecimenLaidFaceDownDrapesAsItsMirrorImageWithItsRestShapeTurned) {
+  // Turned over, a specimen lies mirrored with its back up. The energy is even under a reflection that also turns the
+  // rest angles' sign (membrane strain and gravity are unchanged by it; a dihedral angle changes sign; the tester is
+  // symmetric), so: an elastic drape laid face down is the mirror of the same state face up, and one with a rest
+  // shape is the mirror of the face-up drape with that rest shape negated, but not of the face-up drape with it.
+  DrapeConfig up = drape_config();
+  up.initial.shape = InitialShape::kSine;
+  up.initial.seed = 3;
+  DrapeConfig down = up;
+  down.initial.face_down = true;
+  auto mirror_distance = [](const DrapeResult& face_down, const DrapeResult& face_up) {
+    Eigen::Matrix3Xd mirrored = face_up.mesh.positions;
+    mirrored.row(1) *= -1.0;
+    return (face_down.mesh.positions - mirrored).colwise().norm().maxCoeff();
+  };
+  const double elastic = mirror_distance(drape(down, "elastic, face down"), drape(up, "elastic, face up"));
+
+  DrapeConfig curled = up;
+  curled.effects.edge_curl = EdgeCurl{60.0, 0.03};
+  const DrapeResult curled_up = drape(curled, "curl 60 /m, face up");
+  ASSERT_GT(curled_up.rest_angles.size(), 0);
+  DrapeConfig set_up = up, set_down = down, negated_up = up;
+  set_up.rest_angles = set_down.rest_angles = curled_up.rest_angles;
+  negated_up.rest_angles = -curled_up.rest_angles;
+  const DrapeResult with_set_down = drape(set_down, "curl's rest angles, face down");
+  const double negated = mirror_distance(with_set_down, drape(negated_up, "negated rest angles, face up"));
+  const double same = mirror_distance(with_set_down, drape(set_up, "curl's rest angles, face up"));
+  std::printf("[ face     ] largest distance from the mirror image: elastic %.2g mm; with a rest shape, of the face-up "
+              "drape with it negated %.2g mm, with it as it is %.1f mm\n", elastic * kMm, negated * kMm, same * kMm);
+  EXPECT_LT(elastic, 1e-6);
+  EXPECT_LT(negated, 1e-6);
+  EXPECT_GT(same, 5e-3);
+
+  DrapeConfig from_mesh = down;
+  from_mesh.initial.shape = InitialShape::kMesh;
+  from_mesh.initial.mesh_path = testing::TempDir() + "/face_down_refused.ply";
+  ASSERT_TRUE(static_cast<bool>(write_ply(from_mesh.initial.mesh_path, curled_up.mesh)));
+  const Expected<DrapeResult> refused = simulate_drape(from_mesh);
+  ASSERT_FALSE(refused.has_value());
+  EXPECT_NE(refused.error().message.find("face down"), std::string::npos) << refused.error().message;
+}
+
 TEST(Effects, AYieldedSpecimenKeepsItsSetWhenReleased) {
   // Lifted off the tester, a specimen whose hinges yielded keeps the creases they took (its plastic set); an elastic
   // one springs back flat. "Released" here: the drape's mesh under a thousandth of gravity, the top still held.

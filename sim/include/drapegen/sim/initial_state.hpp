@@ -21,6 +21,11 @@ struct InitialStateSpec {
   std::string mesh_path;        // kMesh: a PLY file
   double lift = 0.001;          // m, height of the flat part above the top (the contact offset)
   double platform_radius = 0.05;
+  /// Laid turned over, its back face up: the layout is mirrored across the specimen's u axis before the rotation. An
+  /// elastic specimen without a rest shape drapes then as the mirror image of the same state laid face up; its own
+  /// rest angles (edge curl, a plastic set) bend the other way in the world, as a turned-over specimen's creases do.
+  /// Not for kMesh (the file's drape lies as it lies).
+  bool face_down = false;
 };
 
 /// Parses "flat", "sine", "fold" or "mesh:FILE".
