@@ -82,6 +82,7 @@ int main(int argc, char** argv) {
   CLI::App app{"drapegen diagnosis benchmark: reality captures, diagnoses, confusion matrix"};
   std::string out = "out/diagnosis_bench", fabrics_path = DRAPEGEN_FABRIC_DATA_DEFAULT, drapegen;
   int per_family = 5, controls = 5, jobs = 1, resolution = 60, diagnose_jobs = 1, placements = 1;
+  bool turn_over = false;
   bool quick = false, generate_only = false, score_only = false, held_out_placement = false, second_placement = false;
   std::uint64_t seed = 1;
   std::vector<std::string> families{"yield", "shear", "curl", "friction", "misalignment", "sensor"};
@@ -149,6 +150,9 @@ int main(int argc, char** argv) {
                "Diagnose with placement 1 as the second capture (in the candidate refits and the gate) and placement 2 "
                "(captures/NAME.p2, made with --placements 3) as the held-out capture")
       ->excludes("--held-out-placement");
+  app.add_flag("--turn-over", turn_over,
+               "Generate with drapegen reality --turn-over: the specimen is turned over each time it is lifted, so "
+               "placement 1 lies face down (a rest shape, such as a yield's creases, bends the other way there)");
   CLI11_PARSE(app, argc, argv);
   if (drapegen.empty()) drapegen = (fs::path(argv[0]).parent_path() / "drapegen").string();
   if (sensor_kinds.empty()) {
@@ -236,6 +240,7 @@ int main(int argc, char** argv) {
       spec.resolution = resolution;
       spec.seed = c.seed;
       spec.placement = p;
+      spec.turn_over = turn_over;
       spec.measured_bending_error = measured_bending_error;
       if (!c.effect.empty()) spec.effects.push_back({c.effect, c.strength});
       auto r = diagnosis::generate_reality(spec, dir.string());

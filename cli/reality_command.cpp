@@ -23,6 +23,7 @@ struct RealityOptions {
   int resolution = 30;
   std::uint64_t seed = 0;
   int placement = 0;
+  bool turn_over = false;
   std::string out;
   bool noise = true;
   bool json = false;
@@ -49,6 +50,7 @@ int run_reality(const RealityOptions& o) {
     return fail(fmt::format("--placement must be between 0 and {}", diagnosis::kMaxPlacement));
   }
   spec.placement = o.placement;
+  spec.turn_over = o.turn_over;
   spec.noise = o.noise;
   if (const double s = o.measured_bending_error;
       !(s == 0.0 || (s >= diagnosis::kMinMeasuredBendingError && s <= 1.0))) {
@@ -103,6 +105,10 @@ Runner add_reality_command(CLI::App& app) {
                  "it. A yielding specimen keeps its plastic set: placement K starts from the set placements 0..K-1 "
                  "left (K + 1 drapes)")
       ->capture_default_str();
+  app.add_flag("--turn-over", o->turn_over,
+               "The specimen is turned over each time it is lifted: odd placements lie face down (capture.json "
+               "\"face\": \"down\"), so a rest shape (edge curl, a yield's creases) bends the other way on them. "
+               "Give it to every placement of one specimen (docs/CAPTURE.md)");
   app.add_option("--out", o->out, "Capture directory (capture.json, view0..3.exr, truth.json, preview.png); an earlier "
                                   "capture of drapegen reality there is replaced, any other refused")
       ->required();

@@ -30,7 +30,9 @@ constexpr int kDriftDirections = 4;
 ///   from `states`;
 /// - a misaligned setup (drift) is placed off centre by the same distance in the best of kDriftDirections directions
 ///   (each simulated from the state of the best drape on `on`, scored by the fit score), then simulated from `states`;
-/// - any other setup's drapes are scored again (turned to the placement's outline).
+/// - an edge-curled setup laid on another face than on `on` is simulated there from `states` (its curl turns over);
+/// - any other setup's drapes are scored again (turned to the placement's outline; turned over, an orthotropic fabric
+///   without a rest shape is the same fabric).
 /// `placed` receives the setup as placed there, `drift_direction` the chosen direction (misaligned setups only).
 sim::Expected<Evaluation> on_next_placement(ForwardModel& next, const ModelSetup& setup, const Evaluation& on,
                                             const std::vector<sim::InitialStateSpec>& states, ModelSetup& placed,
@@ -66,9 +68,13 @@ sim::Expected<Evaluation> on_next_placement(ForwardModel& next, const ModelSetup
     if (drift_direction) *drift_direction = best_direction;
     return next.evaluate(placed, states, &simulated);
   }
+  placed = setup;
+  if (setup.effects.edge_curl && !on.states.empty() &&
+      lies_face_down(on.states.front().mesh) != next.capture().face_down) {
+    return next.evaluate(setup, states);
+  }
   std::vector<sim::ClothMesh> meshes;
   for (const auto& d : on.states) meshes.push_back(d.mesh);
-  placed = setup;
   return next.rescore(meshes, setup);
 }
 

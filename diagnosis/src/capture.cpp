@@ -170,7 +170,7 @@ sim::Expected<Capture> read_capture(const std::string& directory) {
                                     j.contains("version") ? j["version"].dump() : std::string("(none)"))};
     }
     // "notes": the tester's own metadata, any JSON, not read.
-    if (sim::Status st = known_keys_only(j, {"format", "version", "source", "specimen", "views", "scan", "notes"},
+    if (sim::Status st = known_keys_only(j, {"format", "version", "source", "face", "specimen", "views", "scan", "notes"},
                                          where);
         !st) {
       return st.error();
@@ -180,6 +180,13 @@ sim::Expected<Capture> read_capture(const std::string& directory) {
     if (j.contains("source") && !j["source"].is_null()) {
       if (!j["source"].is_string()) return sim::Error{fmt::format("{}: source must be a string", where)};
       c.source = j["source"].get<std::string>();
+    }
+    if (j.contains("face")) {
+      if (!j["face"].is_string() || (j["face"] != "up" && j["face"] != "down")) {
+        return sim::Error{fmt::format("{}: face must be \"up\" or \"down\" (the specimen turned over), not {}", where,
+                                      j["face"].dump())};
+      }
+      c.face_down = j["face"] == "down";
     }
     if (!j.contains("specimen") || !j["specimen"].is_object()) {
       return sim::Error{fmt::format("{}: missing \"specimen\"", where)};
@@ -379,6 +386,7 @@ std::string capture_json_text(const Capture& capture) {
     j["specimen"]["measured_bending"] = measured;
   }
   if (capture.scan_mesh) j["scan"] = *capture.scan_mesh;
+  if (capture.face_down) j["face"] = "down";
   return storage::json_text(j) + "\n";
 }
 

@@ -418,9 +418,9 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
   }
   r.validation_spread = validation_spread(r.validated.states, model.target().shape.all);
   {  // Does the specimen drape the same way on every placement, as often as the fitted model does?
-    std::vector<HemProfile> placements{hem_profile_from_capture(capture)};
+    std::vector<HemProfile> placements{specimen_frame(hem_profile_from_capture(capture), capture.face_down)};
     for (const Capture* other : {others.second, others.held_out})
-      if (other) placements.push_back(hem_profile_from_capture(*other));
+      if (other) placements.push_back(specimen_frame(hem_profile_from_capture(*other), other->face_down));
     r.fold_repeatability =
         fold_repeatability(placements, sine_drapes(r.validated, validation_states(settings.attribution)));
     r.fold_repeatability.model_placements = placement_fold_correlations(

@@ -78,6 +78,7 @@ sim::Expected<sim::ClothMesh> ForwardModel::simulate(const ModelSetup& setup, co
   config.specimen.seed = set ? setup.plastic_set.specimen_seed : state.seed;
   config.rest_angles = setup.plastic_set.rest_angles;
   config.initial = state;
+  config.initial.face_down = capture_.face_down;  // the specimen as this capture saw it laid
   config.initial.platform_radius = config.platform.radius;
   config.initial.drift += setup.drift;
   config.effects = setup.effects;

@@ -146,6 +146,7 @@ sim::Expected<Placement> make_placement(const RealitySpec& spec, int placement) 
   config.initial.shape = sim::InitialShape::kSine;
   config.initial.seed = replaced ? placement_seed : spec.seed;
   config.initial.rotation = 2.0 * M_PI * placement_draw();
+  config.initial.face_down = spec.turn_over && placement % 2 == 1;
   const double small = 2e-3 * placement_draw();  // the data's augmentation range: up to 2 mm off centre
   const double phi = 2.0 * M_PI * placement_draw();
   config.initial.drift = small * Eigen::Vector2d(std::cos(phi), std::sin(phi));
@@ -267,6 +268,7 @@ sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std
 
   Capture capture;
   capture.source = kRealitySource;
+  capture.face_down = config.initial.face_down;
   capture.specimen.size_x = config.specimen.size_x;
   capture.specimen.size_y = config.specimen.size_y;
   capture.specimen.density = spec.density;
@@ -314,6 +316,7 @@ sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std
       {"resolution", spec.resolution},
       {"seed", spec.seed},
       {"placement", spec.placement},
+      {"face", config.initial.face_down ? "down" : "up"},
       {"plastic_set", {{"from_placements", config.rest_angles.size() > 0 ? spec.placement : 0},
                        {"largest_rest_angle_rad", largest_set},
                        {"earlier_drapes_converged", set_converged}}},

@@ -117,6 +117,33 @@ TEST(Capture, MeasuredBendingRoundTripsAndIsOptional) {
   EXPECT_EQ(m.method, "cantilever");
 }
 
+TEST(Capture, TheFaceRoundTripsIsUpByDefaultAndRefusesOtherValues) {
+  const std::string dir = fresh_dir("face");
+  Capture c = plane_capture();
+  ASSERT_TRUE(write_capture(dir, c).ok());
+  nlohmann::json written = nlohmann::json::parse(std::ifstream(fs::path(dir) / "capture.json"));
+  EXPECT_FALSE(written.contains("face"));  // face up: the format's default, not written
+  auto r = read_capture(dir);
+  ASSERT_TRUE(r.has_value()) << r.error().message;
+  EXPECT_FALSE(r->face_down);
+  c.face_down = true;
+  ASSERT_TRUE(write_capture(dir, c).ok());
+  written = nlohmann::json::parse(std::ifstream(fs::path(dir) / "capture.json"));
+  EXPECT_EQ(written.value("face", ""), "down");
+  r = read_capture(dir);
+  ASSERT_TRUE(r.has_value()) << r.error().message;
+  EXPECT_TRUE(r->face_down);
+  written["face"] = "up";
+  std::ofstream(fs::path(dir) / "capture.json") << written.dump();
+  r = read_capture(dir);
+  ASSERT_TRUE(r.has_value()) << r.error().message;
+  EXPECT_FALSE(r->face_down);
+  for (const nlohmann::json bad : {nlohmann::json("Down"), nlohmann::json(true), nlohmann::json(1)}) {
+    const std::string e = error_with(dir, written, [&](nlohmann::json& j) { j["face"] = bad; });
+    EXPECT_NE(e.find("face must be \"up\" or \"down\""), std::string::npos) << e;
+  }
+}
+
 TEST(Capture, BadMeasuredBendingIsAClearError) {
   const std::string dir = fresh_dir("measured_bad");
   ASSERT_TRUE(write_capture(dir, plane_capture()).ok());

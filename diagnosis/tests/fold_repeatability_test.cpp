@@ -3,6 +3,8 @@
 #include <cmath>
 
 #include "drapegen/diagnosis/fold_repeatability.hpp"
+#include "drapegen/sim/initial_state.hpp"
+#include "drapegen/sim/specimen.hpp"
 
 using namespace drapegen::diagnosis;
 
@@ -92,6 +94,39 @@ TEST(FoldRepeatability, DrapesCorrelateByTheirOutlines) {
   EXPECT_LT(std::abs(c[1]), 0.1);   // seven against nine
   EXPECT_LT(std::abs(c[2]), 0.1);
   EXPECT_TRUE(drape_fold_correlations({drapes[0]}).empty());
+}
+
+TEST(FoldRepeatability, ATurnedOverSpecimensFoldsMatchInItsOwnFrame) {
+  // Six folds leaning one way (a sawtooth of three harmonics): no turn matches the pattern with its mirror image
+  // (the best matches 0.63 of it), so only the specimen frame (the face-down outline mirrored back) finds a
+  // turned-over specimen's folds where they were.
+  auto folds = [](bool mirrored, double turn) {
+    HemProfile p;
+    p.radius.resize(kHemBins);
+    for (int k = 0; k < kHemBins; ++k) {
+      const double t = (mirrored ? -1.0 : 1.0) * ((k + 0.5) * 2 * M_PI / kHemBins - turn);
+      p.radius[k] = 0.15 + 0.008 * (std::sin(6 * t) + std::sin(12 * t) / 2 + std::sin(18 * t) / 3);
+    }
+    return p;
+  };
+  const HemProfile up = folds(false, 0.0), down = folds(true, 1.3);
+  EXPECT_LT(fold_correlation(up, down), 0.8);
+  EXPECT_GT(fold_correlation(specimen_frame(up, false), specimen_frame(down, true)), 0.97);
+  EXPECT_EQ(specimen_frame(down, false).radius, down.radius);
+
+  using namespace drapegen::sim;
+  for (const InitialShape shape : {InitialShape::kFlat, InitialShape::kSine}) {
+    for (const bool face_down : {false, true}) {
+      ClothMesh mesh = make_specimen(SpecimenSpec{0.3, 0.3, 12, 12, 0.2, Triangulation::kRandom, 1, 0.0});
+      InitialStateSpec state;
+      state.shape = shape;
+      state.seed = 4;
+      state.rotation = 2.0;
+      state.face_down = face_down;
+      ASSERT_TRUE(apply_initial_state(state, mesh));
+      EXPECT_EQ(lies_face_down(mesh), face_down) << static_cast<int>(shape);
+    }
+  }
 }
 
 TEST(FoldRepeatability, SineDrapesOnly) {

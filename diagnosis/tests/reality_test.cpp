@@ -25,13 +25,14 @@ struct Placed {
 };
 
 Placed place(int placement, const fs::path& dir,
-             const std::vector<std::string>& effects = {"misalign=15", "pose=2"}) {
+             const std::vector<std::string>& effects = {"misalign=15", "pose=2"}, bool turn_over = false) {
   RealitySpec spec;
   spec.bending.alpha = {13923, 11455, 8821};
   spec.bending.beta = {-35390, -29660, -22042};
   spec.resolution = 12;
   spec.seed = 21;
   spec.placement = placement;
+  spec.turn_over = turn_over;
   spec.noise = false;  // so that a difference between two placements is the drape's, not the noise's
   spec.measured_bending_error = 0.1;
   for (const auto& e : effects) spec.effects.push_back(*parse_reality_effect(e));
@@ -148,6 +149,30 @@ TEST(Reality, AYieldingSpecimenCarriesItsPlasticSetToTheNextPlacement) {
   // second drape (from a new state and orientation) sets its own hinges further.
   EXPECT_NE(second.truth["plastic_set"]["largest_rest_angle_rad"].get<double>(),
             third.truth["plastic_set"]["largest_rest_angle_rad"].get<double>());
+  fs::remove_all(root);
+}
+
+TEST(Reality, ASpecimenTurnedOverLiesFaceDownOnOddPlacementsWithItsSet) {
+  const fs::path root = fs::temp_directory_path() / ("drapegen_reality_face_" + std::to_string(::getpid()));
+  fs::remove_all(root);
+  const Placed yield_kept = place(1, root / "yield_kept", {"yield=20"});
+  const Placed yield_turned = place(1, root / "yield_turned", {"yield=20"}, true);
+  const Placed third = place(2, root / "third", {"yield=20"}, true);
+  const Placed elastic_kept = place(1, root / "elastic_kept", {});
+  const Placed elastic_turned = place(1, root / "elastic_turned", {}, true);
+  EXPECT_FALSE(yield_kept.capture.face_down);
+  EXPECT_TRUE(yield_turned.capture.face_down);
+  EXPECT_FALSE(third.capture.face_down);  // turned over twice
+  EXPECT_EQ(yield_turned.truth["face"], "down");
+  EXPECT_EQ(third.truth["face"], "up");
+  // The set the first drape left is carried to the turned-over placement (the sim's tests check that it bends the
+  // other way there: Effects.ASpecimenLaidFaceDownDrapesAsItsMirrorImageWithItsRestShapeTurned).
+  EXPECT_EQ(yield_turned.truth["plastic_set"]["from_placements"], 1);
+  EXPECT_EQ(yield_turned.truth["plastic_set"]["largest_rest_angle_rad"],
+            yield_kept.truth["plastic_set"]["largest_rest_angle_rad"]);
+  EXPECT_NE(yield_turned.truth["drape_coefficient"], yield_kept.truth["drape_coefficient"]);
+  EXPECT_EQ(elastic_turned.truth["face"], "down");
+  EXPECT_EQ(elastic_kept.truth["face"], "up");
   fs::remove_all(root);
 }
 

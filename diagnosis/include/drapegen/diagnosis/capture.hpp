@@ -45,6 +45,9 @@ struct Capture {
   std::vector<CaptureView> views;
   std::optional<std::string> scan_mesh;  // a PLY file, relative to the directory
   std::string source;                    // free text, e.g. "drapegen reality"
+  /// The specimen lay turned over, its back face up ("face": "down"; default "up"). Only the faces of one specimen's
+  /// captures relative to each other matter: a rest shape (edge curl, creases a yield left) bends the other way.
+  bool face_down = false;
 };
 
 /// The number of views a capture must have (the tester's four).

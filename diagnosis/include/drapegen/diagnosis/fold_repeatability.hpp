@@ -19,6 +19,15 @@ namespace drapegen::diagnosis {
 /// the square's corners), which every drape of a fabric shares.
 [[nodiscard]] HemProfile fold_content(const HemProfile& profile);
 
+/// Whether a drape lies turned over (its back face up): the projection of its triangles onto the table, counted with
+/// their orientation, covers a negative area (the rest triangles are counter-clockwise; by Green's theorem the sum is
+/// the area the projected hem encloses, whatever the folds do).
+[[nodiscard]] bool lies_face_down(const sim::ClothMesh& drape);
+
+/// An outline in the specimen's own frame: mirrored (angle -theta) if the specimen lies face down, else as it is. A
+/// specimen turned over folds where it folded before in its own frame, which the table sees mirrored.
+[[nodiscard]] HemProfile specimen_frame(const HemProfile& outline, bool face_down);
+
 /// The correlation of two outlines' fold content at the turn (whole bins) that matches them best: 1 for the same
 /// folds however turned, near 0 for unrelated ones. 0 if either has no fold content (below 1 um RMS).
 [[nodiscard]] double fold_correlation(const HemProfile& a, const HemProfile& b);
@@ -26,7 +35,7 @@ namespace drapegen::diagnosis {
 /// Every pair's fold_correlation (i < j, in order 01, 02, .., 12, ..).
 [[nodiscard]] std::vector<double> pairwise_fold_correlations(const std::vector<HemProfile>& outlines);
 
-/// Every pair's fold_correlation of the drapes' outlines (hem_profile_from_mesh).
+/// Every pair's fold_correlation of the drapes' outlines (hem_profile_from_mesh, each in its specimen frame).
 [[nodiscard]] std::vector<double> drape_fold_correlations(const std::vector<sim::ClothMesh>& drapes);
 
 /// drape_fold_correlations of the drapes a model chose on each placement (null: that placement not given), paired as
@@ -58,7 +67,8 @@ struct FoldRepeatability {
 [[nodiscard]] bool folds_less_alike(const FoldRepeatability& f);
 inline constexpr double kFoldsUnlikeMargin = 0.1;
 
-/// `placements`: the captures' outlines (every view), the capture first; `drapes`: the model's drapes.
+/// `placements`: the captures' outlines (every view) in the specimen frame, the capture first; `drapes`: the model's
+/// drapes.
 [[nodiscard]] FoldRepeatability fold_repeatability(const std::vector<HemProfile>& placements,
                                                    const std::vector<sim::ClothMesh>& drapes);
 

@@ -49,6 +49,9 @@ struct RealitySpec {
   /// A yielding specimen (yield) carries its plastic set from placement to placement: placement K starts from the
   /// rest angles placements 0 .. K-1 left, draped in turn (K + 1 drapes in all). At most kMaxPlacement.
   int placement = 0;
+  /// The specimen is turned over each time it is lifted: placement K lies face down (capture.json "face": "down")
+  /// when K is odd. A rest shape (edge curl, a plastic set) then bends the other way on those placements.
+  bool turn_over = false;
   std::vector<RealityEffect> effects;
   bool noise = true;
   /// > 0: the capture carries a measured bending (SpecimenFacts::measured_bending), measure_bending(bending, this,
