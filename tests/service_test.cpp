@@ -125,7 +125,10 @@ TEST(Service, AWorkerStoppedBySigtermCostsItsJobNoAttempt) {
   const auto deadline = std::chrono::steady_clock::now() + 150s;
   while (coordinator.running() && std::chrono::steady_clock::now() < deadline) {
     std::this_thread::sleep_for(std::chrono::milliseconds(150 + rng() % 250));
-    if (stopped < 8 && coordinator.running()) {
+    // Three stops at most: a job is given back three times per session, the fourth leave costs an attempt
+    // (AJobIsForgivenThreeLeavesNotMore); a requeued job goes to the next worker first, so on a loaded machine one
+    // slow job can be held by every stopped worker in turn (8 stops once failed job 6 so).
+    if (stopped < 3 && coordinator.running()) {
       auto& victim = workers[rng() % workers.size()];
       ::kill(victim.pid(), SIGTERM);
       const int code = victim.wait(30s);
