@@ -170,8 +170,8 @@ sim::Expected<Capture> read_capture(const std::string& directory) {
                                     j.contains("version") ? j["version"].dump() : std::string("(none)"))};
     }
     // "notes": the tester's own metadata, any JSON, not read.
-    if (sim::Status st = known_keys_only(j, {"format", "version", "source", "face", "specimen", "views", "scan", "notes"},
-                                         where);
+    if (sim::Status st = known_keys_only(
+            j, {"format", "version", "source", "face", "specimen", "views", "scan", "notes"}, where);
         !st) {
       return st.error();
     }

@@ -224,9 +224,9 @@ sim::Status check_same_specimen(const Capture& capture, const Capture& other, st
     return sim::Error{fmt::format("{} {}: the capture itself (it must be another placement)", role, other.directory)};
   }
   // A copy of the capture: every view's depth the same (a re-placement, even re-captured, differs in its noise).
+  const auto same_depth = [](const CaptureView& x, const CaptureView& y) { return x.depth.depth == y.depth.depth; };
   const bool copy = capture.views.size() == other.views.size() &&
-                    std::equal(capture.views.begin(), capture.views.end(), other.views.begin(),
-                               [](const CaptureView& x, const CaptureView& y) { return x.depth.depth == y.depth.depth; });
+                    std::equal(capture.views.begin(), capture.views.end(), other.views.begin(), same_depth);
   if (copy) {
     return sim::Error{fmt::format("{} {}: the same depth in every view as the capture (a copy of it; it must be "
                                   "another placement)",

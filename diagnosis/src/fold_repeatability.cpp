@@ -59,8 +59,9 @@ std::vector<double> pairwise_fold_correlations(const std::vector<HemProfile>& ou
 bool lies_face_down(const sim::ClothMesh& drape) {
   double area = 0.0;  // twice the signed projected area
   for (int t = 0; t < drape.triangle_count(); ++t) {
-    const Eigen::Vector3d a = drape.positions.col(drape.triangles(0, t)), b = drape.positions.col(drape.triangles(1, t)),
-                          c = drape.positions.col(drape.triangles(2, t));
+    const auto a = drape.positions.col(drape.triangles(0, t));
+    const auto b = drape.positions.col(drape.triangles(1, t));
+    const auto c = drape.positions.col(drape.triangles(2, t));
     area += (b.x() - a.x()) * (c.y() - a.y()) - (b.y() - a.y()) * (c.x() - a.x());
   }
   return area < 0.0;
