@@ -15,6 +15,7 @@
 #include "drapegen/diagnosis/work_sharing.hpp"
 #include "drapegen/renderer/random.hpp"
 #include "drapegen/sim/logging.hpp"
+#include "drapegen/sim/measures.hpp"
 
 namespace drapegen::diagnosis {
 namespace {
@@ -70,7 +71,7 @@ sim::Expected<Evaluation> on_next_placement(ForwardModel& next, const ModelSetup
   }
   placed = setup;
   if (setup.effects.edge_curl && !on.states.empty() &&
-      lies_face_down(on.states.front().mesh) != next.capture().face_down) {
+      sim::lies_face_down(on.states.front().mesh) != next.capture().face_down) {
     return next.evaluate(setup, states);
   }
   std::vector<sim::ClothMesh> meshes;

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <optional>
 
+#include "drapegen/sim/measures.hpp"
+
 namespace drapegen::diagnosis {
 
 HemProfile fold_content(const HemProfile& profile) {
@@ -56,17 +58,6 @@ std::vector<double> pairwise_fold_correlations(const std::vector<HemProfile>& ou
   return c;
 }
 
-bool lies_face_down(const sim::ClothMesh& drape) {
-  double area = 0.0;  // twice the signed projected area
-  for (int t = 0; t < drape.triangle_count(); ++t) {
-    const auto a = drape.positions.col(drape.triangles(0, t));
-    const auto b = drape.positions.col(drape.triangles(1, t));
-    const auto c = drape.positions.col(drape.triangles(2, t));
-    area += (b.x() - a.x()) * (c.y() - a.y()) - (b.y() - a.y()) * (c.x() - a.x());
-  }
-  return area < 0.0;
-}
-
 HemProfile specimen_frame(const HemProfile& outline, bool face_down) {
   if (!face_down) return outline;
   HemProfile mirrored = outline;  // bin k (centred at (k + 1/2) 2 pi / n) goes to the bin centred at minus that angle
@@ -77,7 +68,7 @@ HemProfile specimen_frame(const HemProfile& outline, bool face_down) {
 
 std::vector<double> drape_fold_correlations(const std::vector<sim::ClothMesh>& drapes) {
   std::vector<HemProfile> outlines;
-  for (const auto& mesh : drapes) outlines.push_back(specimen_frame(hem_profile_from_mesh(mesh), lies_face_down(mesh)));
+  for (const auto& mesh : drapes) outlines.push_back(specimen_frame(hem_profile_from_mesh(mesh), sim::lies_face_down(mesh)));
   return pairwise_fold_correlations(outlines);
 }
 

@@ -8,8 +8,8 @@
 #include <optional>
 #include <string>
 
-#include "drapegen/diagnosis/fold_repeatability.hpp"
 #include "drapegen/diagnosis/forward_model.hpp"
+#include "drapegen/sim/measures.hpp"
 #include "small_reality.hpp"
 
 namespace drapegen::diagnosis {
@@ -95,8 +95,8 @@ TEST(ForwardModel, LaysTheSpecimenOnTheCapturesFace) {
   auto up = small->model->simulate(elastic, states[1]);
   auto down = (*turned)->simulate(elastic, states[1]);
   ASSERT_TRUE(up.has_value() && down.has_value());
-  EXPECT_FALSE(lies_face_down(*up));
-  EXPECT_TRUE(lies_face_down(*down));
+  EXPECT_FALSE(sim::lies_face_down(*up));
+  EXPECT_TRUE(sim::lies_face_down(*down));
   // states[1] has no drift: the face-down drape is the face-up one mirrored across the specimen's u axis turned by the
   // state's rotation (0 here).
   ASSERT_EQ(states[1].rotation, 0.0);

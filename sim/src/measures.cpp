@@ -537,4 +537,16 @@ int count_self_intersections(const ClothMesh& mesh) {
   return count;
 }
 
+bool lies_face_down(const ClothMesh& mesh) {
+  require_valid_mesh(mesh, "lies_face_down");
+  double area = 0.0;  // twice the signed projected area
+  for (int t = 0; t < mesh.triangle_count(); ++t) {
+    const auto a = mesh.positions.col(mesh.triangles(0, t));
+    const auto b = mesh.positions.col(mesh.triangles(1, t));
+    const auto c = mesh.positions.col(mesh.triangles(2, t));
+    area += (b.x() - a.x()) * (c.y() - a.y()) - (b.y() - a.y()) * (c.x() - a.x());
+  }
+  return area < 0.0;
+}
+
 }  // namespace drapegen::sim

@@ -10,6 +10,7 @@
 #include <numbers>
 #include <vector>
 
+#include "drapegen/sim/initial_state.hpp"
 #include "drapegen/sim/specimen.hpp"
 
 namespace drapegen::sim {
@@ -100,6 +101,39 @@ TEST(ProjectedArea, VerticalTrianglesHaveNoShadow) {
   EXPECT_EQ(projected_area(mesh), 0.0);
 }
 
+TEST(LiesFaceDown, ALaidOutSpecimenLiesOnTheFaceItWasLaidOn) {
+  for (const InitialShape shape : {InitialShape::kFlat, InitialShape::kSine}) {
+    for (const bool face_down : {false, true}) {
+      ClothMesh mesh = square_specimen(12, 0.2, true);
+      InitialStateSpec state;
+      state.shape = shape;
+      state.seed = 4;
+      state.rotation = 2.0;
+      state.face_down = face_down;
+      ASSERT_TRUE(apply_initial_state(state, mesh));
+      EXPECT_EQ(lies_face_down(mesh), face_down) << static_cast<int>(shape);
+    }
+  }
+}
+
+TEST(LiesFaceDown, AFoldTurnsTheSpecimenOnlyWhereItLaysMostOfItBack) {
+  // The square (x in +-0.15 m) folded back along x = f: the part beyond lies mirrored at 2f - x, its back face up.
+  // The signed shadow is the unfolded part's area less the folded part's.
+  const auto folded_at = [](double f) {
+    ClothMesh mesh = square_specimen(41);
+    for (int i = 0; i < mesh.vertex_count(); ++i) {
+      const double x = mesh.rest(0, i);
+      if (x > f) mesh.positions.col(i) << 2.0 * f - x, mesh.rest(1, i), 2e-3;
+    }
+    return mesh;
+  };
+  ClothMesh quarter = folded_at(0.075);
+  EXPECT_FALSE(lies_face_down(quarter));  // 0.225 up, 0.075 down
+  quarter.positions.row(1) *= -1.0;       // the same fold seen from below
+  EXPECT_TRUE(lies_face_down(quarter));
+  EXPECT_TRUE(lies_face_down(folded_at(-0.075)));  // 0.075 up, 0.225 down: mostly turned over
+}
+
 TEST(Measures, RejectBadInput) {
   ClothMesh mesh = square_specimen(5);
   EXPECT_THROW((void)projected_area(mesh, 0.0), std::invalid_argument);
@@ -114,6 +148,7 @@ TEST(Measures, RejectBadInput) {
   EXPECT_THROW((void)hem_profile(mesh), std::invalid_argument);
   EXPECT_THROW((void)count_self_intersections(mesh), std::invalid_argument);
   EXPECT_THROW((void)drape_coefficient(mesh, 0.05), std::invalid_argument);
+  EXPECT_THROW((void)lies_face_down(mesh), std::invalid_argument);
 }
 
 TEST(DrapeCoefficient, FlatSpecimenIsOne) {

@@ -19,11 +19,6 @@ namespace drapegen::diagnosis {
 /// the square's corners), which every drape of a fabric shares.
 [[nodiscard]] HemProfile fold_content(const HemProfile& profile);
 
-/// Whether a drape lies turned over (its back face up): the projection of its triangles onto the table, counted with
-/// their orientation, covers a negative area (the rest triangles are counter-clockwise; by Green's theorem the sum is
-/// the area the projected hem encloses, whatever the folds do).
-[[nodiscard]] bool lies_face_down(const sim::ClothMesh& drape);
-
 /// An outline in the specimen's own frame: mirrored (angle -theta) if the specimen lies face down, else as it is. A
 /// specimen turned over folds where it folded before in its own frame, which the table sees mirrored.
 [[nodiscard]] HemProfile specimen_frame(const HemProfile& outline, bool face_down);
@@ -35,7 +30,8 @@ namespace drapegen::diagnosis {
 /// Every pair's fold_correlation (i < j, in order 01, 02, .., 12, ..).
 [[nodiscard]] std::vector<double> pairwise_fold_correlations(const std::vector<HemProfile>& outlines);
 
-/// Every pair's fold_correlation of the drapes' outlines (hem_profile_from_mesh, each in its specimen frame).
+/// Every pair's fold_correlation of the drapes' outlines (hem_profile_from_mesh, each in its specimen frame:
+/// sim::lies_face_down).
 [[nodiscard]] std::vector<double> drape_fold_correlations(const std::vector<sim::ClothMesh>& drapes);
 
 /// drape_fold_correlations of the drapes a model chose on each placement (null: that placement not given), paired as

@@ -60,4 +60,11 @@ namespace drapegen::sim {
 /// vertices are not shared.
 [[nodiscard]] int count_self_intersections(const ClothMesh& mesh);
 
+/// Whether the specimen lies turned over (its back face up): the projection of its triangles onto the xy plane,
+/// counted with their orientation, covers a negative area. The rest triangles are counter-clockwise seen from +z, and
+/// the signed sum is the cloth's area facing up less its area facing down, seen from above (by Green's theorem, the
+/// area the projected boundary encloses, counted with its winding). A drape's folds turn small parts of it; a fold
+/// that lays most of the cloth back over the rest turns the specimen. A sum of exactly 0 reads as face up.
+[[nodiscard]] bool lies_face_down(const ClothMesh& mesh);
+
 }  // namespace drapegen::sim
