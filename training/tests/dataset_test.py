@@ -105,6 +105,56 @@ with warnings.catch_warnings(record=True) as caught:
     assert DrapeDataset(stopped).run_state == "stopped"
 assert any("the run is stopped" in str(w.message) for w in caught), [str(w.message) for w in caught]
 
+# A live run commits while the dataset reads it: everything is read in one snapshot, so a commit between the count
+# of the done jobs' files and the rows themselves (here one that changes a done job's state) leaves neither unfilled
+# nor surplus rows: the dataset is the run as it was before the commit. (Read outside one snapshot, the rows no longer
+# match the count: the test then fails on an index out of bounds.)
+import drapegen_dataset  # noqa: E402
+
+live_copy = os.path.join(work, "concurrent", "manifest.sqlite")
+os.makedirs(os.path.dirname(live_copy))
+shutil.copy(manifest, live_copy)
+before = DrapeDataset(live_copy)
+
+
+class CommitAfter:
+    """The reader's connection, with another connection committing right after the first query naming `after`."""
+
+    def __init__(self, db, after, commit):
+        self.db, self.after, self.commit, self.committed = db, after, commit, False
+
+    def execute(self, sql, *args):
+        cursor = self.db.execute(sql, *args)
+        if self.after in sql and not self.committed:
+            self.committed = True
+            self.commit()
+        return cursor
+
+    def __getattr__(self, name):
+        return getattr(self.db, name)
+
+
+def fail_one_done_job():
+    writer = sqlite3.connect(live_copy)
+    writer.execute("UPDATE jobs SET state = 'failed' WHERE id = (SELECT min(id) FROM jobs WHERE state = 'done')")
+    writer.commit()
+    writer.close()
+
+
+opened = drapegen_dataset.open_manifest
+drapegen_dataset.open_manifest = lambda path: (lambda db, imm: (CommitAfter(db, "SELECT count(*)", fail_one_done_job),
+                                                                imm))(*opened(path))
+try:
+    during = DrapeDataset(live_copy)
+finally:
+    drapegen_dataset.open_manifest = opened
+check = sqlite3.connect(live_copy)
+assert check.execute("SELECT count(*) FROM jobs WHERE state = 'done'").fetchone()[0] == done - 1  # it committed
+check.close()
+assert len(during) == len(before) == done * 2, (len(during), len(before))
+assert np.array_equal(during.jobs, before.jobs) and np.array_equal(during.paths, before.paths), (during.jobs, before.jobs)
+assert len(DrapeDataset(live_copy)) == (done - 1) * 2  # read again: the commit seen
+
 # Another user's finished run in a directory this process cannot write (no -shm can be made beside the WAL
 # database): read as an immutable file. Root writes anywhere, so the reader runs as nobody where root can arrange it.
 runuser = shutil.which("runuser")
