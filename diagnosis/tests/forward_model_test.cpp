@@ -117,6 +117,53 @@ TEST(ForwardModel, LaysTheSpecimenOnTheCapturesFace) {
   fs::remove_all(small->made.dir);
 }
 
+TEST(ForwardModel, AViewWhoseCaptureSeesNoRigidSurfaceHasNoStableTerm) {
+  // The capture's view 3 (the held-out one: the outline the drape is turned to is the fit views') with every pixel on
+  // the platform top or the bare cylinder side cleared (as a view blocked there, or aimed past them): the stable
+  // term's mean is over the other three views, each compared as before, not over four with 0 (or the truncation) for
+  // the view that has none.
+  auto small = small_model("no_rigid_view");
+  ASSERT_TRUE(small.has_value());
+  Capture blocked = small->made.capture;
+  const MetricWeights weights = FitSettings{}.weights;
+  CaptureView& view = blocked.views[3];
+  const ViewFeatures features = view_features(view.depth, view.camera, weights);
+  int cleared = 0;
+  for (int v = 0; v < view.depth.height; ++v) {
+    for (int u = 0; u < view.depth.width; ++u) {
+      const float z = view.depth.at(u, v);
+      if (z > 0.0f && stable_pixel(features, u, v, z, weights)) view.depth.at(u, v) = 0.0f, ++cleared;
+    }
+  }
+  ASSERT_GT(cleared, 100);
+  FitSettings settings;
+  settings.resolution = 12;
+  auto model = ForwardModel::create(blocked, settings);
+  ASSERT_TRUE(model.has_value()) << model.error().message;
+
+  ModelSetup elastic;
+  elastic.bending = small->made.spec.bending;
+  auto drape = small->model->simulate(elastic, fit_initial_states(1, 3)[0]);
+  ASSERT_TRUE(drape.has_value()) << drape.error().message;
+  drape->positions.row(2).array() += 0.003;  // 3 mm above: every view's rigid surfaces disagree
+  auto all = small->model->score(*drape, elastic);
+  auto three = (*model)->score(*drape, elastic);
+  ASSERT_TRUE(all.has_value() && three.has_value());
+  EXPECT_EQ(three->angle, all->angle);
+  EXPECT_EQ(three->views[3].captured_stable_pixels, 0);
+  EXPECT_GT(all->views[3].captured_stable_pixels, 100);
+  double others = 0.0;
+  for (int v : {0, 1, 2}) {
+    EXPECT_EQ(three->views[v].stable_rms, all->views[v].stable_rms) << "view " << v;
+    EXPECT_GT(all->views[v].stable_rms, 1e-3) << "view " << v;
+    others += all->views[v].stable_rms;
+  }
+  EXPECT_NEAR(three->stable_all, others / 3.0, 1e-12);
+  EXPECT_NEAR(all->stable_all, (others + all->views[3].stable_rms) / 4.0, 1e-12);
+  EXPECT_EQ(three->stable_fit, all->stable_fit);
+  fs::remove_all(small->made.dir);
+}
+
 TEST(ForwardModel, EvaluatesOnSeveralThreadsAsOnOne) {
   // The initial states simulated on three threads: the same drapes, scores, best state and plastic sets as on one,
   // each state simulated once.
