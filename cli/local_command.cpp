@@ -49,8 +49,9 @@ const Failure fail{"local"};
 class WorkerPool {
  public:
   static constexpr int kRestartsPerWorker = 3;
-  WorkerPool(std::string endpoint, int count, const std::atomic<bool>& signal_stop)
-      : endpoint_(std::move(endpoint)), count_(count), signal_stop_(signal_stop) {}
+  /// `fail_start`: the worker of this index cannot start (RunConfig::fail_worker_start, tests; -1: none).
+  WorkerPool(std::string endpoint, int count, const std::atomic<bool>& signal_stop, int fail_start = -1)
+      : endpoint_(std::move(endpoint)), count_(count), signal_stop_(signal_stop), fail_start_(fail_start) {}
 
   [[nodiscard]] const std::atomic<bool>& halt() const { return halt_; }
   /// The pool halted the run: no worker was left (every one died with the restarts spent, or stopped).
@@ -106,6 +107,7 @@ class WorkerPool {
   sim::Expected<pid_t> spawn(int k) {
     const std::string self = "/proc/self/exe";
     const std::string name = fmt::format("local-{}", k);
+    if (k == fail_start_) return sim::Error{fmt::format("cannot start a worker: {} (testing.fail_worker_start)", name)};
     std::vector<std::string> args = {"drapegen", "worker", "--connect", endpoint_, "--name", name, "--give-up", "60",
                                      "--log-level", "warn"};
     std::vector<char*> argv;
@@ -187,6 +189,7 @@ class WorkerPool {
   std::string endpoint_;
   int count_;
   const std::atomic<bool>& signal_stop_;
+  int fail_start_;
   std::vector<pid_t> pids_;
   std::thread supervisor_;
   std::atomic<bool> finishing_{false};
@@ -246,7 +249,7 @@ Runner add_local_command(CLI::App& app) {
       c = coordinator::Coordinator::create(text, name, options);
     }
     if (!c) return fail(c.error());
-    WorkerPool pool((*c)->endpoint(), o->workers, stop);
+    WorkerPool pool((*c)->endpoint(), o->workers, stop, (*c)->config().fail_worker_start);
     if (sim::Status s = pool.start(); !s) {
       return fail(fmt::format("{} (the run is planned; continue it with drapegen local --resume {})",
                               s.error().message, (*c)->manifest_path()));

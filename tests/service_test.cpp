@@ -4,6 +4,10 @@
 #include <random>
 #include <set>
 #include <sqlite3.h>
+#include <sys/prctl.h>
+#include <sys/wait.h>
+
+#include <cerrno>
 
 #include "service_harness.hpp"
 
@@ -635,6 +639,34 @@ TEST(Service, LocalStopsWhenItsWorkersAreStoppedBySignals) {
       << local.err();
   EXPECT_NE(local.err().find("drapegen local --resume " + manifest.string()), std::string::npos) << local.err();
   check_manifest(manifest, 2);
+}
+
+// A worker that cannot start (the third of three, testing.fail_worker_start) fails `drapegen local` at once, naming
+// the resume command, and the two it started are stopped and reaped, not left running until they give up. This test
+// process adopts orphans (a child subreaper): a worker left behind would be its child once local exits.
+TEST(Service, LocalStopsTheWorkersItStartedWhenALaterOneCannotStart) {
+  ASSERT_EQ(::prctl(PR_SET_CHILD_SUBREAPER, 1), 0);
+  const fs::path dir = test_dir("local_worker_cannot_start");
+  const fs::path out = dir / "run";
+  write_text(dir / "run.toml", small_config(out, 4, 1, "[testing]\nfail_worker_start = 2\n"));
+  {
+    Process local({"local", "--workers", "3", "--config", (dir / "run.toml").string()}, (dir / "local").string());
+    ASSERT_EQ(local.wait(30s), 1) << local.err();
+    EXPECT_NE(local.err().find("cannot start a worker: local-2"), std::string::npos) << local.err();
+    EXPECT_NE(local.err().find("drapegen local --resume " + (out / "manifest.sqlite").string()), std::string::npos)
+        << local.err();
+  }
+  // Local has exited and been reaped: any worker it left is now this process's child (alive or not yet reaped).
+  std::vector<pid_t> left;
+  for (const auto& task : fs::directory_iterator(fs::path("/proc/self/task"))) {
+    std::istringstream pids(Process::slurp((task.path() / "children").string()));
+    for (pid_t child = 0; pids >> child;) left.push_back(child), ::kill(child, SIGKILL);
+  }
+  while (::waitpid(-1, nullptr, 0) > 0) {
+  }
+  EXPECT_EQ(errno, ECHILD);
+  EXPECT_TRUE(left.empty()) << left.size() << " worker(s) of drapegen local left behind";
+  ::prctl(PR_SET_CHILD_SUBREAPER, 0);
 }
 
 // `drapegen local` starts its workers without keys: a configuration with CurveZMQ keys would lock them out (each

@@ -242,8 +242,9 @@ sim::Expected<RunConfig> parse_run_config(const std::string& toml_text, const st
   r.real(progress, "progress", "interval_s", c.progress_interval_s, 0.1, 86400.0);
 
   const toml::table* testing = r.table("testing");
-  r.only_keys(testing, "testing", {"mode", "poison_samples"});
+  r.only_keys(testing, "testing", {"mode", "poison_samples", "fail_worker_start"});
   r.text(testing, "testing", "mode", c.mode, {"drape", "noop"});
+  r.integer(testing, "testing", "fail_worker_start", c.fail_worker_start, 0, 4096);
   if (testing) {
     if (const toml::node* poison = testing->get("poison_samples")) {
       if (!poison->is_array()) {

@@ -60,6 +60,7 @@ interval_s = 1
 [testing]
 mode = "noop"
 poison_samples = [1, 2]
+fail_worker_start = 1
 )",
                             "run.toml");
   ASSERT_TRUE(c) << c.error().message;
@@ -93,6 +94,7 @@ poison_samples = [1, 2]
   EXPECT_EQ(c->progress_interval_s, 1.0);
   EXPECT_EQ(c->mode, "noop");
   EXPECT_EQ(c->poison_samples, (std::vector<std::int64_t>{1, 2}));
+  EXPECT_EQ(c->fail_worker_start, 1);
   // Each value above differs from its default (else a dropped key would pass unseen).
   EXPECT_NE(d.seed, 7u);
   EXPECT_NE(d.samples, 3);
@@ -118,6 +120,7 @@ poison_samples = [1, 2]
   EXPECT_NE(d.liveness, 3);
   EXPECT_NE(d.lease_s, 60.0);
   EXPECT_FALSE(d.curve);
+  EXPECT_NE(d.fail_worker_start, 1);
   EXPECT_NE(d.max_attempts, 4);
   EXPECT_NE(d.progress_interval_s, 1.0);
   EXPECT_NE(d.mode, "noop");

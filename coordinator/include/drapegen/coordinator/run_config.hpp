@@ -46,6 +46,7 @@ struct RunConfig {
   // [testing]
   std::string mode = "drape";    // drape | noop
   std::vector<std::int64_t> poison_samples;  // these samples' jobs run in poison mode (diverge)
+  int fail_worker_start = -1;  // drapegen local: the worker of this index cannot start (-1: none)
 };
 
 /// What is wrong with a ZeroMQ endpoint to bind or connect ("" if nothing): tcp://HOST:PORT with PORT 1 .. 65535 or
