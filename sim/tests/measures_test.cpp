@@ -105,12 +105,7 @@ TEST(LiesFaceDown, ALaidOutSpecimenLiesOnTheFaceItWasLaidOn) {
   for (const InitialShape shape : {InitialShape::kFlat, InitialShape::kSine}) {
     for (const bool face_down : {false, true}) {
       ClothMesh mesh = square_specimen(12, 0.2, true);
-      InitialStateSpec state;
-      state.shape = shape;
-      state.seed = 4;
-      state.rotation = 2.0;
-      state.face_down = face_down;
-      ASSERT_TRUE(apply_initial_state(state, mesh));
+      ASSERT_TRUE(apply_initial_state({.shape = shape, .seed = 4, .rotation = 2.0, .face_down = face_down}, mesh));
       EXPECT_EQ(lies_face_down(mesh), face_down) << static_cast<int>(shape);
     }
   }
