@@ -68,7 +68,8 @@ HemProfile specimen_frame(const HemProfile& outline, bool face_down) {
 
 std::vector<double> drape_fold_correlations(const std::vector<sim::ClothMesh>& drapes) {
   std::vector<HemProfile> outlines;
-  for (const auto& mesh : drapes) outlines.push_back(specimen_frame(hem_profile_from_mesh(mesh), sim::lies_face_down(mesh)));
+  for (const auto& mesh : drapes)
+    outlines.push_back(specimen_frame(hem_profile_from_mesh(mesh), sim::lies_face_down(mesh)));
   return pairwise_fold_correlations(outlines);
 }
 

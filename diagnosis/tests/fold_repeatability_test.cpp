@@ -4,7 +4,6 @@
 
 #include "drapegen/diagnosis/fold_repeatability.hpp"
 #include "drapegen/sim/initial_state.hpp"
-#include "drapegen/sim/specimen.hpp"
 
 using namespace drapegen::diagnosis;
 

@@ -142,8 +142,14 @@ def fail_one_done_job():
 
 
 opened = drapegen_dataset.open_manifest
-drapegen_dataset.open_manifest = lambda path: (lambda db, imm: (CommitAfter(db, "SELECT count(*)", fail_one_done_job),
-                                                                imm))(*opened(path))
+
+
+def open_with_a_commit_after_the_count(path):
+    db, immutable = opened(path)
+    return CommitAfter(db, "SELECT count(*)", fail_one_done_job), immutable
+
+
+drapegen_dataset.open_manifest = open_with_a_commit_after_the_count
 try:
     during = DrapeDataset(live_copy)
 finally:
@@ -152,7 +158,8 @@ check = sqlite3.connect(live_copy)
 assert check.execute("SELECT count(*) FROM jobs WHERE state = 'done'").fetchone()[0] == done - 1  # it committed
 check.close()
 assert len(during) == len(before) == done * 2, (len(during), len(before))
-assert np.array_equal(during.jobs, before.jobs) and np.array_equal(during.paths, before.paths), (during.jobs, before.jobs)
+assert np.array_equal(during.jobs, before.jobs) and np.array_equal(during.paths, before.paths), (
+    during.jobs, before.jobs)
 assert len(DrapeDataset(live_copy)) == (done - 1) * 2  # read again: the commit seen
 
 # Another user's finished run in a directory this process cannot write (no -shm can be made beside the WAL
