@@ -9,7 +9,9 @@
 // Each cell also gives (after "m") the captures' mean shape features (placements 0 and 1 / placement 0 alone) against
 // the mean over the validation drapes. For a yield capture with a second placement, a second line scores that
 // placement against the truth, the oracle laid again unloaded and the oracle laid again with its plastic set, and
-// with --yield-levels the true bending at each yield curvature against both placements.
+// with --yield-levels the true bending at each yield curvature against both placements. With --curl-levels, a curl
+// capture with a held-out placement (captures/NAME.p2) is scored at each edge curvature with the true bending and the
+// curl refit's, against the capture, the second placement (the refit's objective) and the held-out one.
 // --resolution changes the forward model's mesh (default --fine's).
 // Reads the truth files, so it is a benchmark tool, never part of the diagnosis.
 #include <CLI/CLI.hpp>
@@ -173,9 +175,58 @@ sim::Status probe_yield_levels(diagnosis::ForwardModel& model, diagnosis::Forwar
   return {};
 }
 
+/// The fold counts of an evaluation's drapes, in state order.
+std::string fold_counts(const diagnosis::Evaluation& e) {
+  std::string counts;
+  for (const auto& d : e.states) counts += fmt::format("{}{:.0f}", counts.empty() ? "" : " ", d.shape.all.folds);
+  return counts;
+}
+
+/// Does the curl's curvature decide which stable drapes a placement can reach? For each curvature K, the `bending`
+/// with edge curl K from the validation states: its best drape against the capture and against the held-out
+/// placement (placement 2), the curl refit's objective over the same states (the mean of the best fit scores on the
+/// capture and on the second placement; the refit itself uses the fit's fewer states), and every drape's fold count.
+/// On a placement that lies on the capture's face the capture's drapes are re-scored; on the other face, simulated
+/// there (the curl turns over).
+sim::Status probe_curl_levels(diagnosis::ForwardModel& model, diagnosis::ForwardModel* second,
+                              diagnosis::ForwardModel& held_out, const diagnosis::ModelSetup& bending,
+                              const std::string& label, const std::vector<sim::InitialStateSpec>& states,
+                              const std::vector<double>& levels) {
+  for (const double k : levels) {
+    diagnosis::ModelSetup setup = bending;
+    if (k != 0.0) diagnosis::apply_effect(diagnosis::Effect::kCurl, {k}, setup);
+    auto first = model.evaluate(setup, states);
+    if (!first) return first.error();
+    std::vector<sim::ClothMesh> meshes;
+    for (const auto& d : first->states) meshes.push_back(d.mesh);
+    const auto on = [&](diagnosis::ForwardModel& placement) {
+      return placement.capture().face_down == model.capture().face_down ? placement.rescore(meshes, setup)
+                                                                          : placement.evaluate(setup, states);
+    };
+    auto other = on(held_out);
+    if (!other) return other.error();
+    std::string objective;
+    if (second) {
+      auto on_second = on(*second);
+      if (!on_second) return on_second.error();
+      objective = fmt::format(" objective {:.2f} mm (second {:.2f}, folds {});",
+                              0.5e3 * (first->best.fit_score + on_second->best.fit_score),
+                              on_second->best.fit_score * 1e3, fold_counts(*on_second));
+    }
+    std::cout << fmt::format("  {} curl {:>6.1f} /m:{} capture shape {:.2f} all {:.2f} mm; held-out shape {:.2f} all "
+                             "{:.2f} mm; folds {} | {}\n",
+                             label, k, objective, first->best.shape_all, first->best.all_score * 1e3,
+                             other->best.shape_all, other->best.all_score * 1e3, fold_counts(*first),
+                             fold_counts(*other))
+              << std::flush;
+  }
+  return {};
+}
+
 /// One row: the capture against its fitted (if diagnosed), true and oracle setups.
 sim::Status probe_case(const fs::path& run, const std::string& name, const diagnosis::DiagnosisSettings& settings,
-                       const std::vector<sim::InitialStateSpec>& states, const std::vector<double>& yield_levels) {
+                       const std::vector<sim::InitialStateSpec>& states, const std::vector<double>& yield_levels,
+                       const std::vector<double>& curl_levels) {
   const auto truth = read_json(run / "truth" / (name + ".json"));
   if (!truth) return truth.error();
   // Without a diagnosis (captures generated only), the fitted column stays empty.
@@ -235,6 +286,42 @@ sim::Status probe_case(const fs::path& run, const std::string& name, const diagn
     }
     if (sim::Status s = probe_yield_levels(**model, *held_out, truth_setup, states, yield_levels); !s) return s;
   }
+  const fs::path p2 = run / "captures" / (name + ".p2");
+  if (effect && effect->first == "curl" && !curl_levels.empty() && fs::exists(p2)) {
+    auto c2 = diagnosis::read_capture(p2.string());
+    if (!c2) return c2.error();
+    auto m2 = diagnosis::ForwardModel::create(*c2, settings.fit);
+    if (!m2) return m2.error();
+    std::cout << fmt::format("  folds: capture {:.0f}, held-out placement {:.0f} ({})\n",
+                             (*model)->target().shape.all.folds, (*m2)->target().shape.all.folds,
+                             (*m2)->capture().face_down ? "face down" : "face up");
+    // Placement 1 (`held_out` above, the yield probe's held-out capture) is the diagnosis's second capture here.
+    diagnosis::ForwardModel* second_placement = held_out.get();
+    if (sim::Status s = probe_curl_levels(**model, second_placement, **m2, truth_setup, "truth ", states, curl_levels);
+        !s) {
+      return s;
+    }
+    // The diagnosis's curl refit's bending: the fitted bending times the curl candidate's scale.
+    if (report) {
+      for (const json& c : report->at("attribution").at("candidates")) {
+        if (c.at("effect") != "curl") continue;
+        diagnosis::ModelSetup refitted;
+        auto fitted_bending =
+            diagnosis::bending_from_json(report->at("baseline").at("fitted"), "report baseline.fitted");
+        if (!fitted_bending) return fitted_bending.error();
+        refitted.bending = *fitted_bending;
+        const double scale = c.at("alpha_scale").get<double>();
+        for (auto* v : {&refitted.bending.alpha, &refitted.bending.beta}) {
+          v->warp *= scale, v->bias *= scale, v->weft *= scale;
+        }
+        const std::string label = fmt::format("refit x{:.2f}", scale);
+        if (sim::Status s = probe_curl_levels(**model, second_placement, **m2, refitted, label, states, curl_levels);
+            !s) {
+          return s;
+        }
+      }
+    }
+  }
   return {};
 }
 
@@ -256,6 +343,11 @@ int main(int argc, char** argv) {
                  "For yield captures with a second placement: the true bending with each of these yield curvatures "
                  "(1/m), scored against the capture and, laid again with its set, against the second placement")
       ->check(CLI::PositiveNumber);
+  std::vector<double> curl_levels;
+  app.add_option("--curl-levels", curl_levels,
+                 "For curl captures with a held-out placement (captures/NAME.p2): the true bending, and the curl "
+                 "refit's if diagnosed, with each of these edge curvatures (1/m; 0: none) from the validation states, "
+                 "against the capture and the held-out placement, with every drape's fold count");
   CLI11_PARSE(app, argc, argv);
   if (cases.empty()) {
     // Every placement-0 capture that has a truth file (captures/NAME.pK are other placements).
@@ -282,7 +374,7 @@ int main(int argc, char** argv) {
   int failed = 0;
   for (const auto& name : cases) {
     try {
-      if (sim::Status s = probe_case(fs::path(run), name, settings, states, yield_levels); !s) {
+      if (sim::Status s = probe_case(fs::path(run), name, settings, states, yield_levels, curl_levels); !s) {
         std::cerr << "absorption_probe: " << name << ": " << s.error().message << "\n";
         ++failed;
       }

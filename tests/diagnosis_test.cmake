@@ -47,6 +47,31 @@ function(expect_roles label json paired refitted_on confirmed_on)
   endif()
 endfunction()
 
+# Stops the test unless report.json `json` lists exactly the placements given, in order, each as ROLE:DIRECTORY:FACE
+# (report.json "placements": role, directory, face).
+function(expect_placements label json)
+  string(JSON n LENGTH "${json}" placements)
+  list(LENGTH ARGN expected)
+  if(NOT n EQUAL expected)
+    message(FATAL_ERROR "${label}: ${n} placements in report.json, expected ${expected}")
+  endif()
+  set(i 0)
+  foreach(entry IN LISTS ARGN)
+    string(REPLACE ":" ";" want "${entry}")
+    list(GET want 0 role)
+    list(GET want 1 dir)
+    list(GET want 2 face)
+    string(JSON got_role GET "${json}" placements ${i} role)
+    string(JSON got_dir GET "${json}" placements ${i} directory)
+    string(JSON got_face GET "${json}" placements ${i} face)
+    if(NOT got_role STREQUAL role OR NOT got_dir STREQUAL dir OR NOT got_face STREQUAL face)
+      message(FATAL_ERROR "${label}: placement ${i} is ${got_role} ${got_dir} face ${got_face}, expected ${role} "
+                          "${dir} face ${face}")
+    endif()
+    math(EXPR i "${i} + 1")
+  endforeach()
+endfunction()
+
 set(FABRIC --alpha 13923,11455,8821 --beta=-35390,-29660,-22042 --density 300)
 run_ok(out reality ${FABRIC} --effect bias=12 --resolution 14 --seed 4 --out ${WORK}/capture --json)
 foreach(f capture.json view0.exr view1.exr view2.exr view3.exr truth.json preview.png)
@@ -861,6 +886,23 @@ file(REMOVE ${WORK}/capture.p2/truth.json)
 run_ok(out diagnose --capture ${WORK}/capture --second-capture ${WORK}/capture.p1 --held-out-capture ${WORK}/capture.p2
        --quick --resolution 10 --states 2 --evaluations 8 --refit-evaluations 6 --sensor-evaluations 150 --json)
 expect_roles("--second-capture" "${out}" second_capture capture_and_second_capture held_out_capture)
+expect_placements("three placements" "${out}" "capture:${WORK}/capture:up" "second_capture:${WORK}/capture.p1:up"
+                  "held_out_capture:${WORK}/capture.p2:up")
+# A placement turned over lies face down, and report.json and report.md say so (the three placements' report is
+# checked further below: kept in `three`).
+set(three "${out}")
+run_ok(out reality ${FABRIC} --effect bias=12 --resolution 14 --seed 4 --placement 1 --turn-over
+       --out ${WORK}/capture.turned)
+file(REMOVE ${WORK}/capture.turned/truth.json)
+small_fit_from(${WORK}/capture "drape coefficient" --held-out-capture ${WORK}/capture.turned --report
+               ${WORK}/report_turned)
+expect_placements("a turned placement" "${out}" "capture:${WORK}/capture:up"
+                  "held_out_capture:${WORK}/capture.turned:down")
+file(READ ${WORK}/report_turned/report.md md)
+if(NOT md MATCHES "\\| held_out_capture \\| `[^`]*capture.turned` \\| down \\|")
+  message(FATAL_ERROR "report.md does not list the turned placement face down:\n${md}")
+endif()
+set(out "${three}")
 # Fold repeatability: a correlation for each pair of the three placements, and for each pair of the model's drapes.
 string(JSON npairs LENGTH "${out}" gap_tests fold_repeatability capture_pairs)
 string(JSON nmodel LENGTH "${out}" gap_tests fold_repeatability model_pairs)

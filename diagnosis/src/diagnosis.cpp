@@ -269,6 +269,11 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
   };
   set_threads(settings.attribution.jobs);
   DiagnosisResult r;
+  r.placements.push_back({"capture", capture.directory, capture.face_down});
+  if (others.second) r.placements.push_back({"second_capture", others.second->directory, others.second->face_down});
+  if (others.held_out) {
+    r.placements.push_back({"held_out_capture", others.held_out->directory, others.held_out->face_down});
+  }
   r.budgets = {settings.fit.resolution, settings.fit.initial_states, settings.baseline_optimiser.max_evaluations,
                settings.attribute};
   // 0. The camera from the rigid surfaces (no simulation): the sensor candidate's start.
@@ -522,6 +527,10 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
 nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
   nlohmann::json j;
   j["capture"] = capture.directory;
+  nlohmann::json placements = nlohmann::json::array();
+  for (const auto& p : r.placements)
+    placements.push_back({{"role", p.role}, {"directory", p.directory}, {"face", p.face_down ? "down" : "up"}});
+  j["placements"] = std::move(placements);
   j["verdict"] = r.verdict;
   j["runner_up"] = r.runner_up;
   j["confidence"] = r.attribution.confidence;

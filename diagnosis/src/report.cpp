@@ -192,6 +192,14 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
 
   std::string md;
   md += fmt::format("# Sim-to-real gap diagnosis of `{}`\n\n", capture.directory);
+  if (r.placements.size() > 1) {
+    // Which face each placement lay on: a rest shape (curl, a yield's creases) bends the other way face down.
+    md += "| placement | directory | face |\n|---|---|---|\n";
+    for (const auto& p : r.placements) {
+      md += fmt::format("| {} | `{}` | {} |\n", p.role, p.directory, p.face_down ? "down" : "up");
+    }
+    md += "\n";
+  }
   md += verdict_markdown(r);
   md += "## Gap and floors (score in mm: stable-region RMS + 4 mm x shape-feature distance)\n\n";
   md += "| | all views | held-out view |\n|---|---|---|\n";

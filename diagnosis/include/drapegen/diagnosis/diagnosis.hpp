@@ -85,6 +85,14 @@ struct DiagnosisResult {
     int max_baseline_evaluations = 0;  // per simplex of the baseline fit
     bool attribution = true;           // false: gap, floors and localisation only
   } budgets;
+  /// Each capture it read (report.json "placements"): its directory and the face the specimen lay on (a turned
+  /// specimen's rest shape, a curl or a yield's creases, bends the other way face down).
+  struct Placement {
+    std::string role;  // "capture", "second_capture" or "held_out_capture"
+    std::string directory;
+    bool face_down = false;
+  };
+  std::vector<Placement> placements;
   BendingParameters initial_guess;  // the drape-coefficient guess, or the given start (clamped to the box)
   /// Where the initial guess came from: "drape coefficient", "given start" (DiagnosisSettings::start) or
   /// "measured bending" (the capture's).
