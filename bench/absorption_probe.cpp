@@ -309,11 +309,8 @@ sim::Status probe_case(const fs::path& run, const std::string& name, const diagn
         auto fitted_bending =
             diagnosis::bending_from_json(report->at("baseline").at("fitted"), "report baseline.fitted");
         if (!fitted_bending) return fitted_bending.error();
-        refitted.bending = *fitted_bending;
         const double scale = c.at("alpha_scale").get<double>();
-        for (auto* v : {&refitted.bending.alpha, &refitted.bending.beta}) {
-          v->warp *= scale, v->bias *= scale, v->weft *= scale;
-        }
+        refitted.bending = diagnosis::scaled(*fitted_bending, scale);
         const std::string label = fmt::format("refit x{:.2f}", scale);
         if (sim::Status s = probe_curl_levels(**model, second_placement, **m2, refitted, label, states, curl_levels);
             !s) {

@@ -61,11 +61,7 @@ int main(int argc, char** argv) {
       spec.resolution = resolution;
       spec.seed = static_cast<std::uint64_t>(seed);
       if (effect.rfind("stiff=", 0) == 0) {
-        const double s = std::stod(effect.substr(6));
-        auto& a = spec.bending.alpha;
-        auto& b = spec.bending.beta;
-        a = {a.warp * s, a.bias * s, a.weft * s};
-        b = {b.warp * s, b.bias * s, b.weft * s};
+        spec.bending = diagnosis::scaled(spec.bending, std::stod(effect.substr(6)));
       } else {
         // A+B: several effects in one capture (e.g. friction=0.02+misalign=10: friction with a placement drift).
         for (std::size_t from = 0; from < effect.size();) {

@@ -86,11 +86,7 @@ std::pair<double, double> bending_scale_bounds(const AttributionSettings& settin
 
 /// `setup` with its bending's alpha and beta times exp(ln_scale).
 ModelSetup scaled_bending(ModelSetup setup, double ln_scale) {
-  const double scale = std::exp(ln_scale);
-  auto& a = setup.bending.alpha;
-  auto& b = setup.bending.beta;
-  a = {a.warp * scale, a.bias * scale, a.weft * scale};
-  b = {b.warp * scale, b.bias * scale, b.weft * scale};
+  setup.bending = scaled(setup.bending, std::exp(ln_scale));
   return setup;
 }
 

@@ -5,6 +5,13 @@
 
 namespace drapegen::diagnosis {
 
+BendingParameters scaled(const BendingParameters& p, double factor) {
+  const auto times = [factor](const sim::DirectionalValues& v) {
+    return sim::DirectionalValues{v.warp * factor, v.bias * factor, v.weft * factor};
+  };
+  return {times(p.alpha), times(p.beta)};
+}
+
 BendingParameters from_reduced(const ReducedBending& x) {
   const double mean = std::exp(x[0]);
   // geometric mean of (warp, bias, weft) = mean; warp/weft = e^x1; bias / sqrt(warp weft) = e^x2.

@@ -64,3 +64,18 @@ TEST(FabricSpace, TheBoxOfAKnownBendingHoldsEveryBendingWithinItsFactor) {
   EXPECT_NEAR(lo0[3], -kMinRatioWidth, 1e-15);
   EXPECT_NEAR(hi0[3], kMinRatioWidth, 1e-15);
 }
+
+TEST(FabricSpace, AScaledBendingIsStifferInEveryDirectionWithTheSameShape) {
+  const BendingParameters p{{13923.0, 11455.0, 8821.0}, {-35390.0, -29660.0, -22042.0}};
+  const BendingParameters q = scaled(p, 2.5);
+  EXPECT_DOUBLE_EQ(q.alpha.warp, 2.5 * 13923.0);
+  EXPECT_DOUBLE_EQ(q.alpha.bias, 2.5 * 11455.0);
+  EXPECT_DOUBLE_EQ(q.alpha.weft, 2.5 * 8821.0);
+  EXPECT_DOUBLE_EQ(q.beta.warp, 2.5 * -35390.0);
+  EXPECT_DOUBLE_EQ(q.beta.bias, 2.5 * -29660.0);
+  EXPECT_DOUBLE_EQ(q.beta.weft, 2.5 * -22042.0);
+  // In the fit's reduced coordinates only the mean stiffness moves, by ln 2.5.
+  const ReducedBending a = to_reduced(p), b = to_reduced(q);
+  EXPECT_NEAR(b[0] - a[0], std::log(2.5), 1e-12);
+  for (int k = 1; k < 4; ++k) EXPECT_NEAR(b[k], a[k], 1e-12);
+}

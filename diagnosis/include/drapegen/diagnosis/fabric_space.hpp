@@ -14,6 +14,10 @@ struct BendingParameters {
   sim::DirectionalValues beta{-25000.0, -25000.0, -25000.0};
 };
 
+/// `p` with alpha and beta in every direction times `factor`: a stiffer (or softer) fabric whose bending law has the
+/// same shape (the same -beta/alpha).
+[[nodiscard]] BendingParameters scaled(const BendingParameters& p, double factor);
+
 /// Reduced coordinates (the fit's search space, all of similar scale):
 ///   x0 = ln(geometric mean of alpha),  x1 = ln(alpha_warp / alpha_weft),
 ///   x2 = ln(alpha_bias / sqrt(alpha_warp alpha_weft)),  x3 = -beta / alpha in mm (one ratio for all directions).
