@@ -55,6 +55,7 @@ struct DiagnoseOptions {
   std::optional<double> shape_floor;
   bool gap_only = false;
   bool ablation = false;
+  bool confirm_within_floors = false;
   bool sensor_bending = false;
   bool free_sensor = false;
   std::optional<int> common_bending;
@@ -187,6 +188,7 @@ int run_diagnose(const DiagnoseOptions& o) {
   settings.attribution.jobs = jobs;
   settings.attribute = !o.gap_only;
   settings.attribution.ablation = o.ablation;
+  settings.attribution.confirm_within_floors = o.confirm_within_floors;
   settings.attribution.held_out_tolerance = o.held_out_tolerance;
   if (o.shape_floor) settings.floors.shape_threshold = settings.held_out_shape_threshold = *o.shape_floor;
   // The fleet: the drapes go to workers; the renders, scores and the search stay here.
@@ -436,14 +438,19 @@ Runner add_diagnose_command(CLI::App& app) {
                  "A candidate is confirmed when its score on the held-out view or capture is at most (1 + this) "
                  "times the reference's (0: not worse at all; docs/DIAGNOSIS_RESULTS.md, \"Session 23\")")
       ->capture_default_str();
+  app.add_flag("--confirm-within-floors", o->confirm_within_floors,
+               "Also confirm a candidate whose drape on the held-out capture is within the floors, however its score "
+               "there compares with the reference's (report.json: candidates' \"confirmed_by\"; needs "
+               "--held-out-capture; off by default; docs/DIAGNOSIS_RESULTS.md, \"Session 61\")")
+      ->needs("--held-out-capture");
   CLI::Option* gap_only = app.add_flag(
       "--gap-only", o->gap_only,
       "Stop after the gap, floors and localisation (verdict \"not attributed\" above the floors); the attribution's "
       "options are refused with it");
   // What only the attribution reads would be ignored: refused instead.
-  for (const char* name : {"--candidates", "--ablation", "--sensor-bending", "--free-sensor", "--tie-margin",
-                           "--held-out-tolerance", "--refit-evaluations", "--sensor-evaluations", "--common-bending",
-                           "--refit-scan", "--yield-trade", "--shear-trade", "--drift-scan"}) {
+  for (const char* name : {"--candidates", "--ablation", "--confirm-within-floors", "--sensor-bending", "--free-sensor",
+                           "--tie-margin", "--held-out-tolerance", "--refit-evaluations", "--sensor-evaluations",
+                           "--common-bending", "--refit-scan", "--yield-trade", "--shear-trade", "--drift-scan"}) {
     gap_only->excludes(app.get_option(name));
   }
   app.add_flag("-v,--verbose", o->verbose, "Log every simulation of the fit and the refits on stderr (by default: "

@@ -758,6 +758,8 @@ expect_failure(1 "cannot bind" diagnose --capture ${WORK}/capture --fleet ipc://
 expect_failure(1 "fewer than 1 worker(s) connected" diagnose --capture ${WORK}/capture --fleet ${fleet}
                --fleet-wait 0.5 -q)
 expect_failure(1 "--yield-trade must be 0" diagnose --capture ${WORK}/capture --yield-trade 1)
+expect_failure(1 "--confirm-within-floors requires --held-out-capture" diagnose --capture ${WORK}/capture
+               --confirm-within-floors)
 expect_failure(1 "--shear-trade must be 0" diagnose --capture ${WORK}/capture --shear-trade 1)
 expect_failure(1 "unknown effect 'bogus'" diagnose --capture ${WORK}/capture --candidates yield,bogus)
 expect_failure(1 "'curl' given twice" diagnose --capture ${WORK}/capture --candidates curl,shear,curl)
@@ -883,9 +885,53 @@ endforeach()
 # Three placements: the second in the candidate refits and the gate, the third held out of every fit (the confirmation).
 run_ok(out reality ${FABRIC} --effect bias=12 --resolution 14 --seed 4 --placement 2 --out ${WORK}/capture.p2)
 file(REMOVE ${WORK}/capture.p2/truth.json)
+# With --confirm-within-floors: a candidate is confirmed by its score on the held-out capture (within the tolerance
+# of the reference's) or else, only, by its drape there lying within the floors; report.json says which.
 run_ok(out diagnose --capture ${WORK}/capture --second-capture ${WORK}/capture.p1 --held-out-capture ${WORK}/capture.p2
-       --quick --resolution 10 --states 2 --evaluations 8 --refit-evaluations 6 --sensor-evaluations 150 --json)
+       --quick --resolution 10 --states 2 --evaluations 8 --refit-evaluations 6 --sensor-evaluations 150
+       --confirm-within-floors --json)
 expect_roles("--second-capture" "${out}" second_capture capture_and_second_capture held_out_capture)
+json_boolean(widened "${out}" attribution confirm_within_floors)
+json_number(tolerance "${out}" attribution held_out_tolerance)
+json_number(floor_stable "${out}" floors stable_mm)
+json_number(floor_shape "${out}" floors shape)
+if(NOT widened)
+  message(FATAL_ERROR "--confirm-within-floors: report.json attribution.confirm_within_floors is ${widened}")
+endif()
+string(JSON ncand LENGTH "${out}" attribution candidates)
+math(EXPR last "${ncand} - 1")
+set(by_score 0)
+set(by_floors 0)
+foreach(i RANGE ${last})
+  string(JSON effect GET "${out}" attribution candidates ${i} effect)
+  json_boolean(confirmed "${out}" attribution candidates ${i} confirmed)
+  string(JSON by TYPE "${out}" attribution candidates ${i} confirmed_by)
+  if(by STREQUAL "STRING")
+    string(JSON by GET "${out}" attribution candidates ${i} confirmed_by)
+  endif()
+  json_number(shrunk "${out}" attribution candidates ${i} held_out_shrinkage)
+  json_number(stable "${out}" attribution candidates ${i} validated held_out_capture stable_mm)
+  json_number(shape "${out}" attribution candidates ${i} validated held_out_capture shape)
+  # The score confirms exactly where the held-out shrinkage (1 - score / reference's) is at least -tolerance.
+  set(score_confirms OFF)
+  if(NOT shrunk LESS -${tolerance})
+    set(score_confirms ON)
+  endif()
+  set(within OFF)
+  if(NOT stable GREATER floor_stable AND NOT shape GREATER floor_shape)
+    set(within ON)
+  endif()
+  if(by STREQUAL "held_out_score" AND confirmed AND score_confirms)
+    math(EXPR by_score "${by_score} + 1")
+  elseif(by STREQUAL "held_out_within_floors" AND confirmed AND NOT score_confirms AND within)
+    math(EXPR by_floors "${by_floors} + 1")
+  elseif(NOT (by STREQUAL "NULL" AND NOT confirmed AND NOT score_confirms AND NOT within))
+    message(FATAL_ERROR "--confirm-within-floors: ${effect} confirmed ${confirmed} by '${by}', but its held-out "
+                        "shrinkage ${shrunk} (tolerance ${tolerance}) and its held-out drape at stable ${stable} mm, "
+                        "shape ${shape} (floors ${floor_stable} mm, ${floor_shape})")
+  endif()
+endforeach()
+message(STATUS "--confirm-within-floors: ${by_score} candidates confirmed by the score, ${by_floors} by the floors")
 expect_placements("three placements" "${out}" "capture:${WORK}/capture:up" "second_capture:${WORK}/capture.p1:up"
                   "held_out_capture:${WORK}/capture.p2:up")
 # A placement turned over lies face down, and report.json and report.md say so (the three placements' report is

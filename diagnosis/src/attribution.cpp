@@ -491,6 +491,16 @@ bool confirms(double held_out_after, double held_out_before, double tolerance) {
   return held_out_after <= (1.0 + tolerance) * held_out_before;
 }
 
+Confirmation confirmation(double held_out_after, double held_out_before, const ScoredDrape* held_out_capture,
+                          const Floors& floors, const AttributionSettings& settings) {
+  if (confirms(held_out_after, held_out_before, settings.held_out_tolerance)) return Confirmation::kScore;
+  if (settings.confirm_within_floors && held_out_capture &&
+      excess_above_floors(gap_terms(*held_out_capture), floors) == 0.0) {
+    return Confirmation::kWithinFloors;
+  }
+  return Confirmation::kNone;
+}
+
 double gap_shrinkage(double excess_before, double excess_after) {
   return excess_before > 0.0 ? 1.0 - excess_after / excess_before : 0.0;
 }
@@ -599,9 +609,11 @@ sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& base
   // added, measured from the validation states against the reference: the better (smaller excess) of the baseline
   // and the bar. So an effect counts only for what it adds beyond refitting the bending alone. The held-out view (not
   // in any refit), or the held-out capture, must confirm it: its score there at most (1 + held_out_tolerance) times
-  // the reference's, a tolerance for the noise of choosing the best validation drape there (confirms).
+  // the reference's, a tolerance for the noise of choosing the best validation drape there (confirms); with
+  // confirm_within_floors, also where its drape on the held-out capture is within the floors.
   Attribution a;
   a.held_out_tolerance = settings.held_out_tolerance;
+  a.confirm_within_floors = settings.confirm_within_floors;
   a.significant_shrinkage = settings.significant_shrinkage;
   a.bar = std::move(results.back()->value());
   const double baseline_excess = excess_above_floors(gap_terms(validated.best, baseline_paired), floors);
@@ -623,7 +635,9 @@ sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& base
     }
     c.shrinkage = gap_shrinkage(from, c.validated_excess(floors));
     c.held_out_shrinkage = against > 0.0 ? 1.0 - h / against : 0.0;
-    c.confirmed = confirms(h, against, settings.held_out_tolerance);
+    const Confirmation how = confirmation(h, against, c.held_out_drape(), floors, settings);
+    c.confirmed = how != Confirmation::kNone;
+    c.confirmed_within_floors = how == Confirmation::kWithinFloors;
     a.candidates.push_back(std::move(c));
   }
   std::stable_sort(a.candidates.begin(), a.candidates.end(), ranks_before);

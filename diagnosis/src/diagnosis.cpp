@@ -680,6 +680,9 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                           {"shrinkage", c.shrinkage},
                           {"held_out_shrinkage", c.held_out_shrinkage},
                           {"confirmed", c.confirmed},
+                          {"confirmed_by", !c.confirmed               ? nlohmann::json(nullptr)
+                                           : c.confirmed_within_floors ? nlohmann::json("held_out_within_floors")
+                                                                       : nlohmann::json("held_out_score")},
                           {"evaluations", c.evaluations},
                           {"fold_repeatability",
                            {{"placement_pairs", c.placement_folds}, {"drape_pairs", c.drape_folds}}},
@@ -695,6 +698,7 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                       {"sensor_held", ran ? nlohmann::json(r.attribution.sensor_held) : nullptr},
                       {"confirmed_on", r.validated_held_out ? "held_out_capture" : "held_out_view"},
                       {"held_out_tolerance", ran ? nlohmann::json(r.attribution.held_out_tolerance) : nullptr},
+                      {"confirm_within_floors", ran ? nlohmann::json(r.attribution.confirm_within_floors) : nullptr},
                       {"significant_shrinkage", ran ? nlohmann::json(r.attribution.significant_shrinkage) : nullptr},
                       {"refitted_on", r.validated_second ? "capture_and_second_capture" : "capture"},
                       {"alpha_scale_bounds", ran ? nlohmann::json::array({std::exp(r.refit_scale_lower),

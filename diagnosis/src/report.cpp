@@ -133,6 +133,11 @@ std::string verdict_markdown(const DiagnosisResult& r) {
                       "from fresh initial states) and the score on the held-out {} by {:.0f}%.\n\n",
                       r.verdict, against, 100.0 * c.shrinkage, drapes,
                       r.validated_held_out ? "capture" : "view", 100.0 * c.held_out_shrinkage);
+    if (c.confirmed_within_floors)
+      md += fmt::format("It is confirmed by its drape on the held-out capture lying within the floors "
+                        "(`--confirm-within-floors`); its score there is {:.0f}% above the reference's, more than the "
+                        "{:g}% the score's confirmation allows.\n\n",
+                        -100.0 * c.held_out_shrinkage, 100.0 * r.attribution.held_out_tolerance);
     if (r.attribution.near_tie_promoted && !r.attribution.curl_promoted)
       md += fmt::format("It is named ahead of a candidate whose shrinkage is larger by less than {:.2f}, a tie within "
                         "the validation drapes' noise: the smaller refit objective names one.\n\n",
@@ -322,10 +327,14 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
       const double held = confirmation_score(c.validated, c.held_out_drape());
       md += fmt::format("| {} | {:.2f} | {:.0f}% | {:.2f} | {:.0f}% | {} | {}alpha x{:.2f} |\n", effect_name(c.effect),
                         c.validated.all_score * 1e3, 100 * c.shrinkage, held * 1e3, 100 * c.held_out_shrinkage,
-                        c.confirmed ? "yes" : "no", params, c.alpha_scale);
+                        !c.confirmed ? "no" : c.confirmed_within_floors ? "within the floors" : "yes", params,
+                        c.alpha_scale);
     }
-    md += fmt::format("\nConfirmed: the held-out {}'s score at most {:g}% above the reference's.\n",
-                      held_out ? "capture" : "view", 100 * r.attribution.held_out_tolerance);
+    md += fmt::format("\nConfirmed: the held-out {}'s score at most {:g}% above the reference's{}.\n",
+                      held_out ? "capture" : "view", 100 * r.attribution.held_out_tolerance,
+                      r.attribution.confirm_within_floors
+                          ? ", or (\"within the floors\") its drape on the held-out capture within the floors"
+                          : "");
     if (after) md += "\n![after](residual_after.png)\n\nResidual after adding the named effect.\n";
   }
   md += fmt::format("\nRuntime {:.0f} s (fit {:.0f} s, floors {:.0f} s, attribution {:.0f} s); CPU {:.0f} s; up to "

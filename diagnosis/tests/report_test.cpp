@@ -72,6 +72,18 @@ TEST(VerdictMarkdown, AGapAboveTheFloorsHasNoCaveat) {
   EXPECT_TRUE(contains(md, "**Verdict: yield** (confidence 0.90 against the runner-up, curl)")) << md;
   EXPECT_TRUE(contains(md, "by 80% (the capture's drapes from fresh initial states)")) << md;
   EXPECT_FALSE(contains(md, kCaveat));
+  EXPECT_FALSE(contains(md, "confirmed by its drape on the held-out capture")) << md;
+  // Confirmed only because its drape on the held-out capture is within the floors: said, with how far its score there
+  // lies above the reference's.
+  named.validated_held_out = Evaluation{};
+  named.attribution.held_out_tolerance = 0.1;
+  named.attribution.candidates.back().confirmed_within_floors = true;
+  named.attribution.candidates.back().held_out_shrinkage = -0.22;
+  const std::string within = verdict_markdown(named);
+  EXPECT_TRUE(contains(within, "It is confirmed by its drape on the held-out capture lying within the floors "
+                               "(`--confirm-within-floors`); its score there is 22% above the reference's, more than "
+                               "the 10% the score's confirmation allows."))
+      << within;
 
   DiagnosisResult unexplained;
   unexplained.verdict = "unexplained";
