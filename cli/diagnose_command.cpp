@@ -441,7 +441,8 @@ Runner add_diagnose_command(CLI::App& app) {
   app.add_flag("--confirm-within-floors", o->confirm_within_floors,
                "Also confirm a candidate whose drape on the held-out capture is within the floors, however its score "
                "there compares with the reference's (report.json: candidates' \"confirmed_by\"; needs "
-               "--held-out-capture; off by default; docs/DIAGNOSIS_RESULTS.md, \"Session 61\")")
+               "--held-out-capture; off by default: on fresh captures it changed no verdict; "
+               "docs/DIAGNOSIS_RESULTS.md, \"Session 62\")")
       ->needs("--held-out-capture");
   CLI::Option* gap_only = app.add_flag(
       "--gap-only", o->gap_only,

@@ -142,7 +142,8 @@ struct AttributionSettings {
   /// 54 and 57 in session 61: the elastic reference fitted it as well as the true curl or better), and the score's
   /// comparison then rejects the truth too. Needs a held-out capture (the held-out view alone has no gate terms).
   /// Derived on the 96 turned diagnoses of sessions 59-61 (3 verdicts wrong -> right, none the other way;
-  /// scripts/confirm_within_floors.py, docs/DIAGNOSIS_RESULTS.md "Session 61"). Off by default.
+  /// scripts/confirm_within_floors.py, docs/DIAGNOSIS_RESULTS.md "Session 61"); pre-registered on fresh seeds 58+59
+  /// it changed no verdict (no candidate was confirmed by the floors alone; "Session 62"). Off by default.
   bool confirm_within_floors = false;
   int bootstrap_samples = 1000;
   int tile_px = 16;
