@@ -443,7 +443,7 @@ std::optional<CommonBending> common_bending(const std::vector<CandidateResult>& 
   CommonBending shared;
   std::vector<double> ln_scales;
   for (const auto& c : candidates) {
-    if (c.confirmed && c.validated_excess(floors) == 0.0) {
+    if (c.confirmed() && c.validated_excess(floors) == 0.0) {
       shared.effects.push_back(c.effect);
       ln_scales.push_back(std::log(c.alpha_scale));
     }
@@ -457,7 +457,7 @@ std::optional<CommonBending> common_bending(const std::vector<CandidateResult>& 
 
 bool curl_first(std::vector<CandidateResult>& ranked, double significant) {
   const auto curl = std::find_if(ranked.begin(), ranked.end(), [&](const CandidateResult& c) {
-    return c.effect == Effect::kCurl && c.confirmed && c.shrinkage >= significant;
+    return c.effect == Effect::kCurl && c.confirmed() && c.shrinkage >= significant;
   });
   if (curl == ranked.end() || curl == ranked.begin()) return false;
   std::rotate(ranked.begin(), curl, curl + 1);
@@ -465,7 +465,7 @@ bool curl_first(std::vector<CandidateResult>& ranked, double significant) {
 }
 
 bool ranks_before(const CandidateResult& x, const CandidateResult& y) {
-  if (x.confirmed != y.confirmed) return x.confirmed;
+  if (x.confirmed() != y.confirmed()) return x.confirmed();
   if (x.shrinkage != y.shrinkage) return x.shrinkage > y.shrinkage;
   if (needs_simulation(x.effect) != needs_simulation(y.effect)) return needs_simulation(x.effect);
   if (x.objective != y.objective) return x.objective < y.objective;
@@ -473,13 +473,13 @@ bool ranks_before(const CandidateResult& x, const CandidateResult& y) {
 }
 
 bool near_ties_first(std::vector<CandidateResult>& ranked, double margin, double significant) {
-  if (ranked.empty() || !ranked.front().confirmed || margin <= 0.0) return false;
+  if (ranked.empty() || !ranked.front().confirmed() || margin <= 0.0) return false;
   // A first tied exactly keeps ranks_before's order (a physical effect before the sensor error).
-  if (ranked.size() > 1 && ranked[1].confirmed && ranked[1].shrinkage == ranked.front().shrinkage) return false;
+  if (ranked.size() > 1 && ranked[1].confirmed() && ranked[1].shrinkage == ranked.front().shrinkage) return false;
   const double from = ranked.front().shrinkage - margin;
   auto best = ranked.begin();
   for (auto it = ranked.begin() + 1; it != ranked.end(); ++it) {
-    if (it->confirmed && it->shrinkage >= significant && it->shrinkage >= from && it->objective < best->objective)
+    if (it->confirmed() && it->shrinkage >= significant && it->shrinkage >= from && it->objective < best->objective)
       best = it;
   }
   if (best == ranked.begin()) return false;  // (every other candidate it may pick is significant)
@@ -635,9 +635,7 @@ sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& base
     }
     c.shrinkage = gap_shrinkage(from, c.validated_excess(floors));
     c.held_out_shrinkage = against > 0.0 ? 1.0 - h / against : 0.0;
-    const Confirmation how = confirmation(h, against, c.held_out_drape(), floors, settings);
-    c.confirmed = how != Confirmation::kNone;
-    c.confirmed_within_floors = how == Confirmation::kWithinFloors;
+    c.confirmation = confirmation(h, against, c.held_out_drape(), floors, settings);
     a.candidates.push_back(std::move(c));
   }
   std::stable_sort(a.candidates.begin(), a.candidates.end(), ranks_before);
@@ -672,7 +670,7 @@ sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& base
     a.common_bending = std::move(common);
   }
   if (!a.candidates.empty()) {
-    a.named = !a.bending_within_floors() && a.candidates[0].confirmed &&
+    a.named = !a.bending_within_floors() && a.candidates[0].confirmed() &&
               a.candidates[0].shrinkage >= settings.significant_shrinkage;
     a.confidence = 1.0;
     if (a.candidates.size() > 1) {

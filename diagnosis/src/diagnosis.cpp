@@ -161,6 +161,19 @@ nlohmann::json validated_json(const CandidateResult& c, const Floors& floors) {
           {"excess_above_floors", c.validated_excess(floors)}};
 }
 
+/// How a candidate was confirmed (null: not at all).
+nlohmann::json confirmed_by_json(Confirmation how) {
+  switch (how) {
+    case Confirmation::kScore:
+      return "held_out_score";
+    case Confirmation::kWithinFloors:
+      return "held_out_within_floors";
+    case Confirmation::kNone:
+      break;
+  }
+  return nullptr;
+}
+
 /// A candidate's ablation (null without one): validated as the candidate is, with its refit objective (where the bar's
 /// search would rank that bending scale).
 nlohmann::json ablated_json(const CandidateResult& c, const Floors& floors) {
@@ -679,10 +692,8 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                           {"ablated", ablated_json(c, r.floors)},
                           {"shrinkage", c.shrinkage},
                           {"held_out_shrinkage", c.held_out_shrinkage},
-                          {"confirmed", c.confirmed},
-                          {"confirmed_by", !c.confirmed               ? nlohmann::json(nullptr)
-                                           : c.confirmed_within_floors ? nlohmann::json("held_out_within_floors")
-                                                                       : nlohmann::json("held_out_score")},
+                          {"confirmed", c.confirmed()},
+                          {"confirmed_by", confirmed_by_json(c.confirmation)},
                           {"evaluations", c.evaluations},
                           {"fold_repeatability",
                            {{"placement_pairs", c.placement_folds}, {"drape_pairs", c.drape_folds}}},

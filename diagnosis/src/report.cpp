@@ -117,7 +117,7 @@ std::string verdict_markdown(const DiagnosisResult& r) {
     md += fmt::format("**Verdict: a gap above the floors that no candidate effect both shrinks by {:.0f}% or more and "
                       "holds on the held-out data** (best: {}, shrinkage {:.0f}%, {}).\n\n",
                       100 * r.attribution.significant_shrinkage, effect_name(best.effect), 100 * best.shrinkage,
-                      best.confirmed ? "confirmed" : "not confirmed");
+                      best.confirmed() ? "confirmed" : "not confirmed");
   } else {
     const auto& c = r.attribution.candidates[0];
     // The shrinkage is the gate's, on drapes from fresh initial states; the held-out data only confirm it.
@@ -133,7 +133,7 @@ std::string verdict_markdown(const DiagnosisResult& r) {
                       "from fresh initial states) and the score on the held-out {} by {:.0f}%.\n\n",
                       r.verdict, against, 100.0 * c.shrinkage, drapes,
                       r.validated_held_out ? "capture" : "view", 100.0 * c.held_out_shrinkage);
-    if (c.confirmed_within_floors)
+    if (c.confirmation == Confirmation::kWithinFloors)
       md += fmt::format("It is confirmed by its drape on the held-out capture lying within the floors "
                         "(`--confirm-within-floors`); its score there is {:.0f}% above the reference's, more than the "
                         "{:g}% the score's confirmation allows.\n\n",
@@ -325,10 +325,12 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
       for (std::size_t k = 0; k < c.names.size(); ++k) params += fmt::format("{}={:.3g} ", c.names[k], c.parameters[k]);
       // The scores the confirmation compared: the validated drape's, on the held-out capture or the held-out view.
       const double held = confirmation_score(c.validated, c.held_out_drape());
+      const char* confirmed = c.confirmation == Confirmation::kScore          ? "yes"
+                              : c.confirmation == Confirmation::kWithinFloors ? "within the floors"
+                                                                              : "no";
       md += fmt::format("| {} | {:.2f} | {:.0f}% | {:.2f} | {:.0f}% | {} | {}alpha x{:.2f} |\n", effect_name(c.effect),
                         c.validated.all_score * 1e3, 100 * c.shrinkage, held * 1e3, 100 * c.held_out_shrinkage,
-                        !c.confirmed ? "no" : c.confirmed_within_floors ? "within the floors" : "yes", params,
-                        c.alpha_scale);
+                        confirmed, params, c.alpha_scale);
     }
     md += fmt::format("\nConfirmed: the held-out {}'s score at most {:g}% above the reference's{}.\n",
                       held_out ? "capture" : "view", 100 * r.attribution.held_out_tolerance,

@@ -31,7 +31,7 @@ ScoredDrape drape_of(double stable_all, double shape_all, double all_score = 0.0
 CandidateResult ranked(Effect effect, bool confirmed, double shrinkage, double objective, double held_out) {
   CandidateResult c;
   c.effect = effect;
-  c.confirmed = confirmed;
+  c.confirmation = confirmed ? Confirmation::kScore : Confirmation::kNone;
   c.shrinkage = shrinkage;
   c.objective = objective;
   c.held_out_shrinkage = held_out;

@@ -77,7 +77,7 @@ TEST(VerdictMarkdown, AGapAboveTheFloorsHasNoCaveat) {
   // lies above the reference's.
   named.validated_held_out = Evaluation{};
   named.attribution.held_out_tolerance = 0.1;
-  named.attribution.candidates.back().confirmed_within_floors = true;
+  named.attribution.candidates.back().confirmation = Confirmation::kWithinFloors;
   named.attribution.candidates.back().held_out_shrinkage = -0.22;
   const std::string within = verdict_markdown(named);
   EXPECT_TRUE(contains(within, "It is confirmed by its drape on the held-out capture lying within the floors "

@@ -47,6 +47,13 @@ struct OtherPlacement {
   std::vector<double> all_scores;
 };
 
+/// How a candidate's validated drape was confirmed on held-out data.
+enum class Confirmation {
+  kNone,          // neither way
+  kScore,         // its confirmation score is within the tolerance of the reference's (confirms)
+  kWithinFloors,  // only: its drape on the held-out capture is within the floors (confirm_within_floors)
+};
+
 struct CandidateResult {
   Effect effect = Effect::kYield;
   std::vector<std::string> names;
@@ -58,10 +65,10 @@ struct CandidateResult {
   /// gap_shrinkage of excess_above_floors: the baseline's against this candidate's refitted drape.
   double shrinkage = 0.0;
   double held_out_shrinkage = 0.0;  // 1 - held_out_after / held_out_before (the view not in the refit)
-  bool confirmed = false;           // its held-out score is at most (1 + held_out_tolerance) x the reference's
-  /// Confirmed only because its drape on the held-out capture is within the floors, its score there worse than the
-  /// tolerance allows (AttributionSettings::confirm_within_floors).
-  bool confirmed_within_floors = false;
+  /// Its held-out score is at most (1 + held_out_tolerance) x the reference's (kScore), or only its drape on the
+  /// held-out capture is within the floors (kWithinFloors, AttributionSettings::confirm_within_floors).
+  Confirmation confirmation = Confirmation::kNone;
+  [[nodiscard]] bool confirmed() const { return confirmation != Confirmation::kNone; }
   int evaluations = 0;
   /// A scan's level: the effect's parameter (as in effect_space), the bending scale and the refit objective there.
   struct ScanLevel {
@@ -328,13 +335,6 @@ bool near_ties_first(std::vector<CandidateResult>& ranked, double margin, double
 /// The held-out confirmation: `held_out_after` (the candidate's confirmation_score) is at most (1 + tolerance) times
 /// `held_out_before` (the reference's).
 [[nodiscard]] bool confirms(double held_out_after, double held_out_before, double tolerance);
-
-/// How a candidate's validated drape was confirmed on held-out data.
-enum class Confirmation {
-  kNone,          // neither way
-  kScore,         // its confirmation score is within the tolerance of the reference's (confirms)
-  kWithinFloors,  // only: its drape on the held-out capture is within the floors (confirm_within_floors)
-};
 
 /// A candidate's confirmation: `held_out_after` its confirmation_score, `held_out_before` the reference's,
 /// `held_out_capture` its validated drape on the held-out capture (null: none). Within the floors means that drape's
