@@ -8,6 +8,7 @@
 // not converge, e.g. a specimen sliding off the cylinder on a slippery top, is not a drape to diagnose).
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -444,6 +445,11 @@ int main(int argc, char** argv) {
   // The screen (--visible-only): per family, draws made and draws visible; the verdicts on visible captures.
   std::map<std::string, std::pair<int, int>> screen_draws_by_family;
   int visible_total = 0, visible_correct = 0;
+  // Top-1 by how far the kept draw's true fabric without the effect stood above the floors at the screen (its
+  // excess_above_floors: relative, summed over the stable and shape terms): named right, scored; bins [0, 0.1),
+  // [0.1, 0.3), [0.3, inf).
+  const std::array<double, 2> excess_edges{0.1, 0.3};
+  std::array<std::pair<int, int>, 3> by_excess{};
   // Detection and attribution apart: effect captures reported within the floors at the gate, within them once the
   // bending alone is refitted (verdict "none" either way), and the rest (detected) with their correct verdicts.
   int within_at_gate = 0, within_after_bending = 0, detected_correct = 0;
@@ -475,6 +481,12 @@ int main(int argc, char** argv) {
         }
         // The kept draw's truth files tell whether it settled (logs written before the check have no "settled").
         if (!draws.empty()) screened = draws.back().value("visible", false) && settled(c, out);
+        if (!draws.empty() && family != "none" && draws.back().contains("excess")) {
+          const double excess = draws.back()["excess"].get<double>();
+          const auto bin = std::upper_bound(excess_edges.begin(), excess_edges.end(), excess) - excess_edges.begin();
+          by_excess[bin].first += verdict == family;
+          by_excess[bin].second++;
+        }
       } catch (const std::exception&) {
       }
     }
@@ -576,6 +588,12 @@ int main(int argc, char** argv) {
                       visible_correct, visible_total);
     for (const auto& [family, n] : screen_draws_by_family) md += fmt::format(" {} {}/{},", family, n.second, n.first);
     md.back() = '\n';
+    md += fmt::format("- top-1 by the kept draw's excess above the floors at the screen (its true fabric without "
+                      "the effect; relative, stable and shape terms summed): below {}: {}/{}; {} to {}: {}/{}; from "
+                      "{}: {}/{}\n",
+                      excess_edges[0], by_excess[0].first, by_excess[0].second, excess_edges[0], excess_edges[1],
+                      by_excess[1].first, by_excess[1].second, excess_edges[1], by_excess[2].first,
+                      by_excess[2].second);
   }
   md += fmt::format("- controls within the floors: {}/{} ({:.0f}%)\n", control_within, control_total,
                     control_total ? 100.0 * control_within / control_total : 0.0);
