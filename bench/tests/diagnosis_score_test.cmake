@@ -1,22 +1,24 @@
 # drapegen_diagnosis_bench --score-only on hand-written reports and truth files (no simulation): the confusion
 # matrix and the split of detection from attribution count what the reports say.
 file(REMOVE_RECURSE ${WORK})
-file(MAKE_DIRECTORY ${WORK}/diagnoses ${WORK}/truth)
+file(MAKE_DIRECTORY ${WORK}/diagnoses ${WORK}/truth ${WORK}/screen)
 
-# One report and its truth file: CASE, its family, the verdict, whether the gate found it within the floors.
-function(write_case name family verdict within)
+# One report, its truth file (the effect's region: skirt) and its screen record: CASE, its family, the verdict,
+# whether the gate found it within the floors, the localised region, the kept draw's excess at the screen.
+function(write_case name family verdict within region excess)
+  file(WRITE ${WORK}/screen/${name}.json "[{\"draw\": 0, \"visible\": true, \"excess\": ${excess}}]")
   file(WRITE ${WORK}/diagnoses/${name}.json
        "{\"verdict\": \"${verdict}\", \"within_floors\": ${within}, \"shrinkage\": 1.0,
-         \"localisation\": {\"region\": \"skirt\"}, \"gap_mm\": {\"all_views\": 5.0},
+         \"localisation\": {\"region\": \"${region}\"}, \"gap_mm\": {\"all_views\": 5.0},
          \"floors\": {\"all_views_mm\": 4.0}, \"runtime\": {\"seconds\": 10.0}}")
   file(WRITE ${WORK}/truth/${name}.json
        "{\"family\": \"${family}\", \"regions\": [\"skirt\"], \"effects\": [{\"name\": \"${family}\", \"strength\": 1}]}")
 endfunction()
 
-write_case(yield_00 yield none true)    # within the floors at the gate
-write_case(yield_01 yield none false)   # within them once the bending alone is refitted
-write_case(yield_02 yield yield false)  # found, named right
-write_case(shear_00 shear curl false)   # found, named wrong
+write_case(yield_00 yield none true hem 0.05)       # within the floors at the gate
+write_case(yield_01 yield none false skirt 0.2)     # within them once the bending alone is refitted
+write_case(yield_02 yield yield false skirt 0.5)    # found, named right, its region right
+write_case(shear_00 shear curl false hem 0.3)       # found, named wrong, its region wrong
 
 execute_process(COMMAND ${BENCH} --out ${WORK} --score-only --families yield shear --per-family 3 --controls 0
                         --fabrics ${FABRICS}
@@ -28,7 +30,9 @@ foreach(needle
     "| yield | 2 | 0 | 0 | 1 | 0 | 0 | 0 | 0 | 0 |"
     "| shear | 0 | 0 | 0 | 0 | 0 | 1 | 0 | 0 | 0 |"
     "top-1 correct on effect captures: 1/4 (25%)"
-    "1 effect captures within the floors at the gate, 1 once the bending alone is refitted; of the 2 found above them, named correctly: 1 (50%)")
+    "1 effect captures within the floors at the gate, 1 once the bending alone is refitted; of the 2 found above them, named correctly: 1 (50%)"
+    "localised region matches the effect's region: 2/4 (shear 0/1, yield 2/3); on the 2 found above the floors: 1"
+    "stable and shape terms summed): below 0.1: 0/1; 0.1 to 0.3: 0/1; from 0.3: 1/2")
   string(FIND "${out}" "${needle}" found)
   if(found EQUAL -1)
     message(FATAL_ERROR "the score does not say '${needle}':\n${out}")
