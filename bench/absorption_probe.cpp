@@ -131,23 +131,26 @@ sim::Expected<Scores> score(diagnosis::ForwardModel& model, const diagnosis::Mod
   return r;
 }
 
-/// A yielding specimen's second placement (the held-out capture) against the true bending without the effect, the
+/// A yielding specimen's second placement (captures/NAME.p1: the diagnosis's second capture, fitted with the first
+/// under the three-placement protocol) against the true bending without the effect, the
 /// oracle as if the specimen were laid again unloaded, and the oracle laid again with the plastic set that its best
-/// drape against the capture (`oracle_best_state`) left: what the diagnosis's yield candidate does.
-sim::Status probe_yield_held_out(diagnosis::ForwardModel& held_out,
+/// drape against the capture (`oracle_best_state`) left: what the diagnosis's yield candidate does. The set comes
+/// from `model`, the capture's own (its face: a set made on the second placement's face would not fight a
+/// turned-over drape; before session 63 it was, and the oracle looked unable to reproduce a turned placement).
+sim::Status probe_yield_second(diagnosis::ForwardModel& model, diagnosis::ForwardModel& second,
                                  const diagnosis::ModelSetup& elastic, const std::vector<sim::InitialStateSpec>& states,
                                  const diagnosis::ModelSetup& oracle, int oracle_best_state) {
-  auto laid = held_out.laid_again(oracle, states.at(static_cast<std::size_t>(oracle_best_state)));
+  auto laid = model.laid_again(oracle, states.at(static_cast<std::size_t>(oracle_best_state)));
   if (!laid) return laid.error();
   const diagnosis::ModelSetup& creased = *laid;
   std::string cells;
   const std::array<const diagnosis::ModelSetup*, 3> setups{&elastic, &oracle, &creased};
   for (const diagnosis::ModelSetup* setup : setups) {
-    auto e = held_out.evaluate(*setup, states);
+    auto e = second.evaluate(*setup, states);
     if (!e) return e.error();
     cells += fmt::format(" {:.2f} [{:.2f}]", e->best.shape_all, e->best.stable_all * 1e3);
   }
-  std::cout << fmt::format("  held-out capture: truth, oracle unloaded, oracle with its set (largest {:.2f} rad):{}\n",
+  std::cout << fmt::format("  second placement: truth, oracle unloaded, oracle with its set (largest {:.2f} rad):{}\n",
                            creased.plastic_set.rest_angles.cwiseAbs().maxCoeff(), cells)
             << std::flush;
   return {};
@@ -155,7 +158,7 @@ sim::Status probe_yield_held_out(diagnosis::ForwardModel& held_out,
 
 /// Is the yield curvature observable on the two placements? The true bending with yield curvature K, for each K:
 /// its best drape against the capture, and laid again with that drape's set, its best against the second placement.
-sim::Status probe_yield_levels(diagnosis::ForwardModel& model, diagnosis::ForwardModel& held_out,
+sim::Status probe_yield_levels(diagnosis::ForwardModel& model, diagnosis::ForwardModel& second,
                                const diagnosis::ModelSetup& elastic, const std::vector<sim::InitialStateSpec>& states,
                                const std::vector<double>& levels) {
   for (const double k : levels) {
@@ -163,13 +166,13 @@ sim::Status probe_yield_levels(diagnosis::ForwardModel& model, diagnosis::Forwar
     setup.effects.bending_yield_curvature = k;
     auto first = model.evaluate(setup, states);
     if (!first) return first.error();
-    auto laid = held_out.laid_again(setup, states.at(static_cast<std::size_t>(first->best.state)));
-    if (!laid) return laid.error();
-    auto second = held_out.evaluate(*laid, states);
-    if (!second) return second.error();
+    // The set its best drape on the capture left (evaluate keeps it), as the diagnosis's yield candidate lays it.
+    const diagnosis::ModelSetup laid = diagnosis::ForwardModel::laid_again(setup, first->best);
+    auto on_second = second.evaluate(laid, states);
+    if (!on_second) return on_second.error();
     std::cout << fmt::format("  yield {:>6.1f} /m: capture {:.2f}, second placement {:.2f}, mean {:.2f}\n", k,
-                             first->best.shape_all, second->best.shape_all,
-                             0.5 * (first->best.shape_all + second->best.shape_all))
+                             first->best.shape_all, on_second->best.shape_all,
+                             0.5 * (first->best.shape_all + on_second->best.shape_all))
               << std::flush;
   }
   return {};
@@ -281,7 +284,8 @@ sim::Status probe_case(const fs::path& run, const std::string& name, const diagn
                            oracle, reported)
             << std::flush;
   if (held_out && effect && effect->first == "yield" && with_scores && *with_scores) {
-    if (sim::Status s = probe_yield_held_out(*held_out, truth_setup, states, with, (*with_scores)->best_state); !s) {
+    if (sim::Status s = probe_yield_second(**model, *held_out, truth_setup, states, with, (*with_scores)->best_state);
+        !s) {
       return s;
     }
     if (sim::Status s = probe_yield_levels(**model, *held_out, truth_setup, states, yield_levels); !s) return s;
@@ -295,7 +299,7 @@ sim::Status probe_case(const fs::path& run, const std::string& name, const diagn
     std::cout << fmt::format("  folds: capture {:.0f}, held-out placement {:.0f} ({})\n",
                              (*model)->target().shape.all.folds, (*m2)->target().shape.all.folds,
                              (*m2)->capture().face_down ? "face down" : "face up");
-    // Placement 1 (`held_out` above, the yield probe's held-out capture) is the diagnosis's second capture here.
+    // Placement 1 (`held_out` above, the yield probe's second placement) is the diagnosis's second capture here.
     diagnosis::ForwardModel* second_placement = held_out.get();
     if (sim::Status s = probe_curl_levels(**model, second_placement, **m2, truth_setup, "truth ", states, curl_levels);
         !s) {
