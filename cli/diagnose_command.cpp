@@ -44,6 +44,7 @@ struct DiagnoseOptions {
   std::optional<int> sensor_evaluations;
   std::optional<int> refit_scan;
   std::optional<int> yield_trade;
+  std::vector<double> yield_trade_at;  // empty: the default line
   std::optional<int> shear_trade;
   std::optional<int> drift_scan;
   std::vector<std::string> candidates;  // empty: every effect
@@ -104,6 +105,12 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (bad_scan(o.common_bending, 6)) return fail("--common-bending must be 0 (off) or 2 .. 6");
   if (!(o.tie_margin >= 0.0 && o.tie_margin <= 1.0)) return fail("--tie-margin must be 0 (exact ties only) .. 1");
   if (bad_scan(o.yield_trade, 100)) return fail("--yield-trade must be 0 (off) or 2 .. 100");
+  for (double k : o.yield_trade_at) {
+    if (!(k >= 3.0 && k <= 400.0)) return fail("--yield-trade-at: each curvature must be 3 .. 400 /m");
+  }
+  if (!o.yield_trade_at.empty() && o.yield_trade.value_or(0) == 0) {
+    return fail("--yield-trade-at places the lines of --yield-trade, which is off");
+  }
   if (bad_scan(o.shear_trade, 100)) return fail("--shear-trade must be 0 (off) or 2 .. 100");
   if (outside(o.drift_scan, 0, 100)) return fail("--drift-scan must be 0 (off) .. 100");
   std::optional<diagnosis::BendingParameters> start;
@@ -168,6 +175,7 @@ int run_diagnose(const DiagnoseOptions& o) {
   settings.attribution.tie_margin = o.tie_margin;
   if (o.refit_scan) settings.attribution.scan_levels = *o.refit_scan;
   if (o.yield_trade) settings.attribution.yield_trade_levels = *o.yield_trade;
+  if (!o.yield_trade_at.empty()) settings.attribution.yield_trade_curvatures = o.yield_trade_at;
   if (o.shear_trade) settings.attribution.shear_trade_levels = *o.shear_trade;
   if (o.drift_scan) settings.attribution.drift_scan_levels = *o.drift_scan;
   if (!candidates.empty()) settings.attribution.candidates = candidates;
@@ -177,8 +185,13 @@ int run_diagnose(const DiagnoseOptions& o) {
   settings.use_measured_bending = !o.ignore_measured_bending;
   // A scan asked for must leave the refit's simplex its room; a default one that does not is skipped by the refit.
   constexpr int kKeep = diagnosis::AttributionSettings::kSimplexAfterScan;
-  for (auto [levels, option] : {std::pair{o.refit_scan, "--refit-scan"}, std::pair{o.yield_trade, "--yield-trade"},
-                                 std::pair{o.shear_trade, "--shear-trade"}, std::pair{o.drift_scan, "--drift-scan"}}) {
+  const std::optional<int> yield_points =
+      o.yield_trade ? std::optional<int>(*o.yield_trade *
+                                         static_cast<int>(settings.attribution.yield_trade_curvatures.size()))
+                    : std::nullopt;
+  for (auto [levels, option] :
+       {std::pair{o.refit_scan, "--refit-scan"}, std::pair{yield_points, "--yield-trade (points over its lines)"},
+        std::pair{o.shear_trade, "--shear-trade"}, std::pair{o.drift_scan, "--drift-scan"}}) {
     if (levels && *levels > 0 &&
         *levels > settings.attribution.optimiser.max_evaluations - kKeep) {  // 0: off, nothing to fit
       return fail(fmt::format("{} ({}) must leave the refit's simplex {} of its {} evaluations", option, *levels, kKeep,
@@ -368,6 +381,12 @@ Runner add_diagnose_command(CLI::App& app) {
                              diagnosis::AttributionSettings::kYieldTradeCurvature,
                              diagnosis::AttributionSettings::kSimplexAfterScan,
                              diagnosis::AttributionSettings{}.yield_trade_levels));
+  app.add_option("--yield-trade-at", o->yield_trade_at,
+                 fmt::format("The yield trade's curvature at x1, /m: one line of --yield-trade points per value "
+                             "(default {:.0f}; e.g. 40,120: two lines, twice the points, which must leave the simplex "
+                             "its room)",
+                             diagnosis::AttributionSettings::kYieldTradeCurvature))
+      ->delimiter(',');
   app.add_option(
       "--shear-trade", o->shear_trade,
       fmt::format("The shear refit starts with this many points along the trade of a stiffer bending (x1 "
@@ -451,7 +470,8 @@ Runner add_diagnose_command(CLI::App& app) {
   // What only the attribution reads would be ignored: refused instead.
   for (const char* name : {"--candidates", "--ablation", "--confirm-within-floors", "--sensor-bending", "--free-sensor",
                            "--tie-margin", "--held-out-tolerance", "--refit-evaluations", "--sensor-evaluations",
-                           "--common-bending", "--refit-scan", "--yield-trade", "--shear-trade", "--drift-scan"}) {
+                           "--common-bending", "--refit-scan", "--yield-trade", "--yield-trade-at", "--shear-trade",
+                           "--drift-scan"}) {
     gap_only->excludes(app.get_option(name));
   }
   app.add_flag("-v,--verbose", o->verbose, "Log every simulation of the fit and the refits on stderr (by default: "

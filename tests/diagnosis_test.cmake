@@ -657,6 +657,35 @@ endfunction()
 # ln 100 - (0, 1.5, 3) = 4.6052, 3.1052, 1.6052 (bounds +-0.0001).
 expect_trade(yield --yield-trade "0.9999 1.0001;4.4816 4.4818;20.0854 20.0856"
              "4.6051 4.6053;3.1051 3.1053;1.6051 1.6053")
+# --yield-trade-at 40,120 (session 63): one line of --yield-trade 2 points per curvature, 4 points in all, in that
+# order: (x1, 40 /m), (x e^3, 40 / e^3 = 1.99 /m, held at the box's 3 /m), (x1, 120 /m), (x e^3, 120 / e^3 = 5.97 /m);
+# ln 40 = 3.6889, ln 3 = 1.0986, ln 120 = 4.7875, ln 120 - 3 = 1.7875 (bounds +-0.0001); 7 simulations leave the
+# simplex its 3.
+run_ok(out diagnose --capture ${WORK}/capture --quick --resolution 10 --states 2 --evaluations 8
+       --refit-evaluations 7 --candidates yield --yield-trade 2 --yield-trade-at 40,120 --json)
+string(JSON nscan LENGTH "${out}" attribution candidates 0 scan)
+if(NOT nscan EQUAL 4)
+  message(FATAL_ERROR "--yield-trade 2 --yield-trade-at 40,120: a scan of ${nscan} points, expected 4")
+endif()
+foreach(point "0;0.9999;1.0001;3.6888;3.6890" "1;20.0854;20.0856;1.0985;1.0987" "2;0.9999;1.0001;4.7874;4.7876"
+              "3;20.0854;20.0856;1.7874;1.7876")
+  list(GET point 0 k)
+  list(GET point 1 s_lo)
+  list(GET point 2 s_hi)
+  list(GET point 3 l_lo)
+  list(GET point 4 l_hi)
+  json_number(scale "${out}" attribution candidates 0 scan ${k} alpha_scale)
+  json_number(level "${out}" attribution candidates 0 scan ${k} parameter)
+  if(scale LESS s_lo OR scale GREATER s_hi OR level LESS l_lo OR level GREATER l_hi)
+    message(FATAL_ERROR "--yield-trade-at 40,120: point ${k} at scale ${scale}, parameter ${level}")
+  endif()
+endforeach()
+expect_failure(1 "--yield-trade-at places the lines of --yield-trade, which is off"
+               diagnose --capture ${WORK}/capture --yield-trade-at 40)
+expect_failure(1 "must leave the refit's simplex 3 of its 7"
+               diagnose --capture ${WORK}/capture --refit-evaluations 7 --yield-trade 3 --yield-trade-at 40,120)
+expect_failure(1 "--yield-trade-at: each curvature must be 3 .. 400"
+               diagnose --capture ${WORK}/capture --yield-trade 2 --yield-trade-at 500)
 # --shear-trade 3 starts the shear refit with three points along the trade of a stiffer bending against a more
 # compliant membrane: scales x1, x e^0.75, x e^1.5 (the refits' upper bound) at 3 kg/s^2 over the scale squared
 # (ln G = ln 3 - 2 ln scale), then the simplex. exp(0, 0.75, 1.5) = 1, 2.1170, 4.4817; ln 3 - 2 (0, 0.75, 1.5) =

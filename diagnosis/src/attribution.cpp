@@ -254,28 +254,36 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
   // `levels` points, the bending scale from x1 to e^reach evenly in ln, the effect's parameter at each anchor - power x
   // the ln scale. The yield trade reaches kYieldScaleRange or a known bending's box (no room to trade when the fit is
   // at its edge), beyond the other refits' bound; the shear trade reaches that bound.
+  // Several anchors: one such line each (AttributionSettings::yield_trade_curvatures).
   struct Trade {
     int levels = 0;
-    double reach = 0.0, anchor = 0.0, power = 1.0;
+    double reach = 0.0;
+    std::vector<double> anchors;
+    double power = 1.0;
   };
   std::optional<Trade> trade;
   if (one_parameter && effect == Effect::kYield) {
+    std::vector<double> anchors;
+    for (double k : settings.yield_trade_curvatures) anchors.push_back(std::log(k));
     trade = Trade{settings.yield_trade_levels,
-                  settings.bending_scale_known ? hi[0] : AttributionSettings::kYieldScaleRange,
-                  std::log(AttributionSettings::kYieldTradeCurvature), 1.0};
+                  settings.bending_scale_known ? hi[0] : AttributionSettings::kYieldScaleRange, std::move(anchors),
+                  1.0};
   } else if (one_parameter && effect == Effect::kShear) {
-    trade = Trade{settings.shear_trade_levels, hi[0], std::log(AttributionSettings::kShearTradeStiffness),
+    trade = Trade{settings.shear_trade_levels, hi[0], {std::log(AttributionSettings::kShearTradeStiffness)},
                   AttributionSettings::kShearTradePower};
   }
-  if (trade && trade->levels >= 2 && trade->levels <= room && trade->reach > 0.01) {
+  const int trade_points = trade ? trade->levels * static_cast<int>(trade->anchors.size()) : 0;
+  if (trade && trade->levels >= 2 && trade_points <= room && trade->reach > 0.01) {
     const int n = trade->levels;
     hi[0] = trade->reach;
     spacing = hi[0] / (n - 1);
-    for (int k = 0; k < n; ++k) {
-      std::vector<double> x = x0;
-      x[0] = k + 1 == n ? hi[0] : spacing * k;
-      x[first] = std::clamp(trade->anchor - trade->power * x[0], lo[first], hi[first]);
-      scan.push_back(std::move(x));
+    for (double anchor : trade->anchors) {
+      for (int k = 0; k < n; ++k) {
+        std::vector<double> x = x0;
+        x[0] = k + 1 == n ? hi[0] : spacing * k;
+        x[first] = std::clamp(anchor - trade->power * x[0], lo[first], hi[first]);
+        scan.push_back(std::move(x));
+      }
     }
     scanned_axes = {0, first};
   } else if (one_parameter && settings.scan_levels >= 2 && settings.scan_levels <= room) {

@@ -183,6 +183,12 @@ struct AttributionSettings {
   int yield_trade_levels = 0;
   static constexpr double kYieldScaleRange = 3.0;
   static constexpr double kYieldTradeCurvature = 100.0;  // 1/m
+  /// The trade's yield curvature at x1, one line of yield_trade_levels points per value (1/m; each line's curvature
+  /// falls as 1 / s). One line holds the truth only where the capped torque alpha * s * K the capture needs is the
+  /// line's: on session 63's two turned yield captures (absorption probe) the truth lay at s * K of about 54 and 135
+  /// /m from the fit, so two lines (e.g. 40 and 120) bracket what one (100) misses; yield_trade_levels times their
+  /// count points are scanned, within the same budget.
+  std::vector<double> yield_trade_curvatures{kYieldTradeCurvature};
   /// The shear refit first evaluates this many points along the trade of a stiffer bending against a more compliant
   /// membrane (0: off, the simplex from effect_space's start; replaces scan_levels for shear): the bending scale s
   /// from x1 to the refits' upper bound (bending_scale_upper) evenly in ln, the shear stiffness
