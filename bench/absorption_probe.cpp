@@ -8,7 +8,8 @@
 // if even "oracle" is not below "fitted", the fitting mesh and the multistability hide the effect from any refit.
 // Each cell also gives (after "m") the captures' mean shape features (placements 0 and 1 / placement 0 alone) against
 // the mean over the validation drapes. For a yield capture with a second placement, a second line scores that
-// placement against the truth, the oracle laid again unloaded and the oracle laid again with its plastic set, and
+// placement against the truth, the oracle laid again unloaded and the oracle laid again with its plastic set (and a
+// third line the held-out placement captures/NAME.p2, with the set of both earlier placements), and
 // with --yield-levels the true bending at each yield curvature against both placements. With --curl-levels, a curl
 // capture with a held-out placement (captures/NAME.p2) is scored at each edge curvature with the true bending and the
 // curl refit's, against the capture, the second placement (the refit's objective) and the held-out one.
@@ -137,21 +138,40 @@ sim::Expected<Scores> score(diagnosis::ForwardModel& model, const diagnosis::Mod
 /// drape against the capture (`oracle_best_state`) left: what the diagnosis's yield candidate does. The set comes
 /// from `model`, the capture's own (its face: a set made on the second placement's face would not fight a
 /// turned-over drape; before session 63 it was, and the oracle looked unable to reproduce a turned placement).
+/// With `third` (captures/NAME.p2, the diagnosis's held-out capture), the same three setups there, the oracle laid
+/// again with the set its best drape on the second placement left (after the capture's): what the yield candidate's
+/// validation on the held-out capture does.
 sim::Status probe_yield_second(diagnosis::ForwardModel& model, diagnosis::ForwardModel& second,
-                                 const diagnosis::ModelSetup& elastic, const std::vector<sim::InitialStateSpec>& states,
-                                 const diagnosis::ModelSetup& oracle, int oracle_best_state) {
+                               diagnosis::ForwardModel* third, const diagnosis::ModelSetup& elastic,
+                               const std::vector<sim::InitialStateSpec>& states, const diagnosis::ModelSetup& oracle,
+                               int oracle_best_state) {
   auto laid = model.laid_again(oracle, states.at(static_cast<std::size_t>(oracle_best_state)));
   if (!laid) return laid.error();
   const diagnosis::ModelSetup& creased = *laid;
   std::string cells;
+  std::optional<diagnosis::ModelSetup> creased_twice;  // the set after the capture and the second placement
   const std::array<const diagnosis::ModelSetup*, 3> setups{&elastic, &oracle, &creased};
   for (const diagnosis::ModelSetup* setup : setups) {
     auto e = second.evaluate(*setup, states);
     if (!e) return e.error();
     cells += fmt::format(" {:.2f} [{:.2f}]", e->best.shape_all, e->best.stable_all * 1e3);
+    if (setup == &creased) creased_twice = diagnosis::ForwardModel::laid_again(creased, e->best);
   }
   std::cout << fmt::format("  second placement: truth, oracle unloaded, oracle with its set (largest {:.2f} rad):{}\n",
                            creased.plastic_set.rest_angles.cwiseAbs().maxCoeff(), cells)
+            << std::flush;
+  if (third == nullptr) return {};
+  cells.clear();
+  const std::array<const diagnosis::ModelSetup*, 3> on_third{&elastic, &oracle, &*creased_twice};
+  for (const diagnosis::ModelSetup* setup : on_third) {
+    auto e = third->evaluate(*setup, states);
+    if (!e) return e.error();
+    cells += fmt::format(" {:.2f} [{:.2f}]", e->best.shape_all, e->best.stable_all * 1e3);
+  }
+  std::cout << fmt::format("  third placement ({}): truth, oracle unloaded, oracle with both sets (largest {:.2f} "
+                           "rad):{}\n",
+                           third->capture().face_down ? "face down" : "face up",
+                           creased_twice->plastic_set.rest_angles.cwiseAbs().maxCoeff(), cells)
             << std::flush;
   return {};
 }
@@ -284,7 +304,16 @@ sim::Status probe_case(const fs::path& run, const std::string& name, const diagn
                            oracle, reported)
             << std::flush;
   if (held_out && effect && effect->first == "yield" && with_scores && *with_scores) {
-    if (sim::Status s = probe_yield_second(**model, *held_out, truth_setup, states, with, (*with_scores)->best_state);
+    std::unique_ptr<diagnosis::ForwardModel> third;
+    if (const fs::path p2 = run / "captures" / (name + ".p2"); fs::exists(p2)) {
+      auto c2 = diagnosis::read_capture(p2.string());
+      if (!c2) return c2.error();
+      auto m2 = diagnosis::ForwardModel::create(*c2, settings.fit);
+      if (!m2) return m2.error();
+      third = std::move(*m2);
+    }
+    if (sim::Status s = probe_yield_second(**model, *held_out, third.get(), truth_setup, states, with,
+                                           (*with_scores)->best_state);
         !s) {
       return s;
     }
