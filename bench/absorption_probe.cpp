@@ -148,30 +148,32 @@ sim::Status probe_yield_second(diagnosis::ForwardModel& model, diagnosis::Forwar
   auto laid = model.laid_again(oracle, states.at(static_cast<std::size_t>(oracle_best_state)));
   if (!laid) return laid.error();
   const diagnosis::ModelSetup& creased = *laid;
+  // The three setups' best drapes on `on`, as cells; the last one's evaluation (the creased oracle's).
   std::string cells;
-  std::optional<diagnosis::ModelSetup> creased_twice;  // the set after the capture and the second placement
-  const std::array<const diagnosis::ModelSetup*, 3> setups{&elastic, &oracle, &creased};
-  for (const diagnosis::ModelSetup* setup : setups) {
-    auto e = second.evaluate(*setup, states);
-    if (!e) return e.error();
-    cells += fmt::format(" {:.2f} [{:.2f}]", e->best.shape_all, e->best.stable_all * 1e3);
-    if (setup == &creased) creased_twice = diagnosis::ForwardModel::laid_again(creased, e->best);
-  }
+  const auto score_three = [&](diagnosis::ForwardModel& on,
+                               const diagnosis::ModelSetup& last) -> sim::Expected<diagnosis::Evaluation> {
+    cells.clear();
+    sim::Expected<diagnosis::Evaluation> e = sim::Error{"no setup"};
+    for (const diagnosis::ModelSetup* setup : {&elastic, &oracle, &last}) {
+      e = on.evaluate(*setup, states);
+      if (!e) return e.error();
+      cells += fmt::format(" {:.2f} [{:.2f}]", e->best.shape_all, e->best.stable_all * 1e3);
+    }
+    return e;
+  };
+  auto on_second = score_three(second, creased);
+  if (!on_second) return on_second.error();
   std::cout << fmt::format("  second placement: truth, oracle unloaded, oracle with its set (largest {:.2f} rad):{}\n",
                            creased.plastic_set.rest_angles.cwiseAbs().maxCoeff(), cells)
             << std::flush;
   if (third == nullptr) return {};
-  cells.clear();
-  const std::array<const diagnosis::ModelSetup*, 3> on_third{&elastic, &oracle, &*creased_twice};
-  for (const diagnosis::ModelSetup* setup : on_third) {
-    auto e = third->evaluate(*setup, states);
-    if (!e) return e.error();
-    cells += fmt::format(" {:.2f} [{:.2f}]", e->best.shape_all, e->best.stable_all * 1e3);
-  }
+  // The set after the capture and the second placement.
+  const diagnosis::ModelSetup creased_twice = diagnosis::ForwardModel::laid_again(creased, on_second->best);
+  if (auto on_third = score_three(*third, creased_twice); !on_third) return on_third.error();
   std::cout << fmt::format("  third placement ({}): truth, oracle unloaded, oracle with both sets (largest {:.2f} "
                            "rad):{}\n",
                            third->capture().face_down ? "face down" : "face up",
-                           creased_twice->plastic_set.rest_angles.cwiseAbs().maxCoeff(), cells)
+                           creased_twice.plastic_set.rest_angles.cwiseAbs().maxCoeff(), cells)
             << std::flush;
   return {};
 }
@@ -246,6 +248,14 @@ sim::Status probe_curl_levels(diagnosis::ForwardModel& model, diagnosis::Forward
   return {};
 }
 
+/// The forward model of the capture in `directory`.
+sim::Expected<std::unique_ptr<diagnosis::ForwardModel>> open_model(const fs::path& directory,
+                                                                  const diagnosis::FitSettings& fit) {
+  auto capture = diagnosis::read_capture(directory.string());
+  if (!capture) return capture.error();
+  return diagnosis::ForwardModel::create(*capture, fit);
+}
+
 /// One row: the capture against its fitted (if diagnosed), true and oracle setups.
 sim::Status probe_case(const fs::path& run, const std::string& name, const diagnosis::DiagnosisSettings& settings,
                        const std::vector<sim::InitialStateSpec>& states, const std::vector<double>& yield_levels,
@@ -254,17 +264,13 @@ sim::Status probe_case(const fs::path& run, const std::string& name, const diagn
   if (!truth) return truth.error();
   // Without a diagnosis (captures generated only), the fitted column stays empty.
   const auto report = read_json(run / "diagnoses" / (name + ".json"));
-  auto capture = diagnosis::read_capture((run / "captures" / name).string());
-  if (!capture) return capture.error();
-  auto model = diagnosis::ForwardModel::create(*capture, settings.fit);
+  auto model = open_model(run / "captures" / name, settings.fit);
   if (!model) return model.error();
   // The second placement, if the run has one: its shape features (in its own cameras).
   std::optional<diagnosis::ShapeFeatures> second;
   std::unique_ptr<diagnosis::ForwardModel> held_out;
   if (fs::exists(run / "captures" / (name + ".p1"))) {
-    auto c1 = diagnosis::read_capture((run / "captures" / (name + ".p1")).string());
-    if (!c1) return c1.error();
-    auto m1 = diagnosis::ForwardModel::create(*c1, settings.fit);
+    auto m1 = open_model(run / "captures" / (name + ".p1"), settings.fit);
     if (!m1) return m1.error();
     held_out = std::move(*m1);
     second = held_out->target().shape.all;
@@ -303,15 +309,16 @@ sim::Status probe_case(const fs::path& run, const std::string& name, const diagn
   std::cout << fmt::format("{:<16} {:>8.3g} {:>34} {:>34} {:>34} {:>9}\n", name, strength, fitted, cell(without),
                            oracle, reported)
             << std::flush;
-  if (held_out && effect && effect->first == "yield" && with_scores && *with_scores) {
-    std::unique_ptr<diagnosis::ForwardModel> third;
-    if (const fs::path p2 = run / "captures" / (name + ".p2"); fs::exists(p2)) {
-      auto c2 = diagnosis::read_capture(p2.string());
-      if (!c2) return c2.error();
-      auto m2 = diagnosis::ForwardModel::create(*c2, settings.fit);
-      if (!m2) return m2.error();
-      third = std::move(*m2);
-    }
+  const bool yield_probe = held_out && effect && effect->first == "yield" && with_scores && *with_scores;
+  const bool curl_probe = effect && effect->first == "curl" && !curl_levels.empty();
+  // The held-out placement, if the run has one and a probe below reads it.
+  std::unique_ptr<diagnosis::ForwardModel> third;
+  if (const fs::path p2 = run / "captures" / (name + ".p2"); (yield_probe || curl_probe) && fs::exists(p2)) {
+    auto m2 = open_model(p2, settings.fit);
+    if (!m2) return m2.error();
+    third = std::move(*m2);
+  }
+  if (yield_probe) {
     if (sim::Status s = probe_yield_second(**model, *held_out, third.get(), truth_setup, states, with,
                                            (*with_scores)->best_state);
         !s) {
@@ -319,18 +326,14 @@ sim::Status probe_case(const fs::path& run, const std::string& name, const diagn
     }
     if (sim::Status s = probe_yield_levels(**model, *held_out, truth_setup, states, yield_levels); !s) return s;
   }
-  const fs::path p2 = run / "captures" / (name + ".p2");
-  if (effect && effect->first == "curl" && !curl_levels.empty() && fs::exists(p2)) {
-    auto c2 = diagnosis::read_capture(p2.string());
-    if (!c2) return c2.error();
-    auto m2 = diagnosis::ForwardModel::create(*c2, settings.fit);
-    if (!m2) return m2.error();
+  if (curl_probe && third) {
     std::cout << fmt::format("  folds: capture {:.0f}, held-out placement {:.0f} ({})\n",
-                             (*model)->target().shape.all.folds, (*m2)->target().shape.all.folds,
-                             (*m2)->capture().face_down ? "face down" : "face up");
+                             (*model)->target().shape.all.folds, third->target().shape.all.folds,
+                             third->capture().face_down ? "face down" : "face up");
     // Placement 1 (`held_out` above, the yield probe's second placement) is the diagnosis's second capture here.
     diagnosis::ForwardModel* second_placement = held_out.get();
-    if (sim::Status s = probe_curl_levels(**model, second_placement, **m2, truth_setup, "truth ", states, curl_levels);
+    if (sim::Status s =
+            probe_curl_levels(**model, second_placement, *third, truth_setup, "truth ", states, curl_levels);
         !s) {
       return s;
     }
@@ -345,7 +348,7 @@ sim::Status probe_case(const fs::path& run, const std::string& name, const diagn
         const double scale = c.at("alpha_scale").get<double>();
         refitted.bending = diagnosis::scaled(*fitted_bending, scale);
         const std::string label = fmt::format("refit x{:.2f}", scale);
-        if (sim::Status s = probe_curl_levels(**model, second_placement, **m2, refitted, label, states, curl_levels);
+        if (sim::Status s = probe_curl_levels(**model, second_placement, *third, refitted, label, states, curl_levels);
             !s) {
           return s;
         }

@@ -576,7 +576,8 @@ int main(int argc, char** argv) {
   }
   md += fmt::format("\n- top-1 correct on effect captures: {}/{} ({:.0f}%)\n", effect_correct, effect_total,
                     effect_total ? 100.0 * effect_correct / effect_total : 0.0);
-  if (const int detected = effect_total - within_at_gate - within_after_bending; effect_total > 0) {
+  const int detected = effect_total - within_at_gate - within_after_bending;  // found above the floors
+  if (effect_total > 0) {
     md += fmt::format("- detection and attribution apart: {} effect captures within the floors at the gate, {} once "
                       "the bending alone is refitted; of the {} found above them, named correctly: {} ({:.0f}%)\n",
                       within_at_gate, within_after_bending, detected, detected_correct,
@@ -607,7 +608,7 @@ int main(int argc, char** argv) {
     md.resize(md.size() - 2);
     md += ")";
   }
-  if (const int detected = effect_total - within_at_gate - within_after_bending; detected > 0) {
+  if (detected > 0) {
     md += fmt::format("; on the {} found above the floors: {}", detected, detected_region_match);
   }
   md += "\n";

@@ -105,8 +105,13 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (bad_scan(o.common_bending, 6)) return fail("--common-bending must be 0 (off) or 2 .. 6");
   if (!(o.tie_margin >= 0.0 && o.tie_margin <= 1.0)) return fail("--tie-margin must be 0 (exact ties only) .. 1");
   if (bad_scan(o.yield_trade, 100)) return fail("--yield-trade must be 0 (off) or 2 .. 100");
+  // Within the yield candidate's box (effect_space: ln of the curvature), where the refit would clamp it anyway.
+  const diagnosis::EffectSpace yield_box = diagnosis::effect_space(diagnosis::Effect::kYield);
+  const double yield_lo = std::exp(yield_box.lower[0]), yield_hi = std::exp(yield_box.upper[0]);
   for (double k : o.yield_trade_at) {
-    if (!(k >= 3.0 && k <= 400.0)) return fail("--yield-trade-at: each curvature must be 3 .. 400 /m");
+    if (!(k >= yield_lo * (1 - 1e-9) && k <= yield_hi * (1 + 1e-9))) {
+      return fail(fmt::format("--yield-trade-at: each curvature must be {:g} .. {:g} /m", yield_lo, yield_hi));
+    }
   }
   if (!o.yield_trade_at.empty() && o.yield_trade.value_or(0) == 0) {
     return fail("--yield-trade-at places the lines of --yield-trade, which is off");
