@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "commands.hpp"
 #include "failure.hpp"
@@ -113,7 +114,7 @@ int run_diagnose(const DiagnoseOptions& o) {
       return fail(fmt::format("--yield-trade-at: each curvature must be {:g} .. {:g} /m", yield_lo, yield_hi));
     }
   }
-  if (!o.yield_trade_at.empty() && o.yield_trade.value_or(0) == 0) {
+  if (!o.yield_trade_at.empty() && o.yield_trade.value_or(diagnosis::AttributionSettings{}.yield_trade_levels) == 0) {
     return fail("--yield-trade-at places the lines of --yield-trade, which is off");
   }
   if (bad_scan(o.shear_trade, 100)) return fail("--shear-trade must be 0 (off) or 2 .. 100");
@@ -191,9 +192,10 @@ int run_diagnose(const DiagnoseOptions& o) {
   // A scan asked for must leave the refit's simplex its room; a default one that does not is skipped by the refit.
   constexpr int kKeep = diagnosis::AttributionSettings::kSimplexAfterScan;
   const std::optional<int> yield_points =
-      o.yield_trade ? std::optional<int>(*o.yield_trade *
-                                         static_cast<int>(settings.attribution.yield_trade_curvatures.size()))
-                    : std::nullopt;
+      o.yield_trade || !o.yield_trade_at.empty()
+          ? std::optional<int>(settings.attribution.yield_trade_levels *
+                               static_cast<int>(settings.attribution.yield_trade_curvatures.size()))
+          : std::nullopt;
   for (auto [levels, option] :
        {std::pair{o.refit_scan, "--refit-scan"}, std::pair{yield_points, "--yield-trade (points over its lines)"},
         std::pair{o.shear_trade, "--shear-trade"}, std::pair{o.drift_scan, "--drift-scan"}}) {
@@ -378,19 +380,18 @@ Runner add_diagnose_command(CLI::App& app) {
                              diagnosis::AttributionSettings::kSimplexAfterScan,
                              diagnosis::AttributionSettings{}.scan_levels));
   app.add_option("--yield-trade", o->yield_trade,
-                 fmt::format("The yield refit starts with this many points along the trade of a stiffer bending (x1 "
-                             ".. x{:.0f}) against a lower yield curvature ({:.0f} /m / the scale), then refines from "
-                             "the best within --refit-evaluations, which must leave {} for that; replaces --refit-scan "
-                             "for yield (0: off; default {}; docs/DIAGNOSIS_RESULTS.md, \"Session 19\")",
+                 fmt::format("The yield refit starts with this many points along each line of the trade of a stiffer "
+                             "bending (x1 .. x{:.0f}) against a lower yield curvature (--yield-trade-at / the scale), "
+                             "then refines from the best within --refit-evaluations, which must leave {} for that; "
+                             "replaces --refit-scan for yield (0: off; default {}, off where --refit-evaluations leaves "
+                             "it no room; docs/DIAGNOSIS_RESULTS.md, \"Session 64\")",
                              std::exp(diagnosis::AttributionSettings::kYieldScaleRange),
-                             diagnosis::AttributionSettings::kYieldTradeCurvature,
                              diagnosis::AttributionSettings::kSimplexAfterScan,
                              diagnosis::AttributionSettings{}.yield_trade_levels));
   app.add_option("--yield-trade-at", o->yield_trade_at,
                  fmt::format("The yield trade's curvature at x1, /m: one line of --yield-trade points per value "
-                             "(default {:.0f}; e.g. 40,120: two lines, twice the points, which must leave the simplex "
-                             "its room)",
-                             diagnosis::AttributionSettings::kYieldTradeCurvature))
+                             "(default {}; the points of all lines must leave the simplex its room)",
+                             fmt::join(diagnosis::AttributionSettings{}.yield_trade_curvatures, ",")))
       ->delimiter(',');
   app.add_option(
       "--shear-trade", o->shear_trade,

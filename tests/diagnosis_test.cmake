@@ -621,11 +621,12 @@ if(bar_scale LESS 0.2231 OR bar_scale GREATER 4.4817)
   message(FATAL_ERROR "the bar's bending scale ${bar_scale} is outside exp(-1.5) .. exp(1.5)")
 endif()
 
-# `diagnose --candidates effect option 3` on the small capture (6 refit simulations): one candidate, a scan of three
-# points, point k's bending scale and effect parameter within the k-th "lo hi" of scale_bounds and level_bounds.
+# `diagnose --candidates effect option 3` (and any further arguments) on the small capture (6 refit simulations): one
+# candidate, a scan of three points, point k's bending scale and effect parameter within the k-th "lo hi" of
+# scale_bounds and level_bounds.
 function(expect_trade effect option scale_bounds level_bounds)
   run_ok(out diagnose --capture ${WORK}/capture --quick --resolution 10 --states 2 --evaluations 8
-         --refit-evaluations 6 --candidates ${effect} ${option} 3 --json)
+         --refit-evaluations 6 --candidates ${effect} ${option} 3 ${ARGN} --json)
   string(JSON ncand LENGTH "${out}" attribution candidates)
   string(JSON got_effect GET "${out}" attribution candidates 0 effect)
   json_number(evaluations "${out}" attribution candidates 0 evaluations)
@@ -651,12 +652,12 @@ function(expect_trade effect option scale_bounds level_bounds)
   endforeach()
 endfunction()
 
-# --candidates restricts the refits; --yield-trade 3 starts the yield refit with three points along the trade of a
-# stiffer bending against a lower yield curvature: scales x1, x e^1.5, x e^3 at 100 /m over the scale (ln K = ln 100
-# - ln scale), then the simplex with the rest of the 6 simulations. exp(0, 1.5, 3) = 1, 4.4817, 20.0855;
-# ln 100 - (0, 1.5, 3) = 4.6052, 3.1052, 1.6052 (bounds +-0.0001).
+# --candidates restricts the refits; --yield-trade 3 --yield-trade-at 100 starts the yield refit with three points
+# along one line of the trade of a stiffer bending against a lower yield curvature: scales x1, x e^1.5, x e^3 at 100
+# /m over the scale (ln K = ln 100 - ln scale), then the simplex with the rest of the 6 simulations. exp(0, 1.5, 3) =
+# 1, 4.4817, 20.0855; ln 100 - (0, 1.5, 3) = 4.6052, 3.1052, 1.6052 (bounds +-0.0001).
 expect_trade(yield --yield-trade "0.9999 1.0001;4.4816 4.4818;20.0854 20.0856"
-             "4.6051 4.6053;3.1051 3.1053;1.6051 1.6053")
+             "4.6051 4.6053;3.1051 3.1053;1.6051 1.6053" --yield-trade-at 100)
 # --yield-trade-at 40,120 (session 63): one line of --yield-trade 2 points per curvature, 4 points in all, in that
 # order: (x1, 40 /m), (x e^3, 40 / e^3 = 1.99 /m, held at the box's 3 /m), (x1, 120 /m), (x e^3, 120 / e^3 = 5.97 /m);
 # ln 40 = 3.6889, ln 3 = 1.0986, ln 120 = 4.7875, ln 120 - 3 = 1.7875 (bounds +-0.0001); 7 simulations leave the
@@ -681,7 +682,10 @@ foreach(point "0;0.9999;1.0001;3.6888;3.6890" "1;20.0854;20.0856;1.0985;1.0987" 
   endif()
 endforeach()
 expect_failure(1 "--yield-trade-at places the lines of --yield-trade, which is off"
-               diagnose --capture ${WORK}/capture --yield-trade-at 40)
+               diagnose --capture ${WORK}/capture --yield-trade 0 --yield-trade-at 40)
+# Lines asked for with the default 4 points each must leave the simplex its room too (2 x 4 of 10 leave 2).
+expect_failure(1 "--yield-trade (points over its lines) (8) must leave the refit's simplex 3 of its 10"
+               diagnose --capture ${WORK}/capture --refit-evaluations 10 --yield-trade-at 40,120)
 expect_failure(1 "must leave the refit's simplex 3 of its 7"
                diagnose --capture ${WORK}/capture --refit-evaluations 7 --yield-trade 3 --yield-trade-at 40,120)
 expect_failure(1 "--yield-trade-at: each curvature must be 3 .. 400"
@@ -692,20 +696,30 @@ expect_failure(1 "--yield-trade-at: each curvature must be 3 .. 400"
 # 1.0986, -0.4014, -1.9014 (bounds +-0.0001).
 expect_trade(shear --shear-trade "0.9999 1.0001;2.1169 2.1171;4.4816 4.4818"
              "1.0985 1.0987;-0.4015 -0.4013;-1.9015 -1.9013")
-# By default (session 42) the shear refit starts with five points along that trade where the budget leaves the simplex
-# its three: 8 evaluations scan 5; 7 leave no room, so no scan at all (the strength scan is off by default too).
-foreach(budget_scan "8;5" "7;0")
-  list(GET budget_scan 0 budget)
-  list(GET budget_scan 1 expected)
+# By default the shear refit (session 42) starts with five points along that trade, the yield refit (session 64) with
+# four along each of two lines (40 and 120 /m at x1), where the budget leaves the simplex its three: 8 evaluations
+# scan shear's 5, 11 yield's 8; one fewer leaves no room, so no scan at all (the strength scan is off by default too).
+foreach(case "shear;8;5" "shear;7;0" "yield;11;8" "yield;10;0")
+  list(GET case 0 effect)
+  list(GET case 1 budget)
+  list(GET case 2 expected)
   run_ok(out diagnose --capture ${WORK}/capture --quick --resolution 10 --states 2 --evaluations 8
-         --refit-evaluations ${budget} --candidates shear --json)
+         --refit-evaluations ${budget} --candidates ${effect} --json)
   string(JSON nscan ERROR_VARIABLE no_scan LENGTH "${out}" attribution candidates 0 scan)
   if(no_scan)
     set(nscan 0)
   endif()
   if(NOT nscan EQUAL expected)
-    message(FATAL_ERROR "default shear trade, --refit-evaluations ${budget}: a scan of ${nscan} points (expected "
+    message(FATAL_ERROR "default ${effect} trade, --refit-evaluations ${budget}: a scan of ${nscan} points (expected "
                         "${expected})")
+  endif()
+  if(effect STREQUAL "yield" AND nscan EQUAL 8)
+    # The fifth point opens the 120 /m line: x1, ln 120 = 4.7875.
+    json_number(scale "${out}" attribution candidates 0 scan 4 alpha_scale)
+    json_number(level "${out}" attribution candidates 0 scan 4 parameter)
+    if(scale LESS 0.9999 OR scale GREATER 1.0001 OR level LESS 4.7874 OR level GREATER 4.7876)
+      message(FATAL_ERROR "default yield trade: point 4 at scale ${scale}, parameter ${level} (expected 1, 4.7875)")
+    endif()
   endif()
 endforeach()
 # --ablation: each simulated candidate is validated with its effect switched off at its refitted bending scale as

@@ -173,22 +173,23 @@ struct AttributionSettings {
   int drift_scan_levels = 3;
   /// New evaluations the simplex keeps after a strength scan (its two new vertices and one move, at least).
   static constexpr int kSimplexAfterScan = 3;
-  /// The yield refit first evaluates this many points along the trade of a stiffer bending against a lower yield
-  /// curvature (0: off, the simplex from effect_space's start; replaces scan_levels for yield): the bending scale
-  /// s from x1 to x exp(kYieldScaleRange) evenly in ln, the yield curvature kYieldTradeCurvature / s (the capped torque
-  /// alpha * s * K of the baseline's alpha stays the same). On one monotonic drape a yielding fabric drapes as a softer
-  /// elastic one, so the baseline fit of a yielding specimen stops soft (3-17 times on seeds 4-6) and the yield refit
-  /// must stiffen it as far while it yields: beyond the other candidates' x4.5. The simplex refines from the best point
-  /// (scale up to exp(kYieldScaleRange)) within the same budget.
-  int yield_trade_levels = 0;
+  /// The yield refit first evaluates this many points along each line of the trade of a stiffer bending against a
+  /// lower yield curvature (0: off, the simplex from effect_space's start; replaces scan_levels for yield): the
+  /// bending scale s from x1 to x exp(kYieldScaleRange) evenly in ln, the yield curvature K / s for each K of
+  /// yield_trade_curvatures (the capped torque alpha * s * K of the baseline's alpha stays the same). On one monotonic
+  /// drape a yielding fabric drapes as a softer elastic one, so the baseline fit of a yielding specimen stops soft
+  /// (3-17 times on seeds 4-6) and the yield refit must stiffen it as far while it yields: beyond the other
+  /// candidates' x4.5. The simplex refines from the best point (scale up to exp(kYieldScaleRange)) within the same
+  /// budget; a trade that leaves the simplex fewer than kSimplexAfterScan is skipped. On by default since session 64's
+  /// pre-registered test (docs/DIAGNOSIS_RESULTS.md, "Session 64").
+  int yield_trade_levels = 4;
   static constexpr double kYieldScaleRange = 3.0;
-  static constexpr double kYieldTradeCurvature = 100.0;  // 1/m
   /// The trade's yield curvature at x1, one line of yield_trade_levels points per value (1/m; each line's curvature
   /// falls as 1 / s). One line holds the truth only where the capped torque alpha * s * K the capture needs is the
   /// line's: on session 63's two turned yield captures (absorption probe) the truth lay at s * K of about 54 and 135
-  /// /m from the fit, so two lines (e.g. 40 and 120) bracket what one (100) misses; yield_trade_levels times their
-  /// count points are scanned, within the same budget.
-  std::vector<double> yield_trade_curvatures{kYieldTradeCurvature};
+  /// /m from the fit, so two lines (40 and 120) bracket what one (session 19's 100) misses; yield_trade_levels times
+  /// their count points are scanned, within the same budget.
+  std::vector<double> yield_trade_curvatures{40.0, 120.0};
   /// The shear refit first evaluates this many points along the trade of a stiffer bending against a more compliant
   /// membrane (0: off, the simplex from effect_space's start; replaces scan_levels for shear): the bending scale s
   /// from x1 to the refits' upper bound (bending_scale_upper) evenly in ln, the shear stiffness
