@@ -45,7 +45,7 @@ struct DiagnoseOptions {
   std::optional<int> sensor_evaluations;
   std::optional<int> refit_scan;
   std::optional<int> yield_trade;
-  std::vector<double> yield_trade_at;  // empty: the default line
+  std::vector<double> yield_trade_at;  // empty: the default lines (AttributionSettings::yield_trade_curvatures)
   std::optional<int> shear_trade;
   std::optional<int> drift_scan;
   std::vector<std::string> candidates;  // empty: every effect
