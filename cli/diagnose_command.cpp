@@ -383,8 +383,8 @@ Runner add_diagnose_command(CLI::App& app) {
                  fmt::format("The yield refit starts with this many points along each line of the trade of a stiffer "
                              "bending (x1 .. x{:.0f}) against a lower yield curvature (--yield-trade-at / the scale), "
                              "then refines from the best within --refit-evaluations, which must leave {} for that; "
-                             "replaces --refit-scan for yield (0: off; default {}, off where --refit-evaluations leaves "
-                             "it no room; docs/DIAGNOSIS_RESULTS.md, \"Session 64\")",
+                             "replaces --refit-scan for yield (0: off; default {}, off where --refit-evaluations "
+                             "leaves it no room; docs/DIAGNOSIS_RESULTS.md, \"Session 64\")",
                              std::exp(diagnosis::AttributionSettings::kYieldScaleRange),
                              diagnosis::AttributionSettings::kSimplexAfterScan,
                              diagnosis::AttributionSettings{}.yield_trade_levels));
