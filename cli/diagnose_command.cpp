@@ -191,11 +191,9 @@ int run_diagnose(const DiagnoseOptions& o) {
   settings.use_measured_bending = !o.ignore_measured_bending;
   // A scan asked for must leave the refit's simplex its room; a default one that does not is skipped by the refit.
   constexpr int kKeep = diagnosis::AttributionSettings::kSimplexAfterScan;
-  const std::optional<int> yield_points =
-      o.yield_trade || !o.yield_trade_at.empty()
-          ? std::optional<int>(settings.attribution.yield_trade_levels *
-                               static_cast<int>(settings.attribution.yield_trade_curvatures.size()))
-          : std::nullopt;
+  const std::optional<int> yield_points = o.yield_trade || !o.yield_trade_at.empty()
+                                              ? std::optional<int>(settings.attribution.yield_trade_points())
+                                              : std::nullopt;
   for (auto [levels, option] :
        {std::pair{o.refit_scan, "--refit-scan"}, std::pair{yield_points, "--yield-trade (points over its lines)"},
         std::pair{o.shear_trade, "--shear-trade"}, std::pair{o.drift_scan, "--drift-scan"}}) {

@@ -190,6 +190,10 @@ struct AttributionSettings {
   /// /m from the fit, so two lines (40 and 120) bracket what one (session 19's 100) misses; yield_trade_levels times
   /// their count points are scanned, within the same budget.
   std::vector<double> yield_trade_curvatures{40.0, 120.0};
+  /// The points the yield trade scans: yield_trade_levels on each line of yield_trade_curvatures.
+  [[nodiscard]] int yield_trade_points() const {
+    return yield_trade_levels * static_cast<int>(yield_trade_curvatures.size());
+  }
   /// The shear refit first evaluates this many points along the trade of a stiffer bending against a more compliant
   /// membrane (0: off, the simplex from effect_space's start; replaces scan_levels for shear): the bending scale s
   /// from x1 to the refits' upper bound (bending_scale_upper) evenly in ln, the shear stiffness
