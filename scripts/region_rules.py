@@ -21,7 +21,12 @@
   above its own floor, in reports since session 22);
 - split_enrichment, split_floor_ratio (session 44): where the report placed the gap at the hem or the skirt, whichever
   of the two has the denser pixel residual (enrichment) or the residual further above its own floor (floor_ratio);
-  any other region as run.
+  any other region as run;
+- skirt_floor_ratio (session 65, pre-registered, negative): a gap placed at the skirt moved to the hem where the hem's
+  residual stands further above its own floor than the skirt's (floor_ratio); any other region as run;
+- fold_depth (session 65, pre-registered for seeds 66-67): a gap placed at the skirt moved to the hem where the fold
+  depth (feature group skirt_spread) stands more than --fold-depth times further above its floor than the skirt's
+  mean height (skirt_height); any other region as run.
 
 Per rule: the effect captures whose region is one of the effect's regions (the truth file's `regions`), per family.
 
@@ -33,6 +38,7 @@ run: `tolerance` (the rule since session 23, applied to every report with --tole
     scripts/region_rules.py out/s24s11main_all [more runs ...]
     scripts/region_rules.py --lifted-scale 2 --skirt-denser 1.1 out/s23all       # place_gap with other constants
     scripts/region_rules.py --ranking out/s24s11main_all                          # the region-aware ranking
+    scripts/region_rules.py out/p65/s64 out/p65/s65              # session 65 (diagnoses -> diag/NEW, the default)
 """
 import argparse
 import collections
@@ -46,7 +52,7 @@ from diagnosis_rules import THRESHOLD, confirmation_rule  # noqa: E402  (the tol
 
 OUTLINE = {"harmonics", "off_centre", "sorted_radii", "hem_height"}
 RULES = ["as_run", "largest", "place_gap_24", "place_gap", "place_gap_27", "place_gap_27b", "pixel_region",
-         "floor_region", "split_enrichment", "split_floor_ratio"]
+         "floor_region", "split_enrichment", "split_floor_ratio", "skirt_floor_ratio", "fold_depth"]
 # Where each effect acts (candidate_effect.cpp, effect_regions).
 EFFECT_REGIONS = {"yield": {"skirt"}, "shear": {"skirt"}, "curl": {"hem"}, "misalignment": {"hem"},
                   "friction": {"top", "rim"}, "sensor": {"global"}}
@@ -107,6 +113,24 @@ def split(loc, key):
         return loc["region"]
     share = {r["region"]: r.get(key, 0.0) for r in loc["regions"]}
     return "hem" if share.get("hem", 0.0) > share.get("skirt", 0.0) else "skirt"
+
+
+def skirt_to_hem(loc, hem_side):
+    """The region as run, but a gap placed at the skirt moved to the hem where hem_side(loc) holds."""
+    return "hem" if loc["region"] == "skirt" and hem_side(loc) else loc["region"]
+
+
+def hem_floor_ratio_higher(loc):
+    """Session 65's rule R: the hem's residual further above its own floor than the skirt's."""
+    ratio = {r["region"]: r.get("floor_ratio", 0.0) for r in loc["regions"]}
+    return ratio.get("hem", 0.0) > ratio.get("skirt", 0.0)
+
+
+def folds_deeper_than_mean(loc, factor):
+    """Session 65's rule Q: the folds' depth (skirt_spread) more than `factor` times further above its floor than the
+    skirt's mean height (skirt_height)."""
+    groups = loc["feature_groups"]
+    return groups["skirt_spread"]["ratio"] > factor * groups["skirt_height"]["ratio"]
 
 
 def place_gap_27(loc, sensor_scale, skirt_denser, lifted_scale):
@@ -188,6 +212,8 @@ def main():
     ap.add_argument("--lifted-scale", type=float, default=2.25,
                     help="place_gap: the stable ratio from which a lifted top is 'global' (kLiftedTopSensorRatio)")
     ap.add_argument("--skirt-denser", type=float, default=1.0, help="place_gap's skirt/hem enrichment factor")
+    ap.add_argument("--fold-depth", type=float, default=1.5,
+                    help="fold_depth: the skirt_spread/skirt_height ratio from which a skirt gap is the hem's")
     ap.add_argument("--ranking", action="store_true", help="the region-aware attribution's verdicts instead")
     ap.add_argument("--tolerance", type=float, default=0.1,
                     help="--ranking: the held-out tolerance for every report (default 0.1, the default since session 23)")
@@ -216,7 +242,9 @@ def main():
                       "place_gap_27": place_gap_27(loc, args.sensor_scale, args.skirt_denser, args.lifted_scale),
                       "place_gap_27b": place_gap_27b(loc, args.sensor_scale, args.skirt_denser, args.lifted_scale),
                       "pixel_region": loc["pixel_region"], "floor_region": loc.get("floor_region"),
-                      "split_enrichment": split(loc, "enrichment"), "split_floor_ratio": split(loc, "floor_ratio")}
+                      "split_enrichment": split(loc, "enrichment"), "split_floor_ratio": split(loc, "floor_ratio"),
+                      "skirt_floor_ratio": skirt_to_hem(loc, hem_floor_ratio_higher),
+                      "fold_depth": skirt_to_hem(loc, lambda x: folds_deeper_than_mean(x, args.fold_depth))}
             totals[family] += 1
             for rule in RULES:
                 hits[rule][family] += region[rule] in regions
