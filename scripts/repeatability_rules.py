@@ -9,11 +9,16 @@ among the captures the gate passed as within the floors and among the rest:
 - `scale S`: 1 - min(capture pairs) > S x (1 - min(model pairs));
 - `repeat_excess` (pre-registered in session 26 before seed 18 was diagnosed): every capture pair below the model
   pairs' 10th percentile (sorted model_pairs[floor(0.1 n)]) minus 0.1.
+- `below T` (session 65, the turned protocol; pre-registered for seeds 66-67 in out/p66/prereg_fold.txt): every pair of
+  the capture's placements below T (capture_min < T), whatever the model: on seeds 58-65 the 12 controls' placements
+  fold alike (0.85-0.98), an elastic specimen's one stable drape and its mirror image face down. Its "within" counts
+  the captures within the floors at the gate or once the bending alone is refitted (the other rules': at the gate).
 
     scripts/repeatability_rules.py DIR [DIR ...]            # DIR: a benchmark run (diagnoses/, truth/) or a directory
                                                             # of NAME.json reports beside a run's truth/ (--truth)
     scripts/repeatability_rules.py --truth out/run/truth --scale 1.5 2 3 out/gaponly
     scripts/repeatability_rules.py --candidates out/run          # the candidates' own repeatability (session 27)
+    scripts/repeatability_rules.py out/p65/s64 out/p65/s65 --below 0.75      # the absolute rule (session 65)
 
 With --candidates (reports since session 27, attribution run): per capture the mean of its placements' pairs, the
 fitted model's best drapes' on the three placements (`model_placement_pairs`), and each candidate's (its best drapes
@@ -111,11 +116,14 @@ def main():
     parser.add_argument("--truth", help="truth directory (default: RUN/truth)")
     parser.add_argument("--scale", type=float, nargs="+", default=[1.5, 2.0, 3.0])
     parser.add_argument("--candidates", action="store_true", help="the candidates' own repeatability")
+    parser.add_argument("--below", type=float, nargs="+", default=[0.75],
+                        help="the rule `below T`: every pair of the capture's placements below T")
     args = parser.parse_args()
     if args.candidates:
         candidates(args.runs, args.truth)
         return
     rows = []
+    within_any = {}  # case: within the floors at the gate or once the bending alone is refitted
     for run in args.runs:
         for name, r, truth in reports(run, args.truth):
             f = r["gap_tests"].get("fold_repeatability")
@@ -125,6 +133,7 @@ def main():
             excess = repeat_excess(f)
             rows.append((os.path.basename(os.path.normpath(run)) + "/" + name, truth["family"], r["within_floors"],
                          r["verdict"], f["capture_min"], f["model_min"], max(f["capture_pairs"]), q10, excess))
+            within_any[rows[-1][0]] = r["within_floors"] or r.get("within_floors_after_bending_refit", False)
     print(f"{'case':<32} {'family':<13} {'within':>6} {'verdict':<13} {'cap_min':>7} {'mod_min':>7} {'ratio':>6} "
           f"{'cap_max':>7} {'mod_q10':>7} repeat_excess")
     for case, family, within, verdict, cap, mod, cap_max, q10, excess in rows:
@@ -146,6 +155,14 @@ def main():
         fired[family][k] += excess
     print("repeat_excess: " + ", ".join(f"{fam} {v[0]}/{v[1]} within, {v[2]}/{v[3]} above"
                                         for fam, v in sorted(fired.items())))
+    for threshold in args.below:  # "within": at the gate or once the bending alone is refitted
+        fired = collections.defaultdict(lambda: [0, 0, 0, 0])
+        for case, family, _, _, cap, *_ in rows:
+            k = 0 if within_any[case] else 2
+            fired[family][k + 1] += 1
+            fired[family][k] += cap < threshold
+        print(f"below {threshold:g}: " + ", ".join(f"{fam} {v[0]}/{v[1]} within, {v[2]}/{v[3]} above"
+                                                  for fam, v in sorted(fired.items())))
 
 
 if __name__ == "__main__":
