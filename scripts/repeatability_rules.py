@@ -9,7 +9,7 @@ among the captures the gate passed as within the floors and among the rest:
 - `scale S`: 1 - min(capture pairs) > S x (1 - min(model pairs));
 - `repeat_excess` (pre-registered in session 26 before seed 18 was diagnosed): every capture pair below the model
   pairs' 10th percentile (sorted model_pairs[floor(0.1 n)]) minus 0.1.
-- `below T` (session 65, the turned protocol; pre-registered for seeds 66-67 in out/p66/prereg_fold.txt): every pair of
+- `below T` (session 65, the turned protocol; pre-registered for seeds 66-68 in out/p66/prereg_fold.txt): every pair of
   the capture's placements below T (capture_min < T), whatever the model: on seeds 58-65 the 12 controls' placements
   fold alike (0.85-0.98), an elastic specimen's one stable drape and its mirror image face down. Its "within" counts
   the captures within the floors at the gate or once the bending alone is refitted (the other rules': at the gate).
