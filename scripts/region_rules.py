@@ -120,12 +120,6 @@ def skirt_to_hem(loc, hem_side):
     return "hem" if loc["region"] == "skirt" and hem_side(loc) else loc["region"]
 
 
-def hem_floor_ratio_higher(loc):
-    """Session 65's rule R: the hem's residual further above its own floor than the skirt's."""
-    ratio = {r["region"]: r.get("floor_ratio", 0.0) for r in loc["regions"]}
-    return ratio.get("hem", 0.0) > ratio.get("skirt", 0.0)
-
-
 def folds_deeper_than_mean(loc, factor):
     """Session 65's rule Q: the folds' depth (skirt_spread) more than `factor` times further above its floor than the
     skirt's mean height (skirt_height)."""
@@ -243,7 +237,7 @@ def main():
                       "place_gap_27b": place_gap_27b(loc, args.sensor_scale, args.skirt_denser, args.lifted_scale),
                       "pixel_region": loc["pixel_region"], "floor_region": loc.get("floor_region"),
                       "split_enrichment": split(loc, "enrichment"), "split_floor_ratio": split(loc, "floor_ratio"),
-                      "skirt_floor_ratio": skirt_to_hem(loc, hem_floor_ratio_higher),
+                      "skirt_floor_ratio": skirt_to_hem(loc, lambda x: split(x, "floor_ratio") == "hem"),
                       "fold_depth": skirt_to_hem(loc, lambda x: folds_deeper_than_mean(x, args.fold_depth))}
             totals[family] += 1
             for rule in RULES:
