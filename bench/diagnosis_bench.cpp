@@ -598,9 +598,12 @@ int main(int argc, char** argv) {
   }
   md += fmt::format("- controls within the floors: {}/{} ({:.0f}%)\n", control_within, control_total,
                     control_total ? 100.0 * control_within / control_total : 0.0);
+  auto median_percent = [](const std::vector<double>& v) {
+    return v.empty() ? std::string("n/a") : fmt::format("{:.0f}%", 100.0 * median(v));
+  };
   md += fmt::format("- median shrinkage of the excess above the floors once the named effect is added (0 when "
-                    "none is named): {:.0f}%; over the correctly named captures alone: {:.0f}%\n",
-                    100.0 * median(shrinkages), named_shrinkages.empty() ? 0.0 : 100.0 * median(named_shrinkages));
+                    "none is named): {}; over the correctly named captures alone: {}\n",
+                    median_percent(shrinkages), median_percent(named_shrinkages));
   md += fmt::format("- localised region matches the effect's region: {}/{}", region_match, region_total);
   if (!region_by_family.empty()) {
     md += " (";

@@ -657,6 +657,7 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
   j["localisation"] = {{"region", region_name(L.dominant)},
                        {"dominant_feature", L.dominant_feature.empty() ? nlohmann::json(nullptr)
                                                                        : nlohmann::json(L.dominant_feature)},
+                       {"moved_to_hem", L.moved_to_hem},
                        {"feature_groups", groups},
                        {"stable_ratio", L.stable_ratio},
                        {"camera_moved_mm", L.camera_moved * 1e3},

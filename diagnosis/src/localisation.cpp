@@ -75,6 +75,7 @@ Region stable_region(const Localisation& L) {
 }
 
 void place_gap(Localisation& L) {
+  L.moved_to_hem = false;
   if (L.camera_moved >= kCameraMovedAtPlatform) {  // the rigid surfaces show the camera elsewhere than recorded
     L.dominant_feature = "camera";
     L.dominant = Region::kGlobal;
@@ -113,6 +114,17 @@ void place_gap(Localisation& L) {
     const RegionShare *skirt = region_share(L, Region::kSkirt), *hem = region_share(L, Region::kHem);
     if ((skirt ? skirt->enrichment : 0.0) > (hem ? hem->enrichment : 0.0)) L.dominant = Region::kSkirt;
   }
+  L.moved_to_hem = L.dominant == Region::kSkirt && folds_deepen_at_hem(L);
+  if (L.moved_to_hem) L.dominant = Region::kHem;
+}
+
+bool folds_deepen_at_hem(const Localisation& L) {
+  auto ratio = [&](FeatureGroup g) {
+    const auto k = static_cast<std::size_t>(std::find(std::begin(kFeatureGroups), std::end(kFeatureGroups), g) -
+                                            std::begin(kFeatureGroups));
+    return k < L.group_ratio.size() ? L.group_ratio[k] : 0.0;
+  };
+  return ratio(FeatureGroup::kSkirtSpread) > kFoldDepthAtHem * ratio(FeatureGroup::kSkirtHeight);
 }
 
 double RegionEnergy::mean_square(Region region) const {

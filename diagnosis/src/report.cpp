@@ -79,6 +79,11 @@ std::string leading_feature_text(const Localisation& L) {
                               : "led by the stable term, the platform top lifted at a camera error's scale";
     }
   }
+  if (L.moved_to_hem) {
+    return fmt::format("led by {}, a change of the skirt; the folds' depth stands more than {} times further above "
+                       "its floor than the skirt's mean height, so the folds deepen at the hem",
+                       led, kFoldDepthAtHem);
+  }
   for (FeatureGroup g : kFeatureGroups) {
     if (feature_group_name(g) == led && follows_skirt(g) && L.dominant == Region::kSkirt) {
       return fmt::format("led by {}, an outline group; the skirt's residual is denser than the hem's, so the outline "

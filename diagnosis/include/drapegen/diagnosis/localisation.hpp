@@ -50,6 +50,8 @@ struct Localisation {
   /// That feature: a feature group's name, "stable" for the stable term, "camera" for the rigid surfaces' camera
   /// (camera_moved), empty if nothing exceeds its floor.
   std::string dominant_feature;
+  /// place_gap moved the gap from the skirt to the hem: the folds deepen at the hem (folds_deepen_at_hem).
+  bool moved_to_hem = false;
   /// m: how far the camera error read off the rigid surfaces moves the platform's centre (rigid_pose.hpp,
   /// platform_displacement; diagnose sets it before localise_features), 0 if not estimated.
   double camera_moved = 0.0;
@@ -131,7 +133,17 @@ void localise_features(Localisation& localisation, const ScoredDrape& drape, con
 /// its own floor and seen farther than the fitted cloth, or when it is at least kLiftedTopSensorRatio times its floor
 /// (a camera's error; session 27). The stable term: stable_region. A skirt group: kSkirt. The hem's centre offset:
 /// kHem. The other hem groups (harmonics, sorted radii, hem height): kSkirt if the skirt's pixel residual is denser
-/// than the hem's (the outline carries a change of the skirt above it), else kHem. Nothing above 1: kGlobal.
+/// than the hem's (the outline carries a change of the skirt above it), else kHem. Nothing above 1: kGlobal. Last, a
+/// gap so placed on the skirt moves to the hem where folds_deepen_at_hem.
 void place_gap(Localisation& localisation);
+
+/// The folds' depth (group skirt_spread: the spread of z per annulus of the skirt) stands more than kFoldDepthAtHem
+/// times further above its floor than the skirt's mean height (skirt_height): the skirt's mean profile follows the
+/// bending while an edge band (a curled hem) sets how deep the folds fall, so place_gap puts such a skirt gap at the
+/// hem. Pre-registered in session 65 on seeds 58-65 (curl 4 -> 12 of 14 at the hem, 54 -> 59 of 76 effect captures in
+/// the effect's region), tested in session 66 on fresh seeds 66-67 (+2, -0 of 21): docs/DIAGNOSIS_RESULTS.md,
+/// "Session 66". The reading (an edge band sets the folds' depth) is a hypothesis, not shown.
+[[nodiscard]] bool folds_deepen_at_hem(const Localisation& localisation);
+inline constexpr double kFoldDepthAtHem = 1.5;
 
 }  // namespace drapegen::diagnosis
