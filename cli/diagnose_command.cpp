@@ -59,6 +59,7 @@ struct DiagnoseOptions {
   bool ablation = false;
   bool confirm_within_floors = false;
   bool sensor_bending = false;
+  std::optional<int> sensor_gain_scan;
   bool free_sensor = false;
   std::optional<int> common_bending;
   double tie_margin = diagnosis::AttributionSettings{}.tie_margin;
@@ -105,6 +106,7 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (bad_scan(o.refit_scan, 100)) return fail("--refit-scan must be 0 (off) or 2 .. 100");
   if (bad_scan(o.common_bending, 6)) return fail("--common-bending must be 0 (off) or 2 .. 6");
   if (!(o.tie_margin >= 0.0 && o.tie_margin <= 1.0)) return fail("--tie-margin must be 0 (exact ties only) .. 1");
+  if (bad_scan(o.sensor_gain_scan, 1000)) return fail("--sensor-gain-scan must be 0 (off) or 2 .. 1000");
   if (bad_scan(o.yield_trade, 100)) return fail("--yield-trade must be 0 (off) or 2 .. 100");
   // Within the yield candidate's box (effect_space: ln of the curvature), where the refit would clamp it anyway.
   const diagnosis::EffectSpace yield_box = diagnosis::effect_space(diagnosis::Effect::kYield);
@@ -176,6 +178,7 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (o.refit_evaluations) settings.attribution.optimiser.max_evaluations = *o.refit_evaluations;
   if (o.sensor_evaluations) settings.attribution.sensor_evaluations = *o.sensor_evaluations;
   settings.attribution.sensor_bending = o.sensor_bending;
+  if (o.sensor_gain_scan) settings.attribution.sensor_gain_levels = *o.sensor_gain_scan;
   settings.hold_sensor = !o.free_sensor;
   if (o.common_bending) settings.attribution.common_bending_effects = *o.common_bending;
   settings.attribution.tie_margin = o.tie_margin;
@@ -202,6 +205,10 @@ int run_diagnose(const DiagnoseOptions& o) {
       return fail(fmt::format("{} ({}) must leave the refit's simplex {} of its {} evaluations", option, *levels, kKeep,
                               settings.attribution.optimiser.max_evaluations));
     }
+  }
+  if (settings.attribution.sensor_gain_levels > settings.attribution.sensor_evaluations - kKeep) {
+    return fail(fmt::format("--sensor-gain-scan ({}) must leave the sensor refit's simplex {} of its {} evaluations",
+                            settings.attribution.sensor_gain_levels, kKeep, settings.attribution.sensor_evaluations));
   }
   settings.attribution.jobs = jobs;
   settings.attribute = !o.gap_only;
@@ -352,6 +359,11 @@ Runner add_diagnose_command(CLI::App& app) {
                "by simulation (a grid of 3 scales x 2 gains, a simplex within --refit-evaluations, the best without "
                "multipath), and keeps it if it beats both the re-rendering and that (off by default; "
                "docs/DIAGNOSIS_RESULTS.md, \"Session 29\")");
+  app.add_option("--sensor-gain-scan", o->sensor_gain_scan,
+                 "Levels of the multipath gain (0 to 60 mm, evenly) the sensor candidate's re-rendering scores before "
+                 "its simplex refines from the best (0: off, the simplex from no multipath; 1 is refused; levels "
+                 "count in --sensor-evaluations; off by default; docs/DIAGNOSIS_RESULTS.md, \"Session 66\")")
+;
   app.add_flag("--free-sensor", o->free_sensor,
                "Refit all nine parameters of the sensor candidate (camera pose, depth bias and slope, multipath) "
                "wherever the camera sits. By default, where the rigid surfaces show the camera as recorded (it "
@@ -474,7 +486,7 @@ Runner add_diagnose_command(CLI::App& app) {
   // What only the attribution reads would be ignored: refused instead.
   for (const char* name : {"--candidates", "--ablation", "--confirm-within-floors", "--sensor-bending", "--free-sensor",
                            "--tie-margin", "--held-out-tolerance", "--refit-evaluations", "--sensor-evaluations",
-                           "--common-bending", "--refit-scan", "--yield-trade", "--yield-trade-at", "--shear-trade",
+                           "--sensor-gain-scan", "--common-bending", "--refit-scan", "--yield-trade", "--yield-trade-at", "--shear-trade",
                            "--drift-scan"}) {
     gap_only->excludes(app.get_option(name));
   }

@@ -297,6 +297,17 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
       scan.push_back(std::move(x));
     }
     scanned_axes = {first};
+  } else if (effect == Effect::kSensor && settings.sensor_gain_levels >= 2 && settings.sensor_gain_levels <= room) {
+    // The multipath gain over its range (AttributionSettings::sensor_gain_levels), the camera at its start.
+    const std::size_t gain = x0.size() - 1;  // multipath_mm, effect_space's last
+    const int n = settings.sensor_gain_levels;
+    spacing = (hi[gain] - lo[gain]) / (n - 1);
+    for (int k = 0; k < n; ++k) {
+      std::vector<double> x = x0;
+      x[gain] = k + 1 == n ? hi[gain] : lo[gain] + spacing * k;
+      scan.push_back(std::move(x));
+    }
+    scanned_axes = {gain};
   } else if (effect == Effect::kMisalignment && settings.drift_scan_levels >= 1 &&
              settings.drift_scan_levels <= room) {
     // Drift sizes along the warp (AttributionSettings::drift_scan_levels), no turn, the bending as fitted.
@@ -315,7 +326,8 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
     for (const auto& x : scan) {
       const double value = f(x);
       if (error) return *error;
-      c.scan.push_back({x[first], std::exp(x[0]), value});
+      // (the sensor's: its multipath gain at the baseline's bending)
+      c.scan.push_back({x[scanned_axes.back()], sim ? std::exp(x[0]) : 1.0, value});
       if (value < best_value) best_value = value, known = {x, value};
     }
     x0 = known->first;
@@ -332,6 +344,7 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
   if (effect == Effect::kSensor && settings.sensor_bending) {
     // The bending refitted under the camera the render-only refit found (AttributionSettings::sensor_bending).
     const std::size_t gain = r.x.size() - 1;  // multipath_mm, effect_space's last
+    const std::size_t rendered = c.scan.size();  // the render-only scan's levels (sensor_gain_levels), if any
     auto under_camera = [&](double s, double g) {
       ModelSetup setup = scaled(s);
       std::vector<double> camera = r.x;
@@ -362,7 +375,7 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
       if (const double v = g(y); y_best.empty() || v <= stage_best) y_best = y;
       if (error) return *error;
     }
-    const int grid = static_cast<int>(c.scan.size());
+    const int grid = static_cast<int>(c.scan.size() - rendered);
     NelderMeadOptions refine = settings.optimiser;
     refine.max_evaluations = std::max(1, refine.max_evaluations - grid + 1);  // its first point is the grid's best
     const std::vector<double> known_y = y_best;
@@ -372,7 +385,7 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
                                      y_best[1] < 0.5 * gain_hi ? 5.0 : -5.0};
     NelderMeadResult q = nelder_mead(g_known, y_best, y_step, {lower, 0.0}, {upper, gain_hi}, refine);
     if (error) return *error;
-    const int simulated = static_cast<int>(c.scan.size());
+    const int simulated = static_cast<int>(c.scan.size() - rendered);
     // Its ablation: the same bending scale seen by the same camera without multipath.
     ScoredDrape ablation_drape;
     auto ablation = objective_of(under_camera(q.x[0], 0.0), ablation_drape, true);

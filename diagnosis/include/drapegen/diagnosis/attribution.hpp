@@ -75,9 +75,9 @@ struct CandidateResult {
     double parameter = 0.0, alpha_scale = 1.0, objective = 0.0;
   };
   /// The scan that preceded the simplex, if one ran (AttributionSettings::scan_levels, yield_trade_levels,
-  /// shear_trade_levels, drift_scan_levels); for the sensor candidate with AttributionSettings::sensor_bending, every
-  /// simulation of its bending refit (parameter: the multipath gain, mm): the grid, the simplex, then the best's
-  /// ablation (gain 0).
+  /// shear_trade_levels, drift_scan_levels, sensor_gain_levels: parameter the multipath gain, mm, re-rendered at the
+  /// baseline's bending); for the sensor candidate with AttributionSettings::sensor_bending, then every simulation of
+  /// its bending refit (parameter: the multipath gain, mm): the grid, the simplex, then the best's ablation (gain 0).
   std::vector<ScanLevel> scan;
   /// The sensor candidate refitted the bending with its camera and kept it (AttributionSettings::sensor_bending): its
   /// drapes are simulated, not the baseline's re-rendered.
@@ -242,6 +242,12 @@ struct AttributionSettings {
   /// candidate keeps it, and is then validated by simulation, only if it beats both the render-only refit and its
   /// ablation. Off by default.
   bool sensor_bending = false;
+  /// The sensor candidate's render-only refit first scores the multipath gain at this many levels evenly over its
+  /// range (0 to effect_space's upper bound, 60 mm), the rest of the camera at its start, and the simplex refines
+  /// from the best (0: off, the simplex from no multipath). From no multipath, the held refit (sensor_held: the gain
+  /// alone) stopped at 1.7-2.3 mm on two multipath captures of 17-24 mm (docs/DIAGNOSIS_RESULTS.md, "Session 66").
+  /// Re-rendering is cheap: the levels come out of sensor_evaluations.
+  int sensor_gain_levels = 0;
   static constexpr double kSensorBendingScales[] = {0.5, 1.0, 1.5};  // ln of the bending scale (clamped to the bounds)
   static constexpr double kSensorBendingGains[] = {15.0, 30.0};      // multipath gain, mm
   /// Where at least this many confirmed candidates each bring the gate within the floors, the data single out none
