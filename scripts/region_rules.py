@@ -26,7 +26,8 @@
   residual stands further above its own floor than the skirt's (floor_ratio); any other region as run;
 - fold_depth (session 65, pre-registered for seeds 66-67): a gap placed at the skirt moved to the hem where the fold
   depth (feature group skirt_spread) stands more than --fold-depth times further above its floor than the skirt's
-  mean height (skirt_height); any other region as run.
+  mean height (skirt_height); any other region as run. Adopted in session 66 (place_gap, folds_deepen_at_hem): on
+  reports of later builds "as run" already applies it.
 
 Per rule: the effect captures whose region is one of the effect's regions (the truth file's `regions`), per family.
 
@@ -39,6 +40,7 @@ run: `tolerance` (the rule since session 23, applied to every report with --tole
     scripts/region_rules.py --lifted-scale 2 --skirt-denser 1.1 out/s23all       # place_gap with other constants
     scripts/region_rules.py --ranking out/s24s11main_all                          # the region-aware ranking
     scripts/region_rules.py out/p65/s64 out/p65/s65              # session 65 (diagnoses -> diag/NEW, the default)
+    scripts/region_rules.py out/p66/s66 out/p66/s67              # session 66's test of fold_depth (diag/DEF)
 """
 import argparse
 import collections
