@@ -206,7 +206,8 @@ int run_diagnose(const DiagnoseOptions& o) {
                               settings.attribution.optimiser.max_evaluations));
     }
   }
-  if (settings.attribution.sensor_gain_levels > settings.attribution.sensor_evaluations - kKeep) {
+  if (o.sensor_gain_scan && *o.sensor_gain_scan > 0 &&  // 0: off, nothing to fit
+      *o.sensor_gain_scan > settings.attribution.sensor_evaluations - kKeep) {
     return fail(fmt::format("--sensor-gain-scan ({}) must leave the sensor refit's simplex {} of its {} evaluations",
                             settings.attribution.sensor_gain_levels, kKeep, settings.attribution.sensor_evaluations));
   }
@@ -362,8 +363,7 @@ Runner add_diagnose_command(CLI::App& app) {
   app.add_option("--sensor-gain-scan", o->sensor_gain_scan,
                  "Levels of the multipath gain (0 to 60 mm, evenly) the sensor candidate's re-rendering scores before "
                  "its simplex refines from the best (0: off, the simplex from no multipath; 1 is refused; levels "
-                 "count in --sensor-evaluations; off by default; docs/DIAGNOSIS_RESULTS.md, \"Session 66\")")
-;
+                 "count in --sensor-evaluations; off by default; docs/DIAGNOSIS_RESULTS.md, \"Session 66\")");
   app.add_flag("--free-sensor", o->free_sensor,
                "Refit all nine parameters of the sensor candidate (camera pose, depth bias and slope, multipath) "
                "wherever the camera sits. By default, where the rigid surfaces show the camera as recorded (it "
@@ -486,8 +486,8 @@ Runner add_diagnose_command(CLI::App& app) {
   // What only the attribution reads would be ignored: refused instead.
   for (const char* name : {"--candidates", "--ablation", "--confirm-within-floors", "--sensor-bending", "--free-sensor",
                            "--tie-margin", "--held-out-tolerance", "--refit-evaluations", "--sensor-evaluations",
-                           "--sensor-gain-scan", "--common-bending", "--refit-scan", "--yield-trade", "--yield-trade-at", "--shear-trade",
-                           "--drift-scan"}) {
+                           "--sensor-gain-scan", "--common-bending", "--refit-scan", "--yield-trade",
+                           "--yield-trade-at", "--shear-trade", "--drift-scan"}) {
     gap_only->excludes(app.get_option(name));
   }
   app.add_flag("-v,--verbose", o->verbose, "Log every simulation of the fit and the refits on stderr (by default: "

@@ -261,6 +261,16 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
     std::vector<double> anchors;
     double power = 1.0;
   };
+  // `n` levels of one axis over its whole range (both ends included), the other parameters at x0.
+  auto scan_evenly = [&](std::size_t axis, int n) {
+    spacing = (hi[axis] - lo[axis]) / (n - 1);
+    for (int k = 0; k < n; ++k) {
+      std::vector<double> x = x0;
+      x[axis] = k + 1 == n ? hi[axis] : lo[axis] + spacing * k;
+      scan.push_back(std::move(x));
+    }
+    scanned_axes = {axis};
+  };
   std::optional<Trade> trade;
   if (one_parameter && effect == Effect::kYield) {
     std::vector<double> anchors;
@@ -289,25 +299,10 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
   } else if (one_parameter && settings.scan_levels >= 2 && settings.scan_levels <= room) {
     // The strength over its range, the bending as fitted. A simplex from one fixed start rarely moved the strength
     // within the budget (docs/DIAGNOSIS_RESULTS.md, session 10).
-    const int n = settings.scan_levels;
-    spacing = (hi[first] - lo[first]) / (n - 1);
-    for (int k = 0; k < n; ++k) {
-      std::vector<double> x = x0;
-      x[first] = k + 1 == n ? hi[first] : lo[first] + spacing * k;
-      scan.push_back(std::move(x));
-    }
-    scanned_axes = {first};
+    scan_evenly(first, settings.scan_levels);
   } else if (effect == Effect::kSensor && settings.sensor_gain_levels >= 2 && settings.sensor_gain_levels <= room) {
     // The multipath gain over its range (AttributionSettings::sensor_gain_levels), the camera at its start.
-    const std::size_t gain = x0.size() - 1;  // multipath_mm, effect_space's last
-    const int n = settings.sensor_gain_levels;
-    spacing = (hi[gain] - lo[gain]) / (n - 1);
-    for (int k = 0; k < n; ++k) {
-      std::vector<double> x = x0;
-      x[gain] = k + 1 == n ? hi[gain] : lo[gain] + spacing * k;
-      scan.push_back(std::move(x));
-    }
-    scanned_axes = {gain};
+    scan_evenly(x0.size() - 1, settings.sensor_gain_levels);  // multipath_mm, effect_space's last
   } else if (effect == Effect::kMisalignment && settings.drift_scan_levels >= 1 &&
              settings.drift_scan_levels <= room) {
     // Drift sizes along the warp (AttributionSettings::drift_scan_levels), no turn, the bending as fitted.
