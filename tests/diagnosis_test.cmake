@@ -593,9 +593,10 @@ if(NOT no_drifts STREQUAL "4 0")
   message(FATAL_ERROR "--refit-evaluations 4: misalignment refit (evaluations, scan size) = '${no_drifts}'")
 endif()
 expect_failure(1 "--drift-scan (4) must leave" diagnose --capture ${WORK}/capture --refit-evaluations 6 --drift-scan 4)
-# A refit budget too small for any scan is valid where no scan is asked for (before, a scan of 0 had to leave it 3).
+# A refit budget too small for any scan is valid where no scan is asked for (before, a scan of 0 had to leave it 3;
+# so is a sensor refit's budget too small for --sensor-gain-scan, off by default).
 run_ok(small diagnose --capture ${WORK}/capture --quick --resolution 6 --states 1 --evaluations 2 --refit-evaluations 2
-       --candidates yield --json)
+       --sensor-evaluations 2 --candidates yield --json)
 json_boolean(small_ran "${small}" attribution ran)
 string(JSON small_effect GET "${small}" attribution candidates 0 effect)
 if(NOT small_ran OR NOT small_effect STREQUAL "yield")
