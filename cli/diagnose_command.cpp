@@ -209,7 +209,7 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (o.sensor_gain_scan && *o.sensor_gain_scan > 0 &&  // 0: off, nothing to fit
       *o.sensor_gain_scan > settings.attribution.sensor_evaluations - kKeep) {
     return fail(fmt::format("--sensor-gain-scan ({}) must leave the sensor refit's simplex {} of its {} evaluations",
-                            settings.attribution.sensor_gain_levels, kKeep, settings.attribution.sensor_evaluations));
+                            *o.sensor_gain_scan, kKeep, settings.attribution.sensor_evaluations));
   }
   settings.attribution.jobs = jobs;
   settings.attribute = !o.gap_only;

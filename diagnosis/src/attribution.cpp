@@ -321,7 +321,7 @@ sim::Expected<CandidateResult> refit(ForwardModel& model, ForwardModel* second, 
     for (const auto& x : scan) {
       const double value = f(x);
       if (error) return *error;
-      // (the sensor's: its multipath gain at the baseline's bending)
+      // The scanned parameter (the effect's; the sensor's multipath gain) and the bending scale (x1: re-rendered).
       c.scan.push_back({x[scanned_axes.back()], sim ? std::exp(x[0]) : 1.0, value});
       if (value < best_value) best_value = value, known = {x, value};
     }

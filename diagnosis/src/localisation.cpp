@@ -119,9 +119,8 @@ void place_gap(Localisation& L) {
 }
 
 bool folds_deepen_at_hem(const Localisation& L) {
-  auto ratio = [&](FeatureGroup g) {
-    const auto k = static_cast<std::size_t>(std::find(std::begin(kFeatureGroups), std::end(kFeatureGroups), g) -
-                                            std::begin(kFeatureGroups));
+  auto ratio = [&](FeatureGroup g) {  // group_ratio is indexed as group_differences is: by the group's value
+    const auto k = static_cast<std::size_t>(g);
     return k < L.group_ratio.size() ? L.group_ratio[k] : 0.0;
   };
   return ratio(FeatureGroup::kSkirtSpread) > kFoldDepthAtHem * ratio(FeatureGroup::kSkirtHeight);

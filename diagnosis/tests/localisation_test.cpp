@@ -1,6 +1,5 @@
 #include <gtest/gtest.h>
 
-#include <algorithm>
 #include <cmath>
 
 #include "drapegen/diagnosis/floors.hpp"
@@ -50,11 +49,6 @@ Localisation excess(FeatureGroup group, double lead, double stable, double skirt
   h.enrichment = hem;
   L.regions = {share(Region::kTop, 0.002, 0.1), s, h};
   return L;
-}
-
-std::size_t group_index(FeatureGroup group) {
-  return static_cast<std::size_t>(std::find(std::begin(kFeatureGroups), std::end(kFeatureGroups), group) -
-                                  std::begin(kFeatureGroups));
 }
 
 }  // namespace
@@ -211,7 +205,7 @@ TEST(PlaceGap, TheHemsOutlineCarriesTheSkirtWhereTheSkirtsResidualIsDenser) {
   // The skirt's groups are the skirt's whatever the pixels say (the folds' depth no deeper than the mean height).
   for (FeatureGroup g : {FeatureGroup::kSkirtHeight, FeatureGroup::kSkirtSpread, FeatureGroup::kFolds}) {
     L = excess(g, 2.0, 0.9, 0.8, 1.3, 0.8);
-    if (g == FeatureGroup::kSkirtSpread) L.group_ratio[group_index(FeatureGroup::kSkirtHeight)] = 1.9;
+    if (g == FeatureGroup::kSkirtSpread) L.group_ratio[static_cast<std::size_t>(FeatureGroup::kSkirtHeight)] = 1.9;
     place_gap(L);
     EXPECT_EQ(L.dominant, Region::kSkirt) << feature_group_name(g);
     EXPECT_FALSE(L.moved_to_hem);
@@ -221,25 +215,25 @@ TEST(PlaceGap, TheHemsOutlineCarriesTheSkirtWhereTheSkirtsResidualIsDenser) {
 TEST(PlaceGap, ASkirtGapWhoseFoldsDeepenFarBeyondTheSkirtsMeanHeightIsTheHems) {
   // Led by the folds' depth at 2.0 with the mean height at 1.2: 2.0 > 1.5 x 1.2, the hem (a curled edge band).
   Localisation L = excess(FeatureGroup::kSkirtSpread, 2.0, 0.9, 0.8, 1.3);
-  L.group_ratio[group_index(FeatureGroup::kSkirtHeight)] = 1.2;
+  L.group_ratio[static_cast<std::size_t>(FeatureGroup::kSkirtHeight)] = 1.2;
   place_gap(L);
   EXPECT_EQ(L.dominant, Region::kHem);
   EXPECT_EQ(L.dominant_feature, "skirt_spread");
   EXPECT_TRUE(L.moved_to_hem);
   EXPECT_TRUE(folds_deepen_at_hem(L));
   // At exactly 1.5 times, the skirt.
-  L.group_ratio[group_index(FeatureGroup::kSkirtHeight)] = 2.0 / kFoldDepthAtHem;
+  L.group_ratio[static_cast<std::size_t>(FeatureGroup::kSkirtHeight)] = 2.0 / kFoldDepthAtHem;
   place_gap(L);
   EXPECT_EQ(L.dominant, Region::kSkirt);
   EXPECT_FALSE(L.moved_to_hem);
   // An outline group the skirt carries (denser skirt residual) moves too; placed on the hem already, it stays there.
   L = excess(FeatureGroup::kHarmonics, 3.0, 0.9, 1.6, 1.2, 0.5);
-  L.group_ratio[group_index(FeatureGroup::kSkirtSpread)] = 2.5;
+  L.group_ratio[static_cast<std::size_t>(FeatureGroup::kSkirtSpread)] = 2.5;
   place_gap(L);
   EXPECT_EQ(L.dominant, Region::kHem);
   EXPECT_TRUE(L.moved_to_hem);
   L = excess(FeatureGroup::kHarmonics, 3.0, 0.9, 1.1, 1.2, 0.5);
-  L.group_ratio[group_index(FeatureGroup::kSkirtSpread)] = 2.5;
+  L.group_ratio[static_cast<std::size_t>(FeatureGroup::kSkirtSpread)] = 2.5;
   place_gap(L);
   EXPECT_EQ(L.dominant, Region::kHem);
   EXPECT_FALSE(L.moved_to_hem);
