@@ -361,9 +361,13 @@ Runner add_diagnose_command(CLI::App& app) {
                "multipath), and keeps it if it beats both the re-rendering and that (off by default; "
                "docs/DIAGNOSIS_RESULTS.md, \"Session 29\")");
   app.add_option("--sensor-gain-scan", o->sensor_gain_scan,
-                 "Levels of the multipath gain (0 to 60 mm, evenly) the sensor candidate's re-rendering scores before "
-                 "its simplex refines from the best (0: off, the simplex from no multipath; 1 is refused; levels "
-                 "count in --sensor-evaluations; off by default; docs/DIAGNOSIS_RESULTS.md, \"Session 66\")");
+                 fmt::format("Levels of the multipath gain (0 to 60 mm, evenly) the sensor candidate's re-rendering "
+                             "scores before its simplex refines from the best (0: off, the simplex from no multipath; "
+                             "1 is refused; levels count in --sensor-evaluations, which must leave {} for the simplex; "
+                             "default {}, off where --sensor-evaluations leaves it no room; docs/DIAGNOSIS_RESULTS.md, "
+                             "\"Session 67\")",
+                             diagnosis::AttributionSettings::kSimplexAfterScan,
+                             diagnosis::AttributionSettings{}.sensor_gain_levels));
   app.add_flag("--free-sensor", o->free_sensor,
                "Refit all nine parameters of the sensor candidate (camera pose, depth bias and slope, multipath) "
                "wherever the camera sits. By default, where the rigid surfaces show the camera as recorded (it "

@@ -594,7 +594,7 @@ if(NOT no_drifts STREQUAL "4 0")
 endif()
 expect_failure(1 "--drift-scan (4) must leave" diagnose --capture ${WORK}/capture --refit-evaluations 6 --drift-scan 4)
 # A refit budget too small for any scan is valid where no scan is asked for (before, a scan of 0 had to leave it 3;
-# so is a sensor refit's budget too small for --sensor-gain-scan, off by default).
+# so is a sensor refit's budget too small for the default --sensor-gain-scan).
 run_ok(small diagnose --capture ${WORK}/capture --quick --resolution 6 --states 1 --evaluations 2 --refit-evaluations 2
        --sensor-evaluations 2 --candidates yield --json)
 json_boolean(small_ran "${small}" attribution ran)
@@ -1146,10 +1146,11 @@ expect_failure(1 "--common-bending must be" diagnose --capture ${WORK}/capture -
 expect_failure(1 "--tie-margin must be" diagnose --capture ${WORK}/capture --tie-margin 2)
 # --sensor-bending: the sensor candidate refits the bending scale with a multipath gain under the camera it found (a
 # grid of 3 scales x 2 gains, a simplex, the best without multipath), by simulation on all three placements, and keeps
-# it only where it beats both the re-rendering and that ablation.
+# it only where it beats both the re-rendering and that ablation (here without the re-rendering's gain scan, whose
+# levels would come first in the candidate's scan).
 run_ok(sb diagnose --capture ${WORK}/capture --second-capture ${WORK}/capture.p1 --held-out-capture ${WORK}/capture.p2
        --quick --resolution 10 --states 2 --evaluations 8 --refit-evaluations 8 --sensor-evaluations 40
-       --candidates sensor --sensor-bending --json)
+       --candidates sensor --sensor-bending --sensor-gain-scan 0 --json)
 json_boolean(ran "${sb}" attribution ran)
 if(ran)
   json_number(lo "${sb}" attribution alpha_scale_bounds 0)
@@ -1330,6 +1331,20 @@ json_number(moved "${out}" localisation camera_moved_mm)
 if(NOT ran OR NOT held OR NOT moved LESS 3)
   message(FATAL_ERROR "multipath: attribution ran ${ran}, sensor held ${held}, camera moved ${moved} mm")
 endif()
+# By default the held refit first scores the multipath gain at 13 levels, 0 .. 60 mm every 5 (--sensor-gain-scan 13,
+# within the default --sensor-evaluations); --sensor-gain-scan 0 turns it off, and so does a budget with no room.
+string(JSON nscan LENGTH "${out}" attribution candidates 0 scan)
+json_number(last_level "${out}" attribution candidates 0 scan 12 parameter)
+if(NOT nscan EQUAL 13 OR NOT last_level EQUAL 60)
+  message(FATAL_ERROR "multipath, default gain scan: ${nscan} levels (13 expected), the last at ${last_level} mm")
+endif()
+foreach(off "--sensor-gain-scan;0" "--sensor-evaluations;12")
+  run_ok(no_scan diagnose ${mp_args} --candidates sensor ${off})
+  string(JSON nscan LENGTH "${no_scan}" attribution candidates 0 scan)
+  if(NOT nscan EQUAL 0)
+    message(FATAL_ERROR "multipath, ${off}: a gain scan of ${nscan} levels (none expected)")
+  endif()
+endforeach()
 string(JSON p GET "${out}" attribution candidates 0 parameters)
 set(rnames rot_x_mrad rot_y_mrad rot_z_mrad)
 set(tnames t_x_mm t_y_mm t_z_mm)

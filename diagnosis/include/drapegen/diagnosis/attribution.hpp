@@ -245,9 +245,11 @@ struct AttributionSettings {
   /// The sensor candidate's render-only refit first scores the multipath gain at this many levels evenly over its
   /// range (0 to effect_space's upper bound, 60 mm), the rest of the camera at its start, and the simplex refines
   /// from the best (0: off, the simplex from no multipath). From no multipath, the held refit (sensor_held: the gain
-  /// alone) stopped at 1.7-2.3 mm on two multipath captures of 17-24 mm (docs/DIAGNOSIS_RESULTS.md, "Session 66").
-  /// Re-rendering is cheap: the levels come out of sensor_evaluations.
-  int sensor_gain_levels = 0;
+  /// alone) stopped at 1.7-2.3 mm on two multipath captures of 17-24 mm (docs/DIAGNOSIS_RESULTS.md, "Session 66");
+  /// with 13 levels, pre-registered on fresh captures, sensor was named on 4 of 6 multipath captures against 2, no
+  /// verdict lost ("Session 67"). Re-rendering is cheap: the levels come out of sensor_evaluations; skipped where
+  /// those leave the simplex fewer than kSimplexAfterScan.
+  int sensor_gain_levels = 13;
   static constexpr double kSensorBendingScales[] = {0.5, 1.0, 1.5};  // ln of the bending scale (clamped to the bounds)
   static constexpr double kSensorBendingGains[] = {15.0, 30.0};      // multipath gain, mm
   /// Where at least this many confirmed candidates each bring the gate within the floors, the data single out none
