@@ -247,8 +247,8 @@ struct AttributionSettings {
   /// from the best (0: off, the simplex from no multipath). From no multipath, the held refit (sensor_held: the gain
   /// alone) stopped at 1.7-2.3 mm on two multipath captures of 17-24 mm (docs/DIAGNOSIS_RESULTS.md, "Session 66");
   /// with 13 levels, pre-registered on fresh captures, sensor was named on 4 of 6 multipath captures against 2, no
-  /// verdict lost ("Session 67"). Re-rendering is cheap: the levels come out of sensor_evaluations; skipped where
-  /// those leave the simplex fewer than kSimplexAfterScan.
+  /// verdict lost, both changes marginal ("Session 67"). Re-rendering is cheap: the levels come out of
+  /// sensor_evaluations; skipped where those leave the simplex fewer than kSimplexAfterScan.
   int sensor_gain_levels = 13;
   static constexpr double kSensorBendingScales[] = {0.5, 1.0, 1.5};  // ln of the bending scale (clamped to the bounds)
   static constexpr double kSensorBendingGains[] = {15.0, 30.0};      // multipath gain, mm
