@@ -196,6 +196,35 @@ nlohmann::json common_bending_json(const Attribution& a, const Floors& floors) {
           {"within_floors", a.common_within_floors}};
 }
 
+/// `drape` (a refit's validated drape against the capture) localised as the baseline's gap is: the same floors, the
+/// camera the rigid surfaces show (unset where it has no pixel residuals).
+std::optional<Localisation> localise_refit(const ForwardModel& model, const DiagnosisResult& r,
+                                           const ScoredDrape& drape) {
+  if (drape.views.empty()) return std::nullopt;
+  Localisation l = localise(model, drape);
+  l.camera_moved = r.localisation.camera_moved;
+  localise_against_floors(l, r.floors.region_floor());
+  localise_features(l, drape, model.target(), r.floors.group_floor(), r.floors.stable_floor());
+  return l;
+}
+
+/// Where a refit leaves the gap (null: not localised): the region place_gap says, what leads, and each feature
+/// group's, the stable term's and each region's ratio to its floor.
+nlohmann::json refit_localisation_json(const std::optional<Localisation>& l) {
+  if (!l) return nullptr;
+  nlohmann::json groups = nlohmann::json::object(), regions = nlohmann::json::object();
+  for (std::size_t k = 0; k < l->group_ratio.size(); ++k)
+    groups[std::string(feature_group_name(kFeatureGroups[k]))] = l->group_ratio[k];
+  for (const auto& s : l->regions) regions[std::string(region_name(s.region))] = s.floor_ratio;
+  return {{"region", region_name(l->dominant)},
+          {"dominant_feature",
+           l->dominant_feature.empty() ? nlohmann::json(nullptr) : nlohmann::json(l->dominant_feature)},
+          {"stable_ratio", l->stable_ratio},
+          {"group_ratios", groups},
+          {"region_floor_ratios", regions},
+          {"floor_region", region_name(l->floor_region)}};
+}
+
 }  // namespace
 
 DiagnosisSettings DiagnosisSettings::quick() {
@@ -518,6 +547,8 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
     if (!attribution) return attribution.error();
     r.attribution = std::move(*attribution);
     const auto& c = r.attribution.candidates;
+    r.bar_localisation = localise_refit(model, r, r.attribution.bar.validated);
+    for (const auto& candidate : c) r.candidate_localisations.push_back(localise_refit(model, r, candidate.validated));
     if (r.attribution.bending_within_floors()) {
       r.verdict = "none";  // within the floors once the bending is refitted: the gap was the baseline fit's
     } else {
@@ -672,7 +703,8 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                         {{"capture", L.capture_drape_coefficient}, {"model", L.model_drape_coefficient}}}};
   const bool ran = !r.within_floors && r.verdict != "not attributed";
   nlohmann::json candidates = nlohmann::json::array();
-  for (const auto& c : r.attribution.candidates) {
+  for (std::size_t i = 0; i < r.attribution.candidates.size(); ++i) {
+    const CandidateResult& c = r.attribution.candidates[i];
     nlohmann::json params = nlohmann::json::object();
     for (std::size_t k = 0; k < c.names.size() && k < c.parameters.size(); ++k) params[c.names[k]] = c.parameters[k];
     nlohmann::json scan = nlohmann::json::array();
@@ -700,6 +732,9 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                            {{"placement_pairs", c.placement_folds}, {"drape_pairs", c.drape_folds}}},
                           {"scan", scan},
                           {"bending_under_sensor", c.bending_under_sensor},
+                          {"localisation", refit_localisation_json(i < r.candidate_localisations.size()
+                                                                       ? r.candidate_localisations[i]
+                                                                       : std::nullopt)},
                           {"seconds", c.seconds}});
   }
   j["attribution"] = {{"ran", ran},
@@ -727,6 +762,7 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                         {"fit_score_mm", r.attribution.bar.fit_score * 1e3},
                         {"objective_mm", r.attribution.bar.objective * 1e3},
                         {"validated", ran ? validated_json(r.attribution.bar, r.floors) : nlohmann::json(nullptr)},
+                        {"localisation", refit_localisation_json(r.bar_localisation)},
                         {"shrinkage", r.attribution.bar.shrinkage}}},
                       {"common_bending", common_bending_json(r.attribution, r.floors)},
                       {"common_bending_effects", ran ? nlohmann::json(r.attribution.common_bending_effects) : nullptr},

@@ -136,6 +136,11 @@ struct DiagnosisResult {
   Localisation localisation;
   ShapeSet fit_target;  // the capture's shape features
   Attribution attribution;
+  /// Where each refit leaves the gap: its validated drape localised against the capture as the baseline's is (the
+  /// same floors and camera), the bar's and each candidate's (attribution.candidates' order; unset for a refit
+  /// without a validated drape). Reported only: where an effect closes the gap, against where the baseline left it.
+  std::optional<Localisation> bar_localisation;
+  std::vector<std::optional<Localisation>> candidate_localisations;
   /// The refits' bending scale bounds (AttributionSettings::bending_scale_lower/upper, ln of the factor on the fit's
   /// alpha and beta) where the attribution ran.
   double refit_scale_lower = 0.0, refit_scale_upper = 0.0;
