@@ -202,6 +202,23 @@ endforeach()
 if(NOT region MATCHES "^global$")
   message(FATAL_ERROR "a 12 mm depth bias localised at the ${region}, not everywhere (global)")
 endif()
+# report.json's feature groups: each ratio is its difference over what it was divided by (ratio_floor_mm: the group's
+# floor, at least half its scale), the differences those of the drape the gap is measured on (before session 67 the
+# report gave the fit's best drape's).
+file(WRITE ${WORK}/first.json "${out_first}")
+execute_process(COMMAND ${PYTHON3} -c [=[
+import json, sys
+groups = json.load(open(sys.argv[1]))["localisation"]["feature_groups"]
+bad = [f"{n}: ratio {g['ratio']}, difference {g['difference_mm']} mm over {g['ratio_floor_mm']} mm (floor "
+       f"{g['floor_mm']} mm)" for n, g in groups.items()
+       if g["ratio_floor_mm"] < g["floor_mm"] or g["difference_mm"] >= 0
+       and abs(g["ratio"] - g["difference_mm"] / g["ratio_floor_mm"]) > 1e-9 * max(1.0, g["ratio"])]
+print("; ".join(bad) if bad else f"{len(groups)} groups")
+sys.exit(1 if bad or len(groups) != 7 else 0)
+]=] ${WORK}/first.json RESULT_VARIABLE rc OUTPUT_VARIABLE groups_checked OUTPUT_STRIP_TRAILING_WHITESPACE)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "report.json feature groups: ${groups_checked}")
+endif()
 # Where each refit leaves the gap (attribution.candidates[].localisation and the bar's: its validated drape localised
 # as the baseline's is). The bias sits at the platform top: the sensor refit, which takes it into its camera, leaves
 # the top the least of every refit, below the baseline's; the refits that keep the camera leave it about as it was.

@@ -679,11 +679,15 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
     harmonics.push_back({{"order", h.order}, {"amplitude_mm", h.amplitude * 1e3}, {"phase_rad", h.phase}});
   }
   nlohmann::json groups = nlohmann::json::object();
-  const auto diff = group_differences(r.fit_target.all, r.fit.best.shape.all);
+  // The gap drape's differences, as localise_features's ratios (before session 67 the fit's best drape's).
+  const auto diff = group_differences(r.fit_target.all, r.gap_drape().shape.all);
   const auto floor = r.floors.group_floor();
   for (std::size_t k = 0; k < L.group_ratio.size(); ++k) {
     groups[std::string(feature_group_name(kFeatureGroups[k]))] = {
-        {"difference_mm", diff[k] * 1e3}, {"floor_mm", floor[k] * 1e3}, {"ratio", L.group_ratio[k]}};
+        {"difference_mm", diff[k] * 1e3},
+        {"floor_mm", floor[k] * 1e3},
+        {"ratio_floor_mm", group_ratio_floor(k, floor) * 1e3},
+        {"ratio", L.group_ratio[k]}};
   }
   j["localisation"] = {{"region", region_name(L.dominant)},
                        {"dominant_feature", L.dominant_feature.empty() ? nlohmann::json(nullptr)

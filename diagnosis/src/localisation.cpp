@@ -43,15 +43,18 @@ bool follows_skirt(FeatureGroup group) {
   return feature_region(group) == Region::kHem && group != FeatureGroup::kOffCentre;
 }
 
+double group_ratio_floor(std::size_t k, const std::vector<double>& group_floor) {
+  static const std::vector<double> scale = default_feature_scales();
+  return std::max(k < group_floor.size() ? group_floor[k] : 0.0, 0.5 * scale.at(k));
+}
+
 void localise_features(Localisation& L, const ScoredDrape& drape, const Target& capture,
                        const std::vector<double>& group_floor, double stable_floor) {
   const auto diff = group_differences(capture.shape.all, drape.shape.all);
-  const auto scale = default_feature_scales();
   L.group_ratio.assign(diff.size(), 0.0);
   for (std::size_t k = 0; k < diff.size(); ++k) {
     if (diff[k] < 0.0) continue;
-    const double floor = std::max(k < group_floor.size() ? group_floor[k] : 0.0, 0.5 * scale[k]);
-    L.group_ratio[k] = diff[k] / floor;
+    L.group_ratio[k] = diff[k] / group_ratio_floor(k, group_floor);
   }
   L.stable_ratio = drape.stable_all / std::max(stable_floor, 1e-4);
   place_gap(L);

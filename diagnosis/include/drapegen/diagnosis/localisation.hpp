@@ -120,6 +120,9 @@ inline constexpr double kMinRegionEnrichment = 1.3;
 /// platform, a camera error can put it there); a lifted top (mean <= 0): the specimen's contact (kTop) below
 /// kLiftedTopSensorRatio times the stable floor, a camera error (kGlobal) from it.
 [[nodiscard]] Region stable_region(const Localisation& localisation);
+/// What localise_features divides feature group k's difference by: its floor (`group_floor`, Floors::group_floor), at
+/// least half the group's scale (default_feature_scales).
+[[nodiscard]] double group_ratio_floor(std::size_t k, const std::vector<double>& group_floor);
 /// Sets group_ratio, stable_ratio (and, by place_gap, dominant) from the fitted drape's shape features against the
 /// capture's and the floors (floors.hpp) of each group. Call after localise_against_floors (stable_region reads the
 /// regions' floor ratios).
