@@ -222,14 +222,7 @@ endif()
 # Where each refit leaves the gap (attribution.candidates[].localisation and the bar's: its validated drape localised
 # as the baseline's is). The bias sits at the platform top: the sensor refit, which takes it into its camera, leaves
 # the top the least of every refit, below the baseline's; the refits that keep the camera leave it about as it was.
-string(JSON nregions LENGTH "${out_first}" localisation regions)
-math(EXPR last "${nregions} - 1")
-foreach(k RANGE ${last})
-  string(JSON name GET "${out_first}" localisation regions ${k} region)
-  if(name STREQUAL "top")
-    json_number(base_top "${out_first}" localisation regions ${k} floor_ratio)
-  endif()
-endforeach()
+set(base_top ${top_floor_ratio})  # the baseline's, read above (out is still the first run's)
 json_number(bar_top "${out_first}" attribution bending_refit_bar localisation region_floor_ratios top)
 string(JSON ncand LENGTH "${out_first}" attribution candidates)
 math(EXPR last "${ncand} - 1")
