@@ -28,6 +28,13 @@
   depth (feature group skirt_spread) stands more than --fold-depth times further above its floor than the skirt's
   mean height (skirt_height); any other region as run. Adopted in session 66 (place_gap, folds_deepen_at_hem): on
   reports of later builds "as run" already applies it.
+- closure_groups, closure_regions (session 67, exploratory; reports since df9daf4, whose refits carry their own
+  localisation): where the named effect closes the gap. closure_groups: the feature group (or the stable term) whose
+  ratio to its floor the named candidate's validated drape lowers the most from the baseline's, placed as place_gap
+  places a leading group (skirt groups the skirt, the centre offset the hem, the other outline groups the skirt or
+  the hem by the baseline's enrichment, the stable term by stable_region); closure_regions: the region whose residual
+  RMS over its floor (floor_ratio) it lowers the most. Where no effect is named, nothing is lowered, or the report
+  has no refit localisation: the region as run (--closure-only counts only the reports that have one).
 
 Per rule: the effect captures whose region is one of the effect's regions (the truth file's `regions`), per family.
 
@@ -41,6 +48,7 @@ run: `tolerance` (the rule since session 23, applied to every report with --tole
     scripts/region_rules.py --ranking out/s24s11main_all                          # the region-aware ranking
     scripts/region_rules.py out/p65/s64 out/p65/s65              # session 65 (diagnoses -> diag/NEW, the default)
     scripts/region_rules.py out/p66/s66 out/p66/s67              # session 66's test of fold_depth (diag/DEF)
+    scripts/region_rules.py out/p68/s71 out/p68/s72              # closure_* on reports with refit localisations
 """
 import argparse
 import collections
@@ -54,7 +62,8 @@ from diagnosis_rules import THRESHOLD, confirmation_rule  # noqa: E402  (the tol
 
 OUTLINE = {"harmonics", "off_centre", "sorted_radii", "hem_height"}
 RULES = ["as_run", "largest", "place_gap_24", "place_gap", "place_gap_27", "place_gap_27b", "pixel_region",
-         "floor_region", "split_enrichment", "split_floor_ratio", "skirt_floor_ratio", "fold_depth"]
+         "floor_region", "split_enrichment", "split_floor_ratio", "skirt_floor_ratio", "fold_depth", "closure_groups",
+         "closure_regions"]
 # Where each effect acts (candidate_effect.cpp, effect_regions).
 EFFECT_REGIONS = {"yield": {"skirt"}, "shear": {"skirt"}, "curl": {"hem"}, "misalignment": {"hem"},
                   "friction": {"top", "rim"}, "sensor": {"global"}}
@@ -127,6 +136,43 @@ def folds_deeper_than_mean(loc, factor):
     skirt's mean height (skirt_height)."""
     groups = loc["feature_groups"]
     return groups["skirt_spread"]["ratio"] > factor * groups["skirt_height"]["ratio"]
+
+
+def named_localisation(report):
+    """The named candidate's refit localisation (None: nothing named, or a report without refit localisations)."""
+    a = report.get("attribution") or {}
+    if report["verdict"] in ("none", "unexplained", "not attributed") or not a.get("candidates"):
+        return None
+    return a["candidates"][0].get("localisation")
+
+
+def closure_groups(loc, named, lifted_scale):
+    """The region of the feature group (or the stable term) the named refit lowers the most (as run if none)."""
+    if named is None:
+        return loc["region"]
+    drops = {g: loc["feature_groups"][g]["ratio"] - r for g, r in named["group_ratios"].items()}
+    drops["stable"] = loc["stable_ratio"] - named["stable_ratio"]
+    lead = max(drops, key=drops.get)
+    if drops[lead] <= 0.0:
+        return loc["region"]
+    if lead == "stable":
+        return stable_region(loc, lifted_scale)
+    if lead not in OUTLINE:
+        return "skirt"
+    if lead == "off_centre":
+        return "hem"
+    enrichment = {r["region"]: r["enrichment"] for r in loc["regions"]}
+    return "skirt" if enrichment.get("skirt", 0.0) > enrichment.get("hem", 0.0) else "hem"
+
+
+def closure_regions(loc, named):
+    """The region whose floor ratio the named refit lowers the most (as run if none)."""
+    if named is None:
+        return loc["region"]
+    base = {r["region"]: r["floor_ratio"] for r in loc["regions"]}
+    drops = {r: base[r] - v for r, v in named["region_floor_ratios"].items() if r in base}
+    lead = max(drops, key=drops.get) if drops else None
+    return lead if lead is not None and drops[lead] > 0.0 else loc["region"]
 
 
 def place_gap_27(loc, sensor_scale, skirt_denser, lifted_scale):
@@ -211,6 +257,8 @@ def main():
     ap.add_argument("--fold-depth", type=float, default=1.5,
                     help="fold_depth: the skirt_spread/skirt_height ratio from which a skirt gap is the hem's")
     ap.add_argument("--ranking", action="store_true", help="the region-aware attribution's verdicts instead")
+    ap.add_argument("--closure-only", action="store_true",
+                    help="count only the reports whose named candidate carries its refit localisation")
     ap.add_argument("--tolerance", type=float, default=0.1,
                     help="--ranking: the held-out tolerance for every report (default 0.1, the default since session 23)")
     args = ap.parse_args()
@@ -229,7 +277,10 @@ def main():
             if family == "none":
                 continue
             with open(path) as f:
-                loc = json.load(f)["localisation"]
+                report = json.load(f)
+            loc, named = report["localisation"], named_localisation(report)
+            if args.closure_only and named is None:
+                continue
             with open(truth_path) as f:
                 regions = set(json.load(f)["regions"])
             region = {"as_run": loc["region"], "largest": largest(loc),
@@ -240,7 +291,9 @@ def main():
                       "pixel_region": loc["pixel_region"], "floor_region": loc.get("floor_region"),
                       "split_enrichment": split(loc, "enrichment"), "split_floor_ratio": split(loc, "floor_ratio"),
                       "skirt_floor_ratio": skirt_to_hem(loc, lambda x: split(x, "floor_ratio") == "hem"),
-                      "fold_depth": skirt_to_hem(loc, lambda x: folds_deeper_than_mean(x, args.fold_depth))}
+                      "fold_depth": skirt_to_hem(loc, lambda x: folds_deeper_than_mean(x, args.fold_depth)),
+                      "closure_groups": closure_groups(loc, named, args.lifted_scale),
+                      "closure_regions": closure_regions(loc, named)}
             totals[family] += 1
             for rule in RULES:
                 hits[rule][family] += region[rule] in regions
