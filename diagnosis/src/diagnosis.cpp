@@ -196,16 +196,22 @@ nlohmann::json common_bending_json(const Attribution& a, const Floors& floors) {
           {"within_floors", a.common_within_floors}};
 }
 
-/// `drape` (a refit's validated drape against the capture) localised as the baseline's gap is: the same floors, the
-/// camera the rigid surfaces show (unset where it has no pixel residuals).
+/// `drape` (scored against the capture) localised against `floors`, with the camera error the rigid surfaces show
+/// (`camera_moved`, m): the baseline's gap and each refit's alike.
+Localisation localise_drape(const ForwardModel& model, const ScoredDrape& drape, const Floors& floors,
+                            double camera_moved) {
+  Localisation l = localise(model, drape);
+  l.camera_moved = camera_moved;
+  localise_against_floors(l, floors.region_floor());
+  localise_features(l, drape, model.target(), floors.group_floor(), floors.stable_floor());
+  return l;
+}
+
+/// A refit's validated drape localised as the baseline's gap is (unset where it has no pixel residuals).
 std::optional<Localisation> localise_refit(const ForwardModel& model, const DiagnosisResult& r,
                                            const ScoredDrape& drape) {
   if (drape.views.empty()) return std::nullopt;
-  Localisation l = localise(model, drape);
-  l.camera_moved = r.localisation.camera_moved;
-  localise_against_floors(l, r.floors.region_floor());
-  localise_features(l, drape, model.target(), r.floors.group_floor(), r.floors.stable_floor());
-  return l;
+  return localise_drape(model, drape, r.floors, r.localisation.camera_moved);
 }
 
 /// Where a refit leaves the gap (null: not localised): the region place_gap says, what leads, and each feature
@@ -501,11 +507,9 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
                                         settings.attribution.candidates.size()));
 
   // 3. Where the gap sits.
-  r.localisation = localise(model, gap);
-  if (r.rigid_pose) r.localisation.camera_moved = platform_displacement(r.rigid_pose->pose, capture);
+  r.localisation = localise_drape(model, gap, r.floors,
+                                  r.rigid_pose ? platform_displacement(r.rigid_pose->pose, capture) : 0.0);
   r.fit_target = model.target().shape;
-  localise_against_floors(r.localisation, r.floors.region_floor());
-  localise_features(r.localisation, gap, model.target(), r.floors.group_floor(), r.floors.stable_floor());
 
   // 4. Which effect explains it (not when the gap is within the floors).
   const auto attribution_start = std::chrono::steady_clock::now();
