@@ -471,12 +471,12 @@ std::optional<CommonBending> common_bending(const std::vector<CandidateResult>& 
   return shared;
 }
 
-bool curl_first(std::vector<CandidateResult>& ranked, double significant) {
-  const auto curl = std::find_if(ranked.begin(), ranked.end(), [&](const CandidateResult& c) {
-    return c.effect == Effect::kCurl && c.confirmed() && c.shrinkage >= significant;
+bool promote_first(std::vector<CandidateResult>& ranked, Effect effect, double significant) {
+  const auto it = std::find_if(ranked.begin(), ranked.end(), [&](const CandidateResult& c) {
+    return c.effect == effect && c.confirmed() && c.shrinkage >= significant;
   });
-  if (curl == ranked.end() || curl == ranked.begin()) return false;
-  std::rotate(ranked.begin(), curl, curl + 1);
+  if (it == ranked.end() || it == ranked.begin()) return false;
+  std::rotate(ranked.begin(), it, it + 1);
   return true;
 }
 
@@ -559,8 +559,10 @@ double bootstrap_confidence(const ForwardModel& model, const ScoredDrape& a, con
 
 sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& baseline, const Evaluation& fit,
                                      const Evaluation& validated, const Floors& floors,
-                                     const AttributionSettings& settings, const ModelFactory& make_model,
+                                     const AttributionSettings& given, const ModelFactory& make_model,
                                      const OtherCaptures& others) {
+  AttributionSettings settings = given;
+  if (settings.multipath_first && others.views_imply_multipath) settings.sensor_bending = true;
   // Tasks: the candidates, then the bar (no effect: the baseline's bending scale refitted with the same budget).
   const std::size_t tasks = settings.candidates.size() + 1;
   auto task_effect = [&](std::size_t k) -> std::optional<Effect> {
@@ -664,9 +666,15 @@ sim::Expected<Attribution> attribute(ForwardModel& model, const ModelSetup& base
   if (a.near_tie_promoted)
     sim::logger()->info("attribution: {} within {:.2f} of the first's shrinkage; named first as a tie",
                         effect_name(a.candidates[0].effect), settings.tie_margin);
-  a.curl_promoted = others.fold_unlike_model && curl_first(a.candidates, settings.significant_shrinkage);
+  a.curl_promoted =
+      others.fold_unlike_model && promote_first(a.candidates, Effect::kCurl, settings.significant_shrinkage);
   if (a.curl_promoted)
     sim::logger()->info("attribution: the placements fold less alike than the fitted model's drapes; curl first");
+  a.multipath_first = settings.multipath_first;
+  a.sensor_promoted = settings.multipath_first && others.views_imply_multipath &&
+                      promote_first(a.candidates, Effect::kSensor, settings.significant_shrinkage);
+  if (a.sensor_promoted)
+    sim::logger()->info("attribution: every placement's views imply multipath; the sensor error first");
   if (const auto shared = common_bending(a.candidates, floors, settings.common_bending_effects);
       shared && !a.bar_within_floors) {
     // Unlike effects each within the floors: the bending scale they share, validated as the bar is.

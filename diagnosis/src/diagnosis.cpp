@@ -107,6 +107,23 @@ nlohmann::json spread_json(const ValidationSpread& s) {
           {"pairwise_groups_mm", pair_groups}};
 }
 
+nlohmann::json multipath_json(const MultipathTest& t, const std::vector<DiagnosisResult::Placement>& placements) {
+  nlohmann::json each = nlohmann::json::array();
+  for (std::size_t k = 0; k < t.placements.size(); ++k) {
+    const ViewConsistency& c = t.placements[k];
+    each.push_back({{"role", k < placements.size() ? placements[k].role : ""},
+                    {"gain_mm", c.gain * 1e3},
+                    {"standard_error_mm", c.standard_error * 1e3},
+                    {"offset_mm", c.offset * 1e3},
+                    {"rms_mm", c.rms * 1e3},
+                    {"pixels", c.pixels}});
+  }
+  return {{"placements", each},
+          {"smallest_gain_mm", t.smallest_gain() * 1e3},
+          {"threshold_mm", t.threshold * 1e3},
+          {"multipath", t.detected()}};
+}
+
 nlohmann::json repeatability_json(const FoldRepeatability& f) {
   auto least = [](const std::vector<double>& v) {
     return v.empty() ? nlohmann::json(nullptr) : nlohmann::json(*std::min_element(v.begin(), v.end()));
@@ -480,6 +497,16 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
         r.validated.best, r.validated_second ? &r.validated_second->best : nullptr,
         r.validated_held_out ? &r.validated_held_out->best : nullptr);
   }
+  {  // Do the four views describe one surface on every placement? (A multipath error breaks that; the cloth cannot.)
+    r.multipath.threshold = settings.view_consistency.multipath_gain;
+    for (const Capture* c : {&capture, others.second, others.held_out}) {
+      if (!c) continue;
+      std::vector<renderer::DepthImage> depth;
+      std::vector<renderer::Camera> cameras;
+      for (const CaptureView& v : c->views) depth.push_back(v.depth), cameras.push_back(v.camera);
+      r.multipath.placements.push_back(view_consistency(depth, cameras, settings.view_consistency));
+    }
+  }
   const ScoredDrape& gap = r.gap_drape();
   for (std::size_t v = 0; v < gap.views.size(); ++v) {
     if (gap.views[v].stable_pixels > 0 || gap.views[v].captured_stable_pixels == 0) continue;
@@ -529,6 +556,7 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
     if (second_model) other_captures.second = {second_model.get(), &r.validated_second->best};
     if (held_out_model) other_captures.held_out = {held_out_model.get(), &r.validated_held_out->best};
     other_captures.fold_unlike_model = folds_less_alike(r.fold_repeatability);
+    other_captures.views_imply_multipath = r.multipath.detected();
     AttributionSettings attribution_settings = settings.attribution;
     if (r.search_within_factor > 1.0) {
       // A known bending's box (a measured bending or --start-box) bounds the refits too: the bending scale moves only
@@ -609,6 +637,7 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                     {"best_validation_state", r.gap_drape().state},
                     {"validation_spread", spread_json(r.validation_spread)},
                     {"fold_repeatability", repeatability_json(r.fold_repeatability)},
+                    {"view_consistency", multipath_json(r.multipath, r.placements)},
                     {"validation_drapes", states},
                     {"fit_states", {{"stable_mm", r.fit.best.stable_all * 1e3},
                                     {"shape", r.fit.best.shape_all},
@@ -747,6 +776,9 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
   }
   j["attribution"] = {{"ran", ran},
                       {"curl_first", r.attribution.curl_promoted},
+                      {"sensor_first", ran ? nlohmann::json{{"multipath_first", r.attribution.multipath_first},
+                                                            {"promoted", r.attribution.sensor_promoted}}
+                                           : nlohmann::json(nullptr)},
                       {"near_tie", ran ? nlohmann::json{{"margin", r.attribution.tie_margin},
                                                         {"promoted", r.attribution.near_tie_promoted}}
                                        : nlohmann::json(nullptr)},

@@ -143,11 +143,15 @@ std::string verdict_markdown(const DiagnosisResult& r) {
                         "(`--confirm-within-floors`); its score there is {:.0f}% above the reference's, more than the "
                         "{:g}% the score's confirmation allows.\n\n",
                         -100.0 * c.held_out_shrinkage, 100.0 * r.attribution.held_out_tolerance);
-    if (r.attribution.near_tie_promoted && !r.attribution.curl_promoted)
+    if (r.attribution.near_tie_promoted && !r.attribution.curl_promoted && !r.attribution.sensor_promoted)
       md += fmt::format("It is named ahead of a candidate whose shrinkage is larger by less than {:.2f}, a tie within "
                         "the validation drapes' noise: the smaller refit objective names one.\n\n",
                         r.attribution.tie_margin);
-    if (r.attribution.curl_promoted)
+    if (r.attribution.sensor_promoted)
+      md += "The sensor error is named ahead of the candidate its shrinkage ranks first: on every placement the four "
+            "views disagree as a multipath error makes them (view consistency, below), which no effect on the cloth "
+            "does (`--multipath-first`).\n\n";
+    else if (r.attribution.curl_promoted)
       md += "Curl is named ahead of the candidate its shrinkage ranks first: the capture's placements fold less "
             "alike than the fitted model's drapes do (fold repeatability, below), as rolled edges settle differently "
             "on every placement.\n\n";
@@ -300,6 +304,13 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
     for (double c : f.capture) md += fmt::format(" {:.2f}", c);
     md += fmt::format("; between the fitted model's drapes from {} sine initial states: lowest {:.2f}.\n",
                       f.model_drapes, *std::min_element(f.model.begin(), f.model.end()));
+  }
+  if (const MultipathTest& m = r.multipath; !m.placements.empty()) {
+    md += "View consistency (the multipath gain the four views' disagreement implies, about half the true gain; "
+          "placements in order):";
+    for (const ViewConsistency& c : m.placements) md += fmt::format(" {:.1f} mm", c.gain * 1e3);
+    md += fmt::format("; {} (the smallest against {:.1f} mm).\n",
+                      m.detected() ? "multipath on every placement" : "no multipath test fired", m.threshold * 1e3);
   }
   md += "Hem radius difference (capture - model), largest harmonics:";
   auto h = r.localisation.hem_difference;

@@ -180,25 +180,25 @@ TEST(SensorBendingGrid, IsTheScalesTimesTheGainsInOrderWithinTheBoundsAndTheBudg
   EXPECT_EQ(sensor_bending_grid(-0.1, 0.2, 10.0, 14), (V{{0.2, 10.0}}));
 }
 
-TEST(CurlFirst, MovesAConfirmedSignificantCurlToTheFrontKeepingTheOthersOrder) {
+TEST(PromoteFirst, MovesAConfirmedSignificantCandidateToTheFrontKeepingTheOthersOrder) {
   std::vector<CandidateResult> order{
       ranked(Effect::kYield, true, 0.9, 5e-3, 0.0), ranked(Effect::kShear, true, 0.5, 5e-3, 0.0),
       ranked(Effect::kCurl, true, 0.76, 5e-3, 0.0), ranked(Effect::kSensor, false, 0.3, 5e-3, 0.0)};
-  ASSERT_TRUE(curl_first(order, 0.25));
+  ASSERT_TRUE(promote_first(order, Effect::kCurl, 0.25));
   EXPECT_EQ(order[0].effect, Effect::kCurl);
   EXPECT_EQ(order[1].effect, Effect::kYield);
   EXPECT_EQ(order[2].effect, Effect::kShear);
   EXPECT_EQ(order[3].effect, Effect::kSensor);
-  EXPECT_FALSE(curl_first(order, 0.25));  // already first
+  EXPECT_FALSE(promote_first(order, Effect::kCurl, 0.25));  // already first
   // Unconfirmed, or below the significant shrinkage: nothing moves.
   std::vector<CandidateResult> weak{ranked(Effect::kYield, true, 0.9, 5e-3, 0.0),
                                     ranked(Effect::kCurl, false, 0.8, 5e-3, 0.0)};
-  EXPECT_FALSE(curl_first(weak, 0.25));
+  EXPECT_FALSE(promote_first(weak, Effect::kCurl, 0.25));
   EXPECT_EQ(weak[0].effect, Effect::kYield);
   weak = {ranked(Effect::kYield, true, 0.9, 5e-3, 0.0), ranked(Effect::kCurl, true, 0.2, 5e-3, 0.0)};
-  EXPECT_FALSE(curl_first(weak, 0.25));
+  EXPECT_FALSE(promote_first(weak, Effect::kCurl, 0.25));
   std::vector<CandidateResult> none{ranked(Effect::kYield, true, 0.9, 5e-3, 0.0)};
-  EXPECT_FALSE(curl_first(none, 0.25));
+  EXPECT_FALSE(promote_first(none, Effect::kCurl, 0.25));
 }
 
 TEST(NearTiesFirst, NamesTheSmallestObjectiveOfTheSignificantConfirmedCandidatesWithinTheMargin) {

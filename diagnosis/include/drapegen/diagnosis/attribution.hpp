@@ -123,6 +123,10 @@ struct OtherCaptures {
   /// The placements fold less alike than the fitted model's drapes (fold_repeatability.hpp, folds_less_alike): the
   /// attribution then names curl where curl is confirmed and significant (curl_first).
   bool fold_unlike_model = false;
+  /// Every placement's views imply a multipath gain (view_consistency.hpp, MultipathTest::detected): with
+  /// AttributionSettings::multipath_first, the sensor candidate refits the bending under its camera and is named
+  /// where it is confirmed and significant.
+  bool views_imply_multipath = false;
   [[nodiscard]] const OtherCapture& paired() const { return second ? second : held_out; }
 };
 
@@ -250,6 +254,12 @@ struct AttributionSettings {
   /// verdict lost, both changes marginal ("Session 67"). Re-rendering is cheap: the levels come out of
   /// sensor_evaluations; skipped where those leave the simplex fewer than kSimplexAfterScan.
   int sensor_gain_levels = 13;
+  /// Where the multipath test fires (OtherCaptures::views_imply_multipath: the four views disagree on every placement
+  /// as a multipath error makes them, which no effect on the cloth does), the sensor candidate refits the bending
+  /// under its camera (as sensor_bending does everywhere) and moves to the front where it is confirmed and
+  /// significant (promote_first). Elsewhere nothing changes. Off by default: pre-registered for session 69 on fresh
+  /// captures (docs/DIAGNOSIS_RESULTS.md, "Session 68").
+  bool multipath_first = false;
   static constexpr double kSensorBendingScales[] = {0.5, 1.0, 1.5};  // ln of the bending scale (clamped to the bounds)
   static constexpr double kSensorBendingGains[] = {15.0, 30.0};      // multipath gain, mm
   /// Where at least this many confirmed candidates each bring the gate within the floors, the data single out none
@@ -285,8 +295,12 @@ struct Attribution {
   /// The bar's validated drape is within the floors (gate of the baseline's): the baseline model explains the capture
   /// once its bending is refitted, so the gap was the baseline fit's, and no effect is named.
   bool bar_within_floors = false;
-  /// curl_first moved the curl candidate to the front (OtherCaptures::fold_unlike_model).
+  /// promote_first moved the curl candidate to the front (OtherCaptures::fold_unlike_model).
   bool curl_promoted = false;
+  /// promote_first moved the sensor candidate to the front (AttributionSettings::multipath_first and
+  /// OtherCaptures::views_imply_multipath); it decides over curl_promoted.
+  bool sensor_promoted = false;
+  bool multipath_first = false;  // AttributionSettings::multipath_first, as it ran
   /// near_ties_first moved a candidate within AttributionSettings::tie_margin of the first's shrinkage to the front.
   bool near_tie_promoted = false;
   double tie_margin = 0.0;  // the margin it ran with
@@ -338,12 +352,13 @@ struct CommonBending {
 /// docs/DIAGNOSIS_RESULTS.md, "Session 25"), then the smaller refit objective, then the larger held-out shrinkage.
 [[nodiscard]] bool ranks_before(const CandidateResult& x, const CandidateResult& y);
 
-/// Where the capture's placements fold less alike than the fitted model's drapes, a curl candidate that is confirmed
-/// and shrinks the gap by at least `significant` moves to the front of `ranked` (the others keep their order): edges
-/// that roll settle differently on every placement, which neither a softer elastic fit nor a yielding one laid again
-/// reproduced on seeds 17-20 (rule "repeat_curl", pre-registered before seed 20;
-/// docs/DIAGNOSIS_RESULTS.md, "Session 27"). Returns whether it moved one.
-bool curl_first(std::vector<CandidateResult>& ranked, double significant);
+/// The candidate of `effect`, where it is confirmed and shrinks the gap by at least `significant`, moves to the front
+/// of `ranked` (the others keep their order). Returns whether it moved. For curl where the capture's placements fold
+/// less alike than the fitted model's drapes: edges that roll settle differently on every placement, which neither a
+/// softer elastic fit nor a yielding one laid again reproduced on seeds 17-20 (rule "repeat_curl", pre-registered
+/// before seed 20; docs/DIAGNOSIS_RESULTS.md, "Session 27"); for the sensor error where the views imply multipath
+/// (AttributionSettings::multipath_first).
+bool promote_first(std::vector<CandidateResult>& ranked, Effect effect, double significant);
 
 /// Near ties (AttributionSettings::tie_margin): among the confirmed candidates whose shrinkage is at least
 /// `significant` and within `margin` of the first's (`ranked` in ranks_before's order), the one with the smallest

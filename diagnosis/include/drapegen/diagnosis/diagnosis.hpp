@@ -13,6 +13,7 @@
 #include "drapegen/diagnosis/localisation.hpp"
 #include "drapegen/diagnosis/rigid_pose.hpp"
 #include "drapegen/diagnosis/validation_spread.hpp"
+#include "drapegen/diagnosis/view_consistency.hpp"
 
 namespace drapegen::diagnosis {
 
@@ -48,6 +49,9 @@ struct DiagnosisSettings {
   bool hold_sensor = true;
   std::vector<double> start_ratios_mm{1.8, 3.6};  // about the 20% and 86% quantiles of fabrics618's -beta/alpha
   FloorSettings floors;
+  /// The cross-view slope read off every placement and the multipath test on it (reported; it changes the verdict
+  /// only with AttributionSettings::multipath_first).
+  ViewConsistencySettings view_consistency;
   AttributionSettings attribution;
   /// false: stop after the gap, floors and localisation (a capture above the floors gets the verdict
   /// "not attributed"): a screening run, or a calibration of the floors, at a fraction of the cost.
@@ -126,6 +130,8 @@ struct DiagnosisResult {
   /// Whether the capture's placements fold alike, against the fitted model's drapes from the validation states
   /// (reported; not in the gate).
   FoldRepeatability fold_repeatability;
+  /// The four views' cross-view slope on every placement (the capture's first) and the multipath test on them.
+  MultipathTest multipath;
   /// The camera's pose error read off the platform top and bare side before the fit (the sensor candidate's start),
   /// or why it could not be (rigid_pose_error).
   std::optional<RigidPose> rigid_pose;
