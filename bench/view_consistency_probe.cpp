@@ -7,11 +7,11 @@
 //
 //   r = D_B(q) - z_B(X_A) = g [ S_B(q) - S_A(p) (a . n) / (b . n) ],
 //
-// so the least-squares slope of r on the bracket estimates g from the capture alone, with no fit of the cloth. The
-// sensor noise biases the slope by an amount that depends on the drape's geometry; with --floor-seeds the same slope
-// is measured on the diagnosis's fitted drape (its report's bending and best initial state) rendered without sensor
-// error and with that many noise seeds: a floor for this capture's geometry. Reads the truth files only to print each
-// capture's family and multipath strength, so it is a benchmark tool.
+// so the least-squares slope of r on the bracket estimates g from the capture alone, with no fit of the cloth
+// (diagnosis/view_consistency.hpp). The sensor noise biases the slope by an amount that depends on the drape; with
+// --floor-seeds the same slope is measured on the diagnosis's fitted drape (its report's bending and best initial
+// state) rendered without sensor error, clean and with that many noise seeds (--noise-off drops terms of the noise
+// model). Reads the truth files only to print each capture's family and multipath strength: a benchmark tool.
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <array>
@@ -19,7 +19,6 @@
 #include <filesystem>
 #include <fmt/format.h>
 #include <iostream>
-#include <cstdlib>
 #include <optional>
 
 #include "drapegen/diagnosis/bending_json.hpp"
@@ -46,9 +45,15 @@ ViewConsistency consistency(const diagnosis::Capture& capture, const diagnosis::
   return diagnosis::view_consistency(depth, cameras, o);
 }
 
-/// The slopes of the report's fitted drape rendered without sensor error, with `seeds` noise seeds.
-sim::Expected<std::vector<ViewConsistency>> floor_slopes(const diagnosis::Capture& capture, const fs::path& report_file,
-                                               int seeds, const diagnosis::ViewConsistencySettings& o) {
+/// The slopes of the report's fitted drape (its bending and best initial state) rendered without sensor error: the
+/// clean render's first, then `seeds` renders with the Kinect noise model minus the terms named in `noise_off`.
+struct FloorSlopes {
+  ViewConsistency clean;
+  std::vector<ViewConsistency> noisy;
+};
+
+sim::Expected<FloorSlopes> floor_slopes(const diagnosis::Capture& capture, const fs::path& report_file, int seeds,
+                                        const std::string& noise_off, const diagnosis::ViewConsistencySettings& o) {
   const auto report = bench::read_json(report_file);
   if (!report) return report.error();
   const auto settings = diagnosis::DiagnosisSettings::fine();
@@ -64,27 +69,21 @@ sim::Expected<std::vector<ViewConsistency>> floor_slopes(const diagnosis::Captur
   auto clean = (*model)->render(e->best.mesh, e->best.angle, renderer::SensorError{});
   if (!clean) return clean.error();
   renderer::NoiseModel noise = renderer::NoiseModel::kinect();
-  if (const char* off = std::getenv("VC_OFF")) {
-    const std::string t = off;
-    if (t.find('a') != std::string::npos) noise.axial = false;
-    if (t.find('l') != std::string::npos) noise.lateral = false;
-    if (t.find('g') != std::string::npos) noise.grazing = false;
-    if (t.find('e') != std::string::npos) noise.edges = false;
-    if (t.find('d') != std::string::npos) noise.dropout = false;
-    if (t.find('q') != std::string::npos) noise.quantisation = false;
+  for (const char term : noise_off) {
+    bool* off = term == 'a' ? &noise.axial : term == 'l' ? &noise.lateral : term == 'g' ? &noise.grazing
+              : term == 'e' ? &noise.edges : term == 'd' ? &noise.dropout : term == 'q' ? &noise.quantisation
+                            : nullptr;
+    if (!off) return sim::Error{fmt::format("--noise-off: unknown term '{}' (one of a l g e d q)", term)};
+    *off = false;
   }
-  std::vector<ViewConsistency> out;
-  if (std::getenv("VC_CLEAN")) {
-    diagnosis::Capture pseudo = capture;
-    for (std::size_t v = 0; v < pseudo.views.size(); ++v) pseudo.views[v].depth = (*clean)[v];
-    const auto c = consistency(pseudo, o);
-    fmt::print(stderr, "clean {:.2f} mm ({} px)\n", 1e3 * c.gain, c.pixels);
-  }
+  FloorSlopes out;
+  diagnosis::Capture pseudo = capture;
+  for (std::size_t v = 0; v < pseudo.views.size(); ++v) pseudo.views[v].depth = (*clean)[v];
+  out.clean = consistency(pseudo, o);
   for (int k = 0; k < seeds; ++k) {
-    diagnosis::Capture pseudo = capture;
     for (std::size_t v = 0; v < pseudo.views.size(); ++v)
       pseudo.views[v].depth = noise.apply((*clean)[v], renderer::mix_seed(0xC0515 + static_cast<std::uint64_t>(k), v));
-    out.push_back(consistency(pseudo, o));
+    out.noisy.push_back(consistency(pseudo, o));
   }
   return out;
 }
@@ -99,7 +98,7 @@ int main(int argc, char** argv) {
   diagnosis::ViewConsistencySettings o;
   double kink_mm = 1e3 * o.kink, gate_mm = 1e3 * o.gate;
   int floor_seeds = 0;
-  std::string reports = "diagnoses";
+  std::string reports = "diagnoses", noise_off;
   bool placements = false;
   app.add_option("runs", runs, "benchmark run directories (captures/ and truth/ inside)")->required();
   app.add_option("--kink", kink_mm, "mm: largest second difference of depth around a usable pixel")
@@ -114,13 +113,15 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--floor-seeds", floor_seeds, "noise seeds of the fitted drape's floor (0: no floor; simulates)")
       ->capture_default_str();
+  app.add_option("--noise-off", noise_off, "the floor's noise model without these terms: a(xial) l(ateral) "
+                                           "g(razing) e(dges) d(ropout) q(uantisation), e.g. \"le\"");
   app.add_option("--reports", reports, "the runs' folder of diagnosis reports (for the floor)")->capture_default_str();
   app.add_flag("--placements", placements, "also the second and held-out placements (NAME.p1, NAME.p2)");
   CLI11_PARSE(app, argc, argv);
   o.kink = 1e-3 * kink_mm, o.gate = 1e-3 * gate_mm;
 
-  fmt::print("{:<6} {:<18} {:<13} {:>7} {:>7} {:>6} {:>7} {:>6} {:>6} {:>7} {:>6}\n", "run", "capture", "family",
-             "true_mm", "g_mm", "se_mm", "c_mm", "rms_mm", "pixels", "floor", "sd");
+  fmt::print("{:<6} {:<18} {:<13} {:>7} {:>7} {:>6} {:>7} {:>6} {:>6} {:>7} {:>7} {:>6}\n", "run", "capture",
+             "family", "true_mm", "g_mm", "se_mm", "c_mm", "rms_mm", "pixels", "clean", "floor", "sd");
   for (const std::string& run : runs) {
     std::vector<fs::path> dirs;
     for (const auto& e : fs::directory_iterator(fs::path(run) / "captures"))
@@ -140,22 +141,24 @@ int main(int argc, char** argv) {
         for (const auto& e : t->value("effects", nlohmann::json::array()))
           if (e.value("name", "") == "multipath") truth_mm = e.value("strength", 0.0);
       }
-      double floor_mean = std::nan(""), floor_sd = std::nan("");
+      double clean = std::nan(""), floor_mean = std::nan(""), floor_sd = std::nan("");
       if (floor_seeds > 0) {
         const auto f = floor_slopes(*capture, fs::path(run) / reports / (dir.filename().string() + ".json"),
-                                    floor_seeds, o);
+                                    floor_seeds, noise_off, o);
         if (!f) {
           std::cerr << dir.string() << ": " << f.error().message << "\n";
         } else {
+          const double n = static_cast<double>(f->noisy.size());
           double m = 0.0, q = 0.0;
-          for (const ViewConsistency& x : *f) m += x.gain / f->size();
-          for (const ViewConsistency& x : *f) q += (x.gain - m) * (x.gain - m) / std::max<double>(1.0, f->size() - 1.0);
-          floor_mean = m, floor_sd = std::sqrt(q);
+          for (const ViewConsistency& x : f->noisy) m += x.gain / n;
+          for (const ViewConsistency& x : f->noisy) q += (x.gain - m) * (x.gain - m) / std::max(1.0, n - 1.0);
+          clean = f->clean.gain, floor_mean = m, floor_sd = std::sqrt(q);
         }
       }
-      fmt::print("{:<6} {:<18} {:<13} {:>7.1f} {:>7.2f} {:>6.2f} {:>7.3f} {:>6.2f} {:>6} {:>7.2f} {:>6.2f}\n",
+      fmt::print("{:<6} {:<18} {:<13} {:>7.1f} {:>7.2f} {:>6.2f} {:>7.3f} {:>6.2f} {:>6} {:>7.2f} {:>7.2f} {:>6.2f}\n",
                  fs::path(run).filename().string(), dir.filename().string(), family, truth_mm, s.gain * 1e3,
-                 s.standard_error * 1e3, s.offset * 1e3, s.rms * 1e3, s.pixels, floor_mean * 1e3, floor_sd * 1e3);
+                 s.standard_error * 1e3, s.offset * 1e3, s.rms * 1e3, s.pixels, clean * 1e3, floor_mean * 1e3,
+                 floor_sd * 1e3);
       std::fflush(stdout);
     }
   }

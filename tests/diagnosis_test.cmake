@@ -1126,6 +1126,35 @@ endforeach()
 if(NOT sensor_seen)
   message(FATAL_ERROR "fold repeatability: no sensor candidate among ${ncand}")
 endif()
+# The views' consistency on each of the three placements, in their order; the test fires exactly where the smallest
+# slope reaches the threshold; the flag is off by default.
+set(vc_roles "")
+set(vc_least "")
+foreach(i RANGE 2)
+  string(JSON role GET "${out}" gap_tests view_consistency placements ${i} role)
+  json_number(g "${out}" gap_tests view_consistency placements ${i} gain_mm)
+  json_number(px "${out}" gap_tests view_consistency placements ${i} pixels)
+  list(APPEND vc_roles ${role})
+  if(vc_least STREQUAL "" OR g LESS vc_least)
+    set(vc_least ${g})
+  endif()
+  if(px LESS 100)
+    message(FATAL_ERROR "view consistency: ${px} pixels compared on placement ${i}")
+  endif()
+endforeach()
+json_number(vc_smallest "${out}" gap_tests view_consistency smallest_gain_mm)
+json_number(vc_threshold "${out}" gap_tests view_consistency threshold_mm)
+json_boolean(vc_fired "${out}" gap_tests view_consistency multipath)
+json_boolean(mp_first "${out}" attribution sensor_first multipath_first)
+set(vc_expected OFF)
+if(NOT vc_smallest LESS vc_threshold)
+  set(vc_expected ON)
+endif()
+if(NOT vc_roles STREQUAL "capture;second_capture;held_out_capture" OR NOT vc_smallest EQUAL vc_least
+   OR NOT vc_fired STREQUAL vc_expected OR mp_first)
+  message(FATAL_ERROR "view consistency: roles ${vc_roles}, smallest ${vc_smallest} mm (of ${vc_least}), threshold "
+                      "${vc_threshold}, fired ${vc_fired}, --multipath-first ${mp_first} by default")
+endif()
 # Whether the placements fold less alike than the model's drapes, and whether that put curl first (consistent: curl
 # first only where they do).
 json_boolean(curl_first "${out}" attribution curl_first)
@@ -1377,6 +1406,29 @@ json_number(moved "${out}" localisation camera_moved_mm)
 if(NOT ran OR NOT held OR NOT moved LESS 3)
   message(FATAL_ERROR "multipath: attribution ran ${ran}, sensor held ${held}, camera moved ${moved} mm")
 endif()
+# The four views disagree as a 60 mm multipath error makes them (gap_tests.view_consistency, one placement here): the
+# multipath test fires. --multipath-first then refits the sensor candidate's bending under its camera (the gain scan's
+# 13 re-renderings, then simulations) and reports it asked for.
+string(JSON nvc LENGTH "${out}" gap_tests view_consistency placements)
+json_number(vc_gain "${out}" gap_tests view_consistency placements 0 gain_mm)
+json_number(vc_smallest "${out}" gap_tests view_consistency smallest_gain_mm)
+json_number(vc_threshold "${out}" gap_tests view_consistency threshold_mm)
+json_boolean(vc_fired "${out}" gap_tests view_consistency multipath)
+json_boolean(mp_first "${out}" attribution sensor_first multipath_first)
+if(NOT nvc EQUAL 1 OR NOT vc_smallest EQUAL vc_gain OR vc_gain LESS vc_threshold OR NOT vc_fired OR mp_first)
+  message(FATAL_ERROR "multipath 60 mm: ${nvc} placements, slope ${vc_gain} mm (smallest ${vc_smallest}, threshold "
+                      "${vc_threshold}), fired ${vc_fired}; --multipath-first ${mp_first} without the flag")
+endif()
+run_ok(mf diagnose ${mp_args} --candidates sensor --multipath-first)
+json_boolean(mp_first "${mf}" attribution sensor_first multipath_first)
+string(JSON nscan LENGTH "${mf}" attribution candidates 0 scan)
+json_number(first_scale "${mf}" attribution candidates 0 scan 13 alpha_scale)
+if(NOT mp_first OR nscan LESS 15 OR first_scale EQUAL 1)
+  message(FATAL_ERROR "--multipath-first on a multipath capture: reported ${mp_first}, ${nscan} evaluations in the "
+                      "sensor candidate's scan (the 13 levels, then its bending refit's), the 14th at x${first_scale}")
+endif()
+message(STATUS "multipath 60 mm: the views' slope ${vc_gain} mm (threshold ${vc_threshold}); --multipath-first refits "
+               "the bending (${nscan} evaluations)")
 # By default the held refit first scores the multipath gain at 13 levels, 0 .. 60 mm every 5 (--sensor-gain-scan 13,
 # within the default --sensor-evaluations); --sensor-gain-scan 0 turns it off, and so does a budget with no room.
 string(JSON nscan LENGTH "${out}" attribution candidates 0 scan)
