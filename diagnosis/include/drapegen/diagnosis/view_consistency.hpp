@@ -42,7 +42,8 @@ struct ViewConsistencySettings {
   /// diagnosis benchmark (turned protocol, 3 placements, the Kinect noise model): the smallest of the three was
   /// 0.6-4.8 mm on 136 captures of the five physical families and controls (and below 3.3 mm on 8 with a camera pose
   /// error or a depth bias), 7.2-11.5 mm on 22 captures with 16-30 mm of multipath (docs/DIAGNOSIS_RESULTS.md,
-  /// "Session 68").
+  /// "Session 68"). With one placement the test is weaker: 11 of those 432 placements without multipath read 6 mm
+  /// or more.
   double multipath_gain = 0.006;
 };
 
