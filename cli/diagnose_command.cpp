@@ -59,7 +59,7 @@ struct DiagnoseOptions {
   bool ablation = false;
   bool confirm_within_floors = false;
   bool sensor_bending = false;
-  bool multipath_first = false;
+  bool multipath_first = diagnosis::AttributionSettings{}.multipath_first;
   std::optional<int> sensor_gain_scan;
   bool free_sensor = false;
   std::optional<int> common_bending;
@@ -362,11 +362,12 @@ Runner add_diagnose_command(CLI::App& app) {
                "by simulation (a grid of 3 scales x 2 gains, a simplex within --refit-evaluations, the best without "
                "multipath), and keeps it if it beats both the re-rendering and that (off by default; "
                "docs/DIAGNOSIS_RESULTS.md, \"Session 29\")");
-  app.add_flag("--multipath-first", o->multipath_first,
+  app.add_flag("--multipath-first,!--no-multipath-first", o->multipath_first,
                fmt::format("Where the four views disagree as a multipath error makes them on every placement (the "
                            "cross-view slope at least {:g} mm on each; report.json gap_tests.view_consistency), the "
                            "sensor candidate refits the bending as with --sensor-bending and is named first where it "
-                           "is confirmed and significant (off by default; docs/DIAGNOSIS_RESULTS.md, \"Session 68\")",
+                           "is confirmed and significant (on by default; --no-multipath-first: off; "
+                           "docs/DIAGNOSIS_RESULTS.md, \"Session 68\")",
                            1e3 * diagnosis::ViewConsistencySettings{}.multipath_gain));
   app.add_option("--sensor-gain-scan", o->sensor_gain_scan,
                  fmt::format("Levels of the multipath gain (0 to 60 mm, evenly) the sensor candidate's re-rendering "

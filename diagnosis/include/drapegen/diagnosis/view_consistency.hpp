@@ -14,11 +14,12 @@
 //
 // It is a detector more than a measurement. Without multipath the slope is not 0: the sensor noise leaves a bias
 // that depends on the drape (the fitted drapes of 48 benchmark captures read -0.3-2.5 mm rendered clean, 0.9-5.6 mm
-// with the Kinect noise model: drapegen_view_consistency_probe --floor-seeds 2). With multipath it follows the gain while the residuals stay within the gate and then saturates (on clean
-// renders of a folded skirt, 5 -> 3.4, 10 -> 7.0, 20 -> 12.0, 40 -> 13.0 mm: view_consistency_test.cpp); on benchmark
-// captures it reads about half the true gain. A multipath test therefore reads it on every
-// placement of the specimen (the sensor is the same, the drapes differ) and asks the smallest to reach a threshold
-// calibrated on benchmark captures (docs/DIAGNOSIS_RESULTS.md, "Session 68").
+// with the Kinect noise model: drapegen_view_consistency_probe --floor-seeds 2). With multipath it follows the gain
+// while the residuals stay within the gate, then saturates (clean renders of a folded skirt: 5 -> 3.4, 10 -> 7.0,
+// 20 -> 12.0, 40 -> 13.0 mm; view_consistency_test.cpp); on benchmark captures it reads about half the true gain.
+// A multipath test therefore reads it on every placement of the specimen (the sensor is the same, the drapes differ)
+// and asks the smallest to reach a threshold calibrated on benchmark captures (docs/DIAGNOSIS_RESULTS.md,
+// "Session 68").
 
 #include <vector>
 
