@@ -38,13 +38,6 @@ namespace {
 
 using diagnosis::ViewConsistency;
 
-ViewConsistency consistency(const diagnosis::Capture& capture, const diagnosis::ViewConsistencySettings& o) {
-  std::vector<renderer::DepthImage> depth;
-  std::vector<renderer::Camera> cameras;
-  for (const auto& v : capture.views) depth.push_back(v.depth), cameras.push_back(v.camera);
-  return diagnosis::view_consistency(depth, cameras, o);
-}
-
 /// The slopes of the report's fitted drape (its bending and best initial state) rendered without sensor error: the
 /// clean render's first, then `seeds` renders with the Kinect noise model minus the terms named in `noise_off`.
 struct FloorSlopes {
@@ -79,11 +72,11 @@ sim::Expected<FloorSlopes> floor_slopes(const diagnosis::Capture& capture, const
   FloorSlopes out;
   diagnosis::Capture pseudo = capture;
   for (std::size_t v = 0; v < pseudo.views.size(); ++v) pseudo.views[v].depth = (*clean)[v];
-  out.clean = consistency(pseudo, o);
+  out.clean = diagnosis::view_consistency(pseudo, o);
   for (int k = 0; k < seeds; ++k) {
     for (std::size_t v = 0; v < pseudo.views.size(); ++v)
       pseudo.views[v].depth = noise.apply((*clean)[v], renderer::mix_seed(0xC0515 + static_cast<std::uint64_t>(k), v));
-    out.noisy.push_back(consistency(pseudo, o));
+    out.noisy.push_back(diagnosis::view_consistency(pseudo, o));
   }
   return out;
 }
@@ -133,7 +126,7 @@ int main(int argc, char** argv) {
         std::cerr << capture.error().message << "\n";
         return 1;
       }
-      const ViewConsistency s = consistency(*capture, o);
+      const ViewConsistency s = diagnosis::view_consistency(*capture, o);
       std::string family = "?";
       double truth_mm = 0.0;
       if (const auto t = bench::read_json(fs::path(run) / "truth" / (dir.filename().string() + ".json"))) {

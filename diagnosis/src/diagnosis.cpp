@@ -499,13 +499,8 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
   }
   {  // Do the four views describe one surface on every placement? (A multipath error breaks that; the cloth cannot.)
     r.multipath.threshold = settings.view_consistency.multipath_gain;
-    for (const Capture* c : {&capture, others.second, others.held_out}) {
-      if (!c) continue;
-      std::vector<renderer::DepthImage> depth;
-      std::vector<renderer::Camera> cameras;
-      for (const CaptureView& v : c->views) depth.push_back(v.depth), cameras.push_back(v.camera);
-      r.multipath.placements.push_back(view_consistency(depth, cameras, settings.view_consistency));
-    }
+    for (const Capture* c : {&capture, others.second, others.held_out})
+      if (c) r.multipath.placements.push_back(view_consistency(*c, settings.view_consistency));
   }
   const ScoredDrape& gap = r.gap_drape();
   for (std::size_t v = 0; v < gap.views.size(); ++v) {

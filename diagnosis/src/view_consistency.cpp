@@ -154,4 +154,11 @@ ViewConsistency view_consistency(const std::vector<renderer::DepthImage>& depth,
   return fit.solve();
 }
 
+ViewConsistency view_consistency(const Capture& capture, const ViewConsistencySettings& settings) {
+  std::vector<renderer::DepthImage> depth;
+  std::vector<renderer::Camera> cameras;
+  for (const CaptureView& v : capture.views) depth.push_back(v.depth), cameras.push_back(v.camera);
+  return view_consistency(depth, cameras, settings);
+}
+
 }  // namespace drapegen::diagnosis

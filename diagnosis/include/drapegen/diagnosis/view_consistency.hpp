@@ -23,6 +23,7 @@
 
 #include <vector>
 
+#include "drapegen/diagnosis/capture.hpp"
 #include "drapegen/renderer/camera.hpp"
 #include "drapegen/renderer/depth_image.hpp"
 
@@ -69,5 +70,8 @@ struct MultipathTest {
 [[nodiscard]] ViewConsistency view_consistency(const std::vector<renderer::DepthImage>& depth,
                                                const std::vector<renderer::Camera>& cameras,
                                                const ViewConsistencySettings& settings = {});
+
+/// The same of a capture's views (their depth seen by their recorded cameras).
+[[nodiscard]] ViewConsistency view_consistency(const Capture& capture, const ViewConsistencySettings& settings = {});
 
 }  // namespace drapegen::diagnosis
