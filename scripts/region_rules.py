@@ -35,6 +35,10 @@
   the hem by the baseline's enrichment, the stable term by stable_region); closure_regions: the region whose residual
   RMS over its floor (floor_ratio) it lowers the most. Where no effect is named, nothing is lowered, or the report
   has no refit localisation: the region as run (--closure-only counts only the reports that have one).
+- multipath_floor (rule M, pre-registered in session 69 for seeds 75-77, out/p70/prereg.txt): where the report's
+  multipath test fired (gap_tests.view_consistency.multipath; reports since 0a703f1), floor_region unless "global";
+  any other region as run. The line under the table counts the captures where the test fired (controls apart) and
+  rule M's gains and losses against the region as run there.
 
 Per rule: the effect captures whose region is one of the effect's regions (the truth file's `regions`), per family.
 
@@ -49,6 +53,7 @@ run: `tolerance` (the rule since session 23, applied to every report with --tole
     scripts/region_rules.py out/p65/s64 out/p65/s65              # session 65 (diagnoses -> diag/NEW, the default)
     scripts/region_rules.py out/p66/s66 out/p66/s67              # session 66's test of fold_depth (diag/DEF)
     scripts/region_rules.py out/p68/s71 out/p68/s72              # closure_* on reports with refit localisations
+    scripts/region_rules.py out/p70/s75 out/p70/s76 out/p70/s77  # session 69's test of multipath_floor (diag/DEF)
 """
 import argparse
 import collections
@@ -63,7 +68,7 @@ from diagnosis_rules import THRESHOLD, confirmation_rule  # noqa: E402  (the tol
 OUTLINE = {"harmonics", "off_centre", "sorted_radii", "hem_height"}
 RULES = ["as_run", "largest", "place_gap_24", "place_gap", "place_gap_27", "place_gap_27b", "pixel_region",
          "floor_region", "split_enrichment", "split_floor_ratio", "skirt_floor_ratio", "fold_depth", "closure_groups",
-         "closure_regions"]
+         "closure_regions", "multipath_floor"]
 # Where each effect acts (candidate_effect.cpp, effect_regions).
 EFFECT_REGIONS = {"yield": {"skirt"}, "shear": {"skirt"}, "curl": {"hem"}, "misalignment": {"hem"},
                   "friction": {"top", "rim"}, "sensor": {"global"}}
@@ -175,6 +180,20 @@ def closure_regions(loc, named):
     return lead if lead is not None and drops[lead] > 0.0 else loc["region"]
 
 
+def multipath_fired(report):
+    """The report's multipath test fired (gap_tests.view_consistency, reports since 0a703f1; False without it)."""
+    return bool(((report.get("gap_tests") or {}).get("view_consistency") or {}).get("multipath", False))
+
+
+def multipath_floor(report):
+    """Rule M (pre-registered in session 69): where the multipath test fires, the region furthest above its own floor
+    (floor_region) unless that is "global"; else as run."""
+    loc = report["localisation"]
+    if multipath_fired(report) and loc.get("floor_region", "global") != "global":
+        return loc["floor_region"]
+    return loc["region"]
+
+
 def place_gap_27(loc, sensor_scale, skirt_denser, lifted_scale):
     """place_gap with the rigid surfaces placing the gap whatever leads (pre-registered in session 27 for seed 19):
     a platform top above its own floor and seen farther than the fitted cloth (no cloth lies inside the platform),
@@ -267,6 +286,7 @@ def main():
         return
     hits = {r: collections.Counter() for r in RULES}
     totals = collections.Counter()
+    fired = collections.Counter()  # multipath tests fired: effect captures, controls; rule M's gains and losses
     for run in args.runs:
         for path in sorted(glob.glob(os.path.join(run, "diagnoses", "*.json"))):
             name = os.path.basename(path)[:-len(".json")]
@@ -274,10 +294,11 @@ def main():
             if ".p" in name or not os.path.exists(truth_path):
                 continue
             family = name.rsplit("_", 1)[0]
-            if family == "none":
-                continue
             with open(path) as f:
                 report = json.load(f)
+            if family == "none":
+                fired["controls"] += multipath_fired(report)
+                continue
             loc, named = report["localisation"], named_localisation(report)
             if args.closure_only and named is None:
                 continue
@@ -293,8 +314,13 @@ def main():
                       "skirt_floor_ratio": skirt_to_hem(loc, lambda x: split(x, "floor_ratio") == "hem"),
                       "fold_depth": skirt_to_hem(loc, lambda x: folds_deeper_than_mean(x, args.fold_depth)),
                       "closure_groups": closure_groups(loc, named, args.lifted_scale),
-                      "closure_regions": closure_regions(loc, named)}
+                      "closure_regions": closure_regions(loc, named), "multipath_floor": multipath_floor(report)}
             totals[family] += 1
+            if multipath_fired(report):
+                fired["effect captures"] += 1
+                was, now = region["as_run"] in regions, region["multipath_floor"] in regions
+                fired["rule M gains"] += now and not was
+                fired["rule M losses"] += was and not now
             for rule in RULES:
                 hits[rule][family] += region[rule] in regions
     families = sorted(totals)
@@ -303,6 +329,8 @@ def main():
         n = sum(hits[rule].values())
         print("%-17s %3d/%-3d  " % (rule, n, sum(totals.values())) +
               " ".join("%12s" % ("%d/%d" % (hits[rule][f], totals[f])) for f in families))
+    print("multipath test fired: " + ", ".join("%s %d" % (k, fired[k]) for k in
+                                               ("effect captures", "controls", "rule M gains", "rule M losses")))
 
 
 if __name__ == "__main__":
