@@ -309,8 +309,8 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
     md += "View consistency (the multipath gain the four views' disagreement implies, about half the true gain; "
           "placements in order):";
     for (const ViewConsistency& c : m.placements) md += fmt::format(" {:.1f} mm", c.gain * 1e3);
-    md += fmt::format("; {} (the smallest against {:.1f} mm).\n",
-                      m.detected() ? "multipath on every placement" : "no multipath test fired", m.threshold * 1e3);
+    md += fmt::format("; the smallest {:.1f} mm against a threshold of {:.1f} mm: the multipath test {}.\n",
+                      m.smallest_gain() * 1e3, m.threshold * 1e3, m.detected() ? "fired" : "did not fire");
   }
   md += "Hem radius difference (capture - model), largest harmonics:";
   auto h = r.localisation.hem_difference;
