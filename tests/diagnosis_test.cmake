@@ -312,6 +312,17 @@ string(FIND "${report_md}" "rules out no effect whose drape an elastic fabric" c
 if(caveat_at GREATER -1)
   message(FATAL_ERROR "report.md: verdict '${verdict}', yet the within-the-floors caveat at ${caveat_at}")
 endif()
+# The view-consistency line states the smallest slope, the threshold and whether the multipath test fired, as
+# report.json has them (the slopes to 0.1 mm).
+json_boolean(vc_fired "${out}" gap_tests view_consistency multipath)
+set(said "did not fire")
+if(vc_fired)
+  set(said "fired")
+endif()
+if(NOT report_md MATCHES "View consistency [^\n]*; the smallest [0-9]+\\.[0-9] mm against a threshold of 6\\.0 mm: the multipath test ${said}\\.\n")
+  string(REGEX MATCH "View consistency[^\n]*" stated "${report_md}")
+  message(FATAL_ERROR "report.md's view-consistency line '${stated}' does not say the test ${said}")
+endif()
 message(STATUS "diagnosis: verdict ${verdict}, gap ${gap} mm, floor ${floor} mm, region ${region} (led by '${led}', stable ratio ${stable_ratio}, top mean ${top_mean} mm)")
 
 # --gap-only: the same gate, and no attribution (the capture is above the floors, so the verdict says so).
