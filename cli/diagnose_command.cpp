@@ -60,6 +60,7 @@ struct DiagnoseOptions {
   bool confirm_within_floors = false;
   bool sensor_bending = false;
   bool multipath_first = diagnosis::AttributionSettings{}.multipath_first;
+  bool multipath_region = diagnosis::DiagnosisSettings{}.multipath_region;
   std::optional<int> sensor_gain_scan;
   bool free_sensor = false;
   std::optional<int> common_bending;
@@ -180,6 +181,7 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (o.sensor_evaluations) settings.attribution.sensor_evaluations = *o.sensor_evaluations;
   settings.attribution.sensor_bending = o.sensor_bending;
   settings.attribution.multipath_first = o.multipath_first;
+  settings.multipath_region = o.multipath_region;
   if (o.sensor_gain_scan) settings.attribution.sensor_gain_levels = *o.sensor_gain_scan;
   settings.hold_sensor = !o.free_sensor;
   if (o.common_bending) settings.attribution.common_bending_effects = *o.common_bending;
@@ -369,6 +371,11 @@ Runner add_diagnose_command(CLI::App& app) {
                            "is confirmed and significant (on by default; --no-multipath-first: off; "
                            "docs/DIAGNOSIS_RESULTS.md, \"Session 68\")",
                            1e3 * diagnosis::ViewConsistencySettings{}.multipath_gain));
+  app.add_flag("--multipath-region,!--no-multipath-region", o->multipath_region,
+               "Where the multipath test fires (as for --multipath-first), the gap's region is the one whose pixel "
+               "residuals stand furthest above their own floor, unless none does (report.json "
+               "localisation.placed_by_views; on by default; --no-multipath-region: the shape features place it "
+               "alone; docs/DIAGNOSIS_RESULTS.md, \"Session 69\")");
   app.add_option("--sensor-gain-scan", o->sensor_gain_scan,
                  fmt::format("Levels of the multipath gain (0 to 60 mm, evenly) the sensor candidate's re-rendering "
                              "scores before its simplex refines from the best (0: off, the simplex from no multipath; "

@@ -1432,6 +1432,26 @@ if(NOT nvc EQUAL 1 OR NOT vc_smallest EQUAL vc_gain OR vc_gain LESS vc_threshold
   message(FATAL_ERROR "multipath 60 mm: ${nvc} placements, slope ${vc_gain} mm (smallest ${vc_smallest}, threshold "
                       "${vc_threshold}), fired ${vc_fired}; multipath first ${mp_first} with --no-multipath-first")
 endif()
+# Where the test fires, the gap sits where the pixels stand furthest above their own floor (rule M,
+# place_sensor_gap), unless no region does; --no-multipath-region leaves the shape features to place it.
+string(JSON floor_region GET "${out}" localisation floor_region)
+string(JSON region GET "${out}" localisation region)
+json_boolean(by_views "${out}" localisation placed_by_views)
+run_ok(shape_placed diagnose --capture ${WORK}/multipath --quick --resolution 10 --states 2 --evaluations 8 --json
+       --gap-only --no-multipath-region)  # the gap and its localisation as above, no attribution
+json_boolean(by_views_off "${shape_placed}" localisation placed_by_views)
+string(JSON region_off GET "${shape_placed}" localisation region)
+set(region_expected "${floor_region}")
+if(floor_region STREQUAL "global")
+  set(region_expected "${region_off}")
+endif()
+if((by_views AND floor_region STREQUAL "global") OR (NOT by_views AND NOT floor_region STREQUAL "global")
+   OR by_views_off OR NOT region STREQUAL region_expected)
+  message(FATAL_ERROR "multipath 60 mm: region ${region} (placed by the views ${by_views}, floor_region "
+                      "${floor_region}); with --no-multipath-region ${region_off} (placed by the views ${by_views_off})")
+endif()
+message(STATUS "multipath 60 mm: region ${region} (floor_region ${floor_region}); the shape features alone: "
+               "${region_off}")
 run_ok(mf diagnose ${mp_args} --candidates sensor --multipath-first)  # the later flag wins: on
 json_boolean(mp_first "${mf}" attribution sensor_first multipath_first)
 string(JSON nscan LENGTH "${mf}" attribution candidates 0 scan)

@@ -531,6 +531,7 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
   // 3. Where the gap sits.
   r.localisation = localise_drape(model, gap, r.floors,
                                   r.rigid_pose ? platform_displacement(r.rigid_pose->pose, capture) : 0.0);
+  if (settings.multipath_region && r.multipath.detected()) place_sensor_gap(r.localisation);
   r.fit_target = model.target().shape;
 
   // 4. Which effect explains it (not when the gap is within the floors).
@@ -721,6 +722,7 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                        {"dominant_feature", L.dominant_feature.empty() ? nlohmann::json(nullptr)
                                                                        : nlohmann::json(L.dominant_feature)},
                        {"moved_to_hem", L.moved_to_hem},
+                       {"placed_by_views", L.placed_by_views},
                        {"feature_groups", groups},
                        {"stable_ratio", L.stable_ratio},
                        {"camera_moved_mm", L.camera_moved * 1e3},

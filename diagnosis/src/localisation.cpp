@@ -79,6 +79,7 @@ Region stable_region(const Localisation& L) {
 
 void place_gap(Localisation& L) {
   L.moved_to_hem = false;
+  L.placed_by_views = false;
   if (L.camera_moved >= kCameraMovedAtPlatform) {  // the rigid surfaces show the camera elsewhere than recorded
     L.dominant_feature = "camera";
     L.dominant = Region::kGlobal;
@@ -119,6 +120,13 @@ void place_gap(Localisation& L) {
   }
   L.moved_to_hem = L.dominant == Region::kSkirt && folds_deepen_at_hem(L);
   if (L.moved_to_hem) L.dominant = Region::kHem;
+}
+
+void place_sensor_gap(Localisation& L) {
+  if (L.floor_region == Region::kGlobal || L.dominant_feature == "camera") return;
+  L.placed_by_views = true;
+  L.moved_to_hem = false;
+  L.dominant = L.floor_region;
 }
 
 bool folds_deepen_at_hem(const Localisation& L) {

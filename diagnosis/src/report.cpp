@@ -56,6 +56,11 @@ namespace {
 /// What placed the gap (place_gap), for the report's "Dominant region" line.
 std::string leading_feature_text(const Localisation& L) {
   const std::string& led = L.dominant_feature;
+  if (L.placed_by_views) {
+    return fmt::format("the four views disagree as a sensor error makes them (the multipath test fired): where the "
+                       "pixels' residuals stand furthest above their own floor ({})",
+                       led.empty() ? "no shape feature above its floor" : "the shape features led by " + led);
+  }
   if (led.empty()) return "nothing exceeds its floor";
   if (led == "camera") {
     return fmt::format(

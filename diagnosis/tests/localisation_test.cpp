@@ -265,3 +265,50 @@ TEST(PlaceGap, ACameraTheRigidSurfacesMoveFromItsCalibrationPlacesTheGapEverywhe
   EXPECT_EQ(L.dominant, Region::kSkirt);
   EXPECT_EQ(L.dominant_feature, "skirt_height");
 }
+
+TEST(PlaceSensorGap, WhereTheViewsDisagreeThePixelsFurthestAboveTheirFloorPlaceTheGap) {
+  // The hem's height leads the shape features and the hem's residual is the denser: place_gap says the hem.
+  Localisation L = excess(FeatureGroup::kHemHeight, 1.8, 0.9, 1.1, 1.3);
+  L.regions.push_back(share(Region::kCylinder, 0.006, 0.05));
+  // Pixel residuals over their floors: top 2/1, skirt 10/4, hem 10/5, cylinder 6/2 (3x, the furthest).
+  localise_against_floors(L, floors_of(0.001, 0.001, 0.004, 0.005, 0.002));
+  ASSERT_EQ(L.floor_region, Region::kCylinder);
+  place_gap(L);
+  ASSERT_EQ(L.dominant, Region::kHem);
+  place_sensor_gap(L);
+  EXPECT_EQ(L.dominant, Region::kCylinder);
+  EXPECT_TRUE(L.placed_by_views);
+  EXPECT_EQ(L.dominant_feature, "hem_height");  // what led the shape features stays reported
+  // place_gap places afresh (and clears the flag).
+  place_gap(L);
+  EXPECT_EQ(L.dominant, Region::kHem);
+  EXPECT_FALSE(L.placed_by_views);
+  // No region above its own floor: place_gap's region stands.
+  localise_against_floors(L, floors_of(0.01, 0.01, 0.02, 0.02, 0.01));
+  ASSERT_EQ(L.floor_region, Region::kGlobal);
+  place_sensor_gap(L);
+  EXPECT_EQ(L.dominant, Region::kHem);
+  EXPECT_FALSE(L.placed_by_views);
+  // A gap place_gap moved to the hem (the folds deepen there) is moved again, and no longer said to be so moved.
+  L = excess(FeatureGroup::kSkirtSpread, 2.0, 0.9, 0.8, 1.3);
+  L.group_ratio[static_cast<std::size_t>(FeatureGroup::kSkirtHeight)] = 1.2;
+  L.regions.push_back(share(Region::kCylinder, 0.006, 0.05));
+  localise_against_floors(L, floors_of(0.001, 0.001, 0.004, 0.005, 0.002));
+  place_gap(L);
+  ASSERT_TRUE(L.moved_to_hem);
+  place_sensor_gap(L);
+  EXPECT_EQ(L.dominant, Region::kCylinder);
+  EXPECT_FALSE(L.moved_to_hem);
+}
+
+TEST(PlaceSensorGap, ACameraTheRigidSurfacesPutOffStaysEverywhere) {
+  Localisation L = excess(FeatureGroup::kHemHeight, 1.8, 0.9, 1.1, 1.3);
+  L.regions.push_back(share(Region::kCylinder, 0.006, 0.05));
+  localise_against_floors(L, floors_of(0.001, 0.001, 0.004, 0.005, 0.002));
+  L.camera_moved = 2.0 * kCameraMovedAtPlatform;
+  place_gap(L);
+  ASSERT_EQ(L.dominant_feature, "camera");
+  place_sensor_gap(L);
+  EXPECT_EQ(L.dominant, Region::kGlobal);
+  EXPECT_FALSE(L.placed_by_views);
+}

@@ -50,8 +50,10 @@ struct DiagnosisSettings {
   std::vector<double> start_ratios_mm{1.8, 3.6};  // about the 20% and 86% quantiles of fabrics618's -beta/alpha
   FloorSettings floors;
   /// The cross-view slope read off every placement and the multipath test on it (reported; it changes the verdict
-  /// only with AttributionSettings::multipath_first).
+  /// only with AttributionSettings::multipath_first, the region only with multipath_region).
   ViewConsistencySettings view_consistency;
+  /// Where the multipath test fires, the gap's region is the pixels' (place_sensor_gap). false: place_gap's alone.
+  bool multipath_region = true;
   AttributionSettings attribution;
   /// false: stop after the gap, floors and localisation (a capture above the floors gets the verdict
   /// "not attributed"): a screening run, or a calibration of the floors, at a fraction of the cost.

@@ -52,6 +52,8 @@ struct Localisation {
   std::string dominant_feature;
   /// place_gap moved the gap from the skirt to the hem: the folds deepen at the hem (folds_deepen_at_hem).
   bool moved_to_hem = false;
+  /// place_sensor_gap placed the gap where the pixels stand furthest above their floor (the views disagree).
+  bool placed_by_views = false;
   /// m: how far the camera error read off the rigid surfaces moves the platform's centre (rigid_pose.hpp,
   /// platform_displacement; diagnose sets it before localise_features), 0 if not estimated.
   double camera_moved = 0.0;
@@ -148,5 +150,15 @@ void place_gap(Localisation& localisation);
 /// "Session 66". The reading (an edge band sets the folds' depth) is a hypothesis, not shown.
 [[nodiscard]] bool folds_deepen_at_hem(const Localisation& localisation);
 inline constexpr double kFoldDepthAtHem = 1.5;
+
+/// Where the four views disagree (view_consistency.hpp: the multipath test fired) the gap is a sensor error's, and a
+/// sensor error moves pixels, not the cloth: the shape features answer to it only through the fit, while the pixels'
+/// own excess shows where the readings are off. So the gap goes to floor_region (the region whose pixel residuals
+/// stand furthest above their own floor) and placed_by_views is set; where no region stands above its floor
+/// (kGlobal), and where the rigid surfaces put the camera off (place_gap's "camera": an error of the whole view,
+/// kGlobal), place_gap's region stays. Rule M, pre-registered in session 69 on the 28 multipath captures of seeds
+/// 59-73 (13 -> 19 in the effect's region) and tested on fresh seeds 75-77: docs/DIAGNOSIS_RESULTS.md,
+/// "Session 69". Call after place_gap (localise_features).
+void place_sensor_gap(Localisation& localisation);
 
 }  // namespace drapegen::diagnosis
