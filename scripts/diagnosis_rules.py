@@ -22,6 +22,9 @@ score. Hypotheses for the next evaluation, not the diagnosis's rule (docs/DIAGNO
 - common4 (session 46): the verdict with `--common-bending 4` (the common bending decides only where four or more
   effects are each within the floors), from reports made with the default 3; pre-registered on fresh seed 41
   (out/s48_prereg.txt);
+- views_sensor (rule V, session 69, pre-registered for fresh seeds 78-79: out/p71/prereg.txt): "sensor" wherever the
+  report's multipath test fired (the four views disagree, which no physical effect makes them), within the floors
+  too; elsewhere the verdict as run;
 - min_objective: the candidate whose refit objective (in-sample: the capture and the second capture) is the smallest;
   it ignores the held-out data, which the issue's attribution must use: a diagnostic of the refits, not a rule.
 
@@ -80,7 +83,7 @@ THRESHOLD = 0.25  # AttributionSettings::significant_shrinkage
 TOLERANCE = 0.1  # AttributionSettings::held_out_tolerance (since session 23); --tolerance sets the rule's
 RULES = ["current", "strict", "tolerance", "objective_ties", "parsimony", "tie_objective", "no_bar", "no_bar_unconfirmed",
          "mean3", "held_out_excess", "held_out_rank", "min_objective", "without_ablation", "reach", "reach_objective",
-         "tie_held_out_view", "common4"]
+         "tie_held_out_view", "common4", "views_sensor"]
 PARAMETERS = {"sensor": 9, "misalignment": 2}  # effect_space's dimension; the others have 1
 # How each rule orders candidates of equal shrinkage before their objectives (confirmation_rule).
 TIES = {"physical_first": lambda effect: effect == "sensor",  # attribute() since session 25 (needs_simulation)
@@ -193,12 +196,21 @@ def common_at_least(j, k):
     return top["effect"] if top["confirmed"] and top["shrinkage"] >= a["significant_shrinkage"] else "unexplained"
 
 
+def views_sensor(j):
+    """Rule V (pre-registered in session 69 for seeds 78-79): "sensor" where the report's multipath test fired
+    (gap_tests.view_consistency.multipath, reports since 0a703f1), within the floors too; else the verdict as run."""
+    fired = ((j.get("gap_tests") or {}).get("view_consistency") or {}).get("multipath", False)
+    return "sensor" if fired else j["verdict"]
+
+
 def verdicts(j):
     g = j["gap_tests"]
     a = j["attribution"]
     cands = a.get("candidates", [])
     if not cands:
-        return {r: j["verdict"] for r in RULES}
+        v = {r: j["verdict"] for r in RULES}
+        v["views_sensor"] = views_sensor(j)
+        return v
     sf, shf = g["stable_floor_mm"], g["shape_floor"]
     within = j.get("within_floors_after_bending_refit", False)
     v = {"current": j["verdict"], "strict": confirmation_rule(j, 0.0), "tolerance": confirmation_rule(j, TOLERANCE),
@@ -247,6 +259,7 @@ def verdicts(j):
     v["common4"] = common_at_least(j, 4)
     for rule in ("without_ablation", "reach", "reach_objective"):
         v[rule] = reference_rule(j, rule)
+    v["views_sensor"] = views_sensor(j)
     return v
 
 
