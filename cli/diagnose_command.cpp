@@ -373,9 +373,10 @@ Runner add_diagnose_command(CLI::App& app) {
                            1e3 * diagnosis::ViewConsistencySettings{}.multipath_gain));
   app.add_flag("--multipath-region,!--no-multipath-region", o->multipath_region,
                "Where the multipath test fires (as for --multipath-first), the gap's region is the one whose pixel "
-               "residuals stand furthest above their own floor, unless none does (report.json "
-               "localisation.placed_by_views; on by default; --no-multipath-region: the shape features place it "
-               "alone; docs/DIAGNOSIS_RESULTS.md, \"Session 69\")");
+               "residuals stand furthest above their own floor, unless none does or the rigid surfaces put the "
+               "camera off (a camera error: everywhere, as without it); report.json localisation.placed_by_views; on "
+               "by default; --no-multipath-region: the shape features place it alone (docs/DIAGNOSIS_RESULTS.md, "
+               "\"Session 69\")");
   app.add_option("--sensor-gain-scan", o->sensor_gain_scan,
                  fmt::format("Levels of the multipath gain (0 to 60 mm, evenly) the sensor candidate's re-rendering "
                              "scores before its simplex refines from the best (0: off, the simplex from no multipath; "
