@@ -196,11 +196,15 @@ def common_at_least(j, k):
     return top["effect"] if top["confirmed"] and top["shrinkage"] >= a["significant_shrinkage"] else "unexplained"
 
 
+def multipath_fired(report):
+    """The report's multipath test fired (gap_tests.view_consistency, reports since 0a703f1; False without it)."""
+    return bool(((report.get("gap_tests") or {}).get("view_consistency") or {}).get("multipath", False))
+
+
 def views_sensor(j):
-    """Rule V (pre-registered in session 69 for seeds 78-79): "sensor" where the report's multipath test fired
-    (gap_tests.view_consistency.multipath, reports since 0a703f1), within the floors too; else the verdict as run."""
-    fired = ((j.get("gap_tests") or {}).get("view_consistency") or {}).get("multipath", False)
-    return "sensor" if fired else j["verdict"]
+    """Rule V (pre-registered in session 69 for seeds 78-79): "sensor" where the report's multipath test fired, within
+    the floors too; else the verdict as run."""
+    return "sensor" if multipath_fired(j) else j["verdict"]
 
 
 def verdicts(j):

@@ -63,7 +63,7 @@ import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from diagnosis_rules import THRESHOLD, confirmation_rule  # noqa: E402  (the tolerance rule and its threshold)
+from diagnosis_rules import THRESHOLD, confirmation_rule, multipath_fired  # noqa: E402  (shared with it)
 
 OUTLINE = {"harmonics", "off_centre", "sorted_radii", "hem_height"}
 RULES = ["as_run", "largest", "place_gap_24", "place_gap", "place_gap_27", "place_gap_27b", "pixel_region",
@@ -178,11 +178,6 @@ def closure_regions(loc, named):
     drops = {r: base[r] - v for r, v in named["region_floor_ratios"].items() if r in base}
     lead = max(drops, key=drops.get) if drops else None
     return lead if lead is not None and drops[lead] > 0.0 else loc["region"]
-
-
-def multipath_fired(report):
-    """The report's multipath test fired (gap_tests.view_consistency, reports since 0a703f1; False without it)."""
-    return bool(((report.get("gap_tests") or {}).get("view_consistency") or {}).get("multipath", False))
 
 
 def multipath_floor(report):
