@@ -1,0 +1,65 @@
+#!/usr/bin/env bash
+# One fresh diagnosis set under the protocol of sessions 59-70 (docs/DIAGNOSIS_RESULTS.md): three placements of each
+# specimen, turned over between them, every effect draw screened for visibility (at most 20 draws), diagnosed with
+# `drapegen diagnose --fine --ignore-measured-bending` and the second and held-out placements. Three steps, each
+# resumable (the bench keeps what exists):
+#
+#   scripts/diagnosis_set.sh generate OUT BENCH-OPTIONS...  # copies build/bin's programs into OUT/bin (the build the
+#                                                            # set is diagnosed with, commit in OUT/bin/COMMIT), keeps
+#                                                            # the options in OUT/set.args, generates, then OUT/generated
+#   scripts/diagnosis_set.sh diagnose OUT [JOBS]             # JOBS diagnoses at once (default 2), one core each
+#   scripts/diagnosis_set.sh score OUT...                    # each set's summary, then the verdict and region tables
+#
+# BENCH-OPTIONS choose the captures (drapegen_diagnosis_bench --help): e.g.
+#   scripts/diagnosis_set.sh generate out/p72/s80 --families sensor --per-family 6 --controls 3 --seed 80 \
+#       --sensor-kinds pose bias
+set -euo pipefail
+cd "$(dirname "$0")/.."
+usage() { sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//' >&2; exit 2; }
+[ $# -ge 2 ] || usage
+step=$1 out=$2
+shift 2
+protocol=(--placements 3 --turn-over --visible-only 20 --fabrics sampler/data/fabrics618.csv)
+
+set_args() {  # the set's own options, one per line in OUT/set.args
+  [ -f "$1/set.args" ] || { echo "diagnosis_set: $1/set.args is missing (run the generate step first)" >&2; exit 1; }
+  mapfile -t args < "$1/set.args"
+}
+
+case $step in
+  generate)
+    [ $# -gt 0 ] || usage
+    for p in drapegen drapegen_diagnosis_bench; do
+      [ -x "build/bin/$p" ] || { echo "diagnosis_set: build/bin/$p is missing (scripts/build.sh)" >&2; exit 1; }
+    done
+    mkdir -p "$out/bin"
+    if [ -f "$out/set.args" ]; then  # a resumed generation keeps its build and options
+      set_args "$out"
+      [ "${args[*]}" = "$*" ] || { echo "diagnosis_set: $out was generated with: ${args[*]}" >&2; exit 1; }
+    else
+      cp build/bin/drapegen build/bin/drapegen_diagnosis_bench "$out/bin/"
+      { git rev-parse HEAD; git status --porcelain --untracked-files=no | sed 's/^/dirty: /'; } > "$out/bin/COMMIT"
+      printf '%s\n' "$@" > "$out/set.args"
+      set_args "$out"
+    fi
+    "$out/bin/drapegen_diagnosis_bench" --out "$out" --generate-only "${protocol[@]}" "${args[@]}"
+    date -u +%FT%TZ > "$out/generated"
+    ;;
+  diagnose)
+    [ -f "$out/generated" ] || { echo "diagnosis_set: $out is not generated yet ($out/generated)" >&2; exit 1; }
+    set_args "$out"
+    "$out/bin/drapegen_diagnosis_bench" --out "$out" "${protocol[@]}" "${args[@]}" --second-placement \
+      --jobs "${1:-2}" --diagnose-args "--fine --ignore-measured-bending"
+    ;;
+  score)
+    runs=("$out" "$@")
+    for run in "${runs[@]}"; do
+      set_args "$run"
+      echo "== $run: ${args[*]}"
+      "$run/bin/drapegen_diagnosis_bench" --out "$run" "${protocol[@]}" "${args[@]}" --second-placement --score-only
+    done
+    python3 scripts/diagnosis_rules.py --matrix current --pooled "${runs[@]}"
+    python3 scripts/region_rules.py "${runs[@]}"
+    ;;
+  *) usage ;;
+esac
