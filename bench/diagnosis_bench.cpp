@@ -7,6 +7,10 @@
 // effect is visible at all to the diagnosis's gap test and its specimen settled on every placement (a drape that did
 // not converge, e.g. a specimen sliding off the cylinder on a slippery top, is not a drape to diagnose).
 #include <CLI/CLI.hpp>
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -76,6 +80,33 @@ void move_into(const fs::path& from, const fs::path& to) {
   fs::rename(from, to);
 }
 
+/// A case's diagnosis claimed by this process: an exclusive flock on RESULT.lock, held until destruction (the kernel
+/// drops it when a process ends, so a stopped run leaves nothing stale). Several benchmark processes can then diagnose
+/// one directory, each taking the cases no other holds (scripts/diagnosis_set.sh's lanes).
+class CaseLock {
+ public:
+  explicit CaseLock(fs::path path) : path_(std::move(path)) {
+    fd_ = ::open(path_.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd_ >= 0 && ::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+      ::close(fd_);
+      fd_ = -1;
+    }
+  }
+  CaseLock(const CaseLock&) = delete;
+  CaseLock& operator=(const CaseLock&) = delete;
+  ~CaseLock() {
+    if (fd_ < 0) return;
+    std::error_code ec;
+    fs::remove(path_, ec);  // a process that opened it meanwhile finds the result on its second look
+    ::close(fd_);
+  }
+  [[nodiscard]] bool held() const { return fd_ >= 0; }
+
+ private:
+  fs::path path_;
+  int fd_ = -1;
+};
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -88,7 +119,8 @@ int main(int argc, char** argv) {
   std::uint64_t seed = 1;
   std::vector<std::string> families{"yield", "shear", "curl", "friction", "misalignment", "sensor"};
   std::vector<std::string> sensor_kinds{"pose", "bias", "multipath"};
-  app.add_option("--out", out, "Benchmark directory (diagnoses already in it are kept: a rerun resumes)")
+  app.add_option("--out", out, "Benchmark directory (diagnoses already in it are kept: a rerun resumes; runs sharing it take the cases "
+                 "no other has taken)")
       ->capture_default_str();
   app.add_option("--fabrics", fabrics_path, "fabrics618.csv")->capture_default_str();
   app.add_option("--drapegen", drapegen, "The drapegen program (default: beside this program)");
@@ -412,8 +444,11 @@ int main(int argc, char** argv) {
         const auto& c = cases[*k];
         const fs::path dir = fs::path(out) / "captures" / c.name;
         const fs::path result = fs::path(out) / "diagnoses" / (c.name + ".json");
-        if (fs::exists(result) && fs::file_size(result) > 0) continue;
+        const auto done = [&] { return fs::exists(result) && fs::file_size(result) > 0; };
+        if (done()) continue;
         fs::create_directories(result.parent_path());
+        const CaseLock claim(result.string() + ".lock");
+        if (!claim.held() || done()) continue;  // another process diagnoses it, or has
         const std::string second =
             second_placement     ? fmt::format(" --second-capture '{0}.p1' --held-out-capture '{0}.p2'", dir.string())
             : held_out_placement ? fmt::format(" --held-out-capture '{}.p1'", dir.string())

@@ -7,7 +7,9 @@
 #   scripts/diagnosis_set.sh generate OUT BENCH-OPTIONS...  # copies build/bin's programs into OUT/bin (the build the
 #                                                            # set is diagnosed with, commit in OUT/bin/COMMIT), keeps
 #                                                            # the options in OUT/set.args, generates, then OUT/generated
-#   scripts/diagnosis_set.sh diagnose OUT [JOBS]             # JOBS diagnoses at once (default 2), one core each
+#   scripts/diagnosis_set.sh diagnose OUT... [--lanes N]     # N diagnoses at once (default: the cores), one core
+#                                                            # each, sharing the sets' cases (the bench's case
+#                                                            # locks: sets generated since session 70)
 #   scripts/diagnosis_set.sh score OUT...                    # each set's summary, then the verdict and region tables
 #
 # BENCH-OPTIONS choose the captures (drapegen_diagnosis_bench --help): e.g.
@@ -15,7 +17,7 @@
 #       --sensor-kinds pose bias
 set -euo pipefail
 cd "$(dirname "$0")/.."
-usage() { sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//' >&2; exit 2; }
+usage() { sed -n '2,18p' "$0" | sed 's/^# \{0,1\}//' >&2; exit 2; }
 [ $# -ge 2 ] || usage
 step=$1 out=$2
 shift 2
@@ -46,10 +48,25 @@ case $step in
     date -u +%FT%TZ > "$out/generated"
     ;;
   diagnose)
-    [ -f "$out/generated" ] || { echo "diagnosis_set: $out is not generated yet ($out/generated)" >&2; exit 1; }
-    set_args "$out"
-    "$out/bin/drapegen_diagnosis_bench" --out "$out" "${protocol[@]}" "${args[@]}" --second-placement \
-      --jobs "${1:-2}" --diagnose-args "--fine --ignore-measured-bending"
+    sets=("$out") lanes=$(nproc)
+    while [ $# -gt 0 ]; do
+      case $1 in
+        --lanes) lanes=$2; shift 2 ;;
+        *) sets+=("$1"); shift ;;
+      esac
+    done
+    for s in "${sets[@]}"; do
+      [ -f "$s/generated" ] || { echo "diagnosis_set: $s is not generated yet ($s/generated)" >&2; exit 1; }
+    done
+    lane() {  # lane K: every set in turn, one diagnosis at a time on core K; the bench's case locks share the work
+      for s in "${sets[@]}"; do
+        set_args "$s"
+        taskset -c "$(( $1 % $(nproc) ))" "$s/bin/drapegen_diagnosis_bench" --out "$s" "${protocol[@]}" "${args[@]}" \
+          --second-placement --jobs 1 --diagnose-args "--fine --ignore-measured-bending" | sed "s/^/lane $1: /"
+      done
+    }
+    for ((k = 0; k < lanes; ++k)); do lane "$k" & done
+    wait
     ;;
   score)
     runs=("$out" "$@")
