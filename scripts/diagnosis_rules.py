@@ -25,6 +25,10 @@ score. Hypotheses for the next evaluation, not the diagnosis's rule (docs/DIAGNO
 - views_sensor (rule V, session 69, pre-registered for fresh seeds 78-79: out/p71/prereg.txt): "sensor" wherever the
   report's multipath test fired (the four views disagree, which no physical effect makes them), within the floors
   too; elsewhere the verdict as run;
+- views_camera (rule C, session 70, pre-registered for fresh seeds 82-83: docs/preregistrations/session70.md):
+  "sensor" wherever the smallest cross-view residual RMS over the placements reaches 4.0 mm (a camera pose error
+  makes the views disagree; session 70's seeds 80-81: 4.05-4.92 mm on 4 pose errors, at most 3.70 on 4 depth biases
+  and 3.36 on 18 physical captures and controls), within the floors too; elsewhere the verdict as run;
 - min_objective: the candidate whose refit objective (in-sample: the capture and the second capture) is the smallest;
   it ignores the held-out data, which the issue's attribution must use: a diagnostic of the refits, not a rule.
 
@@ -83,7 +87,7 @@ THRESHOLD = 0.25  # AttributionSettings::significant_shrinkage
 TOLERANCE = 0.1  # AttributionSettings::held_out_tolerance (since session 23); --tolerance sets the rule's
 RULES = ["current", "strict", "tolerance", "objective_ties", "parsimony", "tie_objective", "no_bar", "no_bar_unconfirmed",
          "mean3", "held_out_excess", "held_out_rank", "min_objective", "without_ablation", "reach", "reach_objective",
-         "tie_held_out_view", "common4", "views_sensor"]
+         "tie_held_out_view", "common4", "views_sensor", "views_camera"]
 PARAMETERS = {"sensor": 9, "misalignment": 2}  # effect_space's dimension; the others have 1
 # How each rule orders candidates of equal shrinkage before their objectives (confirmation_rule).
 TIES = {"physical_first": lambda effect: effect == "sensor",  # attribute() since session 25 (needs_simulation)
@@ -207,6 +211,19 @@ def views_sensor(j):
     return "sensor" if multipath_fired(j) else j["verdict"]
 
 
+CAMERA_RMS_MM = 4.0  # rule C's threshold (docs/preregistrations/session70.md)
+
+
+def views_camera(j):
+    """Rule C (pre-registered in session 70 for seeds 82-83: docs/preregistrations/session70.md): "sensor" where the
+    smallest cross-view residual RMS over the placements (gap_tests.view_consistency.placements[].rms_mm) is at least
+    CAMERA_RMS_MM, within the floors too: the views disagree, which a camera error makes them and no physical effect
+    does; else the verdict as run."""
+    views = ((j.get("gap_tests") or {}).get("view_consistency") or {}).get("placements") or []
+    rms = [p["rms_mm"] for p in views]
+    return "sensor" if rms and min(rms) >= CAMERA_RMS_MM else j["verdict"]
+
+
 def verdicts(j):
     g = j["gap_tests"]
     a = j["attribution"]
@@ -214,6 +231,7 @@ def verdicts(j):
     if not cands:
         v = {r: j["verdict"] for r in RULES}
         v["views_sensor"] = views_sensor(j)
+        v["views_camera"] = views_camera(j)
         return v
     sf, shf = g["stable_floor_mm"], g["shape_floor"]
     within = j.get("within_floors_after_bending_refit", False)
@@ -264,6 +282,7 @@ def verdicts(j):
     for rule in ("without_ablation", "reach", "reach_objective"):
         v[rule] = reference_rule(j, rule)
     v["views_sensor"] = views_sensor(j)
+    v["views_camera"] = views_camera(j)
     return v
 
 

@@ -182,9 +182,11 @@ def closure_regions(loc, named):
 
 def multipath_floor(report):
     """Rule M (pre-registered in session 69): where the multipath test fires, the region furthest above its own floor
-    (floor_region) unless that is "global"; else as run."""
+    (floor_region) unless that is "global" or the rigid surfaces lead (dominant_feature "camera", as
+    place_sensor_gap); else as run."""
     loc = report["localisation"]
-    if multipath_fired(report) and loc.get("floor_region", "global") != "global":
+    if (multipath_fired(report) and loc.get("floor_region", "global") != "global"
+            and loc.get("dominant_feature") != "camera"):
         return loc["floor_region"]
     return loc["region"]
 
