@@ -504,6 +504,13 @@ int main(int argc, char** argv) {
     } catch (const std::exception&) {
       continue;
     }
+    if (!d.is_object() || !d.value("localisation", nlohmann::json()).is_object() ||
+        !d.value("runtime", nlohmann::json()).is_object() || !t.is_object()) {
+      std::cerr << fmt::format("diagnosis_bench: {}: not a drapegen diagnose report (no localisation or runtime): "
+                               "not scored\n",
+                               result.string());
+      continue;
+    }
     const std::string verdict = d.value("verdict", "?");
     const std::string family = t.value("family", "none");
     nlohmann::json screened = nullptr;  // the kept draw passed the screen (visible, settled), if it was screened
