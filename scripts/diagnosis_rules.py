@@ -29,6 +29,9 @@ score. Hypotheses for the next evaluation, not the diagnosis's rule (docs/DIAGNO
   "sensor" wherever the smallest cross-view residual RMS over the placements reaches 4.0 mm (a camera pose error
   makes the views disagree; session 70's seeds 80-81: 4.05-4.92 mm on 4 pose errors, at most 3.70 on 4 depth biases
   and 3.36 on 18 physical captures and controls), within the floors too; elsewhere the verdict as run;
+- tie_region (rule R, session 70, pre-registered for fresh seeds 82-83): where the named effect is tied at its
+  shrinkage with other confirmed candidates and the gap's localised region is not where it acts but is where a tied
+  one acts, that one (EFFECT_REGIONS); elsewhere the verdict as run;
 - min_objective: the candidate whose refit objective (in-sample: the capture and the second capture) is the smallest;
   it ignores the held-out data, which the issue's attribution must use: a diagnostic of the refits, not a rule.
 
@@ -87,7 +90,7 @@ THRESHOLD = 0.25  # AttributionSettings::significant_shrinkage
 TOLERANCE = 0.1  # AttributionSettings::held_out_tolerance (since session 23); --tolerance sets the rule's
 RULES = ["current", "strict", "tolerance", "objective_ties", "parsimony", "tie_objective", "no_bar", "no_bar_unconfirmed",
          "mean3", "held_out_excess", "held_out_rank", "min_objective", "without_ablation", "reach", "reach_objective",
-         "tie_held_out_view", "common4", "views_sensor", "views_camera"]
+         "tie_held_out_view", "common4", "views_sensor", "views_camera", "tie_region"]
 PARAMETERS = {"sensor": 9, "misalignment": 2}  # effect_space's dimension; the others have 1
 # How each rule orders candidates of equal shrinkage before their objectives (confirmation_rule).
 TIES = {"physical_first": lambda effect: effect == "sensor",  # attribute() since session 25 (needs_simulation)
@@ -224,6 +227,27 @@ def views_camera(j):
     return "sensor" if rms and min(rms) >= CAMERA_RMS_MM else j["verdict"]
 
 
+# Where each effect acts (candidate_effect.cpp, effect_regions; as scripts/region_rules.py's EFFECT_REGIONS).
+EFFECT_REGIONS = {"yield": {"skirt"}, "shear": {"skirt"}, "curl": {"hem"}, "misalignment": {"hem"},
+                  "friction": {"top", "rim"}, "sensor": {"global"}}
+
+
+def tie_region(j):
+    """Rule R (pre-registered in session 70 for seeds 82-83: docs/preregistrations/session70.md): where the verdict as
+    run is a candidate tied at its shrinkage with other confirmed candidates, and the report's localised region
+    (localisation.region, as run) is not where the named effect acts but is where a tied one acts, that one (the
+    smallest refit objective among such); elsewhere the verdict as run."""
+    named_effect = j["verdict"]
+    cands = (j.get("attribution") or {}).get("candidates") or []
+    named_c = next((c for c in cands if c["effect"] == named_effect), None)
+    region = (j.get("localisation") or {}).get("region")
+    if named_c is None or region is None or region in EFFECT_REGIONS.get(named_effect, set()):
+        return named_effect
+    tied = [c for c in cands if c is not named_c and c["confirmed"] and c["shrinkage"] == named_c["shrinkage"]
+            and region in EFFECT_REGIONS.get(c["effect"], set())]
+    return min(tied, key=lambda c: c["objective_mm"])["effect"] if tied else named_effect
+
+
 def verdicts(j):
     g = j["gap_tests"]
     a = j["attribution"]
@@ -232,6 +256,7 @@ def verdicts(j):
         v = {r: j["verdict"] for r in RULES}
         v["views_sensor"] = views_sensor(j)
         v["views_camera"] = views_camera(j)
+        v["tie_region"] = tie_region(j)
         return v
     sf, shf = g["stable_floor_mm"], g["shape_floor"]
     within = j.get("within_floors_after_bending_refit", False)
@@ -283,6 +308,7 @@ def verdicts(j):
         v[rule] = reference_rule(j, rule)
     v["views_sensor"] = views_sensor(j)
     v["views_camera"] = views_camera(j)
+    v["tie_region"] = tie_region(j)
     return v
 
 
