@@ -119,8 +119,9 @@ int main(int argc, char** argv) {
   std::uint64_t seed = 1;
   std::vector<std::string> families{"yield", "shear", "curl", "friction", "misalignment", "sensor"};
   std::vector<std::string> sensor_kinds{"pose", "bias", "multipath"};
-  app.add_option("--out", out, "Benchmark directory (diagnoses already in it are kept: a rerun resumes; runs sharing it take the cases "
-                 "no other has taken)")
+  app.add_option("--out", out,
+                 "Benchmark directory (diagnoses already in it are kept: a rerun resumes; runs sharing it take the "
+                 "cases no other has taken)")
       ->capture_default_str();
   app.add_option("--fabrics", fabrics_path, "fabrics618.csv")->capture_default_str();
   app.add_option("--drapegen", drapegen, "The drapegen program (default: beside this program)");
