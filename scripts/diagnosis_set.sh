@@ -6,7 +6,8 @@
 #
 #   scripts/diagnosis_set.sh generate OUT BENCH-OPTIONS...  # copies build/bin's programs into OUT/bin (the build the
 #                                                            # set is diagnosed with, commit in OUT/bin/COMMIT), keeps
-#                                                            # the options in OUT/set.args, generates, then OUT/generated
+#                                                            # the options in OUT/set.args, generates, marks
+#                                                            # OUT/generated
 #   scripts/diagnosis_set.sh diagnose OUT... [--lanes N]     # N diagnoses at once (default: the cores), one core
 #                                                            # each, sharing the sets' cases (the bench's case
 #                                                            # locks: sets generated since session 70)

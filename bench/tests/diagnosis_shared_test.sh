@@ -16,14 +16,16 @@ chmod +x "$work/drapegen"
 cases=(yield_00 yield_01 yield_02 yield_03 yield_04 yield_05)
 for c in "${cases[@]}"; do  # generated already: the bench skips generation
   mkdir -p "$work/captures/$c" && : > "$work/captures/$c/capture.json"
-  echo '{"family": "yield", "regions": ["skirt"], "effects": [{"name": "yield", "strength": 1}]}' > "$work/truth/$c.json"
+  echo '{"family": "yield", "regions": ["skirt"], "effects": [{"name": "yield", "strength": 1}]}' \
+    > "$work/truth/$c.json"
 done
 run() { "$bench" --out "$work" --families yield --per-family 6 --controls 0 --fabrics "$fabrics" --jobs 2 \
           --drapegen "$work/drapegen" > "$work/run$1.log" 2>&1; }
 run 1 & run 2 &
 wait
 fail() { echo "FAIL: $*"; cat "$work/asked.log" "$work"/run*.log; exit 1; }
-[ "$(wc -l < "$work/asked.log")" -eq ${#cases[@]} ] || fail "$(wc -l < "$work/asked.log") diagnoses for ${#cases[@]} cases"
+asked=$(wc -l < "$work/asked.log")
+[ "$asked" -eq ${#cases[@]} ] || fail "$asked diagnoses for ${#cases[@]} cases"
 [ "$(sort -u "$work/asked.log" | wc -l)" -eq ${#cases[@]} ] || fail "a case was diagnosed twice"
 for c in "${cases[@]}"; do [ -s "$work/diagnoses/$c.json" ] || fail "$c has no report"; done
 if compgen -G "$work/diagnoses/*.lock" > /dev/null; then fail "locks left behind"; fi
