@@ -217,17 +217,22 @@ def views_sensor(j):
 CAMERA_RMS_MM = 4.0  # rule C's threshold (docs/preregistrations/session70.md)
 
 
+def placement_rms(report):
+    """mm: each placement's cross-view residual RMS (gap_tests.view_consistency.placements[].rms_mm; [] without)."""
+    views = ((report.get("gap_tests") or {}).get("view_consistency") or {}).get("placements") or []
+    return [p["rms_mm"] for p in views]
+
+
 def views_camera(j):
     """Rule C (pre-registered in session 70 for seeds 82-83: docs/preregistrations/session70.md): "sensor" where the
     smallest cross-view residual RMS over the placements (gap_tests.view_consistency.placements[].rms_mm) is at least
     CAMERA_RMS_MM, within the floors too: the views disagree, which a camera error makes them and no physical effect
     does; else the verdict as run."""
-    views = ((j.get("gap_tests") or {}).get("view_consistency") or {}).get("placements") or []
-    rms = [p["rms_mm"] for p in views]
+    rms = placement_rms(j)
     return "sensor" if rms and min(rms) >= CAMERA_RMS_MM else j["verdict"]
 
 
-# Where each effect acts (candidate_effect.cpp, effect_regions; as scripts/region_rules.py's EFFECT_REGIONS).
+# Where each effect acts (candidate_effect.cpp, effect_regions; scripts/region_rules.py imports it).
 EFFECT_REGIONS = {"yield": {"skirt"}, "shear": {"skirt"}, "curl": {"hem"}, "misalignment": {"hem"},
                   "friction": {"top", "rim"}, "sensor": {"global"}}
 
@@ -248,15 +253,17 @@ def tie_region(j):
     return min(tied, key=lambda c: c["objective_mm"])["effect"] if tied else named_effect
 
 
+# The rules read off the verdict as run and one more field of the report, with or without candidates.
+REPORT_RULES = {"views_sensor": views_sensor, "views_camera": views_camera, "tie_region": tie_region}
+
+
 def verdicts(j):
     g = j["gap_tests"]
     a = j["attribution"]
     cands = a.get("candidates", [])
     if not cands:
         v = {r: j["verdict"] for r in RULES}
-        v["views_sensor"] = views_sensor(j)
-        v["views_camera"] = views_camera(j)
-        v["tie_region"] = tie_region(j)
+        v.update({rule: f(j) for rule, f in REPORT_RULES.items()})
         return v
     sf, shf = g["stable_floor_mm"], g["shape_floor"]
     within = j.get("within_floors_after_bending_refit", False)
@@ -306,9 +313,7 @@ def verdicts(j):
     v["common4"] = common_at_least(j, 4)
     for rule in ("without_ablation", "reach", "reach_objective"):
         v[rule] = reference_rule(j, rule)
-    v["views_sensor"] = views_sensor(j)
-    v["views_camera"] = views_camera(j)
-    v["tie_region"] = tie_region(j)
+    v.update({rule: f(j) for rule, f in REPORT_RULES.items()})
     return v
 
 

@@ -28,6 +28,11 @@ set_args() {  # the set's own options, one per line in OUT/set.args
   [ -f "$1/set.args" ] || { echo "diagnosis_set: $1/set.args is missing (run the generate step first)" >&2; exit 1; }
   mapfile -t args < "$1/set.args"
 }
+runner=()  # a prefix for the bench (a lane's taskset)
+bench() {  # bench SET MORE-OPTIONS...: the set's own bench on the set, under the protocol and the set's options
+  set_args "$1"
+  "${runner[@]}" "$1/bin/drapegen_diagnosis_bench" --out "$1" "${protocol[@]}" "${args[@]}" "${@:2}"
+}
 
 case $step in
   generate)
@@ -45,7 +50,7 @@ case $step in
       printf '%s\n' "$@" > "$out/set.args"
       set_args "$out"
     fi
-    "$out/bin/drapegen_diagnosis_bench" --out "$out" --generate-only "${protocol[@]}" "${args[@]}"
+    bench "$out" --generate-only
     date -u +%FT%TZ > "$out/generated"
     ;;
   diagnose)
@@ -60,10 +65,10 @@ case $step in
       [ -f "$s/generated" ] || { echo "diagnosis_set: $s is not generated yet ($s/generated)" >&2; exit 1; }
     done
     lane() {  # lane K: every set in turn, one diagnosis at a time on core K; the bench's case locks share the work
+      runner=(taskset -c "$(( $1 % $(nproc) ))")
       for s in "${sets[@]}"; do
-        set_args "$s"
-        taskset -c "$(( $1 % $(nproc) ))" "$s/bin/drapegen_diagnosis_bench" --out "$s" "${protocol[@]}" "${args[@]}" \
-          --second-placement --jobs 1 --diagnose-args "--fine --ignore-measured-bending" | sed "s/^/lane $1: /"
+        bench "$s" --second-placement --jobs 1 --diagnose-args "--fine --ignore-measured-bending" \
+          | sed "s/^/lane $1: /"
       done
     }
     for ((k = 0; k < lanes; ++k)); do lane "$k" & done
@@ -74,7 +79,7 @@ case $step in
     for run in "${runs[@]}"; do
       set_args "$run"
       echo "== $run: ${args[*]}"
-      "$run/bin/drapegen_diagnosis_bench" --out "$run" "${protocol[@]}" "${args[@]}" --second-placement --score-only
+      bench "$run" --second-placement --score-only
     done
     python3 scripts/diagnosis_rules.py --matrix current --pooled "${runs[@]}"
     python3 scripts/region_rules.py "${runs[@]}"

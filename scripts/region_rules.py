@@ -63,15 +63,13 @@ import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from diagnosis_rules import THRESHOLD, confirmation_rule, multipath_fired  # noqa: E402  (shared with it)
+from diagnosis_rules import (EFFECT_REGIONS, THRESHOLD, confirmation_rule,  # noqa: E402  (shared with it)
+                             multipath_fired)
 
 OUTLINE = {"harmonics", "off_centre", "sorted_radii", "hem_height"}
 RULES = ["as_run", "largest", "place_gap_24", "place_gap", "place_gap_27", "place_gap_27b", "pixel_region",
          "floor_region", "split_enrichment", "split_floor_ratio", "skirt_floor_ratio", "fold_depth", "closure_groups",
          "closure_regions", "multipath_floor"]
-# Where each effect acts (candidate_effect.cpp, effect_regions).
-EFFECT_REGIONS = {"yield": {"skirt"}, "shear": {"skirt"}, "curl": {"hem"}, "misalignment": {"hem"},
-                  "friction": {"top", "rim"}, "sensor": {"global"}}
 
 
 def leading(loc):

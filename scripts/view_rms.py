@@ -11,6 +11,10 @@ import glob
 import json
 import os
 import statistics
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from diagnosis_rules import CAMERA_RMS_MM, placement_rms  # noqa: E402  (rule C reads the same)
 
 
 def kind(truth):
@@ -24,7 +28,7 @@ def kind(truth):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("runs", nargs="+", help="benchmark output directories (diagnoses/, truth/)")
-    ap.add_argument("--threshold", type=float, default=4.0, help="mm: the smallest RMS from which the test fires")
+    ap.add_argument("--threshold", type=float, default=CAMERA_RMS_MM, help="mm: the smallest RMS from which the test fires")
     a = ap.parse_args()
     fired = {}
     print(f"{'capture':28} {'truth':>18} {'rms min':>8} {'mean':>6} {'slope min':>9} {'multipath':>9}  verdict")
@@ -36,7 +40,7 @@ def main():
             with open(os.path.join(run, "truth", name + ".json")) as f:
                 k, strength = kind(json.load(f))
             views = (report.get("gap_tests") or {}).get("view_consistency") or {}
-            rms = [p["rms_mm"] for p in views.get("placements", [])]
+            rms = placement_rms(report)
             if not rms:
                 continue
             fires = min(rms) >= a.threshold
