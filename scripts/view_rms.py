@@ -28,7 +28,8 @@ def kind(truth):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("runs", nargs="+", help="benchmark output directories (diagnoses/, truth/)")
-    ap.add_argument("--threshold", type=float, default=CAMERA_RMS_MM, help="mm: the smallest RMS from which the test fires")
+    ap.add_argument("--threshold", type=float, default=CAMERA_RMS_MM,
+                    help="mm: the smallest RMS from which the test fires")
     a = ap.parse_args()
     fired = {}
     print(f"{'capture':28} {'truth':>18} {'rms min':>8} {'mean':>6} {'slope min':>9} {'multipath':>9}  verdict")
