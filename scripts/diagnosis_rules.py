@@ -19,6 +19,11 @@ score. Hypotheses for the next evaluation, not the diagnosis's rule (docs/DIAGNO
   shrinkage (physical effects before the sensor error) the smallest score on the capture's held-out view, which no
   refit sees, instead of the smallest refit objective (3 more right on seeds 17-32; pre-registered on fresh seed 33,
   it named one fewer: negative, not the diagnosis's rule);
+- tie_held_out (rule H, session 71, pre-registered for fresh seeds 84-86: docs/preregistrations/session71.md): the
+  verdict as run, but among the confirmed candidates tied exactly at the top shrinkage (physical effects before the
+  sensor error) the largest held-out shrinkage (on the held-out placement, which no refit sees) instead of the
+  smallest refit objective; not where the run put curl or the sensor error first (the tie rule before session 19,
+  under the protocol with one placement);
 - common4 (session 46): the verdict with `--common-bending 4` (the common bending decides only where four or more
   effects are each within the floors), from reports made with the default 3; pre-registered on fresh seed 41
   (out/s48_prereg.txt);
@@ -90,7 +95,7 @@ THRESHOLD = 0.25  # AttributionSettings::significant_shrinkage
 TOLERANCE = 0.1  # AttributionSettings::held_out_tolerance (since session 23); --tolerance sets the rule's
 RULES = ["current", "strict", "tolerance", "objective_ties", "parsimony", "tie_objective", "no_bar", "no_bar_unconfirmed",
          "mean3", "held_out_excess", "held_out_rank", "min_objective", "without_ablation", "reach", "reach_objective",
-         "tie_held_out_view", "common4", "views_sensor", "views_camera", "tie_region"]
+         "tie_held_out_view", "tie_held_out", "common4", "views_sensor", "views_camera", "tie_region"]
 PARAMETERS = {"sensor": 9, "misalignment": 2}  # effect_space's dimension; the others have 1
 # How each rule orders candidates of equal shrinkage before their objectives (confirmation_rule).
 TIES = {"physical_first": lambda effect: effect == "sensor",  # attribute() since session 25 (needs_simulation)
@@ -277,6 +282,9 @@ def verdicts(j):
     physical = [c for c in tied if c["effect"] != "sensor"] or tied  # attribute()'s order: physical effects first
     v["tie_held_out_view"] = min(physical, key=lambda c: c["held_out_score_mm"])["effect"] if (
         j["verdict"] not in ("none", "unexplained") and tied and not a.get("curl_first")) else j["verdict"]
+    promoted = a.get("curl_first") or (a.get("sensor_first") or {}).get("promoted")
+    v["tie_held_out"] = max(physical, key=lambda c: c["held_out_shrinkage"])["effect"] if (
+        j["verdict"] not in ("none", "unexplained") and tied and not promoted) else j["verdict"]
     e0 = g["excess_above_floors"]
     h0 = g["held_out_capture"]["all_views_score_mm"]
 

@@ -7,7 +7,6 @@ namespace drapegen::diagnosis {
 namespace {
 
 constexpr Region kRegions[] = {Region::kTop, Region::kRim, Region::kSkirt, Region::kHem, Region::kCylinder};
-constexpr double kMinPixelShare = 0.02;
 
 }  // namespace
 

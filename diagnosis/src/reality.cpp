@@ -10,6 +10,7 @@
 
 #include "drapegen/diagnosis/bending_json.hpp"
 #include "drapegen/diagnosis/candidate_effect.hpp"
+#include "drapegen/diagnosis/error_footprint.hpp"
 #include "drapegen/renderer/depth_renderer.hpp"
 #include "drapegen/renderer/noise.hpp"
 #include "drapegen/renderer/preview.hpp"
@@ -191,7 +192,7 @@ sim::Expected<Placement> make_placement(const RealitySpec& spec, int placement) 
   if (!spec.effects.empty()) {
     const std::string& first = spec.effects.front().name;
     if (first == "multipath") {
-      p.regions = {"cylinder", "rim"};
+      p.regions.clear();  // where its rendered error lies: generate_reality's ErrorFootprint
     } else if (auto eff = parse_effect(reality_family(first))) {
       p.regions.clear();
       for (Region r : effect_regions(*eff)) p.regions.emplace_back(region_name(r));
@@ -278,6 +279,10 @@ sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std
   }
   std::vector<std::vector<renderer::DepthImage>> preview(1);
   const auto& setup = setups.front();
+  // Where the sensor's depth error lies on the specimen (truth.json's sensor_footprint; a multipath capture's regions).
+  const bool depth_error = sensor.bias_offset != 0.0 || sensor.bias_slope != 0.0 || sensor.multipath_gain != 0.0;
+  const HemProfile outline = hem_profile_from_mesh(drape->mesh);
+  ErrorFootprint footprint;
   for (int v = 0; v < static_cast<int>(setup.views.size()); ++v) {
     CaptureView view;
     view.file = fmt::format("view{}.exr", v);
@@ -287,6 +292,7 @@ sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std
     auto clean = renderer->render(truth);
     if (!clean) return clean.error();
     renderer::DepthImage biased = sensor.any() ? sensor.apply(*clean, view.camera.intrinsics) : *clean;
+    if (depth_error) footprint.add_view(*clean, biased, truth, outline, rig.cylinder.radius);
     const std::uint64_t noise_seed =
         replaced ? renderer::mix_seed(setup.noise_seed(v), placement_stream(spec.placement)) : setup.noise_seed(v);
     view.depth = noise.any() ? noise.apply(biased, noise_seed) : biased;
@@ -307,6 +313,10 @@ sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std
     return s.error();
   }
 
+  if (p.regions.empty()) {  // multipath: the regions its error stands out in
+    p.regions.clear();
+    for (Region r : footprint.regions()) p.regions.emplace_back(region_name(r));
+  }
   nlohmann::json truth = {
       {"warning", "ground truth: the diagnosis never reads this file"},
       {"family", p.family},
@@ -334,6 +344,13 @@ sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std
       {"drape_coefficient", drape->measures.drape_coefficient},
       {"folds", drape->measures.folds}};
   truth.update(bending_json(spec.bending));  // "alpha", "beta"
+  if (depth_error) {
+    nlohmann::json& f = truth["sensor_footprint"] = nlohmann::json::object();
+    for (const RegionShare& s : footprint.shares()) {
+      f[std::string(region_name(s.region))] = {
+          {"energy_share", s.energy_share}, {"pixel_share", s.pixel_share}, {"enrichment", s.enrichment}};
+    }
+  }
   RealityResult result;
   result.truth_path = (fs::path(directory) / "truth.json").string();
   if (sim::Status s = storage::write_file_atomic(result.truth_path, storage::json_text(truth) + "\n"); !s) {

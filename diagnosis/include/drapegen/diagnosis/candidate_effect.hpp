@@ -37,7 +37,7 @@ enum class Region { kTop, kRim, kSkirt, kHem, kCylinder, kGlobal };
 [[nodiscard]] std::string_view region_name(Region region);
 /// Where each effect acts (the truth the localisation is checked against): yield and shear the skirt's folds, curl
 /// and misalignment the hem, friction the rim and the platform top, sensor errors everywhere (kGlobal; the reality
-/// generator puts multipath at the rim and the cylinder's gaps).
+/// generator's truth for multipath is where its rendered error stands out: ErrorFootprint::regions).
 [[nodiscard]] std::vector<Region> effect_regions(Effect effect);
 
 }  // namespace drapegen::diagnosis
