@@ -21,9 +21,9 @@ score. Hypotheses for the next evaluation, not the diagnosis's rule (docs/DIAGNO
   it named one fewer: negative, not the diagnosis's rule);
 - tie_held_out (rule H, session 71, pre-registered for fresh seeds 84-86: docs/preregistrations/session71.md): the
   verdict as run, but among the confirmed candidates tied exactly at the top shrinkage (physical effects before the
-  sensor error) the largest held-out shrinkage (on the held-out placement, which no refit sees) instead of the
-  smallest refit objective; not where the run put curl or the sensor error first (the tie rule before session 19,
-  under the protocol with one placement);
+  sensor error) the largest held-out shrinkage (on the held-out placement, which no refit sees; else the held-out
+  view) instead of the smallest refit objective (the tie rule before session 19, under the protocol with one
+  placement); not where the run put curl, the sensor error or a near tie first;
 - common4 (session 46): the verdict with `--common-bending 4` (the common bending decides only where four or more
   effects are each within the floors), from reports made with the default 3; pre-registered on fresh seed 41
   (out/s48_prereg.txt);
@@ -282,7 +282,8 @@ def verdicts(j):
     physical = [c for c in tied if c["effect"] != "sensor"] or tied  # attribute()'s order: physical effects first
     v["tie_held_out_view"] = min(physical, key=lambda c: c["held_out_score_mm"])["effect"] if (
         j["verdict"] not in ("none", "unexplained") and tied and not a.get("curl_first")) else j["verdict"]
-    promoted = a.get("curl_first") or (a.get("sensor_first") or {}).get("promoted")
+    promoted = (a.get("curl_first") or (a.get("sensor_first") or {}).get("promoted")
+                or (a.get("near_tie") or {}).get("promoted"))
     v["tie_held_out"] = max(physical, key=lambda c: c["held_out_shrinkage"])["effect"] if (
         j["verdict"] not in ("none", "unexplained") and tied and not promoted) else j["verdict"]
     e0 = g["excess_above_floors"]

@@ -1,12 +1,10 @@
 #include "drapegen/diagnosis/error_footprint.hpp"
 
-#include <cassert>
-
 namespace drapegen::diagnosis {
 
 void ErrorFootprint::add_view(const renderer::DepthImage& clean, const renderer::DepthImage& injected,
                               const renderer::Camera& camera, const HemProfile& outline, double cylinder_radius) {
-  assert(clean.width == injected.width && clean.height == injected.height);
+  if (clean.width != injected.width || clean.height != injected.height) return;
   const Eigen::Isometry3d to_specimen = camera.world_to_camera.inverse();
   for (int row = 0; row < clean.height; ++row) {
     for (int u = 0; u < clean.width; ++u) {

@@ -124,6 +124,7 @@ struct Placement {
   nlohmann::json effects = nlohmann::json::array();
   std::string family = "none";
   std::vector<std::string> regions{"global"};
+  bool regions_from_footprint = false;  // multipath: regions are where its rendered error stands out (ErrorFootprint)
 };
 
 sim::Expected<Placement> make_placement(const RealitySpec& spec, int placement) {
@@ -192,7 +193,7 @@ sim::Expected<Placement> make_placement(const RealitySpec& spec, int placement) 
   if (!spec.effects.empty()) {
     const std::string& first = spec.effects.front().name;
     if (first == "multipath") {
-      p.regions.clear();  // where its rendered error lies: generate_reality's ErrorFootprint
+      p.regions_from_footprint = true;
     } else if (auto eff = parse_effect(reality_family(first))) {
       p.regions.clear();
       for (Region r : effect_regions(*eff)) p.regions.emplace_back(region_name(r));
@@ -313,7 +314,7 @@ sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std
     return s.error();
   }
 
-  if (p.regions.empty()) {  // multipath: the regions its error stands out in
+  if (p.regions_from_footprint) {
     p.regions.clear();
     for (Region r : footprint.regions()) p.regions.emplace_back(region_name(r));
   }

@@ -16,17 +16,23 @@ namespace {
 
 constexpr double kR = 0.05;  // the tester's cylinder radius (m)
 
-/// A camera 0.5 m above the platform looking straight down, and what it sees: the plane z = 0 everywhere (within the
-/// cylinder's radius the platform top, beyond it the rim and then the skirt's region).
-struct DownView {
+/// A camera about 0.5 m above the platform looking down at it a little obliquely (so that its pose is not its own
+/// inverse), and what it sees of the plane z = `height`: the depth of every pixel and the point there.
+struct PlaneView {
   renderer::Camera camera = renderer::Camera::look_at(renderer::Intrinsics::pinhole(64, 64, 80, 80, 31.5, 31.5),
-                                                      {0, 0, 0.5}, {0, 0, 0}, Eigen::Vector3d::UnitY());
+                                                      {0.04, -0.03, 0.5}, {0, 0, -0.05}, Eigen::Vector3d::UnitY());
   renderer::DepthImage clean{64, 64};
-  DownView() { std::fill(clean.depth.begin(), clean.depth.end(), 0.5f); }
-  /// The horizontal radius of the point pixel (u, v) sees.
-  [[nodiscard]] double radius(int u, int v) const {
-    const Eigen::Vector3d p = camera.world_to_camera.inverse() * (0.5 * camera.ray(u, v));
-    return std::hypot(p.x(), p.y());
+  std::vector<Eigen::Vector3d> points;  // per pixel, in the specimen's frame
+  explicit PlaneView(double height) {
+    const Eigen::Matrix3d to_world = camera.world_to_camera.linear().transpose();
+    for (int v = 0; v < 64; ++v) {
+      for (int u = 0; u < 64; ++u) {
+        const Eigen::Vector3d ray = camera.ray(u, v), along = to_world * ray;
+        const double z = (height - camera.position().z()) / along.z();  // camera depth: ray has z = 1
+        clean.depth[static_cast<std::size_t>(v) * 64 + u] = static_cast<float>(z);
+        points.push_back(camera.position() + z * along);
+      }
+    }
   }
 };
 
@@ -39,19 +45,15 @@ HemProfile round_outline(double r) {
 // An error on the top's pixels alone (to 5 mm from its edge: classify_point's top) stands out on the top; one of the
 // same size everywhere stands out nowhere.
 TEST(ErrorFootprint, AnErrorOnTheTopAloneStandsOutThereAndAUniformOneNowhere) {
-  DownView view;
-  ASSERT_NEAR(view.radius(31, 31), 0.0, 0.005);
+  const PlaneView view(0.0);
   renderer::DepthImage on_top = view.clean, everywhere = view.clean;
   int top_pixels = 0;
-  for (int v = 0; v < 64; ++v) {
-    for (int u = 0; u < 64; ++u) {
-      const std::size_t i = static_cast<std::size_t>(v) * 64 + u;
-      everywhere.depth[i] += 0.004f;
-      if (view.radius(u, v) < kR - 0.005) on_top.depth[i] += 0.004f, ++top_pixels;
-    }
+  for (std::size_t i = 0; i < view.points.size(); ++i) {
+    everywhere.depth[i] += 0.004f;
+    if (std::hypot(view.points[i].x(), view.points[i].y()) < kR - 0.005) on_top.depth[i] += 0.004f, ++top_pixels;
   }
   ASSERT_GT(top_pixels, 100);
-  const HemProfile outline = round_outline(0.3);  // far outside the image: no hem in view
+  const HemProfile outline = round_outline(0.3);  // (the plane lies at the top's height: no hem there)
   ErrorFootprint top, uniform;
   top.add_view(view.clean, on_top, view.camera, outline, kR);
   uniform.add_view(view.clean, everywhere, view.camera, outline, kR);
@@ -60,13 +62,40 @@ TEST(ErrorFootprint, AnErrorOnTheTopAloneStandsOutThereAndAUniformOneNowhere) {
   double pixels = 0.0;
   for (const RegionShare& s : uniform.shares()) {
     pixels += s.pixel_share;
-    if (s.pixel_share > 0.0) EXPECT_NEAR(s.enrichment, 1.0, 1e-9) << region_name(s.region);
+    if (s.pixel_share > 0.0) EXPECT_NEAR(s.enrichment, 1.0, 1e-5) << region_name(s.region);  // float depths
   }
   EXPECT_NEAR(pixels, 1.0, 1e-12);
   const auto shares = top.shares();
   EXPECT_NEAR(shares[static_cast<int>(Region::kTop)].energy_share, 1.0, 1e-12);
-  EXPECT_NEAR(top.pixels[static_cast<int>(Region::kTop)], top_pixels, 0.5);
+  EXPECT_NEAR(top.pixels[static_cast<int>(Region::kTop)], top_pixels, 2.0);  // float depths at the edge
   EXPECT_EQ(ErrorFootprint{}.regions(), std::vector<Region>{Region::kGlobal});  // no error at all
+}
+
+// Below the top, the outline decides the hem: with an outline of 0.1 m over the angles [0, pi) and 0.4 m over the
+// rest, an error on the points beyond 75 mm from the axis at y > 0 is the hem's, and the same error at y < 0 (whose
+// hem lies beyond the image) the skirt's. A footprint in another frame than the outline's (the camera not inverted,
+// the points turned) puts them elsewhere.
+TEST(ErrorFootprint, BelowTheTopTheOutlineDecidesTheHem) {
+  const PlaneView view(-0.05);
+  HemProfile outline;
+  for (int k = 0; k < kHemBins; ++k) outline.radius.push_back(k < kHemBins / 2 ? 0.1 : 0.4);
+  renderer::DepthImage north = view.clean, south = view.clean;
+  int north_pixels = 0, south_pixels = 0;
+  for (std::size_t i = 0; i < view.points.size(); ++i) {
+    const Eigen::Vector3d& p = view.points[i];
+    if (std::hypot(p.x(), p.y()) <= 0.08) continue;
+    if (p.y() > 0.005) north.depth[i] += 0.004f, ++north_pixels;
+    if (p.y() < -0.005) south.depth[i] += 0.004f, ++south_pixels;
+  }
+  ASSERT_GT(north_pixels, 200);
+  ASSERT_GT(south_pixels, 200);
+  ErrorFootprint n, s;
+  n.add_view(view.clean, north, view.camera, outline, kR);
+  s.add_view(view.clean, south, view.camera, outline, kR);
+  EXPECT_EQ(n.regions(), std::vector<Region>{Region::kHem});
+  EXPECT_EQ(s.regions(), std::vector<Region>{Region::kSkirt});
+  EXPECT_NEAR(n.shares()[static_cast<int>(Region::kHem)].energy_share, 1.0, 1e-12);
+  EXPECT_NEAR(s.shares()[static_cast<int>(Region::kSkirt)].energy_share, 1.0, 1e-12);
 }
 
 // The reality generator's truth: a multipath capture's regions are where its rendered error stands out (recorded

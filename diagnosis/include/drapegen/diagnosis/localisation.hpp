@@ -116,7 +116,8 @@ inline constexpr double kCameraMovedAtPlatform = 0.003;
 /// A region stands out in the residual maps (Localisation::pixel_region) from this enrichment: its share of the
 /// residual energy over its share of the pixels.
 inline constexpr double kMinRegionEnrichment = 1.3;
-/// ... among the regions holding at least this share of the pixels.
+/// A region counts in the residual maps (pixel_region, floor_region, ErrorFootprint::regions) from this share of the
+/// pixels.
 inline constexpr double kMinPixelShare = 0.02;
 /// Where the stable term's excess (platform top, bare cylinder) sits, from the rigid regions' residuals (their
 /// floor_ratio set): the bare cylinder (kCylinder) if the platform top is within its own floor; everywhere (kGlobal)
