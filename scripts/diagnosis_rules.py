@@ -23,7 +23,8 @@ score. Hypotheses for the next evaluation, not the diagnosis's rule (docs/DIAGNO
   verdict as run, but among the confirmed candidates tied exactly at the top shrinkage (physical effects before the
   sensor error) the largest held-out shrinkage (on the held-out placement, which no refit sees; else the held-out
   view) instead of the smallest refit objective (the tie rule before session 19, under the protocol with one
-  placement); not where the run put curl, the sensor error or a near tie first;
+  placement); not where the run put curl, the sensor error or a near tie first (+1 in sample on seeds 80-83; on
+  seeds 84-86 it named as the default: not adopted);
 - common4 (session 46): the verdict with `--common-bending 4` (the common bending decides only where four or more
   effects are each within the floors), from reports made with the default 3; pre-registered on fresh seed 41
   (out/s48_prereg.txt);
