@@ -25,6 +25,10 @@ score. Hypotheses for the next evaluation, not the diagnosis's rule (docs/DIAGNO
   view) instead of the smallest refit objective (the tie rule before session 19, under the protocol with one
   placement); not where the run put curl, the sensor error or a near tie first (+1 in sample on seeds 80-83; on
   seeds 84-86 it named as the default: not adopted);
+- no_near_tie (rule N, session 71, a lead for a later registration): the verdict as run, but where the run promoted
+  a near tie (report.json attribution.near_tie.promoted; `--tie-margin`, default 0.1), the confirmed candidate it
+  displaced: near ties as `--tie-margin 0` would leave them (the one promotion on seeds 80-86, seed 84's sensor_04,
+  named a depth bias yield by a refit objective the sensor candidate's cannot match: it keeps the bending);
 - common4 (session 46): the verdict with `--common-bending 4` (the common bending decides only where four or more
   effects are each within the floors), from reports made with the default 3; pre-registered on fresh seed 41
   (out/s48_prereg.txt);
@@ -96,7 +100,8 @@ THRESHOLD = 0.25  # AttributionSettings::significant_shrinkage
 TOLERANCE = 0.1  # AttributionSettings::held_out_tolerance (since session 23); --tolerance sets the rule's
 RULES = ["current", "strict", "tolerance", "objective_ties", "parsimony", "tie_objective", "no_bar", "no_bar_unconfirmed",
          "mean3", "held_out_excess", "held_out_rank", "min_objective", "without_ablation", "reach", "reach_objective",
-         "tie_held_out_view", "tie_held_out", "common4", "views_sensor", "views_camera", "tie_region"]
+         "tie_held_out_view", "tie_held_out", "no_near_tie",
+         "common4", "views_sensor", "views_camera", "tie_region"]
 PARAMETERS = {"sensor": 9, "misalignment": 2}  # effect_space's dimension; the others have 1
 # How each rule orders candidates of equal shrinkage before their objectives (confirmation_rule).
 TIES = {"physical_first": lambda effect: effect == "sensor",  # attribute() since session 25 (needs_simulation)
@@ -287,6 +292,13 @@ def verdicts(j):
                 or (a.get("near_tie") or {}).get("promoted"))
     v["tie_held_out"] = max(physical, key=lambda c: c["held_out_shrinkage"])["effect"] if (
         j["verdict"] not in ("none", "unexplained") and tied and not promoted) else j["verdict"]
+    # Rule N: no near ties (--tie-margin 0): where the run promoted a near tie, the confirmed candidate it displaced,
+    # the first by shrinkage (attribute()'s order: physical effects first among exact ties, then the objective).
+    led = sorted((c for c in cands if c["confirmed"]),
+                 key=lambda c: (-c["shrinkage"], c["effect"] == "sensor", c["objective_mm"]))
+    first_after = a.get("curl_first") or (a.get("sensor_first") or {}).get("promoted")  # applied after near ties
+    v["no_near_tie"] = led[0]["effect"] if ((a.get("near_tie") or {}).get("promoted") and led and not first_after
+                                            and j["verdict"] not in ("none", "unexplained")) else j["verdict"]
     e0 = g["excess_above_floors"]
     h0 = g["held_out_capture"]["all_views_score_mm"]
 
