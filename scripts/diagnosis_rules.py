@@ -288,16 +288,15 @@ def verdicts(j):
     physical = [c for c in tied if c["effect"] != "sensor"] or tied  # attribute()'s order: physical effects first
     v["tie_held_out_view"] = min(physical, key=lambda c: c["held_out_score_mm"])["effect"] if (
         j["verdict"] not in ("none", "unexplained") and tied and not a.get("curl_first")) else j["verdict"]
-    promoted = (a.get("curl_first") or (a.get("sensor_first") or {}).get("promoted")
-                or (a.get("near_tie") or {}).get("promoted"))
+    first_after = a.get("curl_first") or (a.get("sensor_first") or {}).get("promoted")  # applied after near ties
+    near_tie = (a.get("near_tie") or {}).get("promoted")
     v["tie_held_out"] = max(physical, key=lambda c: c["held_out_shrinkage"])["effect"] if (
-        j["verdict"] not in ("none", "unexplained") and tied and not promoted) else j["verdict"]
+        j["verdict"] not in ("none", "unexplained") and tied and not (first_after or near_tie)) else j["verdict"]
     # Rule N: no near ties (--tie-margin 0): where the run promoted a near tie, the confirmed candidate it displaced,
     # the first by shrinkage (attribute()'s order: physical effects first among exact ties, then the objective).
     led = sorted((c for c in cands if c["confirmed"]),
                  key=lambda c: (-c["shrinkage"], c["effect"] == "sensor", c["objective_mm"]))
-    first_after = a.get("curl_first") or (a.get("sensor_first") or {}).get("promoted")  # applied after near ties
-    v["no_near_tie"] = led[0]["effect"] if ((a.get("near_tie") or {}).get("promoted") and led and not first_after
+    v["no_near_tie"] = led[0]["effect"] if (near_tie and led and not first_after
                                             and j["verdict"] not in ("none", "unexplained")) else j["verdict"]
     e0 = g["excess_above_floors"]
     h0 = g["held_out_capture"]["all_views_score_mm"]

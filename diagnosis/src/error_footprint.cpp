@@ -20,17 +20,8 @@ void ErrorFootprint::add_view(const renderer::DepthImage& clean, const renderer:
 }
 
 std::vector<RegionShare> ErrorFootprint::shares() const {
-  double total_energy = 0.0, total_pixels = 0.0;
-  for (int k = 0; k < kCount; ++k) total_energy += energy[k], total_pixels += pixels[k];
   std::vector<RegionShare> out;
-  for (int k = 0; k < kCount; ++k) {
-    RegionShare s;
-    s.region = static_cast<Region>(k);
-    s.energy_share = total_energy > 0.0 ? energy[k] / total_energy : 0.0;
-    s.pixel_share = total_pixels > 0.0 ? pixels[k] / total_pixels : 0.0;
-    s.enrichment = s.pixel_share > 0.0 ? s.energy_share / s.pixel_share : 0.0;
-    out.push_back(s);
-  }
+  for (int k = 0; k < kCount; ++k) out.push_back(share_of_region(static_cast<Region>(k), energy, pixels));
   return out;
 }
 

@@ -152,7 +152,7 @@ sim::Expected<std::vector<renderer::DepthImage>> ForwardModel::render(const sim:
     const renderer::Camera camera = sensor.true_camera(view.camera);
     auto image = renderer_.render(camera);
     if (!image) return image.error();
-    images.push_back(sensor.any() ? sensor.apply(*image, view.camera.intrinsics) : std::move(*image));
+    images.push_back(sensor.changes_depth() ? sensor.apply(*image, view.camera.intrinsics) : std::move(*image));
   }
   return images;
 }

@@ -59,6 +59,19 @@ void localise_features(Localisation& L, const ScoredDrape& drape, const Target& 
   place_gap(L);
 }
 
+RegionShare share_of_region(Region region, const std::array<double, RegionEnergy::kCount>& energy,
+                            const std::array<double, RegionEnergy::kCount>& pixels) {
+  double total_energy = 0.0, total_pixels = 0.0;
+  for (int k = 0; k < RegionEnergy::kCount; ++k) total_energy += energy[k], total_pixels += pixels[k];
+  const int k = static_cast<int>(region);
+  RegionShare s;
+  s.region = region;
+  s.energy_share = total_energy > 0.0 ? energy[k] / total_energy : 0.0;
+  s.pixel_share = total_pixels > 0.0 ? pixels[k] / total_pixels : 0.0;
+  s.enrichment = s.pixel_share > 0.0 ? s.energy_share / s.pixel_share : 0.0;
+  return s;
+}
+
 const RegionShare* region_share(const Localisation& L, Region region) {
   const auto s =
       std::find_if(L.regions.begin(), L.regions.end(), [&](const RegionShare& x) { return x.region == region; });
@@ -205,16 +218,11 @@ Localisation localise(const ForwardModel& model, const ScoredDrape& drape) {
   const Capture& capture = model.capture();
   const HemProfile model_outline = rotate(hem_profile_from_mesh(drape.mesh), drape.angle);
   const RegionEnergy E = region_energy(model, drape, model_outline);
-  double total_energy = 0.0, total_pixels = 0.0;
-  for (int k = 0; k < RegionEnergy::kCount; ++k) total_energy += E.energy[k], total_pixels += E.pixels[k];
+  double total_energy = 0.0;
+  for (int k = 0; k < RegionEnergy::kCount; ++k) total_energy += E.energy[k];
   double best = 0.0;
   for (Region r : kRegions) {
-    const int k = static_cast<int>(r);
-    RegionShare s;
-    s.region = r;
-    s.energy_share = total_energy > 0.0 ? E.energy[k] / total_energy : 0.0;
-    s.pixel_share = total_pixels > 0.0 ? E.pixels[k] / total_pixels : 0.0;
-    s.enrichment = s.pixel_share > 0.0 ? s.energy_share / s.pixel_share : 0.0;
+    RegionShare s = share_of_region(r, E.energy, E.pixels);
     s.rms = std::sqrt(E.mean_square(r));
     s.mean = E.mean(r);
     for (std::size_t v = 0; v < drape.views.size(); ++v) s.view_mean.push_back(E.view_mean(v, r));

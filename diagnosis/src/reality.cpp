@@ -281,7 +281,7 @@ sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std
   std::vector<std::vector<renderer::DepthImage>> preview(1);
   const auto& setup = setups.front();
   // Where the sensor's depth error lies on the specimen (truth.json's sensor_footprint; a multipath capture's regions).
-  const bool depth_error = sensor.bias_offset != 0.0 || sensor.bias_slope != 0.0 || sensor.multipath_gain != 0.0;
+  const bool depth_error = sensor.changes_depth();
   const HemProfile outline = hem_profile_from_mesh(drape->mesh);
   ErrorFootprint footprint;
   for (int v = 0; v < static_cast<int>(setup.views.size()); ++v) {
@@ -292,7 +292,7 @@ sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std
     const renderer::Camera truth = sensor.true_camera(view.camera);
     auto clean = renderer->render(truth);
     if (!clean) return clean.error();
-    renderer::DepthImage biased = sensor.any() ? sensor.apply(*clean, view.camera.intrinsics) : *clean;
+    renderer::DepthImage biased = depth_error ? sensor.apply(*clean, view.camera.intrinsics) : *clean;
     if (depth_error) footprint.add_view(*clean, biased, truth, outline, rig.cylinder.radius);
     const std::uint64_t noise_seed =
         replaced ? renderer::mix_seed(setup.noise_seed(v), placement_stream(spec.placement)) : setup.noise_seed(v);

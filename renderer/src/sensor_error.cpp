@@ -6,10 +6,9 @@
 
 namespace drapegen::renderer {
 
-bool SensorError::any() const {
-  return !rotation.isZero(0.0) || !translation.isZero(0.0) || bias_offset != 0.0 || bias_slope != 0.0 ||
-         multipath_gain != 0.0;
-}
+bool SensorError::any() const { return !rotation.isZero(0.0) || !translation.isZero(0.0) || changes_depth(); }
+
+bool SensorError::changes_depth() const { return bias_offset != 0.0 || bias_slope != 0.0 || multipath_gain != 0.0; }
 
 Camera SensorError::true_camera(const Camera& recorded) const {
   Eigen::Isometry3d delta = Eigen::Isometry3d::Identity();

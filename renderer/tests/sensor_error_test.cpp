@@ -41,13 +41,17 @@ TEST(SensorError, BiasKeepsHolesAndPoseMovesTheCamera) {
   EXPECT_NEAR(out.at(10, 10), 0.8 + 0.004 + 0.001, 1e-6);
   EXPECT_EQ(out.at(11, 10), 0.0f);
   EXPECT_TRUE(e.any());
+  EXPECT_TRUE(e.changes_depth());
 
   const Camera recorded = RigSpec{}.camera();
   SensorError none;
   EXPECT_FALSE(none.any());
+  EXPECT_FALSE(none.changes_depth());
   EXPECT_TRUE(none.true_camera(recorded).world_to_camera.isApprox(recorded.world_to_camera));
   SensorError pose;
   pose.translation = Eigen::Vector3d(0.01, 0, 0);
+  EXPECT_TRUE(pose.any());
+  EXPECT_FALSE(pose.changes_depth());  // a pose error moves the camera, not the depths
   const Camera moved = pose.true_camera(recorded);
   // A point seen at the image centre moves by f * 0.01 / z pixels along u.
   const Eigen::Vector3d target(0, 0, -0.08);

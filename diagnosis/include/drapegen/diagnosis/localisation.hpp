@@ -43,6 +43,11 @@ struct RegionEnergy {
   [[nodiscard]] double view_mean(std::size_t view, Region region) const;
 };
 
+/// The region's energy_share, pixel_share and enrichment (the other fields 0) from squared residuals and pixels per
+/// region (indexed by Region).
+[[nodiscard]] RegionShare share_of_region(Region region, const std::array<double, RegionEnergy::kCount>& energy,
+                                          const std::array<double, RegionEnergy::kCount>& pixels);
+
 struct Localisation {
   /// Where the gap sits (place_gap): from the shape-feature group or the stable term that exceeds its floor the most
   /// (dominant_feature), kGlobal if nothing exceeds its floor.

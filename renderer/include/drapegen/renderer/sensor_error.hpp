@@ -30,6 +30,8 @@ struct SensorError {
   int multipath_radius_px = 4;
 
   [[nodiscard]] bool any() const;
+  /// A depth bias or multipath: apply() changes the depths (a pose error moves only the camera).
+  [[nodiscard]] bool changes_depth() const;
   /// The camera that really took the picture when `recorded` is what the calibration says.
   [[nodiscard]] Camera true_camera(const Camera& recorded) const;
   /// Bias and multipath applied to a clean depth image (keeps the incidence channel for the noise model).
