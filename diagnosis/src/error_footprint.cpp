@@ -1,7 +1,5 @@
 #include "drapegen/diagnosis/error_footprint.hpp"
 
-#include <cmath>
-
 namespace drapegen::diagnosis {
 
 void ErrorFootprint::add_view(const renderer::DepthImage& clean, const renderer::DepthImage& injected,
@@ -19,21 +17,6 @@ void ErrorFootprint::add_view(const renderer::DepthImage& clean, const renderer:
       pixels[k] += 1.0;
     }
   }
-}
-
-void ErrorFootprint::add_comparison(const ViewComparison& comparison, const renderer::Camera& camera,
-                                    const HemProfile& outline, double cylinder_radius) {
-  for_each_residual_point(comparison, camera, [&](const Eigen::Vector3d& p, double residual) {
-    const int k = static_cast<int>(classify_point(p, outline, cylinder_radius));
-    energy[k] += residual * residual;
-    pixels[k] += 1.0;
-  });
-}
-
-double ErrorFootprint::rms() const {
-  double e = 0.0, n = 0.0;
-  for (int k = 0; k < kCount; ++k) e += energy[k], n += pixels[k];
-  return n > 0.0 ? std::sqrt(e / n) : 0.0;
 }
 
 std::vector<RegionShare> ErrorFootprint::shares() const {

@@ -168,29 +168,21 @@ double RegionEnergy::view_mean(std::size_t view, Region region) const {
   return view_sum[view][k] / view_pixels[view][k];
 }
 
-void for_each_residual_point(const ViewComparison& comparison, const renderer::Camera& camera,
-                             const std::function<void(const Eigen::Vector3d& point, double residual)>& visit) {
-  const Eigen::Isometry3d to_specimen = camera.world_to_camera.inverse();
-  const int W = camera.intrinsics.width;
-  if (comparison.residual.size() != static_cast<std::size_t>(W) * camera.intrinsics.height ||
-      comparison.depth.size() != comparison.residual.size()) {
-    return;  // a comparison of images of another size (compare_view's infinite score) has no pixels to place
-  }
-  for (std::size_t i = 0; i < comparison.residual.size(); ++i) {
-    const float res = comparison.residual[i];
-    if (!std::isfinite(res) || comparison.depth[i] <= 0.0f) continue;
-    const int u = static_cast<int>(i % W), row = static_cast<int>(i / W);
-    visit(to_specimen * (static_cast<double>(comparison.depth[i]) * camera.ray(u, row)), static_cast<double>(res));
-  }
-}
-
 void for_each_residual_point(
     const ForwardModel& model, const ScoredDrape& drape,
     const std::function<void(std::size_t view, const Eigen::Vector3d& point, double residual)>& visit) {
   const Capture& capture = model.capture();
   for (std::size_t v = 0; v < drape.views.size(); ++v) {
-    for_each_residual_point(drape.views[v], capture.views[v].camera,
-                            [&](const Eigen::Vector3d& p, double res) { visit(v, p, res); });
+    const auto& cmp = drape.views[v];
+    const auto& view = capture.views[v];
+    const Eigen::Isometry3d to_specimen = view.camera.world_to_camera.inverse();
+    const int W = view.depth.width;
+    for (std::size_t i = 0; i < cmp.residual.size(); ++i) {
+      const float res = cmp.residual[i];
+      if (!std::isfinite(res) || cmp.depth[i] <= 0.0f) continue;
+      const int u = static_cast<int>(i % W), row = static_cast<int>(i / W);
+      visit(v, to_specimen * (static_cast<double>(cmp.depth[i]) * view.camera.ray(u, row)), static_cast<double>(res));
+    }
   }
 }
 

@@ -7,11 +7,9 @@
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
-#include <optional>
 
 #include "drapegen/diagnosis/bending_json.hpp"
 #include "drapegen/diagnosis/candidate_effect.hpp"
-#include "drapegen/diagnosis/depth_metric.hpp"
 #include "drapegen/diagnosis/error_footprint.hpp"
 #include "drapegen/renderer/depth_renderer.hpp"
 #include "drapegen/renderer/noise.hpp"
@@ -127,13 +125,6 @@ struct Placement {
   std::string family = "none";
   std::vector<std::string> regions{"global"};
   bool regions_from_footprint = false;  // multipath: regions are where its rendered error stands out (ErrorFootprint)
-  /// A physical effect's (yield, shear, curl, friction, misalignment): regions are where the drape with it differs
-  /// from the drape without it (`elastic`); `mechanism` keeps the regions where it acts (effect_regions).
-  bool regions_from_drape = false;
-  std::vector<std::string> mechanism;
-  /// The same specimen and placement without the physical effects: flat at rest, no plastic set, no friction or
-  /// shear compliance, only the augmentation's drift.
-  sim::DrapeConfig elastic;
 };
 
 sim::Expected<Placement> make_placement(const RealitySpec& spec, int placement) {
@@ -161,7 +152,6 @@ sim::Expected<Placement> make_placement(const RealitySpec& spec, int placement) 
   const double small = 2e-3 * placement_draw();  // the data's augmentation range: up to 2 mm off centre
   const double phi = 2.0 * M_PI * placement_draw();
   config.initial.drift = small * Eigen::Vector2d(std::cos(phi), std::sin(phi));
-  p.elastic = config;
 
   renderer::SensorError& sensor = p.sensor;
   for (const auto& e : spec.effects) {
@@ -207,7 +197,6 @@ sim::Expected<Placement> make_placement(const RealitySpec& spec, int placement) 
     } else if (auto eff = parse_effect(reality_family(first))) {
       p.regions.clear();
       for (Region r : effect_regions(*eff)) p.regions.emplace_back(region_name(r));
-      if (*eff != Effect::kSensor) p.regions_from_drape = true, p.mechanism = p.regions;
     }
   }
   return p;
@@ -267,13 +256,6 @@ sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std
   auto drape = sim::simulate_drape(config);
   if (!drape) return sim::Error{fmt::format("placement {}: {}", spec.placement, drape.error().message)};
   const bool converged = drape->report.outcome == sim::SolveOutcome::kConverged;
-  // Where a physical effect shows (truth.json's effect_footprint, its regions): the specimen draped without it.
-  std::optional<sim::DrapeResult> elastic;
-  if (p.regions_from_drape) {
-    auto e = sim::simulate_drape(p.elastic);
-    if (!e) return sim::Error{fmt::format("placement {} without the effect: {}", spec.placement, e.error().message)};
-    elastic = std::move(*e);
-  }
 
   auto cloth = renderer::cloth_triangles(drape->mesh);
   if (!cloth) return cloth.error();
@@ -302,8 +284,6 @@ sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std
   const bool depth_error = sensor.changes_depth();
   const HemProfile outline = hem_profile_from_mesh(drape->mesh);
   ErrorFootprint footprint;
-  std::vector<renderer::Camera> true_cameras;
-  std::vector<renderer::DepthImage> with_effect;  // the clean views (the true cameras), for the effect's footprint
   for (int v = 0; v < static_cast<int>(setup.views.size()); ++v) {
     CaptureView view;
     view.file = fmt::format("view{}.exr", v);
@@ -314,7 +294,6 @@ sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std
     if (!clean) return clean.error();
     renderer::DepthImage biased = depth_error ? sensor.apply(*clean, view.camera.intrinsics) : *clean;
     if (depth_error) footprint.add_view(*clean, biased, truth, outline, rig.cylinder.radius);
-    if (elastic) true_cameras.push_back(truth), with_effect.push_back(*clean);
     const std::uint64_t noise_seed =
         replaced ? renderer::mix_seed(setup.noise_seed(v), placement_stream(spec.placement)) : setup.noise_seed(v);
     view.depth = noise.any() ? noise.apply(biased, noise_seed) : biased;
@@ -338,26 +317,6 @@ sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std
   if (p.regions_from_footprint) {
     p.regions.clear();
     for (Region r : footprint.regions()) p.regions.emplace_back(region_name(r));
-  }
-  // The effect's footprint: the clean views against the elastic drape's, as the localisation places a fit's residual
-  // (classified with the elastic drape's outline, as it classifies with the fitted drape's).
-  ErrorFootprint drape_footprint;
-  if (elastic) {
-    auto plain = renderer::cloth_triangles(elastic->mesh);
-    if (!plain) return plain.error();
-    if (sim::Status s = renderer->set_scene(renderer::tester_scene(*plain, rig)); !s) return s.error();
-    const HemProfile elastic_outline = hem_profile_from_mesh(elastic->mesh);
-    MetricWeights weights;
-    weights.cylinder_radius = rig.cylinder.radius;
-    for (std::size_t v = 0; v < true_cameras.size(); ++v) {
-      auto without = renderer->render(true_cameras[v]);
-      if (!without) return without.error();
-      const ViewComparison c =
-          compare_view(view_features(with_effect[v], true_cameras[v].intrinsics, weights), *without, weights);
-      drape_footprint.add_comparison(c, true_cameras[v], elastic_outline, rig.cylinder.radius);
-    }
-    p.regions.clear();
-    for (Region r : drape_footprint.regions()) p.regions.emplace_back(region_name(r));
   }
   nlohmann::json truth = {
       {"warning", "ground truth: the diagnosis never reads this file"},
@@ -386,21 +345,12 @@ sim::Expected<RealityResult> generate_reality(const RealitySpec& spec, const std
       {"drape_coefficient", drape->measures.drape_coefficient},
       {"folds", drape->measures.folds}};
   truth.update(bending_json(spec.bending));  // "alpha", "beta"
-  const auto footprint_json = [](const ErrorFootprint& f) {
-    nlohmann::json j = nlohmann::json::object();
-    for (const RegionShare& s : f.shares()) {
-      j[std::string(region_name(s.region))] = {
+  if (depth_error) {
+    nlohmann::json& f = truth["sensor_footprint"] = nlohmann::json::object();
+    for (const RegionShare& s : footprint.shares()) {
+      f[std::string(region_name(s.region))] = {
           {"energy_share", s.energy_share}, {"pixel_share", s.pixel_share}, {"enrichment", s.enrichment}};
     }
-    return j;
-  };
-  if (depth_error) truth["sensor_footprint"] = footprint_json(footprint);
-  if (elastic) {
-    truth["effect_footprint"] = footprint_json(drape_footprint);
-    truth["effect_footprint"]["rms_mm"] = 1e3 * drape_footprint.rms();
-    truth["mechanism_regions"] = p.mechanism;
-    truth["elastic_converged"] = elastic->report.outcome == sim::SolveOutcome::kConverged;
-    truth["elastic_folds"] = elastic->measures.folds;
   }
   RealityResult result;
   result.truth_path = (fs::path(directory) / "truth.json").string();

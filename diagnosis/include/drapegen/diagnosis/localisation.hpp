@@ -8,7 +8,6 @@
 #include <vector>
 
 #include "drapegen/diagnosis/candidate_effect.hpp"
-#include "drapegen/diagnosis/depth_metric.hpp"
 #include "drapegen/diagnosis/forward_model.hpp"
 #include "drapegen/diagnosis/shape_features.hpp"
 
@@ -93,10 +92,6 @@ struct Localisation {
 void for_each_residual_point(
     const ForwardModel& model, const ScoredDrape& drape,
     const std::function<void(std::size_t view, const Eigen::Vector3d& point, double residual)>& visit);
-
-/// The same for one view's comparison (compare_view) seen by `camera`: visit(point, residual) per pixel.
-void for_each_residual_point(const ViewComparison& comparison, const renderer::Camera& camera,
-                             const std::function<void(const Eigen::Vector3d& point, double residual)>& visit);
 
 /// `drape` scored against the capture (or a floor sample, with the capture's cameras): its residuals per region.
 [[nodiscard]] RegionEnergy region_energy(const ForwardModel& model, const ScoredDrape& drape);
