@@ -62,7 +62,9 @@ TEST(ErrorFootprint, AnErrorOnTheTopAloneStandsOutThereAndAUniformOneNowhere) {
   double pixels = 0.0;
   for (const RegionShare& s : uniform.shares()) {
     pixels += s.pixel_share;
-    if (s.pixel_share > 0.0) EXPECT_NEAR(s.enrichment, 1.0, 1e-5) << region_name(s.region);  // float depths
+    if (s.pixel_share > 0.0) {
+      EXPECT_NEAR(s.enrichment, 1.0, 1e-5) << region_name(s.region);  // float depths
+    }
   }
   EXPECT_NEAR(pixels, 1.0, 1e-12);
   const auto shares = top.shares();
@@ -125,8 +127,11 @@ TEST(ErrorFootprint, TheRealityGeneratorPlacesMultipathWhereItsErrorLies) {
   EXPECT_EQ(regions, enriched);
   // The platform top is a plane seen from above: no valley, no multipath there.
   EXPECT_LT(f["top"]["enrichment"].get<double>(), 0.5);
-  for (const auto& [name, share] : b["sensor_footprint"].items())
-    if (share["pixel_share"].get<double>() > 0.0) EXPECT_NEAR(share["enrichment"].get<double>(), 1.0, 0.05) << name;
+  for (const auto& [name, share] : b["sensor_footprint"].items()) {
+    if (share["pixel_share"].get<double>() > 0.0) {
+      EXPECT_NEAR(share["enrichment"].get<double>(), 1.0, 0.05) << name;
+    }
+  }
   EXPECT_EQ(b["regions"], nlohmann::json::array({"global"}));
   EXPECT_FALSE(p.contains("sensor_footprint"));
   EXPECT_EQ(p["regions"], nlohmann::json::array({"global"}));
