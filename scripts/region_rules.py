@@ -39,6 +39,9 @@
   multipath test fired (gap_tests.view_consistency.multipath; reports since 0a703f1), floor_region unless "global";
   any other region as run. The line under the table counts the captures where the test fired (controls apart) and
   rule M's gains and losses against the region as run there.
+- lifted_top (rule T, registered in session 72 for seeds 88-89): as run, but a gap the stable term placed on the
+  platform top while a feature group stands further above its floor stays there only if the top is lifted by at least
+  --lifted-mm (default 1 mm: its mean residual at most -1 mm); else the leading group places it, as place_gap does.
 
 Per rule: the effect captures whose region is one of the effect's regions (the truth file's `regions`), per family.
 
@@ -69,7 +72,7 @@ from diagnosis_rules import (EFFECT_REGIONS, THRESHOLD, confirmation_rule,  # no
 OUTLINE = {"harmonics", "off_centre", "sorted_radii", "hem_height"}
 RULES = ["as_run", "largest", "place_gap_24", "place_gap", "place_gap_27", "place_gap_27b", "pixel_region",
          "floor_region", "split_enrichment", "split_floor_ratio", "skirt_floor_ratio", "fold_depth", "closure_groups",
-         "closure_regions", "multipath_floor"]
+         "closure_regions", "multipath_floor", "lifted_top"]
 
 
 def leading(loc):
@@ -189,6 +192,28 @@ def multipath_floor(report):
     return loc["region"]
 
 
+def lifted_top(loc, lifted_mm, fold_depth):
+    """Rule T (session 72): as run, but a gap placed on the platform top by the stable term where a feature group
+    stands further above its floor (place_gap's "a lifted top leads whatever else exceeds its floor") stays there only
+    if the top is lifted by at least lifted_mm (its mean residual at most -lifted_mm: cloth that slid rises in
+    wrinkles over the top); otherwise the group furthest above its floor places it, as place_gap places a group's gap
+    (an outline group follows the skirt where the skirt's residual is the denser; fold_depth's move to the hem)."""
+    if loc["region"] != "top" or loc.get("dominant_feature") != "stable" or loc.get("placed_by_views"):
+        return loc["region"]
+    top = {r["region"]: r for r in loc["regions"]}["top"]
+    lead = leading(loc)
+    if top["mean_mm"] <= -lifted_mm or lead in (None, "stable"):
+        return loc["region"]
+    if lead not in OUTLINE:
+        region = "skirt"
+    elif lead == "off_centre":
+        region = "hem"
+    else:
+        enrichment = {r["region"]: r["enrichment"] for r in loc["regions"]}
+        region = "skirt" if enrichment.get("skirt", 0.0) > enrichment.get("hem", 0.0) else "hem"
+    return "hem" if region == "skirt" and folds_deeper_than_mean(loc, fold_depth) else region
+
+
 def place_gap_27(loc, sensor_scale, skirt_denser, lifted_scale):
     """place_gap with the rigid surfaces placing the gap whatever leads (pre-registered in session 27 for seed 19):
     a platform top above its own floor and seen farther than the fitted cloth (no cloth lies inside the platform),
@@ -270,6 +295,8 @@ def main():
     ap.add_argument("--skirt-denser", type=float, default=1.0, help="place_gap's skirt/hem enrichment factor")
     ap.add_argument("--fold-depth", type=float, default=1.5,
                     help="fold_depth: the skirt_spread/skirt_height ratio from which a skirt gap is the hem's")
+    ap.add_argument("--lifted-mm", type=float, default=1.0,
+                    help="lifted_top: how far (mm) the top must be lifted for a lifted top to lead (rule T)")
     ap.add_argument("--ranking", action="store_true", help="the region-aware attribution's verdicts instead")
     ap.add_argument("--closure-only", action="store_true",
                     help="count only the reports whose named candidate carries its refit localisation")
@@ -309,7 +336,8 @@ def main():
                       "skirt_floor_ratio": skirt_to_hem(loc, lambda x: split(x, "floor_ratio") == "hem"),
                       "fold_depth": skirt_to_hem(loc, lambda x: folds_deeper_than_mean(x, args.fold_depth)),
                       "closure_groups": closure_groups(loc, named, args.lifted_scale),
-                      "closure_regions": closure_regions(loc, named), "multipath_floor": multipath_floor(report)}
+                      "closure_regions": closure_regions(loc, named), "multipath_floor": multipath_floor(report),
+                      "lifted_top": lifted_top(loc, args.lifted_mm, args.fold_depth)}
             totals[family] += 1
             if multipath_fired(report):
                 fired["effect captures"] += 1
