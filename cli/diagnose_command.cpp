@@ -55,6 +55,7 @@ struct DiagnoseOptions {
   bool ignore_measured_bending = false;
   std::optional<int> jobs;  // unset: one per CPU this process may run on, with a fleet --fleet-workers (run_diagnose)
   std::optional<double> shape_floor;
+  double placement_shape_floor = 0.0;
   bool gap_only = false;
   bool ablation = false;
   bool confirm_within_floors = false;
@@ -102,6 +103,12 @@ int run_diagnose(const DiagnoseOptions& o) {
   }
   if (o.shape_floor && !(*o.shape_floor >= 0.0 && *o.shape_floor <= 100.0)) {
     return fail("--shape-floor must be 0 (from the floor samples) .. 100");
+  }
+  if (!(o.placement_shape_floor >= 0.0 && o.placement_shape_floor <= 100.0)) {
+    return fail("--placement-shape-floor must be 0 (no such test) .. 100");
+  }
+  if (o.placement_shape_floor > 0.0 && o.second.empty() && o.held_out.empty()) {
+    return fail("--placement-shape-floor tests two placements: give --second-capture or --held-out-capture");
   }
   if (!(o.held_out_tolerance >= 0.0 && o.held_out_tolerance <= 1.0)) return fail("--held-out-tolerance must be 0 .. 1");
   if (outside(o.starts, 0, 100)) return fail("--starts must be 0 (the guess alone) .. 100");
@@ -221,6 +228,7 @@ int run_diagnose(const DiagnoseOptions& o) {
   settings.attribution.confirm_within_floors = o.confirm_within_floors;
   settings.attribution.held_out_tolerance = o.held_out_tolerance;
   if (o.shape_floor) settings.floors.shape_threshold = settings.held_out_shape_threshold = *o.shape_floor;
+  settings.floors.placement_shape_threshold = o.placement_shape_floor;
   // The fleet: the drapes go to workers; the renders, scores and the search stay here.
   std::unique_ptr<coordinator::SimulationFleet> fleet;
   if (!o.fleet.empty()) {
@@ -274,6 +282,11 @@ int run_diagnose(const DiagnoseOptions& o) {
     std::cout << fmt::format("  tests: stable term {:.2f} mm against its floor {:.2f} mm; shape distance {:.2f} "
                              "against its floor {:.2f}\n",
                              gap.stable * 1e3, r.floors.stable * 1e3, gap.shape, r.floors.shape);
+    if (r.floors.placement_shape > 0.0) {
+      std::cout << fmt::format("  placement test: the larger placement's shape distance {:.2f} against its floor "
+                               "{:.2f}\n",
+                               gap.shape_max, r.floors.placement_shape);
+    }
     std::cout << fmt::format("  score {:.2f} mm (all views), {:.2f} mm (held-out view); the scores' floors {:.2f} / "
                              "{:.2f} mm\n",
                              r.gap_all * 1e3, r.gap_held_out * 1e3, r.floors.all * 1e3, r.floors.held_out * 1e3);
@@ -486,6 +499,11 @@ Runner add_diagnose_command(CLI::App& app) {
                              "--held-out-capture or --second-capture {:.2f}; 0: the largest floor sample)",
                              diagnosis::FloorSettings{}.shape_threshold, diagnosis::DiagnosisSettings::kFineShapeFloor,
                              diagnosis::DiagnosisSettings::kFineHeldOutShapeFloor));
+  app.add_option("--placement-shape-floor", o->placement_shape_floor,
+                 "With --second-capture or --held-out-capture: also test the larger of the two placements' shape "
+                 "distances against this floor (0, the default: no such test; an experiment, docs/DIAGNOSIS.md, "
+                 "\"Floors\")")
+      ->capture_default_str();
   app.add_flag("--ablation", o->ablation,
                "Also validate each simulated candidate with its effect switched off at its refitted bending scale, and "
                "credit it only for what the effect adds beyond that (report.json: candidates' \"ablated\"; off by "

@@ -1399,6 +1399,30 @@ expect_roles("--second-capture alone" "${out}" second_capture capture_and_second
 expect_failure(1 "the second capture too" diagnose --capture ${WORK}/capture --second-capture ${WORK}/capture.p1
                --held-out-capture ${WORK}/capture.p1/.)
 expect_failure(1 "second capture" diagnose --capture ${WORK}/capture --second-capture ${WORK}/does_not_exist)
+# The placement test (off by default): the larger placement's shape distance against its own floor; a floor below it
+# adds that test's excess to the gate's, and the report states both.
+run_ok(out diagnose --capture ${WORK}/capture --second-capture ${WORK}/capture.p1 --quick --resolution 10 --states 2
+       --evaluations 4 --gap-only --json)
+run_ok(placed diagnose --capture ${WORK}/capture --second-capture ${WORK}/capture.p1 --quick --resolution 10 --states 2
+       --evaluations 4 --gap-only --json --placement-shape-floor 0.01)
+json_number(off_floor "${out}" gap_tests placement_shape_floor)
+json_number(off_excess "${out}" gap_tests excess_above_floors)
+json_number(placed_floor "${placed}" gap_tests placement_shape_floor)
+json_number(placed_max "${placed}" gap_tests shape_max)
+json_number(placed_excess "${placed}" gap_tests excess_above_floors)
+json_number(capture_shape "${placed}" gap_tests capture shape)
+json_number(second_shape "${placed}" gap_tests second_capture shape)
+set(max_is_one 0)
+if(placed_max EQUAL capture_shape OR placed_max EQUAL second_shape)
+  set(max_is_one 1)
+endif()
+if(NOT off_floor EQUAL 0 OR NOT placed_floor EQUAL 0.01 OR NOT max_is_one OR NOT placed_excess GREATER off_excess)
+  message(FATAL_ERROR "--placement-shape-floor 0.01: floor ${placed_floor} (off: ${off_floor}), shape_max "
+                      "${placed_max} (placements ${capture_shape}, ${second_shape}), excess ${placed_excess} "
+                      "(off: ${off_excess})")
+endif()
+expect_failure(1 "--placement-shape-floor must be" diagnose --capture ${WORK}/capture --placement-shape-floor -1)
+expect_failure(1 "tests two placements" diagnose --capture ${WORK}/capture --placement-shape-floor 1.2)
 
 # The sensor candidate held to the rigid surfaces: a multipath error leaves the platform top and the bare side where
 # the tester puts them (the camera they show moves the platform's centre less than 3 mm), so the candidate keeps their

@@ -469,6 +469,7 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
   if ((others.second || others.held_out) && settings.held_out_shape_threshold > 0.0) {
     floor_settings.shape_threshold = settings.held_out_shape_threshold;
   }
+  if (!others.second && !others.held_out) floor_settings.placement_shape_threshold = 0.0;  // one placement: no test
   auto floors = measure_floors(model, fitted, r.fit, floor_settings);
   if (!floors) return floors.error();
   r.floors = *floors;
@@ -622,6 +623,8 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                     {"stable_floor_mm", r.floors.stable * 1e3},
                     {"shape", gap.shape},
                     {"shape_floor", r.floors.shape},
+                    {"shape_max", gap.shape_max},
+                    {"placement_shape_floor", r.floors.placement_shape},
                     {"excess_above_floors", excess_above_floors(gap, r.floors)},
                     {"paired_with", r.validated_second     ? nlohmann::json("second_capture")
                                     : r.validated_held_out ? nlohmann::json("held_out_capture")

@@ -79,15 +79,18 @@ std::array<double, RegionEnergy::kCount> Floors::region_floor() const {
 double Floors::stable_floor() const { return largest(pooled(*this, &FloorSamples::stable)); }
 
 GapTerms gap_terms(const ScoredDrape& drape, const ScoredDrape* held_out_capture) {
-  if (!held_out_capture) return {drape.stable_all, drape.shape_all};
+  if (!held_out_capture) return {drape.stable_all, drape.shape_all, drape.shape_all};
   return {0.5 * (drape.stable_all + held_out_capture->stable_all),
-          0.5 * (drape.shape_all + held_out_capture->shape_all)};
+          0.5 * (drape.shape_all + held_out_capture->shape_all),
+          std::max(drape.shape_all, held_out_capture->shape_all)};
 }
 
 double excess_above_floors(const GapTerms& gap, const Floors& floors) {
   // value - floor is positive exactly when value > floor, so the sum is 0 exactly when both tests pass.
   auto relative_excess = [](double value, double floor) { return value > floor ? (value - floor) / floor : 0.0; };
-  return relative_excess(gap.stable, floors.stable) + relative_excess(gap.shape, floors.shape);
+  const double placement =
+      floors.placement_shape > 0.0 ? relative_excess(gap.shape_max, floors.placement_shape) : 0.0;
+  return relative_excess(gap.stable, floors.stable) + relative_excess(gap.shape, floors.shape) + placement;
 }
 
 double excess_above_floors(const ScoredDrape& drape, const Floors& floors) {
@@ -122,6 +125,7 @@ sim::Expected<Floors> measure_floors(ForwardModel& model, const ModelSetup& fitt
   floors.shape_margin = settings.shape_margin;
   floors.shape = settings.shape_threshold > 0.0 ? settings.shape_threshold
                                                 : settings.shape_margin * largest(pooled(floors, &FloorSamples::shape));
+  floors.placement_shape = std::max(0.0, settings.placement_shape_threshold);
   floors.typical_all = median_or_zero(pooled(floors, &FloorSamples::all));
   floors.typical_held_out = median_or_zero(pooled(floors, &FloorSamples::held_out));
   return floors;

@@ -233,6 +233,10 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
       : r.validated_held_out ? ", mean of the capture and the held-out capture"
                              : "",
       gap.stable * 1e3, r.floors.stable * 1e3, gap.shape, r.floors.shape);
+  if (r.floors.placement_shape > 0.0) {
+    md += fmt::format("Placement test: the larger placement's shape distance {:.2f} against its floor {:.2f}.\n\n",
+                      gap.shape_max, r.floors.placement_shape);
+  }
   if (r.rigid_pose) {
     const RigidPose& p = *r.rigid_pose;
     md += fmt::format(

@@ -78,6 +78,26 @@ TEST(GapTerms, AreTheMeanOfTheCaptureAndTheHeldOutCapture) {
   EXPECT_EQ(excess_above_floors(both, f), 0.0);
 }
 
+// The placement test (off unless its floor is set): the larger placement's shape distance against its own floor, so
+// an effect that shows on one placement and not the other (a plastic set carried to the next placement) is not lost
+// in the mean; its excess adds to the others'.
+TEST(GapTerms, TheLargerPlacementHasATestOfItsOwn) {
+  const ScoredDrape a = drape_of(2e-3, 0.4), b = drape_of(2e-3, 1.5);
+  const GapTerms both = gap_terms(a, &b), reversed = gap_terms(b, &a);
+  EXPECT_EQ(both.shape_max, 1.5);
+  EXPECT_EQ(reversed.shape_max, 1.5);
+  EXPECT_EQ(gap_terms(a).shape_max, 0.4);  // one placement: its own
+  Floors f = floors_of(5e-3, 1.15);
+  EXPECT_EQ(excess_above_floors(both, f), 0.0);  // the mean, 0.95, is within; no placement test
+  f.placement_shape = 1.2;
+  EXPECT_NEAR(excess_above_floors(both, f), 0.25, 1e-12);  // 1.5 / 1.2 - 1
+  f.placement_shape = 1.5;
+  EXPECT_EQ(excess_above_floors(both, f), 0.0);  // at its floor is within it
+  const GapTerms far = gap_terms(drape_of(2e-3, 1.3), &b);  // mean 1.4: 1.4 / 1.15 - 1, and 1.5 / 1.2 - 1
+  f.placement_shape = 1.2;
+  EXPECT_NEAR(excess_above_floors(far, f), 1.4 / 1.15 - 1.0 + 0.25, 1e-12);
+}
+
 TEST(GapShrinkage, CreditsRemovingTheReasonTheGateFired) {
   const Floors f = floors_of(2e-3, 1.15);
   const double before = excess_above_floors(drape_of(1e-3, 1.38), f);  // the gate fired on the shape test

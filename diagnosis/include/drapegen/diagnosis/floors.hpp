@@ -34,6 +34,9 @@ struct Floors {
   double stable = 0.0;
   double shape = 0.0;
   double shape_margin = 1.0;
+  /// With a paired capture, a third test (FloorSettings::placement_shape_threshold): the larger of the two
+  /// placements' shape distances (GapTerms::shape_max). 0: no such test.
+  double placement_shape = 0.0;
   /// The median sample score over all views / the held-out view: what a correct model typically leaves (reported
   /// for reference; the gate and the attribution use `stable` and `shape`, see excess_above_floors).
   double typical_all = 0.0;
@@ -57,6 +60,10 @@ struct FloorSettings {
   /// overstate the floor. 1.39: the largest of 8 calibration controls (--seed 2, 60x60 reality, --quick, the gap
   /// measured from the validation states) was 1.26, plus 10%.
   double shape_threshold = 1.39;
+  /// If positive, the floor of the placement shape test (Floors::placement_shape): an effect that shows on one
+  /// placement more than on the other (a yielding specimen's plastic set, carried to the next placement and turned
+  /// over with it) is diluted in the two placements' mean. 0 (the default): no such test.
+  double placement_shape_threshold = 0.0;
 };
 
 /// What the gate tests of a model drape: its stable-region term (m) and its shape distance, over all views. With a
@@ -65,11 +72,13 @@ struct FloorSettings {
 struct GapTerms {
   double stable = 0.0;
   double shape = 0.0;
+  double shape_max = 0.0;  // the larger of the two placements' shape distances (one placement: its own)
 };
 [[nodiscard]] GapTerms gap_terms(const ScoredDrape& drape, const ScoredDrape* held_out_capture = nullptr);
 
 /// How far a drape is above the floors, in the terms of the gate "within the floors" (dimensionless): the excess of
-/// the stable-region term over `floors.stable` and of the shape distance over `floors.shape`, each relative to its
+/// the stable-region term over `floors.stable` and of the shape distance over `floors.shape` (and, where
+/// floors.placement_shape is positive, of the larger placement's shape distance over it), each relative to its
 /// floor and clipped at 0, summed. Zero exactly when the drape is within the floors (both tests pass); the floors
 /// must be positive.
 [[nodiscard]] double excess_above_floors(const GapTerms& gap, const Floors& floors);
