@@ -86,7 +86,7 @@ GapTerms gap_terms(const ScoredDrape& drape, const ScoredDrape* held_out_capture
 }
 
 double excess_above_floors(const GapTerms& gap, const Floors& floors) {
-  // value - floor is positive exactly when value > floor, so the sum is 0 exactly when both tests pass.
+  // value - floor is positive exactly when value > floor, so the sum is 0 exactly when every test passes.
   auto relative_excess = [](double value, double floor) { return value > floor ? (value - floor) / floor : 0.0; };
   const double placement =
       floors.placement_shape > 0.0 ? relative_excess(gap.shape_max, floors.placement_shape) : 0.0;

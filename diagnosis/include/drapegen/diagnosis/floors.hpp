@@ -79,7 +79,7 @@ struct GapTerms {
 /// How far a drape is above the floors, in the terms of the gate "within the floors" (dimensionless): the excess of
 /// the stable-region term over `floors.stable` and of the shape distance over `floors.shape` (and, where
 /// floors.placement_shape is positive, of the larger placement's shape distance over it), each relative to its
-/// floor and clipped at 0, summed. Zero exactly when the drape is within the floors (both tests pass); the floors
+/// floor and clipped at 0, summed. Zero exactly when the drape is within the floors (every test passes); the floors
 /// must be positive.
 [[nodiscard]] double excess_above_floors(const GapTerms& gap, const Floors& floors);
 [[nodiscard]] double excess_above_floors(const ScoredDrape& drape, const Floors& floors);
