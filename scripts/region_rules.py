@@ -84,6 +84,17 @@ def leading(loc):
     return "stable" if loc["stable_ratio"] > best else lead
 
 
+def group_region(loc, lead, skirt_denser=1.0):
+    """Where place_gap puts a gap a feature group leads: an outline group follows the skirt where the skirt's residual
+    is the denser (by skirt_denser), the centre's offset is the hem's, every other group the skirt's."""
+    if lead not in OUTLINE:
+        return "skirt"
+    if lead == "off_centre":
+        return "hem"
+    enrichment = {r["region"]: r["enrichment"] for r in loc["regions"]}
+    return "skirt" if enrichment.get("skirt", 0.0) > skirt_denser * enrichment.get("hem", 0.0) else "hem"
+
+
 def largest(loc):
     lead = leading(loc)
     if lead is None or lead == "stable":
@@ -116,12 +127,7 @@ def place_gap(loc, sensor_scale, skirt_denser, lifted_scale=None):
         if signed:
             return stable_region(loc, lifted_scale)
         return "global" if loc["stable_ratio"] >= sensor_scale else "top"
-    if lead not in OUTLINE:
-        return "skirt"
-    if lead == "off_centre":
-        return "hem"
-    enrichment = {r["region"]: r["enrichment"] for r in loc["regions"]}
-    return "skirt" if enrichment.get("skirt", 0.0) > skirt_denser * enrichment.get("hem", 0.0) else "hem"
+    return group_region(loc, lead, skirt_denser)
 
 
 def split(loc, key):
@@ -163,12 +169,7 @@ def closure_groups(loc, named, lifted_scale):
         return loc["region"]
     if lead == "stable":
         return stable_region(loc, lifted_scale)
-    if lead not in OUTLINE:
-        return "skirt"
-    if lead == "off_centre":
-        return "hem"
-    enrichment = {r["region"]: r["enrichment"] for r in loc["regions"]}
-    return "skirt" if enrichment.get("skirt", 0.0) > enrichment.get("hem", 0.0) else "hem"
+    return group_region(loc, lead)
 
 
 def closure_regions(loc, named):
@@ -204,13 +205,7 @@ def lifted_top(loc, lifted_mm, fold_depth):
     lead = leading(loc)
     if top["mean_mm"] <= -lifted_mm or lead in (None, "stable"):
         return loc["region"]
-    if lead not in OUTLINE:
-        region = "skirt"
-    elif lead == "off_centre":
-        region = "hem"
-    else:
-        enrichment = {r["region"]: r["enrichment"] for r in loc["regions"]}
-        region = "skirt" if enrichment.get("skirt", 0.0) > enrichment.get("hem", 0.0) else "hem"
+    region = group_region(loc, lead)
     return "hem" if region == "skirt" and folds_deeper_than_mean(loc, fold_depth) else region
 
 
