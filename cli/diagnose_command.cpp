@@ -56,6 +56,7 @@ struct DiagnoseOptions {
   std::optional<int> jobs;  // unset: one per CPU this process may run on, with a fleet --fleet-workers (run_diagnose)
   std::optional<double> shape_floor;
   double placement_shape_floor = 0.0;
+  bool placement_drape_test = false;
   bool gap_only = false;
   bool ablation = false;
   bool confirm_within_floors = false;
@@ -109,6 +110,9 @@ int run_diagnose(const DiagnoseOptions& o) {
   }
   if (o.placement_shape_floor > 0.0 && o.second.empty() && o.held_out.empty()) {
     return fail("--placement-shape-floor tests two placements: give --second-capture or --held-out-capture");
+  }
+  if (o.placement_drape_test && o.second.empty() && o.held_out.empty()) {
+    return fail("--placement-drape-test tests two placements: give --second-capture or --held-out-capture");
   }
   if (!(o.held_out_tolerance >= 0.0 && o.held_out_tolerance <= 1.0)) return fail("--held-out-tolerance must be 0 .. 1");
   if (outside(o.starts, 0, 100)) return fail("--starts must be 0 (the guess alone) .. 100");
@@ -229,6 +233,7 @@ int run_diagnose(const DiagnoseOptions& o) {
   settings.attribution.held_out_tolerance = o.held_out_tolerance;
   if (o.shape_floor) settings.floors.shape_threshold = settings.held_out_shape_threshold = *o.shape_floor;
   settings.floors.placement_shape_threshold = o.placement_shape_floor;
+  settings.floors.placement_drape_coefficient = o.placement_drape_test;
   // The fleet: the drapes go to workers; the renders, scores and the search stay here.
   std::unique_ptr<coordinator::SimulationFleet> fleet;
   if (!o.fleet.empty()) {
@@ -286,6 +291,11 @@ int run_diagnose(const DiagnoseOptions& o) {
       std::cout << fmt::format("  placement test: the larger placement's shape distance {:.2f} against its floor "
                                "{:.2f}\n",
                                gap.shape_max, r.floors.placement_shape);
+    }
+    if (r.floors.placement_dc > 0.0) {
+      std::cout << fmt::format("  placement drape test: the placements' drape-coefficient difference less the "
+                               "model's {:.4f} against its floor {:.4f}\n",
+                               gap.placement_dc, r.floors.placement_dc);
     }
     std::cout << fmt::format("  score {:.2f} mm (all views), {:.2f} mm (held-out view); the scores' floors {:.2f} / "
                              "{:.2f} mm\n",
@@ -504,6 +514,11 @@ Runner add_diagnose_command(CLI::App& app) {
                  "distances against this floor (0, the default: no such test; an experiment, docs/DIAGNOSIS.md, "
                  "\"Floors\")")
       ->capture_default_str();
+  app.add_flag("--placement-drape-test", o->placement_drape_test,
+               "With --second-capture or --held-out-capture: also test whether the two placements' drape coefficients "
+               "differ by more than the model's (its stable drapes' range x the floors' margin): a yielding or "
+               "curled specimen drapes otherwise once turned over (off by default; an experiment, docs/DIAGNOSIS.md, "
+               "\"Floors\")");
   app.add_flag("--ablation", o->ablation,
                "Also validate each simulated candidate with its effect switched off at its refitted bending scale, and "
                "credit it only for what the effect adds beyond that (report.json: candidates' \"ablated\"; off by "

@@ -1423,6 +1423,48 @@ if(NOT off_floor EQUAL 0 OR NOT placed_floor EQUAL 0.01 OR NOT max_is_one OR NOT
 endif()
 expect_failure(1 "--placement-shape-floor must be" diagnose --capture ${WORK}/capture --placement-shape-floor -1)
 expect_failure(1 "tests two placements" diagnose --capture ${WORK}/capture --placement-shape-floor 1.2)
+# The placement drape test (off by default): the placements' drape-coefficient difference less the model's, against a
+# floor from the fitted fabric's stable drapes; the report gives the coefficients it is computed from.
+run_ok(dct diagnose --capture ${WORK}/capture --second-capture ${WORK}/capture.p1 --quick --resolution 10 --states 2
+       --evaluations 4 --gap-only --json --placement-drape-test)
+json_number(off_dc_floor "${out}" gap_tests placement_dc_floor)
+json_number(dc_floor "${dct}" gap_tests placement_dc_floor)
+json_number(dc_term "${dct}" gap_tests placement_dc)
+json_number(dc_excess "${dct}" gap_tests excess_above_floors)
+json_nano(term_n "${dc_term}")
+set(dc_n "")
+foreach(role capture second_capture)
+  foreach(field drape_coefficient model_drape_coefficient)
+    json_number(v "${dct}" gap_tests ${role} ${field})
+    if(NOT v GREATER 0 OR NOT v LESS 1)
+      message(FATAL_ERROR "--placement-drape-test: gap_tests.${role}.${field} ${v} is no drape coefficient")
+    endif()
+    json_nano(n "${v}")
+    list(APPEND dc_n ${n})
+  endforeach()
+endforeach()
+list(GET dc_n 0 c0)
+list(GET dc_n 1 m0)
+list(GET dc_n 2 c1)
+list(GET dc_n 3 m1)
+math(EXPR expected "(${c1} - ${c0}) - (${m1} - ${m0})")
+if(expected LESS 0)
+  math(EXPR expected "-(${expected})")
+endif()
+math(EXPR off_by "${expected} - ${term_n}")
+if(NOT off_floor EQUAL 0 OR NOT off_dc_floor EQUAL 0 OR dc_floor LESS 0 OR off_by GREATER 4 OR off_by LESS -4)
+  message(FATAL_ERROR "--placement-drape-test: floor ${dc_floor} (off: ${off_dc_floor}), term ${dc_term} against "
+                      "|(c1 - c0) - (m1 - m0)| = ${expected} nano")
+endif()
+if(dc_floor GREATER 0 AND dc_term GREATER dc_floor AND NOT dc_excess GREATER off_excess)
+  message(FATAL_ERROR "--placement-drape-test: the term ${dc_term} is above its floor ${dc_floor} but the excess "
+                      "${dc_excess} is not above the excess without the test, ${off_excess}")
+endif()
+if(NOT dc_term GREATER dc_floor AND NOT dc_excess EQUAL off_excess)
+  message(FATAL_ERROR "--placement-drape-test: the term ${dc_term} is within its floor ${dc_floor}, yet the excess "
+                      "${dc_excess} differs from the excess without the test, ${off_excess}")
+endif()
+expect_failure(1 "tests two placements" diagnose --capture ${WORK}/capture --placement-drape-test)
 
 # The sensor candidate held to the rigid surfaces: a multipath error leaves the platform top and the bare side where
 # the tester puts them (the camera they show moves the platform's centre less than 3 mm), so the candidate keeps their

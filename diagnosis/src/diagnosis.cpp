@@ -148,7 +148,9 @@ nlohmann::json placement_json(const ScoredDrape* best, const std::vector<double>
           {"shape", best->shape_all},
           {"all_views_score_mm", best->all_score * 1e3},
           {"best_validation_state", best->state},
-          {"validation_all_views_scores_mm", millimetres(all_scores)}};
+          {"validation_all_views_scores_mm", millimetres(all_scores)},
+          {"drape_coefficient", best->capture_drape_coefficient},
+          {"model_drape_coefficient", best->median_drape_coefficient}};
 }
 nlohmann::json placement_json(const std::optional<Evaluation>& e) {
   return e ? placement_json(&e->best, e->all_scores()) : nullptr;
@@ -168,6 +170,7 @@ nlohmann::json validated_json(const CandidateResult& c, const Floors& floors) {
   };
   return {{"stable_mm", c.validated.stable_all * 1e3},
           {"shape", c.validated.shape_all},
+          {"model_drape_coefficient", c.validated.median_drape_coefficient},
           {"held_out_score_mm", c.validated.held_out_score * 1e3},
           {"second_capture", placement_json(c.second)},
           {"second_plastic_set_rad", set_json(c.second)},
@@ -487,6 +490,8 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
     if (!e) return e.error();
     *into = std::move(*e);
   }
+  if (settings.floors.placement_drape_coefficient && (second_model || held_out_model))
+    r.floors.placement_dc = placement_dc_floor(r.validated, r.floors.margin);
   r.validation_spread = validation_spread(r.validated.states, model.target().shape.all);
   {  // Does the specimen drape the same way on every placement, as often as the fitted model does?
     std::vector<HemProfile> placements{specimen_frame(hem_profile_from_capture(capture), capture.face_down)};
@@ -625,11 +630,17 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                     {"shape_floor", r.floors.shape},
                     {"shape_max", gap.shape_max},
                     {"placement_shape_floor", r.floors.placement_shape},
+                    {"placement_dc", gap.placement_dc},
+                    {"placement_dc_floor", r.floors.placement_dc},
                     {"excess_above_floors", excess_above_floors(gap, r.floors)},
                     {"paired_with", r.validated_second     ? nlohmann::json("second_capture")
                                     : r.validated_held_out ? nlohmann::json("held_out_capture")
                                                            : nlohmann::json(nullptr)},
-                    {"capture", {{"stable_mm", r.gap_drape().stable_all * 1e3}, {"shape", r.gap_drape().shape_all}}},
+                    {"capture",
+                     {{"stable_mm", r.gap_drape().stable_all * 1e3},
+                      {"shape", r.gap_drape().shape_all},
+                      {"drape_coefficient", r.gap_drape().capture_drape_coefficient},
+                      {"model_drape_coefficient", r.gap_drape().median_drape_coefficient}}},
                     {"second_capture", placement_json(r.validated_second)},
                     {"held_out_capture", placement_json(r.validated_held_out)},
                     {"validation_states", r.validated.states.size()},

@@ -1,6 +1,7 @@
 #include "drapegen/diagnosis/floors.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <optional>
 #include <utility>
@@ -79,10 +80,21 @@ std::array<double, RegionEnergy::kCount> Floors::region_floor() const {
 double Floors::stable_floor() const { return largest(pooled(*this, &FloorSamples::stable)); }
 
 GapTerms gap_terms(const ScoredDrape& drape, const ScoredDrape* held_out_capture) {
-  if (!held_out_capture) return {drape.stable_all, drape.shape_all, drape.shape_all};
-  return {0.5 * (drape.stable_all + held_out_capture->stable_all),
-          0.5 * (drape.shape_all + held_out_capture->shape_all),
-          std::max(drape.shape_all, held_out_capture->shape_all)};
+  if (!held_out_capture) return {drape.stable_all, drape.shape_all, drape.shape_all, 0.0};
+  const ScoredDrape& other = *held_out_capture;
+  const double captures = other.capture_drape_coefficient - drape.capture_drape_coefficient;
+  const double model = other.median_drape_coefficient - drape.median_drape_coefficient;
+  return {0.5 * (drape.stable_all + other.stable_all), 0.5 * (drape.shape_all + other.shape_all),
+          std::max(drape.shape_all, other.shape_all), std::abs(captures - model)};
+}
+
+double placement_dc_floor(const Evaluation& validated, double margin) {
+  if (validated.states.size() < 2) return 0.0;
+  const auto [lo, hi] = std::minmax_element(validated.states.begin(), validated.states.end(),
+                                            [](const ScoredDrape& a, const ScoredDrape& b) {
+                                              return a.drape_coefficient < b.drape_coefficient;
+                                            });
+  return margin * (hi->drape_coefficient - lo->drape_coefficient);
 }
 
 double excess_above_floors(const GapTerms& gap, const Floors& floors) {
@@ -90,7 +102,9 @@ double excess_above_floors(const GapTerms& gap, const Floors& floors) {
   auto relative_excess = [](double value, double floor) { return value > floor ? (value - floor) / floor : 0.0; };
   const double placement =
       floors.placement_shape > 0.0 ? relative_excess(gap.shape_max, floors.placement_shape) : 0.0;
-  return relative_excess(gap.stable, floors.stable) + relative_excess(gap.shape, floors.shape) + placement;
+  const double coefficient = floors.placement_dc > 0.0 ? relative_excess(gap.placement_dc, floors.placement_dc) : 0.0;
+  return relative_excess(gap.stable, floors.stable) + relative_excess(gap.shape, floors.shape) + placement +
+         coefficient;
 }
 
 double excess_above_floors(const ScoredDrape& drape, const Floors& floors) {

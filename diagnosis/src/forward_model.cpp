@@ -13,6 +13,7 @@
 #include "drapegen/renderer/rig.hpp"
 #include "drapegen/renderer/scene.hpp"
 #include "drapegen/sim/drape.hpp"
+#include "drapegen/sim/median.hpp"
 
 namespace drapegen::diagnosis {
 
@@ -116,6 +117,10 @@ sim::Expected<Evaluation> evaluation_of(std::vector<ScoredDrape> states) {
     }
   }
   if (!std::isfinite(best_score)) return sim::Error{"no initial state's drape has a finite score"};
+  std::vector<double> coefficients;
+  for (const auto& d : states) coefficients.push_back(d.drape_coefficient);
+  const double median = sim::median(std::move(coefficients));
+  for (auto& d : states) d.median_drape_coefficient = median;
   Evaluation e;
   e.best = states[best];
   e.states = std::move(states);
@@ -198,6 +203,7 @@ Target ForwardModel::make_target(const std::vector<renderer::DepthImage>& depth)
   }
   t.outline = hem_profile_from_views(c, settings_.fit_views);
   t.shape = shape_set(depth);
+  t.drape_coefficient = drape_coefficient(hem_profile_from_capture(c), c.specimen);
   return t;
 }
 
@@ -206,7 +212,11 @@ sim::Expected<ScoredDrape> ForwardModel::score(const sim::ClothMesh& mesh, const
   if (!mesh.positions.allFinite()) return sim::Error{"the drape to score has non-finite positions"};
   ScoredDrape d;
   d.mesh = mesh;
-  d.angle = align_orientation(hem_profile_from_mesh(mesh), target.outline).angle;
+  const HemProfile outline = hem_profile_from_mesh(mesh);
+  d.angle = align_orientation(outline, target.outline).angle;
+  d.drape_coefficient = drape_coefficient(outline, capture_.specimen);
+  d.capture_drape_coefficient = target.drape_coefficient;
+  d.median_drape_coefficient = d.drape_coefficient;
   auto images = render(mesh, d.angle, setup.sensor);
   if (!images) return images.error();
   // The shape features of the model are taken from renders with the capture's kind of noise (a fixed seed), so

@@ -237,6 +237,11 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
     md += fmt::format("Placement test: the larger placement's shape distance {:.2f} against its floor {:.2f}.\n\n",
                       gap.shape_max, r.floors.placement_shape);
   }
+  if (r.floors.placement_dc > 0.0) {
+    md += fmt::format("Placement drape test: the placements' drape-coefficient difference less the model's {:.4f} "
+                      "against its floor {:.4f}.\n\n",
+                      gap.placement_dc, r.floors.placement_dc);
+  }
   if (r.rigid_pose) {
     const RigidPose& p = *r.rigid_pose;
     md += fmt::format(

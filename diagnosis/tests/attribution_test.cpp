@@ -98,6 +98,47 @@ TEST(GapTerms, TheLargerPlacementHasATestOfItsOwn) {
   EXPECT_NEAR(excess_above_floors(far, f), 1.4 / 1.15 - 1.0 + 0.25, 1e-12);
 }
 
+/// A drape on a placement whose capture has drape coefficient `capture` and whose setup's drapes have the median
+/// `model` there (the gated terms within any floor).
+ScoredDrape placed(double capture, double model) {
+  ScoredDrape d = drape_of(1e-3, 0.5);
+  d.capture_drape_coefficient = capture;
+  d.median_drape_coefficient = model;
+  return d;
+}
+
+// The placement drape test (off unless its floor is set): the captures' drape-coefficient difference less the
+// model's, either sign, against a floor from the fitted fabric's stable drapes; its excess adds to the others'.
+TEST(GapTerms, ThePlacementsDrapeCoefficientsHaveATestOfTheirOwn) {
+  // A yielding specimen turned over drapes less (0.25 -> 0.33); an elastic model drapes alike on both (0.24).
+  const ScoredDrape first = placed(0.25, 0.24), second = placed(0.33, 0.24), shifted = placed(0.33, 0.31);
+  EXPECT_NEAR(gap_terms(first, &second).placement_dc, 0.08, 1e-12);
+  EXPECT_NEAR(gap_terms(second, &first).placement_dc, 0.08, 1e-12);  // either order, either sign
+  EXPECT_EQ(gap_terms(first).placement_dc, 0.0);                      // one placement: no test
+  // A model whose drapes shift as the captures do (its plastic set laid again) explains the difference.
+  EXPECT_NEAR(gap_terms(first, &shifted).placement_dc, 0.01, 1e-12);
+  Floors f = floors_of(5e-3, 1.15);
+  EXPECT_EQ(excess_above_floors(gap_terms(first, &second), f), 0.0);  // no floor: no test
+  f.placement_dc = 0.02;
+  EXPECT_NEAR(excess_above_floors(gap_terms(first, &second), f), 3.0, 1e-9);            // 0.08 / 0.02 - 1
+  EXPECT_EQ(excess_above_floors(gap_terms(first, &shifted), f), 0.0);                   // 0.01: within
+  EXPECT_NEAR(gap_shrinkage(excess_above_floors(gap_terms(first, &second), f),
+                            excess_above_floors(gap_terms(first, &shifted), f)),
+              1.0, 1e-12);
+}
+
+// Its floor: the largest difference two of the fitted fabric's stable drapes show, times the margin.
+TEST(GapTerms, ThePlacementDrapeFloorIsTheStableDrapesRange) {
+  Evaluation e;
+  for (double dc : {0.21, 0.19, 0.23, 0.20}) {
+    e.states.push_back(placed(0.2, 0.2));
+    e.states.back().drape_coefficient = dc;
+  }
+  EXPECT_NEAR(placement_dc_floor(e, 1.15), 1.15 * 0.04, 1e-12);
+  e.states.resize(1);
+  EXPECT_EQ(placement_dc_floor(e, 1.15), 0.0);  // one drape: no range, no test
+}
+
 TEST(GapShrinkage, CreditsRemovingTheReasonTheGateFired) {
   const Floors f = floors_of(2e-3, 1.15);
   const double before = excess_above_floors(drape_of(1e-3, 1.38), f);  // the gate fired on the shape test

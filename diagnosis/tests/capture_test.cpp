@@ -138,7 +138,7 @@ TEST(Capture, TheFaceRoundTripsIsUpByDefaultAndRefusesOtherValues) {
   r = read_capture(dir);
   ASSERT_TRUE(r.has_value()) << r.error().message;
   EXPECT_FALSE(r->face_down);
-  for (const nlohmann::json bad : {nlohmann::json("Down"), nlohmann::json(true), nlohmann::json(1)}) {
+  for (const nlohmann::json& bad : {nlohmann::json("Down"), nlohmann::json(true), nlohmann::json(1)}) {
     const std::string e = error_with(dir, written, [&](nlohmann::json& j) { j["face"] = bad; });
     EXPECT_NE(e.find("face must be \"up\" or \"down\""), std::string::npos) << e;
   }

@@ -2,6 +2,7 @@
 // again, or kept by evaluate).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <limits>
 #include <memory>
@@ -9,6 +10,7 @@
 #include <string>
 
 #include "drapegen/diagnosis/forward_model.hpp"
+#include "drapegen/diagnosis/hem_profile.hpp"
 #include "drapegen/sim/measures.hpp"
 #include "small_reality.hpp"
 
@@ -190,6 +192,35 @@ TEST(ForwardModel, EvaluatesOnSeveralThreadsAsOnOne) {
     EXPECT_EQ(three->states[k].fit_score, one->states[k].fit_score) << "state " << k;
     EXPECT_EQ(three->states[k].left.rest_angles, one->states[k].left.rest_angles) << "state " << k;
   }
+  fs::remove_all(small->made.dir);
+}
+
+TEST(ForwardModel, EveryDrapeCarriesItsDrapeCoefficientTheCapturesAndTheEvaluationsMedian) {
+  // The placement drape test's inputs (floors.hpp, GapTerms::placement_dc): each drape's drape coefficient from its
+  // mesh's outline, the capture's from the outline every view sees, and the median over the evaluation's drapes.
+  auto small = small_model("coefficients");
+  ASSERT_TRUE(small.has_value());
+  auto& model = small->model;
+  ModelSetup elastic;
+  elastic.bending = small->made.spec.bending;
+  auto e = model->evaluate(elastic, fit_initial_states(3, 7));
+  ASSERT_TRUE(e.has_value()) << e.error().message;
+  const SpecimenFacts& specimen = model->capture().specimen;
+  const double capture = drape_coefficient(hem_profile_from_capture(model->capture()), specimen);
+  EXPECT_GT(capture, 0.0);
+  EXPECT_LT(capture, 1.0);
+  std::vector<double> own;
+  for (const auto& d : e->states) {
+    EXPECT_EQ(d.drape_coefficient, drape_coefficient(hem_profile_from_mesh(d.mesh), specimen));
+    EXPECT_EQ(d.capture_drape_coefficient, capture);
+    own.push_back(d.drape_coefficient);
+  }
+  std::sort(own.begin(), own.end());
+  for (const auto& d : e->states) EXPECT_EQ(d.median_drape_coefficient, own[1]);
+  EXPECT_EQ(e->best.median_drape_coefficient, own[1]);
+  auto alone = model->score(e->states[0].mesh, elastic);  // scored alone: its own
+  ASSERT_TRUE(alone.has_value()) << alone.error().message;
+  EXPECT_EQ(alone->median_drape_coefficient, alone->drape_coefficient);
   fs::remove_all(small->made.dir);
 }
 

@@ -37,6 +37,10 @@ struct Floors {
   /// With a paired capture, a third test (FloorSettings::placement_shape_threshold): the larger of the two
   /// placements' shape distances (GapTerms::shape_max). 0: no such test.
   double placement_shape = 0.0;
+  /// With a paired capture and FloorSettings::placement_drape_coefficient, a fourth test, of the two placements'
+  /// drape-coefficient difference against the model's (GapTerms::placement_dc): `margin` x the range of the fitted
+  /// fabric's drape coefficients over its validation drapes (placement_dc_floor). 0: no such test.
+  double placement_dc = 0.0;
   /// The median sample score over all views / the held-out view: what a correct model typically leaves (reported
   /// for reference; the gate and the attribution use `stable` and `shape`, see excess_above_floors).
   double typical_all = 0.0;
@@ -64,6 +68,11 @@ struct FloorSettings {
   /// placement more than on the other (a yielding specimen's plastic set, carried to the next placement and turned
   /// over with it) is diluted in the two placements' mean. 0 (the default): no such test.
   double placement_shape_threshold = 0.0;
+  /// With a paired capture, test the placements' drape coefficients (Floors::placement_dc): an elastic specimen
+  /// lifted, turned over and laid again drapes from the same stable states each time, so its placements' drape
+  /// coefficients differ by no more than two of its stable drapes' do; a yielding one lays its earlier drape's creases,
+  /// turned over, against the next drape, a curled edge rolls to the other face. Off by default (an experiment).
+  bool placement_drape_coefficient = false;
 };
 
 /// What the gate tests of a model drape: its stable-region term (m) and its shape distance, over all views. With a
@@ -73,16 +82,25 @@ struct GapTerms {
   double stable = 0.0;
   double shape = 0.0;
   double shape_max = 0.0;  // the larger of the two placements' shape distances (one placement: its own)
+  /// With a paired capture: |(c1 - c0) - (m1 - m0)|, the captures' drape-coefficient difference (paired minus
+  /// capture) less the model's (the medians of its drapes on each placement, ScoredDrape::median_drape_coefficient);
+  /// 0 with one placement.
+  double placement_dc = 0.0;
 };
 [[nodiscard]] GapTerms gap_terms(const ScoredDrape& drape, const ScoredDrape* held_out_capture = nullptr);
 
 /// How far a drape is above the floors, in the terms of the gate "within the floors" (dimensionless): the excess of
 /// the stable-region term over `floors.stable` and of the shape distance over `floors.shape` (and, where
-/// floors.placement_shape is positive, of the larger placement's shape distance over it), each relative to its
+/// floors.placement_shape is positive, of the larger placement's shape distance over it; where floors.placement_dc
+/// is, of the placements' drape-coefficient difference over it), each relative to its
 /// floor and clipped at 0, summed. Zero exactly when the drape is within the floors (every test passes); the floors
 /// must be positive.
 [[nodiscard]] double excess_above_floors(const GapTerms& gap, const Floors& floors);
 [[nodiscard]] double excess_above_floors(const ScoredDrape& drape, const Floors& floors);
+
+/// The placement test's floor: `margin` x the range of the drape coefficients of `validated`'s drapes (the fitted
+/// fabric's stable drapes; the largest difference two placements of it can show). 0 (no test) without two drapes.
+[[nodiscard]] double placement_dc_floor(const Evaluation& validated, double margin);
 
 [[nodiscard]] sim::Expected<Floors> measure_floors(ForwardModel& model, const ModelSetup& fitted,
                                                    const Evaluation& fit, const FloorSettings& settings);

@@ -49,6 +49,9 @@ struct Target {
   std::vector<ViewFeatures> views;
   HemProfile outline;                 // from the fit views
   ShapeSet shape;
+  /// Cusick's drape coefficient of the outline seen by every view (hem_profile_from_capture's): the placement
+  /// drape-coefficient test (floors.hpp, GapTerms::placement_dc).
+  double drape_coefficient = 0.0;
 };
 
 /// One drape of the model, turned to best match an outline, and how it compares with each view.
@@ -70,6 +73,12 @@ struct ScoredDrape {
   double all_score = 0.0;
   /// A yielding setup's drape from ForwardModel::evaluate: the plastic set it leaves (empty otherwise).
   PlasticSet left;
+  /// Cusick's drape coefficient of the mesh's outline, and of the capture's it was scored against
+  /// (Target::drape_coefficient).
+  double drape_coefficient = 0.0, capture_drape_coefficient = 0.0;
+  /// The median drape coefficient of the drapes of the evaluation this one belongs to (its own where scored alone):
+  /// what the setup drapes to on this placement over stable states, for the placement test (GapTerms::placement_dc).
+  double median_drape_coefficient = 0.0;
 };
 
 struct Evaluation {
