@@ -194,7 +194,9 @@ def multipath_floor(report):
 
 
 def lifted_top(loc, lifted_mm, fold_depth):
-    """Rule T (session 72): as run, but a gap placed on the platform top by the stable term where a feature group
+    """Rule T (registered in session 72, adopted in 73: localisation.cpp's place_gap, kLiftedTopContact, since then;
+    on reports made before, the rule read off them): as run, but a gap placed on the platform top by the stable term
+    where a feature group
     stands further above its floor (place_gap's "a lifted top leads whatever else exceeds its floor") stays there only
     if the top is lifted by at least lifted_mm (its mean residual at most -lifted_mm: cloth that slid rises in
     wrinkles over the top); otherwise the group furthest above its floor places it, as place_gap places a group's gap

@@ -109,8 +109,11 @@ void place_gap(Localisation& L) {
   // kLiftedTopSensorRatio times its floor (beyond what a specimen's contact lifts); an error of the camera moves the
   // outline as well, often further above its floor than the rigid surfaces.
   // (stable_region says kGlobal exactly for a top seen farther, or a lifted one from that ratio.)
+  // A top lifted by less than kLiftedTopContact is the fit's own offset there, not cloth that slid (rule T).
   const Region stable_at = stable_region(L);
-  if (L.stable_ratio > best || (L.stable_ratio > 1.0 && stable_at == Region::kTop) || stable_at == Region::kGlobal ||
+  const RegionShare* top = region_share(L, Region::kTop);
+  const bool slid = stable_at == Region::kTop && top && top->mean <= -kLiftedTopContact;
+  if (L.stable_ratio > best || (L.stable_ratio > 1.0 && slid) || stable_at == Region::kGlobal ||
       L.stable_ratio >= kLiftedTopSensorRatio) {
     L.dominant_feature = "stable";
     L.dominant = stable_at;

@@ -169,6 +169,19 @@ TEST(PlaceGap, TheStableTermSitsWhereTheRigidSurfacesSayAndLeadsOnlyAboveTheGrou
   L = with_top(excess(FeatureGroup::kHarmonics, 2.5, 0.95, 1.6, 1.2), -3.0e-3, 1.4);  // the stable term within
   place_gap(L);
   EXPECT_EQ(L.dominant, Region::kSkirt);
+  // A top lifted by less than kLiftedTopContact is the fit's own offset (rule T): the larger group leads (seed 91's
+  // shear_00, its top 0.24 mm above the fitted cloth); from it, the top does.
+  L = with_top(excess(FeatureGroup::kHarmonics, 2.5, 1.3, 1.6, 1.2), -0.24e-3, 1.4);
+  place_gap(L);
+  EXPECT_EQ(L.dominant, Region::kSkirt);
+  EXPECT_EQ(L.dominant_feature, "harmonics");
+  L = with_top(excess(FeatureGroup::kHarmonics, 2.5, 1.3, 1.6, 1.2), -kLiftedTopContact, 1.4);
+  place_gap(L);
+  EXPECT_EQ(L.dominant, Region::kTop);
+  // Leading on its own, the stable term places a top lifted less as before.
+  L = with_top(excess(FeatureGroup::kHarmonics, 1.2, 1.3, 1.0, 1.0), -0.24e-3, 1.4);
+  place_gap(L);
+  EXPECT_EQ(L.dominant, Region::kTop);
 }
 
 TEST(RegionEnergy, MeanIsTheSignedResidualPerPixelOverallAndPerView) {

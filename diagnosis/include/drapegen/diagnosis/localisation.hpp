@@ -114,6 +114,10 @@ void localise_against_floors(Localisation& localisation,
 /// docs/DIAGNOSIS_RESULTS.md, "Session 25": a specimen lifted by friction reached 1.64, a camera pose error that lifts
 /// the top 3.15).
 inline constexpr double kLiftedTopSensorRatio = 2.25;
+/// m: how far above the fitted cloth a lifted platform top must lie for place_gap to let it lead a larger feature
+/// group (rule T, registered in session 72, adopted in 73: on seeds 80-92 every friction capture's top lay 2.5-4.7 mm
+/// above, every other physical capture's 0.0-0.4 mm, the fit's own offset; docs/DIAGNOSIS_RESULTS.md, "Session 73").
+inline constexpr double kLiftedTopContact = 0.001;
 /// m: the camera_moved from which place_gap calls the gap a camera error's (everywhere) whatever leads (session 28,
 /// seeds 17-20: pose and bias errors 4.6-24 mm; friction, whose cloth sits higher on the top, at most 2.2 mm;
 /// anything else at most 1.2 mm).
@@ -142,7 +146,8 @@ void localise_features(Localisation& localisation, const ScoredDrape& drape, con
 /// Sets dominant and dominant_feature from camera_moved, group_ratio, stable_ratio and the regions' enrichment, mean
 /// and floor ratio. A camera the rigid surfaces put kCameraMovedAtPlatform or farther from its calibration places
 /// it everywhere (kGlobal, "camera"). Else the largest ratio above 1 leads, but the stable term leads whatever else
-/// exceeds its floor when it is above its floor with stable_region kTop (a lifted platform top), when the top is above
+/// exceeds its floor when it is above its floor with stable_region kTop and the top lifted by kLiftedTopContact or
+/// more (a specimen that slid over the platform), when the top is above
 /// its own floor and seen farther than the fitted cloth, or when it is at least kLiftedTopSensorRatio times its floor
 /// (a camera's error; session 27). The stable term: stable_region. A skirt group: kSkirt. The hem's centre offset:
 /// kHem. The other hem groups (harmonics, sorted radii, hem height): kSkirt if the skirt's pixel residual is denser
