@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fmt/format.h>
 #include <iostream>
+#include <optional>
 
 #include "drapegen/diagnosis/attribution.hpp"
 #include "drapegen/diagnosis/bending_json.hpp"
@@ -77,6 +78,7 @@ int main(int argc, char** argv) {
     for (const fs::path& dir : dirs) {
       std::string family = "none";
       fmt::memory_buffer row;
+      std::optional<diagnosis::Capture> first;  // placement 0: the one the report's fit was made on
       for (int p = 0; p < placements; ++p) {
         const std::string name = dir.filename().string() + (p > 0 ? fmt::format(".p{}", p) : "");
         const auto capture = diagnosis::read_capture((dir.parent_path() / name).string());
@@ -92,12 +94,11 @@ int main(int argc, char** argv) {
           truth = t->value("drape_coefficient", std::nan(""));
         }
         fmt::format_to(std::back_inserter(row), " {:>7.4f} {:>7.4f}", dc, truth);
+        if (p == 0) first = *capture;
       }
       if (!model_reports.empty()) {
-        const auto capture = diagnosis::read_capture(dir.string());
         const auto report = fs::path(run) / model_reports / (dir.filename().string() + ".json");
-        const auto dc = capture ? model_coefficients(*capture, report) : sim::Expected<std::vector<double>>(
-                                                                             capture.error());
+        const auto dc = model_coefficients(*first, report);
         if (!dc || dc->empty()) {
           std::cerr << dir.string() << ": " << (dc ? std::string("no validation states") : dc.error().message)
                     << "\n";
