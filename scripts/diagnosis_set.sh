@@ -8,9 +8,11 @@
 #                                                            # set is diagnosed with, commit in OUT/bin/COMMIT), keeps
 #                                                            # the options in OUT/set.args, generates, marks
 #                                                            # OUT/generated
-#   scripts/diagnosis_set.sh diagnose OUT... [--lanes N]     # N diagnoses at once (default: the cores), one core
-#                                                            # each, sharing the sets' cases (the bench's case
-#                                                            # locks: sets generated since session 70)
+#   scripts/diagnosis_set.sh diagnose OUT... [--lanes N] [--first-core K]
+#                                                            # N diagnoses at once (default: the cores), one core
+#                                                            # each (K, K+1, ...; default 0), sharing the sets'
+#                                                            # cases (the bench's case locks: sets generated since
+#                                                            # session 70; lanes may join a running diagnose)
 #   scripts/diagnosis_set.sh score OUT...                    # each set's summary, then the verdict and region tables
 #
 # BENCH-OPTIONS choose the captures (drapegen_diagnosis_bench --help): e.g.
@@ -54,10 +56,11 @@ case $step in
     date -u +%FT%TZ > "$out/generated"
     ;;
   diagnose)
-    sets=("$out") lanes=$(nproc)
+    sets=("$out") lanes=$(nproc) first=0
     while [ $# -gt 0 ]; do
       case $1 in
         --lanes) lanes=$2; shift 2 ;;
+        --first-core) first=$2; shift 2 ;;
         *) sets+=("$1"); shift ;;
       esac
     done
@@ -65,7 +68,7 @@ case $step in
       [ -f "$s/generated" ] || { echo "diagnosis_set: $s is not generated yet ($s/generated)" >&2; exit 1; }
     done
     lane() {  # lane K: every set in turn, one diagnosis at a time on core K; the bench's case locks share the work
-      runner=(taskset -c "$(( $1 % $(nproc) ))")
+      runner=(taskset -c "$(( ($first + $1) % $(nproc) ))")
       for s in "${sets[@]}"; do
         bench "$s" --second-placement --jobs 1 --diagnose-args "--fine --ignore-measured-bending" \
           | sed "s/^/lane $1: /"

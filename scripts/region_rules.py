@@ -42,6 +42,9 @@
 - lifted_top (rule T, registered in session 72 for seeds 88-89): as run, but a gap the stable term placed on the
   platform top while a feature group stands further above its floor stays there only if the top is lifted by at least
   --lifted-mm (default 1 mm: its mean residual at most -1 mm); else the leading group places it, as place_gap does.
+- skirt_dense (rule S, registered in session 74 for seeds 93-94): lifted_top's region, but a gap placed at the hem
+  (not by the views) goes to the skirt where the skirt's pixel enrichment is at least --skirt-dense (1.3) times the
+  hem's.
 
 Per rule: the effect captures whose region is one of the effect's regions (the truth file's `regions`), per family.
 
@@ -72,7 +75,7 @@ from diagnosis_rules import (EFFECT_REGIONS, THRESHOLD, confirmation_rule,  # no
 OUTLINE = {"harmonics", "off_centre", "sorted_radii", "hem_height"}
 RULES = ["as_run", "largest", "place_gap_24", "place_gap", "place_gap_27", "place_gap_27b", "pixel_region",
          "floor_region", "split_enrichment", "split_floor_ratio", "skirt_floor_ratio", "fold_depth", "closure_groups",
-         "closure_regions", "multipath_floor", "lifted_top"]
+         "closure_regions", "multipath_floor", "lifted_top", "skirt_dense"]
 
 
 def leading(loc):
@@ -211,6 +214,17 @@ def lifted_top(loc, lifted_mm, fold_depth):
     return "hem" if region == "skirt" and folds_deeper_than_mean(loc, fold_depth) else region
 
 
+def skirt_dense(loc, region, factor):
+    """Rule S (explored in session 74 on seeds 80-92): `region` (lifted_top's), but a gap an outline group or the fold
+    depth put at the hem goes to the skirt where the skirt's pixel residual is at least `factor` times as dense as the
+    hem's (enrichment): an edge band (a curled hem) leaves its residual at the hem, a change of the whole skirt (its
+    shear, its yielding folds) leaves it denser above."""
+    if region != "hem" or loc.get("placed_by_views"):
+        return region
+    enrichment = {r["region"]: r["enrichment"] for r in loc["regions"]}
+    return "skirt" if enrichment.get("skirt", 0.0) >= factor * enrichment.get("hem", 0.0) else region
+
+
 def place_gap_27(loc, sensor_scale, skirt_denser, lifted_scale):
     """place_gap with the rigid surfaces placing the gap whatever leads (pre-registered in session 27 for seed 19):
     a platform top above its own floor and seen farther than the fitted cloth (no cloth lies inside the platform),
@@ -294,6 +308,8 @@ def main():
                     help="fold_depth: the skirt_spread/skirt_height ratio from which a skirt gap is the hem's")
     ap.add_argument("--lifted-mm", type=float, default=1.0,
                     help="lifted_top: how far (mm) the top must be lifted for a lifted top to lead (rule T)")
+    ap.add_argument("--skirt-dense", type=float, default=1.3,
+                    help="skirt_dense: the skirt/hem enrichment ratio from which a hem gap is the skirt's (rule S)")
     ap.add_argument("--ranking", action="store_true", help="the region-aware attribution's verdicts instead")
     ap.add_argument("--closure-only", action="store_true",
                     help="count only the reports whose named candidate carries its refit localisation")
@@ -335,6 +351,7 @@ def main():
                       "closure_groups": closure_groups(loc, named, args.lifted_scale),
                       "closure_regions": closure_regions(loc, named), "multipath_floor": multipath_floor(report),
                       "lifted_top": lifted_top(loc, args.lifted_mm, args.fold_depth)}
+            region["skirt_dense"] = skirt_dense(loc, region["lifted_top"], args.skirt_dense)
             totals[family] += 1
             if multipath_fired(report):
                 fired["effect captures"] += 1
