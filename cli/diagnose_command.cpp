@@ -525,7 +525,8 @@ Runner add_diagnose_command(CLI::App& app) {
                "default; docs/DIAGNOSIS_RESULTS.md, \"Session 19\")");
   app.add_option("--held-out-tolerance", o->held_out_tolerance,
                  "A candidate is confirmed when its score on the held-out view or capture is at most (1 + this) "
-                 "times the reference's (0: not worse at all; docs/DIAGNOSIS_RESULTS.md, \"Session 23\")")
+                 "times the reference's (0: not worse at all; docs/DIAGNOSIS_RESULTS.md, \"Session 23\", "
+                 "\"Session 74\")")
       ->capture_default_str();
   app.add_flag("--confirm-within-floors", o->confirm_within_floors,
                "Also confirm a candidate whose drape on the held-out capture is within the floors, however its score "

@@ -185,7 +185,11 @@ TEST(Confirms, AllowsTheToleranceAboveTheReferenceAndNoMore) {
   EXPECT_TRUE(confirms(5.968e-3, 5.44e-3, 0.1));
   // ... 10.5% worse is not.
   EXPECT_FALSE(confirms(6.012e-3, 5.44e-3, 0.1));
-  EXPECT_EQ(AttributionSettings{}.held_out_tolerance, 0.1);
+  // The default since session 74 (rule W), 20%: seed 93's friction_01 in kind, its refit 12.3% worse there than the
+  // reference, is confirmed; 21% worse is not.
+  EXPECT_EQ(AttributionSettings{}.held_out_tolerance, 0.2);
+  EXPECT_TRUE(confirms(1.123 * 5.44e-3, 5.44e-3, 0.2));
+  EXPECT_FALSE(confirms(1.21 * 5.44e-3, 5.44e-3, 0.2));
 }
 
 TEST(Confirmation, WithinTheFloorsOnTheHeldOutCaptureConfirmsOnlyWhenAskedAndOnlyWhereTheScoreDoesNot) {

@@ -145,8 +145,11 @@ struct AttributionSettings {
   /// reference's (confirms). Both are the best of the validation drapes chosen on the held-out capture's own fit views,
   /// a noisy selection: in 11 of the 270 effect diagnoses of seeds 4-10 the right effect's refit was up to 10% worse
   /// than the reference there, and the tolerance names it (and a wrong effect in 6 others; docs/DIAGNOSIS_RESULTS.md,
-  /// "Session 23"). 0: must not be worse at all (before session 23).
-  double held_out_tolerance = 0.1;
+  /// "Session 23"). 0: must not be worse at all (before session 23). 0.2 since session 74 (rule W, registered in
+  /// session 73 on seeds 80-90, where the held-out data had become a third placement turned over, taking its own
+  /// stable state: two true effects that closed the gap left unexplained at 11% and 17% worse; on fresh seeds 91-94 one
+  /// more named right, none lost, no control named; docs/DIAGNOSIS_RESULTS.md, "Session 74"). 0.1 from 23 to 73.
+  double held_out_tolerance = 0.2;
   /// A candidate whose validated drape on the held-out capture is within the floors (both gate terms of that drape
   /// alone at most the floors: `confirmation`) is confirmed as well, however its score there compares with the
   /// reference's: the reference may fit a held-out placement as well as the true setup does (curl captures of seeds
