@@ -57,6 +57,7 @@ struct DiagnoseOptions {
   std::optional<double> shape_floor;
   double placement_shape_floor = 0.0;
   bool placement_drape_test = false;
+  double placement_drape_floor = 0.0;
   bool gap_only = false;
   bool ablation = false;
   bool confirm_within_floors = false;
@@ -113,6 +114,9 @@ int run_diagnose(const DiagnoseOptions& o) {
   }
   if (o.placement_drape_test && o.second.empty() && o.held_out.empty()) {
     return fail("--placement-drape-test tests two placements: give --second-capture or --held-out-capture");
+  }
+  if (!(o.placement_drape_floor >= 0.0 && o.placement_drape_floor < 1.0)) {
+    return fail("--placement-drape-floor must be 0 (the model's range) .. 1 (a drape-coefficient difference)");
   }
   if (!(o.held_out_tolerance >= 0.0 && o.held_out_tolerance <= 1.0)) return fail("--held-out-tolerance must be 0 .. 1");
   if (outside(o.starts, 0, 100)) return fail("--starts must be 0 (the guess alone) .. 100");
@@ -234,6 +238,7 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (o.shape_floor) settings.floors.shape_threshold = settings.held_out_shape_threshold = *o.shape_floor;
   settings.floors.placement_shape_threshold = o.placement_shape_floor;
   settings.floors.placement_drape_coefficient = o.placement_drape_test;
+  settings.floors.placement_drape_floor = o.placement_drape_floor;
   // The fleet: the drapes go to workers; the renders, scores and the search stay here.
   std::unique_ptr<coordinator::SimulationFleet> fleet;
   if (!o.fleet.empty()) {
@@ -519,6 +524,12 @@ Runner add_diagnose_command(CLI::App& app) {
                "differ by more than the model's (its stable drapes' range x the floors' margin): a yielding or "
                "curled specimen drapes otherwise once turned over (off by default; an experiment, docs/DIAGNOSIS.md, "
                "\"Floors\")");
+  app.add_option("--placement-drape-floor", o->placement_drape_floor,
+                 "With --placement-drape-test: its floor, a drape-coefficient difference (e.g. 0.02), instead of the "
+                 "model's stable drapes' range x the floors' margin (0, the default: the range; an experiment, "
+                 "docs/DIAGNOSIS_RESULTS.md, \"Session 74\")")
+      ->needs("--placement-drape-test")
+      ->capture_default_str();
   app.add_flag("--ablation", o->ablation,
                "Also validate each simulated candidate with its effect switched off at its refitted bending scale, and "
                "credit it only for what the effect adds beyond that (report.json: candidates' \"ablated\"; off by "

@@ -1465,6 +1465,25 @@ if(NOT dc_term GREATER dc_floor AND NOT dc_excess EQUAL off_excess)
                       "${dc_excess} differs from the excess without the test, ${off_excess}")
 endif()
 expect_failure(1 "tests two placements" diagnose --capture ${WORK}/capture --placement-drape-test)
+# --placement-drape-floor: the same term against a fixed floor instead of the model's range.
+run_ok(dcf diagnose --capture ${WORK}/capture --second-capture ${WORK}/capture.p1 --quick --resolution 10 --states 2
+       --evaluations 4 --gap-only --json --placement-drape-test --placement-drape-floor 0.001)
+json_number(fixed_floor "${dcf}" gap_tests placement_dc_floor)
+json_number(fixed_term "${dcf}" gap_tests placement_dc)
+json_number(fixed_excess "${dcf}" gap_tests excess_above_floors)
+if(NOT fixed_floor EQUAL 0.001 OR NOT fixed_term EQUAL dc_term)
+  message(FATAL_ERROR "--placement-drape-floor 0.001: floor ${fixed_floor}, term ${fixed_term} (without the fixed "
+                      "floor: ${dc_term})")
+endif()
+if((fixed_term GREATER 0.001 AND NOT fixed_excess GREATER off_excess) OR
+   (NOT fixed_term GREATER 0.001 AND NOT fixed_excess EQUAL off_excess))
+  message(FATAL_ERROR "--placement-drape-floor 0.001: term ${fixed_term}, excess ${fixed_excess} against "
+                      "${off_excess} without the test")
+endif()
+expect_failure(1 "--placement-drape-floor must be" diagnose --capture ${WORK}/capture --second-capture
+               ${WORK}/capture.p1 --placement-drape-test --placement-drape-floor -0.1)
+expect_failure(1 "--placement-drape-floor requires --placement-drape-test" diagnose --capture ${WORK}/capture
+               --second-capture ${WORK}/capture.p1 --placement-drape-floor 0.02)
 
 # The sensor candidate held to the rigid surfaces: a multipath error leaves the platform top and the bare side where
 # the tester puts them (the camera they show moves the platform's centre less than 3 mm), so the candidate keeps their

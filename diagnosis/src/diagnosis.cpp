@@ -490,8 +490,11 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
     if (!e) return e.error();
     *into = std::move(*e);
   }
-  if (settings.floors.placement_drape_coefficient && (second_model || held_out_model))
-    r.floors.placement_dc = placement_dc_floor(r.validated, r.floors.margin);
+  if (settings.floors.placement_drape_coefficient && (second_model || held_out_model)) {
+    r.floors.placement_dc = settings.floors.placement_drape_floor > 0.0
+                                ? settings.floors.placement_drape_floor
+                                : placement_dc_floor(r.validated, r.floors.margin);
+  }
   r.validation_spread = validation_spread(r.validated.states, model.target().shape.all);
   {  // Does the specimen drape the same way on every placement, as often as the fitted model does?
     std::vector<HemProfile> placements{specimen_frame(hem_profile_from_capture(capture), capture.face_down)};

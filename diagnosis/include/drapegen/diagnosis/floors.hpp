@@ -39,7 +39,8 @@ struct Floors {
   double placement_shape = 0.0;
   /// With a paired capture and FloorSettings::placement_drape_coefficient, a fourth test, of the two placements'
   /// drape-coefficient difference against the model's (GapTerms::placement_dc): `margin` x the range of the fitted
-  /// fabric's drape coefficients over its validation drapes (placement_dc_floor). 0: no such test.
+  /// fabric's drape coefficients over its validation drapes (placement_dc_floor), or
+  /// FloorSettings::placement_drape_floor where that is positive. 0: no such test.
   double placement_dc = 0.0;
   /// The median sample score over all views / the held-out view: what a correct model typically leaves (reported
   /// for reference; the gate and the attribution use `stable` and `shape`, see excess_above_floors).
@@ -73,6 +74,11 @@ struct FloorSettings {
   /// coefficients differ by no more than two of its stable drapes' do; a yielding one lays its earlier drape's creases,
   /// turned over, against the next drape, a curled edge rolls to the other face. Off by default (an experiment).
   bool placement_drape_coefficient = false;
+  /// If positive, that test's floor (a drape-coefficient difference) instead of placement_dc_floor's margin x the
+  /// fitted fabric's stable-drape range, which is wider than what an elastic specimen's placements show (at most 0.018
+  /// on the 173 controls and friction, misalignment, shear and sensor captures of seeds 80-94; 0.02 or more on 24 of
+  /// the 26 yields: docs/DIAGNOSIS_RESULTS.md, "Session 74"). 0 (the default): the range.
+  double placement_drape_floor = 0.0;
 };
 
 /// What the gate tests of a model drape: its stable-region term (m) and its shape distance, over all views. With a
