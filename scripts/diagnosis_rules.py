@@ -42,7 +42,8 @@ score. Hypotheses for the next evaluation, not the diagnosis's rule (docs/DIAGNO
 - tie_region (rule R, session 70, pre-registered for fresh seeds 82-83): where the named effect is tied at its
   shrinkage with other confirmed candidates and the gap's localised region is not where it acts but is where a tied
   one acts, that one (EFFECT_REGIONS); elsewhere the verdict as run;
-- wide_tolerance (rule W, session 73, pre-registered for fresh seeds 91-92: docs/preregistrations/session73.md):
+- wide_tolerance (rule W, session 73, pre-registered for fresh seeds 91-92: docs/preregistrations/session73.md;
+  adopted in session 74, the default since 926e8af: on reports since, the verdict as run):
   attribute()'s verdict recomputed with the held-out tolerance 0.2 (`--held-out-tolerance 0.2`) instead of the
   run's 0.1 (`reattribute`: the whole ranking, near ties and promotions as attribute() runs them; `--wide T` sets
   another tolerance; `--check-reattribute DIR...` checks that the run's own tolerance gives every verdict as run);
@@ -103,7 +104,7 @@ import statistics
 import sys
 
 THRESHOLD = 0.25  # AttributionSettings::significant_shrinkage
-TOLERANCE = 0.1  # AttributionSettings::held_out_tolerance (since session 23); --tolerance sets the rule's
+TOLERANCE = 0.1  # AttributionSettings::held_out_tolerance (sessions 23-73; 0.2 since 74); --tolerance sets the rule's
 RULES = ["current", "strict", "tolerance", "objective_ties", "parsimony", "tie_objective", "no_bar", "no_bar_unconfirmed",
          "mean3", "held_out_excess", "held_out_rank", "min_objective", "without_ablation", "reach", "reach_objective",
          "tie_held_out_view", "tie_held_out", "no_near_tie",
