@@ -58,6 +58,7 @@ struct DiagnoseOptions {
   double placement_shape_floor = 0.0;
   bool placement_drape_test = false;
   double placement_drape_floor = 0.0;
+  bool placement_drape_when_seen = false;
   bool gap_only = false;
   bool ablation = false;
   bool confirm_within_floors = false;
@@ -239,6 +240,7 @@ int run_diagnose(const DiagnoseOptions& o) {
   settings.floors.placement_shape_threshold = o.placement_shape_floor;
   settings.floors.placement_drape_coefficient = o.placement_drape_test;
   settings.floors.placement_drape_floor = o.placement_drape_floor;
+  settings.floors.placement_drape_when_seen = o.placement_drape_when_seen;
   // The fleet: the drapes go to workers; the renders, scores and the search stay here.
   std::unique_ptr<coordinator::SimulationFleet> fleet;
   if (!o.fleet.empty()) {
@@ -530,6 +532,11 @@ Runner add_diagnose_command(CLI::App& app) {
                  "docs/DIAGNOSIS_RESULTS.md, \"Session 74\")")
       ->needs("--placement-drape-test")
       ->capture_default_str();
+  app.add_flag("--placement-drape-when-seen", o->placement_drape_when_seen,
+               "With --placement-drape-test: the test counts only where the captures' own drape coefficients differ "
+               "by more than its floor (report.json gap_tests.placement_dc_floor 0 elsewhere; an experiment, "
+               "docs/DIAGNOSIS_RESULTS.md, \"Session 74\")")
+      ->needs("--placement-drape-test");
   app.add_flag("--ablation", o->ablation,
                "Also validate each simulated candidate with its effect switched off at its refitted bending scale, and "
                "credit it only for what the effect adds beyond that (report.json: candidates' \"ablated\"; off by "

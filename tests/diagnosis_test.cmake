@@ -1480,6 +1480,27 @@ if((fixed_term GREATER 0.001 AND NOT fixed_excess GREATER off_excess) OR
   message(FATAL_ERROR "--placement-drape-floor 0.001: term ${fixed_term}, excess ${fixed_excess} against "
                       "${off_excess} without the test")
 endif()
+# --placement-drape-when-seen: a floor the captures' own change does not pass is no test (floor 0, the excess as
+# without the test); one it passes stands.
+run_ok(dcs diagnose --capture ${WORK}/capture --second-capture ${WORK}/capture.p1 --quick --resolution 10 --states 2
+       --evaluations 4 --gap-only --json --placement-drape-test --placement-drape-floor 0.5
+       --placement-drape-when-seen)
+json_number(seen_floor "${dcs}" gap_tests placement_dc_floor)
+json_number(seen_excess "${dcs}" gap_tests excess_above_floors)
+if(NOT dc_term LESS 0.5 OR NOT seen_floor EQUAL 0 OR NOT seen_excess EQUAL off_excess)
+  message(FATAL_ERROR "--placement-drape-when-seen, floor 0.5: term ${dc_term}, floor ${seen_floor}, excess "
+                      "${seen_excess} against ${off_excess} without the test")
+endif()
+run_ok(dcs diagnose --capture ${WORK}/capture --second-capture ${WORK}/capture.p1 --quick --resolution 10 --states 2
+       --evaluations 4 --gap-only --json --placement-drape-test --placement-drape-floor 0.001
+       --placement-drape-when-seen)
+json_number(seen_floor "${dcs}" gap_tests placement_dc_floor)
+if((fixed_term GREATER 0.001 AND NOT seen_floor EQUAL 0.001) OR
+   (NOT fixed_term GREATER 0.001 AND NOT seen_floor EQUAL 0))
+  message(FATAL_ERROR "--placement-drape-when-seen, floor 0.001: term ${fixed_term}, floor ${seen_floor}")
+endif()
+expect_failure(1 "--placement-drape-when-seen requires --placement-drape-test" diagnose --capture ${WORK}/capture
+               --second-capture ${WORK}/capture.p1 --placement-drape-when-seen)
 expect_failure(1 "--placement-drape-floor must be" diagnose --capture ${WORK}/capture --second-capture
                ${WORK}/capture.p1 --placement-drape-test --placement-drape-floor -0.1)
 expect_failure(1 "--placement-drape-floor requires --placement-drape-test" diagnose --capture ${WORK}/capture

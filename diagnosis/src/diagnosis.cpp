@@ -494,6 +494,8 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
     r.floors.placement_dc = settings.floors.placement_drape_floor > 0.0
                                 ? settings.floors.placement_drape_floor
                                 : placement_dc_floor(r.validated, r.floors.margin);
+    if (settings.floors.placement_drape_when_seen && !(r.gap().placement_dc > r.floors.placement_dc))
+      r.floors.placement_dc = 0.0;  // the captures show no change beyond the floor: no test
   }
   r.validation_spread = validation_spread(r.validated.states, model.target().shape.all);
   {  // Does the specimen drape the same way on every placement, as often as the fitted model does?

@@ -79,6 +79,11 @@ struct FloorSettings {
   /// on the 173 controls and friction, misalignment, shear and sensor captures of seeds 80-94; 0.02 or more on 24 of
   /// the 26 yields: docs/DIAGNOSIS_RESULTS.md, "Session 74"). 0 (the default): the range.
   double placement_drape_floor = 0.0;
+  /// The test counts only where the captures themselves differ by more than its floor (the baseline's own term: an
+  /// elastic setup drapes alike on every placement); elsewhere Floors::placement_dc is 0 and no setup is held to its
+  /// own prediction of a change the captures do not show (in sample, a curl refit's turned-over prediction cost curl
+  /// two captures whose change stayed below the floor: docs/DIAGNOSIS_RESULTS.md, "Session 74"). Off by default.
+  bool placement_drape_when_seen = false;
 };
 
 /// What the gate tests of a model drape: its stable-region term (m) and its shape distance, over all views. With a
