@@ -1465,39 +1465,38 @@ if(NOT dc_term GREATER dc_floor AND NOT dc_excess EQUAL off_excess)
                       "${dc_excess} differs from the excess without the test, ${off_excess}")
 endif()
 expect_failure(1 "tests two placements" diagnose --capture ${WORK}/capture --placement-drape-test)
-# --placement-drape-floor: the same term against a fixed floor instead of the model's range.
-run_ok(dcf diagnose --capture ${WORK}/capture --second-capture ${WORK}/capture.p1 --quick --resolution 10 --states 2
-       --evaluations 4 --gap-only --json --placement-drape-test --placement-drape-floor 0.001)
-json_number(fixed_floor "${dcf}" gap_tests placement_dc_floor)
-json_number(fixed_term "${dcf}" gap_tests placement_dc)
-json_number(fixed_excess "${dcf}" gap_tests excess_above_floors)
-if(NOT fixed_floor EQUAL 0.001 OR NOT fixed_term EQUAL dc_term)
-  message(FATAL_ERROR "--placement-drape-floor 0.001: floor ${fixed_floor}, term ${fixed_term} (without the fixed "
-                      "floor: ${dc_term})")
+# --placement-drape-floor: the same term against a fixed floor instead of the model's range. drape_floor_run(FLOOR
+# ...) runs the small gap-only diagnosis with the test at that floor (more options after it) and sets floor, term and
+# excess from its report.
+function(drape_floor_run fixed)
+  run_ok(report diagnose --capture ${WORK}/capture --second-capture ${WORK}/capture.p1 --quick --resolution 10
+         --states 2 --evaluations 4 --gap-only --json --placement-drape-test --placement-drape-floor ${fixed} ${ARGN})
+  json_number(v "${report}" gap_tests placement_dc_floor)
+  set(floor "${v}" PARENT_SCOPE)
+  json_number(v "${report}" gap_tests placement_dc)
+  set(term "${v}" PARENT_SCOPE)
+  json_number(v "${report}" gap_tests excess_above_floors)
+  set(excess "${v}" PARENT_SCOPE)
+endfunction()
+drape_floor_run(0.001)
+if(NOT floor EQUAL 0.001 OR NOT term EQUAL dc_term)
+  message(FATAL_ERROR "--placement-drape-floor 0.001: floor ${floor}, term ${term} (without the fixed floor: "
+                      "${dc_term})")
 endif()
-if((fixed_term GREATER 0.001 AND NOT fixed_excess GREATER off_excess) OR
-   (NOT fixed_term GREATER 0.001 AND NOT fixed_excess EQUAL off_excess))
-  message(FATAL_ERROR "--placement-drape-floor 0.001: term ${fixed_term}, excess ${fixed_excess} against "
-                      "${off_excess} without the test")
+if((term GREATER 0.001 AND NOT excess GREATER off_excess) OR (NOT term GREATER 0.001 AND NOT excess EQUAL off_excess))
+  message(FATAL_ERROR "--placement-drape-floor 0.001: term ${term}, excess ${excess} against ${off_excess} without "
+                      "the test")
 endif()
 # --placement-drape-when-seen: a floor the captures' own change does not pass is no test (floor 0, the excess as
 # without the test); one it passes stands.
-run_ok(dcs diagnose --capture ${WORK}/capture --second-capture ${WORK}/capture.p1 --quick --resolution 10 --states 2
-       --evaluations 4 --gap-only --json --placement-drape-test --placement-drape-floor 0.5
-       --placement-drape-when-seen)
-json_number(seen_floor "${dcs}" gap_tests placement_dc_floor)
-json_number(seen_excess "${dcs}" gap_tests excess_above_floors)
-if(NOT dc_term LESS 0.5 OR NOT seen_floor EQUAL 0 OR NOT seen_excess EQUAL off_excess)
-  message(FATAL_ERROR "--placement-drape-when-seen, floor 0.5: term ${dc_term}, floor ${seen_floor}, excess "
-                      "${seen_excess} against ${off_excess} without the test")
+drape_floor_run(0.5 --placement-drape-when-seen)
+if(NOT term LESS 0.5 OR NOT floor EQUAL 0 OR NOT excess EQUAL off_excess)
+  message(FATAL_ERROR "--placement-drape-when-seen, floor 0.5: term ${term}, floor ${floor}, excess ${excess} "
+                      "against ${off_excess} without the test")
 endif()
-run_ok(dcs diagnose --capture ${WORK}/capture --second-capture ${WORK}/capture.p1 --quick --resolution 10 --states 2
-       --evaluations 4 --gap-only --json --placement-drape-test --placement-drape-floor 0.001
-       --placement-drape-when-seen)
-json_number(seen_floor "${dcs}" gap_tests placement_dc_floor)
-if((fixed_term GREATER 0.001 AND NOT seen_floor EQUAL 0.001) OR
-   (NOT fixed_term GREATER 0.001 AND NOT seen_floor EQUAL 0))
-  message(FATAL_ERROR "--placement-drape-when-seen, floor 0.001: term ${fixed_term}, floor ${seen_floor}")
+drape_floor_run(0.001 --placement-drape-when-seen)
+if((term GREATER 0.001 AND NOT floor EQUAL 0.001) OR (NOT term GREATER 0.001 AND NOT floor EQUAL 0))
+  message(FATAL_ERROR "--placement-drape-when-seen, floor 0.001: term ${term}, floor ${floor}")
 endif()
 expect_failure(1 "--placement-drape-when-seen requires --placement-drape-test" diagnose --capture ${WORK}/capture
                --second-capture ${WORK}/capture.p1 --placement-drape-when-seen)
