@@ -40,7 +40,8 @@ struct Floors {
   /// With a paired capture and FloorSettings::placement_drape_coefficient, a fourth test, of the two placements'
   /// drape-coefficient difference against the model's (GapTerms::placement_dc): `margin` x the range of the fitted
   /// fabric's drape coefficients over its validation drapes (placement_dc_floor), or
-  /// FloorSettings::placement_drape_floor where that is positive. 0: no such test.
+  /// FloorSettings::placement_drape_floor where that is positive. 0: no such test (also, with
+  /// FloorSettings::placement_drape_when_seen, where the captures' own change does not pass the floor).
   double placement_dc = 0.0;
   /// The median sample score over all views / the held-out view: what a correct model typically leaves (reported
   /// for reference; the gate and the attribution use `stable` and `shape`, see excess_above_floors).
