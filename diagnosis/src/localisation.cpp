@@ -78,6 +78,13 @@ const RegionShare* region_share(const Localisation& L, Region region) {
   return s == L.regions.end() ? nullptr : &*s;
 }
 
+namespace {
+double enrichment(const Localisation& L, Region region) {
+  const RegionShare* share = region_share(L, region);
+  return share ? share->enrichment : 0.0;
+}
+}  // namespace
+
 Region stable_region(const Localisation& L) {
   const RegionShare* top = region_share(L, Region::kTop);
   // The top within what noise and other stable drapes leave there: the excess is on the bare cylinder below the
@@ -128,13 +135,17 @@ void place_gap(Localisation& L) {
   L.dominant_feature = feature_group_name(g);
   L.dominant = feature_region(g);
   // The outline's shape (its harmonics, sorted radii, height) follows the skirt above it: the hem carries the skirt's
-  // change where the skirt's residual is the denser one. A shift of the centre is the hem's own (a placement).
-  if (follows_skirt(g)) {
-    const RegionShare *skirt = region_share(L, Region::kSkirt), *hem = region_share(L, Region::kHem);
-    if ((skirt ? skirt->enrichment : 0.0) > (hem ? hem->enrichment : 0.0)) L.dominant = Region::kSkirt;
+  // change where the skirt's residual is the denser one.
+  const double skirt = enrichment(L, Region::kSkirt), hem = enrichment(L, Region::kHem);
+  if (follows_skirt(g) && skirt > hem) L.dominant = Region::kSkirt;
+  // A skirt gap whose folds deepen far more than its mean height falls is an edge band's (a curled hem), and a shift
+  // of the centre is the hem's own (a placement): the hem, unless the skirt's residual is the far denser (rule S: a
+  // change of the whole skirt, its shear or its yielding folds, moves the outline and its centre as well).
+  const bool skirt_far_denser = skirt > 0.0 && skirt >= kSkirtDenseAtHem * hem;
+  L.moved_to_hem = L.dominant == Region::kSkirt && folds_deepen_at_hem(L) && !skirt_far_denser;
+  if (L.moved_to_hem || (g == FeatureGroup::kOffCentre && skirt_far_denser)) {
+    L.dominant = L.moved_to_hem ? Region::kHem : Region::kSkirt;
   }
-  L.moved_to_hem = L.dominant == Region::kSkirt && folds_deepen_at_hem(L);
-  if (L.moved_to_hem) L.dominant = Region::kHem;
 }
 
 void place_sensor_gap(Localisation& L) {

@@ -210,8 +210,8 @@ TEST(PlaceGap, TheHemsOutlineCarriesTheSkirtWhereTheSkirtsResidualIsDenser) {
     place_gap(L);
     EXPECT_EQ(L.dominant, Region::kHem) << feature_group_name(g);
   }
-  // A shifted centre is the hem's own (a placement), however dense the skirt's residual.
-  Localisation L = excess(FeatureGroup::kOffCentre, 2.0, 0.9, 1.6, 1.2);
+  // A shifted centre is the hem's own (a placement) where the skirt's residual is denser by less than rule S's 1.3.
+  Localisation L = excess(FeatureGroup::kOffCentre, 2.0, 0.9, 1.5, 1.2);
   place_gap(L);
   EXPECT_EQ(L.dominant, Region::kHem);
   EXPECT_EQ(L.dominant_feature, "off_centre");
@@ -240,7 +240,7 @@ TEST(PlaceGap, ASkirtGapWhoseFoldsDeepenFarBeyondTheSkirtsMeanHeightIsTheHems) {
   EXPECT_EQ(L.dominant, Region::kSkirt);
   EXPECT_FALSE(L.moved_to_hem);
   // An outline group the skirt carries (denser skirt residual) moves too; placed on the hem already, it stays there.
-  L = excess(FeatureGroup::kHarmonics, 3.0, 0.9, 1.6, 1.2, 0.5);
+  L = excess(FeatureGroup::kHarmonics, 3.0, 0.9, 1.4, 1.2, 0.5);
   L.group_ratio[static_cast<std::size_t>(FeatureGroup::kSkirtSpread)] = 2.5;
   place_gap(L);
   EXPECT_EQ(L.dominant, Region::kHem);
@@ -255,6 +255,42 @@ TEST(PlaceGap, ASkirtGapWhoseFoldsDeepenFarBeyondTheSkirtsMeanHeightIsTheHems) {
   place_gap(L);
   EXPECT_EQ(L.dominant, Region::kCylinder);
   EXPECT_FALSE(L.moved_to_hem);
+}
+
+TEST(PlaceGap, ASkirtFarDenserThanTheHemKeepsItsGap) {
+  // Rule S: the skirt's pixel residual at least 1.3 times as dense as the hem's (a change of the whole skirt) keeps a
+  // gap the folds' depth or the centre's offset would put at the hem on the skirt.
+  const auto fold_depth_led = [](double skirt, double hem) {
+    Localisation L = excess(FeatureGroup::kSkirtSpread, 2.0, 0.9, skirt, hem);
+    L.group_ratio[static_cast<std::size_t>(FeatureGroup::kSkirtHeight)] = 1.2;  // 2.0 > 1.5 x 1.2: the folds deepen
+    place_gap(L);
+    return L;
+  };
+  Localisation L = fold_depth_led(1.25 * kSkirtDenseAtHem, 1.25);
+  EXPECT_EQ(L.dominant, Region::kSkirt);
+  EXPECT_FALSE(L.moved_to_hem);
+  EXPECT_TRUE(folds_deepen_at_hem(L));
+  L = fold_depth_led(1.25 * kSkirtDenseAtHem - 0.01, 1.25);
+  EXPECT_EQ(L.dominant, Region::kHem);
+  EXPECT_TRUE(L.moved_to_hem);
+  // An outline group the skirt carries: the same.
+  L = excess(FeatureGroup::kHemHeight, 3.0, 0.9, 1.2 * kSkirtDenseAtHem, 1.2, 0.5);
+  L.group_ratio[static_cast<std::size_t>(FeatureGroup::kSkirtSpread)] = 2.5;
+  place_gap(L);
+  EXPECT_EQ(L.dominant, Region::kSkirt);
+  EXPECT_FALSE(L.moved_to_hem);
+  // The centre's offset: at the factor the skirt's, below it the hem's.
+  L = excess(FeatureGroup::kOffCentre, 2.0, 0.9, 1.2 * kSkirtDenseAtHem, 1.2);
+  place_gap(L);
+  EXPECT_EQ(L.dominant, Region::kSkirt);
+  EXPECT_EQ(L.dominant_feature, "off_centre");
+  L = excess(FeatureGroup::kOffCentre, 2.0, 0.9, 1.2 * kSkirtDenseAtHem - 0.01, 1.2);
+  place_gap(L);
+  EXPECT_EQ(L.dominant, Region::kHem);
+  // No pixels on either: the centre's offset stays the hem's.
+  L = excess(FeatureGroup::kOffCentre, 2.0, 0.9, 0.0, 0.0);
+  place_gap(L);
+  EXPECT_EQ(L.dominant, Region::kHem);
 }
 
 TEST(PlaceGap, GlobalWithNoFeatureNamedWhenNothingExceedsItsFloor) {

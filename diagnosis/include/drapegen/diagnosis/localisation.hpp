@@ -152,8 +152,17 @@ void localise_features(Localisation& localisation, const ScoredDrape& drape, con
 /// (a camera's error; session 27). The stable term: stable_region. A skirt group: kSkirt. The hem's centre offset:
 /// kHem. The other hem groups (harmonics, sorted radii, hem height): kSkirt if the skirt's pixel residual is denser
 /// than the hem's (the outline carries a change of the skirt above it), else kHem. Nothing above 1: kGlobal. Last, a
-/// gap so placed on the skirt moves to the hem where folds_deepen_at_hem.
+/// gap so placed on the skirt moves to the hem where folds_deepen_at_hem. Rule S: where the skirt's pixel residual is
+/// at least kSkirtDenseAtHem times as dense as the hem's (enrichment), neither the centre offset nor the folds' depth
+/// puts the gap at the hem; it stays on the skirt.
 void place_gap(Localisation& localisation);
+
+/// Rule S's factor: a skirt whose pixel residual is this much denser than the hem's changed as a whole (its shear,
+/// its yielding folds), and the outline's centre and the folds' depth at the hem follow it. Registered in session 74
+/// on seeds 80-92 (the curl and misalignment gaps placed at the hem: skirt over hem enrichment 0.76-1.25; five shear
+/// and a yield capture's: 1.36-1.83; +6 -0 there); on fresh seeds 93-96 +1 -0 (seed 96's yield_01, a skirt change
+/// the folds' depth had put at the hem): adopted in session 75, docs/DIAGNOSIS_RESULTS.md, "Session 75".
+inline constexpr double kSkirtDenseAtHem = 1.3;
 
 /// The folds' depth (group skirt_spread: the spread of z per annulus of the skirt) stands more than kFoldDepthAtHem
 /// times further above its floor than the skirt's mean height (skirt_height): the skirt's mean profile follows the
