@@ -42,9 +42,9 @@
 - lifted_top (rule T, registered in session 72 for seeds 88-89): as run, but a gap the stable term placed on the
   platform top while a feature group stands further above its floor stays there only if the top is lifted by at least
   --lifted-mm (default 1 mm: its mean residual at most -1 mm); else the leading group places it, as place_gap does.
-- skirt_dense (rule S, registered in session 74, adopted in session 75: place_gap since then): lifted_top's region, but a gap placed at the hem
-  (not by the views) goes to the skirt where the skirt's pixel enrichment is at least --skirt-dense (1.3) times the
-  hem's.
+- skirt_dense (rule S, registered in session 74, adopted in session 75: place_gap's since then): lifted_top's
+  region, but a gap placed at the hem (not by the views) goes to the skirt where the skirt's pixel enrichment is at
+  least --skirt-dense (1.3) times the hem's.
 
 Per rule: the effect captures whose region is one of the effect's regions (the truth file's `regions`), per family.
 
