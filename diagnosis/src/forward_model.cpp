@@ -178,6 +178,12 @@ double ForwardModel::held_out_mean(const std::vector<ViewComparison>& views) con
   return n > 0 ? s / n : 0.0;
 }
 
+double ForwardModel::views_drape_coefficient(const std::vector<renderer::DepthImage>& depth) const {
+  Capture c = capture_;
+  for (std::size_t v = 0; v < depth.size(); ++v) c.views[v].depth = depth[v];
+  return drape_coefficient(hem_profile_from_capture(c), c.specimen);
+}
+
 ShapeSet ForwardModel::shape_set(const std::vector<renderer::DepthImage>& depth) const {
   Capture c = capture_;
   for (std::size_t v = 0; v < depth.size(); ++v) c.views[v].depth = depth[v];
@@ -203,7 +209,7 @@ Target ForwardModel::make_target(const std::vector<renderer::DepthImage>& depth)
   }
   t.outline = hem_profile_from_views(c, settings_.fit_views);
   t.shape = shape_set(depth);
-  t.drape_coefficient = drape_coefficient(hem_profile_from_capture(c), c.specimen);
+  t.drape_coefficient = views_drape_coefficient(depth);
   return t;
 }
 
@@ -214,9 +220,7 @@ sim::Expected<ScoredDrape> ForwardModel::score(const sim::ClothMesh& mesh, const
   d.mesh = mesh;
   const HemProfile outline = hem_profile_from_mesh(mesh);
   d.angle = align_orientation(outline, target.outline).angle;
-  d.drape_coefficient = drape_coefficient(outline, capture_.specimen);
   d.capture_drape_coefficient = target.drape_coefficient;
-  d.median_drape_coefficient = d.drape_coefficient;
   auto images = render(mesh, d.angle, setup.sensor);
   if (!images) return images.error();
   // The shape features of the model are taken from renders with the capture's kind of noise (a fixed seed), so
@@ -228,6 +232,8 @@ sim::Expected<ScoredDrape> ForwardModel::score(const sim::ClothMesh& mesh, const
     noisy.push_back(noise.apply((*images)[v], renderer::mix_seed(kModelNoiseSeed, v)));
   }
   d.shape = shape_set(noisy);
+  d.drape_coefficient = views_drape_coefficient(noisy);
+  d.median_drape_coefficient = d.drape_coefficient;
   const std::vector<double> scales = default_feature_scales();
   d.shape_fit = feature_distance(target.shape.fit, d.shape.fit, scales);
   d.shape_held_out = feature_distance(target.shape.held_out, d.shape.held_out, scales);

@@ -11,6 +11,8 @@
 
 #include "drapegen/diagnosis/forward_model.hpp"
 #include "drapegen/diagnosis/hem_profile.hpp"
+#include "drapegen/renderer/noise.hpp"
+#include "drapegen/renderer/random.hpp"
 #include "drapegen/sim/measures.hpp"
 #include "small_reality.hpp"
 
@@ -196,8 +198,9 @@ TEST(ForwardModel, EvaluatesOnSeveralThreadsAsOnOne) {
 }
 
 TEST(ForwardModel, EveryDrapeCarriesItsDrapeCoefficientTheCapturesAndTheEvaluationsMedian) {
-  // The placement drape test's inputs (floors.hpp, GapTerms::placement_dc): each drape's drape coefficient from its
-  // mesh's outline, the capture's from the outline every view sees, and the median over the evaluation's drapes.
+  // The placement drape test's inputs (floors.hpp, GapTerms::placement_dc): each drape's drape coefficient measured
+  // as the capture's is, from the outline its noisy renders show in every view; the capture's from its own views;
+  // the median over the evaluation's drapes.
   auto small = small_model("coefficients");
   ASSERT_TRUE(small.has_value());
   auto& model = small->model;
@@ -209,9 +212,21 @@ TEST(ForwardModel, EveryDrapeCarriesItsDrapeCoefficientTheCapturesAndTheEvaluati
   const double capture = drape_coefficient(hem_profile_from_capture(model->capture()), specimen);
   EXPECT_GT(capture, 0.0);
   EXPECT_LT(capture, 1.0);
+  std::vector<renderer::DepthImage> own_views;
+  for (const auto& view : model->capture().views) own_views.push_back(view.depth);
+  EXPECT_EQ(model->views_drape_coefficient(own_views), capture);
+  EXPECT_EQ(model->target().drape_coefficient, capture);
+  const renderer::NoiseModel noise = renderer::NoiseModel::kinect();
   std::vector<double> own;
   for (const auto& d : e->states) {
-    EXPECT_EQ(d.drape_coefficient, drape_coefficient(hem_profile_from_mesh(d.mesh), specimen));
+    auto clean = model->render(d.mesh, d.angle, elastic.sensor);
+    ASSERT_TRUE(clean.has_value()) << clean.error().message;
+    std::vector<renderer::DepthImage> noisy;
+    for (std::size_t v = 0; v < clean->size(); ++v)
+      noisy.push_back(noise.apply((*clean)[v], renderer::mix_seed(ForwardModel::kModelNoiseSeed, v)));
+    EXPECT_EQ(d.drape_coefficient, model->views_drape_coefficient(noisy));
+    // An elastic drape's hem is seen where it lies: the views' measure is the mesh outline's, to the views' pixels.
+    EXPECT_NEAR(d.drape_coefficient, drape_coefficient(hem_profile_from_mesh(d.mesh), specimen), 0.03);
     EXPECT_EQ(d.capture_drape_coefficient, capture);
     own.push_back(d.drape_coefficient);
   }

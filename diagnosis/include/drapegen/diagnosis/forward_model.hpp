@@ -73,8 +73,11 @@ struct ScoredDrape {
   double all_score = 0.0;
   /// A yielding setup's drape from ForwardModel::evaluate: the plastic set it leaves (empty otherwise).
   PlasticSet left;
-  /// Cusick's drape coefficient of the mesh's outline, and of the capture's it was scored against
-  /// (Target::drape_coefficient).
+  /// Cusick's drape coefficient of the drape as its renders (with the capture's kind of noise) show it, measured as
+  /// the capture's is (ForwardModel::views_drape_coefficient), and of the capture's it was scored against
+  /// (Target::drape_coefficient). Not the mesh's own outline: where the views see a hem otherwise than it lies (a
+  /// face-up curled band: 0.027 lower on average on seeds 80-96's curl captures, face down 0.004; every other family
+  /// within 0.006 either way), the placement test must compare like with like.
   double drape_coefficient = 0.0, capture_drape_coefficient = 0.0;
   /// The median drape coefficient of the drapes of the evaluation this one belongs to (its own where scored alone):
   /// what the setup drapes to on this placement over stable states, for the placement test (GapTerms::placement_dc).
@@ -115,6 +118,9 @@ class ForwardModel {
   /// The target of a capture with these views (same cameras as the capture).
   [[nodiscard]] Target make_target(const std::vector<renderer::DepthImage>& depth) const;
   [[nodiscard]] sim::Expected<ScoredDrape> score(const sim::ClothMesh& mesh, const ModelSetup& setup);
+  /// Cusick's drape coefficient of the outline a set of views (one image per capture view) sees, as the capture's
+  /// own is measured (hem_profile_from_capture).
+  [[nodiscard]] double views_drape_coefficient(const std::vector<renderer::DepthImage>& depth) const;
   /// The shape features of a set of views (one image per capture view) over the fit / held-out / all views.
   [[nodiscard]] ShapeSet shape_set(const std::vector<renderer::DepthImage>& depth) const;
   /// The noise seed of the model renders' shape features.
