@@ -4,7 +4,8 @@
 // Prints each case's drape coefficient (Cusick's, from the capture's back-projected outline: hem_profile_from_capture)
 // on its three placements (NAME, NAME.p1, NAME.p2) and the truth's where a truth file is there; with --model, the
 // spread an elastic specimen's drape coefficient has over stable states: the diagnosis's fitted bending (its report's
-// baseline) draped from the attribution's validation states, each drape's coefficient from its mesh's outline. Reads
+// baseline) draped from the attribution's validation states, each drape's coefficient measured as the diagnosis
+// measures it (from the outline its noisy renders show, ForwardModel::views_drape_coefficient). Reads
 // the truth files only to print the family and the true coefficients: a benchmark tool (docs/DIAGNOSIS_RESULTS.md,
 // "Session 73").
 #include <CLI/CLI.hpp>
@@ -44,7 +45,9 @@ sim::Expected<std::vector<double>> model_coefficients(const diagnosis::Capture& 
   for (const auto& state : diagnosis::validation_states(settings.attribution)) {
     auto mesh = (*model)->simulate(setup, state);
     if (!mesh) return mesh.error();
-    dc.push_back(diagnosis::drape_coefficient(diagnosis::hem_profile_from_mesh(*mesh), capture.specimen));
+    auto scored = (*model)->score(*mesh, setup);
+    if (!scored) return scored.error();
+    dc.push_back(scored->drape_coefficient);
   }
   return dc;
 }
