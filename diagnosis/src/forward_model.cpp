@@ -178,24 +178,37 @@ double ForwardModel::held_out_mean(const std::vector<ViewComparison>& views) con
   return n > 0 ? s / n : 0.0;
 }
 
-double ForwardModel::views_drape_coefficient(const std::vector<renderer::DepthImage>& depth) const {
+namespace {
+/// Cusick's drape coefficient of the outline a capture's views see (hem_profile_from_capture).
+double seen_drape_coefficient(const Capture& seen) {
+  return drape_coefficient(hem_profile_from_capture(seen), seen.specimen);
+}
+}  // namespace
+
+Capture ForwardModel::with_views(const std::vector<renderer::DepthImage>& depth) const {
   Capture c = capture_;
   for (std::size_t v = 0; v < depth.size(); ++v) c.views[v].depth = depth[v];
-  return drape_coefficient(hem_profile_from_capture(c), c.specimen);
+  return c;
+}
+
+double ForwardModel::views_drape_coefficient(const std::vector<renderer::DepthImage>& depth) const {
+  return seen_drape_coefficient(with_views(depth));
 }
 
 ShapeSet ForwardModel::shape_set(const std::vector<renderer::DepthImage>& depth) const {
-  Capture c = capture_;
-  for (std::size_t v = 0; v < depth.size(); ++v) c.views[v].depth = depth[v];
+  return shape_set(with_views(depth));
+}
+
+ShapeSet ForwardModel::shape_set(const Capture& seen) const {
   std::vector<int> held, all;
   for (int v = 0; v < kCaptureViews; ++v) {
     all.push_back(v);
     if (!is_fit_view_[v]) held.push_back(v);
   }
   ShapeSet s;
-  s.fit = shape_features(c, settings_.fit_views);
-  s.held_out = held.empty() ? ShapeFeatures{} : shape_features(c, held);
-  s.all = shape_features(c, all);
+  s.fit = shape_features(seen, settings_.fit_views);
+  s.held_out = held.empty() ? ShapeFeatures{} : shape_features(seen, held);
+  s.all = shape_features(seen, all);
   return s;
 }
 
@@ -209,7 +222,7 @@ Target ForwardModel::make_target(const std::vector<renderer::DepthImage>& depth)
   }
   t.outline = hem_profile_from_views(c, settings_.fit_views);
   t.shape = shape_set(depth);
-  t.drape_coefficient = views_drape_coefficient(depth);
+  t.drape_coefficient = seen_drape_coefficient(c);
   return t;
 }
 
@@ -231,8 +244,9 @@ sim::Expected<ScoredDrape> ForwardModel::score(const sim::ClothMesh& mesh, const
     d.views.push_back(compare_view(target.views[v], (*images)[v], settings_.weights));
     noisy.push_back(noise.apply((*images)[v], renderer::mix_seed(kModelNoiseSeed, v)));
   }
-  d.shape = shape_set(noisy);
-  d.drape_coefficient = views_drape_coefficient(noisy);
+  const Capture seen = with_views(noisy);  // the drape as the capture's views would see it
+  d.shape = shape_set(seen);
+  d.drape_coefficient = seen_drape_coefficient(seen);
   d.median_drape_coefficient = d.drape_coefficient;
   const std::vector<double> scales = default_feature_scales();
   d.shape_fit = feature_distance(target.shape.fit, d.shape.fit, scales);

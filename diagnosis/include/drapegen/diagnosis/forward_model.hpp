@@ -164,6 +164,10 @@ class ForwardModel {
 
  private:
   ForwardModel(const Capture& capture, const FitSettings& settings, renderer::DepthRenderer renderer);
+  /// The capture with these views' depth (one image per capture view) in place of its own.
+  [[nodiscard]] Capture with_views(const std::vector<renderer::DepthImage>& depth) const;
+  /// shape_set of a capture with_views made.
+  [[nodiscard]] ShapeSet shape_set(const Capture& seen) const;
   Capture capture_;
   FitSettings settings_;
   renderer::DepthRenderer renderer_;
