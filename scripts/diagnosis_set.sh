@@ -13,6 +13,10 @@
 #                                                            # each (K, K+1, ...; default 0), sharing the sets'
 #                                                            # cases (the bench's case locks: sets generated since
 #                                                            # session 70; lanes may join a running diagnose)
+#   scripts/diagnosis_set.sh arm ARM BASE OPTIONS...         # ARM: an arm of the generated set BASE (its build,
+#                                                            # captures, truth and screen linked), diagnosed with
+#                                                            # these diagnose options added (kept in ARM/arm.args);
+#                                                            # then `diagnose ARM` and `scripts/compare_arms.py`
 #   scripts/diagnosis_set.sh score OUT...                    # each set's summary, then the verdict and region tables
 #
 # BENCH-OPTIONS choose the captures (drapegen_diagnosis_bench --help): e.g.
@@ -70,12 +74,25 @@ case $step in
     lane() {  # lane K: every set in turn, one diagnosis at a time on core K; the bench's case locks share the work
       runner=(taskset -c "$(( ($first + $1) % $(nproc) ))")
       for s in "${sets[@]}"; do
-        bench "$s" --second-placement --jobs 1 --diagnose-args "--fine --ignore-measured-bending" \
+        extra=$(cat "$s/arm.args" 2>/dev/null || true)
+        bench "$s" --second-placement --jobs 1 --diagnose-args "--fine --ignore-measured-bending${extra:+ $extra}" \
           | sed "s/^/lane $1: /"
       done
     }
     for ((k = 0; k < lanes; ++k)); do lane "$k" & done
     wait
+    ;;
+  arm)
+    [ $# -ge 2 ] || usage
+    base=$1
+    shift
+    [ -f "$base/generated" ] || { echo "diagnosis_set: $base is not generated yet ($base/generated)" >&2; exit 1; }
+    [ ! -e "$out" ] || { echo "diagnosis_set: $out exists" >&2; exit 1; }
+    mkdir -p "$out"
+    for f in bin captures truth screen set.args generated; do
+      if [ -e "$base/$f" ]; then ln -s "$(realpath "$base/$f")" "$out/$f"; fi
+    done
+    echo "$*" > "$out/arm.args"
     ;;
   score)
     runs=("$out" "$@")
