@@ -39,6 +39,7 @@ struct DiagnoseOptions {
   bool fine = false;
   // Unset options keep the settings' value (default, --quick or --fine).
   std::optional<int> resolution;
+  int confirm_resolution = 0;
   std::optional<int> states;
   std::optional<int> evaluations;
   std::optional<int> refit_evaluations;
@@ -98,6 +99,9 @@ int run_diagnose(const DiagnoseOptions& o) {
   // A scan of N levels: 0 (off) or 2 .. hi (one level is no scan).
   const auto bad_scan = [&](const std::optional<int>& value, int hi) { return outside(value, 0, hi) || value == 1; };
   if (outside(o.resolution, 6, 60)) return fail("--resolution must be 6 .. 60");
+  if (o.confirm_resolution != 0 && (o.confirm_resolution < 6 || o.confirm_resolution > 60)) {
+    return fail("--confirm-resolution must be 0 (off) or 6 .. 60");
+  }
   if (outside(o.states, 1, 16)) return fail("--states must be 1 .. 16");
   for (auto [value, option] : {std::pair{&o.evaluations, "--evaluations"},
                                std::pair{&o.refit_evaluations, "--refit-evaluations"},
@@ -191,6 +195,7 @@ int run_diagnose(const DiagnoseOptions& o) {
                                           : o.quick ? diagnosis::DiagnosisSettings::quick()
                                                     : diagnosis::DiagnosisSettings{};
   if (o.resolution) settings.fit.resolution = *o.resolution;
+  settings.confirm_resolution = o.confirm_resolution;
   if (o.states) settings.fit.initial_states = *o.states;
   if (o.evaluations) settings.baseline_optimiser.max_evaluations = *o.evaluations;
   if (o.refit_evaluations) settings.attribution.optimiser.max_evaluations = *o.refit_evaluations;
@@ -277,7 +282,9 @@ int run_diagnose(const DiagnoseOptions& o) {
     fleet.reset();  // the workers are told to shut down
   }
   if (!o.report.empty()) {
-    auto model = diagnosis::ForwardModel::create(*capture, settings.fit);
+    diagnosis::FitSettings fit = settings.fit;  // the reported diagnosis's mesh (--confirm-resolution's, maybe)
+    fit.resolution = result->budgets.resolution;
+    auto model = diagnosis::ForwardModel::create(*capture, fit);
     if (!model) return fail(model.error().message);
     if (sim::Status s = diagnosis::write_report(o.report, *result, *capture, **model); !s) {
       return fail(s.error().message, kExitIo);
@@ -308,6 +315,15 @@ int run_diagnose(const DiagnoseOptions& o) {
                              "{:.2f} mm\n",
                              r.gap_all * 1e3, r.gap_held_out * 1e3, r.floors.all * 1e3, r.floors.held_out * 1e3);
     std::cout << fmt::format("  localised: {}\n", diagnosis::region_name(r.localisation.dominant));
+    if (const auto& m = r.mesh_confirmation) {
+      const int first = m->gap_found ? m->other->budgets.resolution : r.budgets.resolution;
+      std::cout << (m->gap_found ? fmt::format("  mesh confirmation: the {0}x{0} mesh finds the gap too: its diagnosis "
+                                               "here (the {1}x{1} mesh's verdict: {2})\n",
+                                               m->resolution, first, m->other->verdict)
+                                 : fmt::format("  mesh confirmation: the {0}x{0} mesh leaves the gap within its "
+                                               "floors: the {1}x{1} mesh's diagnosis here\n",
+                                               m->resolution, first));
+    }
     if (r.verdict == "none") {
       std::cout << fmt::format("  verdict: within the floors{} (no effect named)\n",
                                r.attribution.bending_within_floors() ? " once the bending is refitted" : "");
@@ -356,6 +372,11 @@ Runner add_diagnose_command(CLI::App& app) {
   app.add_option("--resolution", o->resolution,
                  "Fitting mesh vertices per side (default 20; quick 16; fine " +
                      std::to_string(diagnosis::DiagnosisSettings::kFineResolution) + ")");
+  app.add_option("--confirm-resolution", o->confirm_resolution,
+                 "Where the gap is found above the floors, diagnose again on a fitting mesh of this many vertices per "
+                 "side and report that diagnosis where it finds the gap too, else the first (both in report.json "
+                 "\"mesh_confirmation\"; an experiment, default 0: off)")
+      ->capture_default_str();
   app.add_option("--states", o->states, "Initial states per evaluation (default 3; quick and fine 2)");
   app.add_option("--evaluations", o->evaluations,
                  "Baseline fit evaluations per simplex (default 40; quick and fine 20; a second one with --starts)");
@@ -558,7 +579,7 @@ Runner add_diagnose_command(CLI::App& app) {
       "options are refused with it");
   // What only the attribution reads would be ignored: refused instead.
   for (const char* name : {"--candidates", "--ablation", "--confirm-within-floors", "--sensor-bending", "--free-sensor",
-                           "--tie-margin", "--held-out-tolerance", "--refit-evaluations", "--sensor-evaluations",
+                           "--tie-margin", "--held-out-tolerance", "--confirm-resolution", "--refit-evaluations", "--sensor-evaluations",
                            "--sensor-gain-scan", "--common-bending", "--refit-scan", "--yield-trade",
                            "--yield-trade-at", "--shear-trade", "--drift-scan"}) {
     gap_only->excludes(app.get_option(name));

@@ -660,6 +660,57 @@ string(JSON small_effect GET "${small}" attribution candidates 0 effect)
 if(NOT small_ran OR NOT small_effect STREQUAL "yield")
   message(FATAL_ERROR "--refit-evaluations 2 --candidates yield: attribution ran ${small_ran}, first ${small_effect}")
 endif()
+# --confirm-resolution: the depth bias is far above the floors on both meshes, so the second mesh's diagnosis is
+# reported (its settings and report), the first one's whole in mesh_confirmation.other, the runtime both together.
+run_ok(confirmed diagnose --capture ${WORK}/capture --quick --resolution 6 --states 1 --evaluations 2
+       --refit-evaluations 2 --sensor-evaluations 2 --candidates yield --confirm-resolution 7 --json
+       --report ${WORK}/report_confirmed)
+string(JSON reported_resolution GET "${confirmed}" settings resolution)
+string(JSON confirm_resolution GET "${confirmed}" mesh_confirmation resolution)
+json_boolean(confirm_found "${confirmed}" mesh_confirmation gap_found)
+string(JSON confirm_reported GET "${confirmed}" mesh_confirmation reported)
+string(JSON first_resolution GET "${confirmed}" mesh_confirmation other settings resolution)
+json_boolean(first_within "${confirmed}" mesh_confirmation other within_floors)
+string(JSON first_verdict GET "${confirmed}" mesh_confirmation other verdict)
+string(JSON first_nested ERROR_VARIABLE no_nested GET "${confirmed}" mesh_confirmation other mesh_confirmation)
+json_number(both_cpu "${confirmed}" runtime cpu_seconds)
+json_number(first_cpu "${confirmed}" mesh_confirmation other runtime cpu_seconds)
+file(READ ${WORK}/report_confirmed/report.json confirmed_file)
+string(JSON file_resolution GET "${confirmed_file}" settings resolution)
+if(NOT reported_resolution EQUAL 7 OR NOT confirm_resolution EQUAL 7 OR NOT confirm_found
+   OR NOT confirm_reported STREQUAL "confirming mesh" OR NOT first_resolution EQUAL 6 OR first_within
+   OR first_verdict STREQUAL "none" OR NOT no_nested OR NOT both_cpu GREATER first_cpu OR NOT file_resolution EQUAL 7)
+  message(FATAL_ERROR "--confirm-resolution 7 on a 6x6 fit: reported mesh ${reported_resolution} (report.json "
+                      "${file_resolution}), confirmation ${confirm_resolution} found ${confirm_found} reported "
+                      "'${confirm_reported}', first mesh ${first_resolution} within ${first_within} verdict "
+                      "${first_verdict}, nested '${first_nested}', CPU ${both_cpu} s against the first's ${first_cpu} s")
+endif()
+# A control the 10x10 fit finds above the floors (shape 1.43 against 1.39 on this tiny case) and the 12x12 fit
+# within them (0.93): the first mesh's diagnosis is reported, the second's within its floors in mesh_confirmation.
+run_ok(control_out reality ${FABRIC} --resolution 14 --seed 4 --out ${WORK}/control)
+run_ok(unconfirmed diagnose --capture ${WORK}/control --quick --resolution 10 --states 1 --evaluations 4
+       --refit-evaluations 2 --sensor-evaluations 2 --candidates yield --confirm-resolution 12 --json)
+string(JSON kept_resolution GET "${unconfirmed}" settings resolution)
+json_boolean(kept_within "${unconfirmed}" within_floors)
+json_boolean(kept_found "${unconfirmed}" mesh_confirmation gap_found)
+string(JSON kept_reported GET "${unconfirmed}" mesh_confirmation reported)
+string(JSON finer_resolution GET "${unconfirmed}" mesh_confirmation other settings resolution)
+json_boolean(finer_within "${unconfirmed}" mesh_confirmation other within_floors)
+if(NOT kept_resolution EQUAL 10 OR kept_within OR kept_found OR NOT kept_reported STREQUAL "first mesh"
+   OR NOT finer_resolution EQUAL 12 OR NOT finer_within)
+  message(FATAL_ERROR "--confirm-resolution 12 on a 10x10 fit of a control: reported mesh ${kept_resolution} within "
+                      "${kept_within}, confirmation found ${kept_found} reported '${kept_reported}', the 12x12 "
+                      "diagnosis's mesh ${finer_resolution} within ${finer_within}")
+endif()
+# The same mesh confirms nothing: no second diagnosis.
+run_ok(same diagnose --capture ${WORK}/capture --quick --resolution 6 --states 1 --evaluations 2
+       --refit-evaluations 2 --sensor-evaluations 2 --candidates yield --confirm-resolution 6 --json)
+string(JSON same_confirmation ERROR_VARIABLE no_confirmation GET "${same}" mesh_confirmation)
+if(NOT no_confirmation)
+  message(FATAL_ERROR "--confirm-resolution equal to --resolution: mesh_confirmation ${same_confirmation}")
+endif()
+expect_failure(1 "--confirm-resolution must be 0 (off) or 6 .. 60" diagnose --capture ${WORK}/capture
+               --confirm-resolution 5)
 expect_failure(1 "--drift-scan must be" diagnose --capture ${WORK}/capture --drift-scan -3)
 # Each option is either unset (the settings' value) or checked: no value of it means "the default".
 expect_failure(1 "--drift-scan must be" diagnose --capture ${WORK}/capture --drift-scan -1)

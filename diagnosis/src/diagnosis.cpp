@@ -303,8 +303,11 @@ sim::Status check_same_specimen(const Capture& capture, const Capture& other, st
   return {};
 }
 
-sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisSettings& settings,
-                                        const OtherPlacements& others) {
+namespace {
+
+// The diagnosis on settings.fit.resolution's mesh (diagnose() adds the confirming mesh's).
+sim::Expected<DiagnosisResult> diagnose_on_mesh(const Capture& capture, const DiagnosisSettings& settings,
+                                                const OtherPlacements& others) {
   const auto start = std::chrono::steady_clock::now();
   const double cpu_start = process_cpu_seconds();
   if (others.second) {
@@ -607,6 +610,37 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
   return r;
 }
 
+}  // namespace
+
+sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisSettings& settings,
+                                        const OtherPlacements& others) {
+  auto first = diagnose_on_mesh(capture, settings, others);
+  const int finer = settings.confirm_resolution;
+  if (!first || finer <= 0 || finer == settings.fit.resolution || first->within_floors || !settings.attribute) {
+    return first;
+  }
+  sim::logger()->info("diagnosis: the gap above the floors on the {0}x{0} mesh; diagnosing again on {1}x{1}",
+                      settings.fit.resolution, finer);
+  DiagnosisSettings confirming = settings;
+  confirming.fit.resolution = finer;
+  confirming.confirm_resolution = 0;
+  auto second = diagnose_on_mesh(capture, confirming, others);
+  if (!second) return second.error();
+  const bool gap_found = !second->within_floors;
+  sim::logger()->info("diagnosis: the {0}x{0} mesh {1}: the verdict {2}", finer,
+                      gap_found ? "finds the gap too" : "leaves it within its floors", gap_found ? second->verdict
+                                                                                                : first->verdict);
+  const double seconds = first->seconds + second->seconds, cpu_seconds = first->cpu_seconds + second->cpu_seconds;
+  const int simulations = first->simulations + second->simulations;
+  DiagnosisResult reported = std::move(gap_found ? *second : *first);
+  auto other = std::make_shared<const DiagnosisResult>(std::move(gap_found ? *first : *second));
+  reported.seconds = seconds;
+  reported.cpu_seconds = cpu_seconds;
+  reported.simulations = simulations;
+  reported.mesh_confirmation = DiagnosisResult::MeshConfirmation{finer, gap_found, std::move(other)};
+  return reported;
+}
+
 nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
   nlohmann::json j;
   j["capture"] = capture.directory;
@@ -830,6 +864,12 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                    {"initial_states", r.budgets.initial_states},
                    {"max_baseline_evaluations", r.budgets.max_baseline_evaluations},
                    {"attribution", r.budgets.attribution}};
+  if (const auto& m = r.mesh_confirmation) {
+    j["mesh_confirmation"] = {{"resolution", m->resolution},
+                              {"gap_found", m->gap_found},
+                              {"reported", m->gap_found ? "confirming mesh" : "first mesh"},
+                              {"other", m->other ? to_json(*m->other, capture) : nlohmann::json(nullptr)}};
+  }
   j["runtime"] = {{"seconds", r.seconds},
                   {"cpu_seconds", r.cpu_seconds},
                   {"jobs", r.jobs},

@@ -3,6 +3,7 @@
 
 #include <nlohmann/json_fwd.hpp>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -67,6 +68,11 @@ struct DiagnosisSettings {
   /// (FitSettings::simulator: a fleet), so that up to attribution.jobs x this many are in flight. The result does not
   /// depend on it (ForwardModel::set_threads).
   int refit_state_threads = 1;
+  /// Where the diagnosis on fit.resolution's mesh finds the gap above the floors, diagnose again on a mesh of this
+  /// many vertices per side and report that diagnosis where it finds the gap too (the first one otherwise, the
+  /// gate's verdict staying the first mesh's): a finer mesh refits the effects closer, while the floors are
+  /// calibrated on the preset's (docs/DIAGNOSIS_RESULTS.md, "Session 76"). 0: off (an experiment, not the default).
+  int confirm_resolution = 0;
 
   /// Small budgets for tests and the --quick benchmark.
   [[nodiscard]] static DiagnosisSettings quick();
@@ -166,6 +172,15 @@ struct DiagnosisResult {
   /// The threads it was allowed (AttributionSettings::jobs; with a fleet, the refits in flight); fewer run at once
   /// where there are fewer refits or initial states to share out.
   int jobs = 1;
+  /// With DiagnosisSettings::confirm_resolution where the first mesh found the gap: the diagnosis on the other mesh
+  /// (the first mesh's where this one is the confirming mesh's, and the reverse), whole. `seconds`, `cpu_seconds` and
+  /// `simulations` above are then both diagnoses' together.
+  struct MeshConfirmation {
+    int resolution = 0;          // the confirming mesh's vertices per side
+    bool gap_found = false;      // the confirming mesh found the gap above its floors: its diagnosis is this one
+    std::shared_ptr<const DiagnosisResult> other;
+  };
+  std::optional<MeshConfirmation> mesh_confirmation;
 };
 
 /// Other placements of the capture's specimen on the tester (attribution.hpp, OtherCaptures); either may be null.
