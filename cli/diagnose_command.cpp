@@ -579,9 +579,9 @@ Runner add_diagnose_command(CLI::App& app) {
       "options are refused with it");
   // What only the attribution reads would be ignored: refused instead.
   for (const char* name : {"--candidates", "--ablation", "--confirm-within-floors", "--sensor-bending", "--free-sensor",
-                           "--tie-margin", "--held-out-tolerance", "--confirm-resolution", "--refit-evaluations", "--sensor-evaluations",
-                           "--sensor-gain-scan", "--common-bending", "--refit-scan", "--yield-trade",
-                           "--yield-trade-at", "--shear-trade", "--drift-scan"}) {
+                           "--tie-margin", "--held-out-tolerance", "--confirm-resolution", "--refit-evaluations",
+                           "--sensor-evaluations", "--sensor-gain-scan", "--common-bending", "--refit-scan",
+                           "--yield-trade", "--yield-trade-at", "--shear-trade", "--drift-scan"}) {
     gap_only->excludes(app.get_option(name));
   }
   app.add_flag("-v,--verbose", o->verbose, "Log every simulation of the fit and the refits on stderr (by default: "

@@ -4,8 +4,8 @@ and of an arm ARM (a run of the same set with other diagnose options, its captur
 BASE's), the arm's placement drape test (gap_tests.placement_dc over placement_dc_floor; 0 without the test) and its
 CPU seconds; then top-1 of each, the gains and losses (captures the arm names right and the default wrong, and the
 reverse), and the controls each names; last, rule Z: the arm's verdict where the arm finds the gap above its floors,
-the default's elsewhere (session 76: an arm on a finer fitting mesh), scored the same way. The truth files are read only to score (docs/DIAGNOSIS_RESULTS.md, "Session
-73").
+the default's elsewhere (session 76: an arm on a finer fitting mesh), scored the same way. The truth files are read
+only to score (docs/DIAGNOSIS_RESULTS.md, "Session 73").
 
     scripts/compare_arms.py out/p75/s91:out/p75/s91D out/p75/s92:out/p75/s92D
 """

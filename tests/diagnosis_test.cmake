@@ -683,7 +683,8 @@ if(NOT reported_resolution EQUAL 7 OR NOT confirm_resolution EQUAL 7 OR NOT conf
   message(FATAL_ERROR "--confirm-resolution 7 on a 6x6 fit: reported mesh ${reported_resolution} (report.json "
                       "${file_resolution}), confirmation ${confirm_resolution} found ${confirm_found} reported "
                       "'${confirm_reported}', first mesh ${first_resolution} within ${first_within} verdict "
-                      "${first_verdict}, nested '${first_nested}', CPU ${both_cpu} s against the first's ${first_cpu} s")
+                      "${first_verdict}, nested '${first_nested}', CPU ${both_cpu} s against the first's "
+                      "${first_cpu} s")
 endif()
 # A control the 10x10 fit finds above the floors (shape 1.43 against 1.39 on this tiny case) and the 12x12 fit
 # within them (0.93): the first mesh's diagnosis is reported, the second's within its floors in mesh_confirmation.
