@@ -99,7 +99,7 @@ int run_diagnose(const DiagnoseOptions& o) {
   // A scan of N levels: 0 (off) or 2 .. hi (one level is no scan).
   const auto bad_scan = [&](const std::optional<int>& value, int hi) { return outside(value, 0, hi) || value == 1; };
   if (outside(o.resolution, 6, 60)) return fail("--resolution must be 6 .. 60");
-  if (o.confirm_resolution != 0 && (o.confirm_resolution < 6 || o.confirm_resolution > 60)) {
+  if (o.confirm_resolution != 0 && outside(o.confirm_resolution, 6, 60)) {
     return fail("--confirm-resolution must be 0 (off) or 6 .. 60");
   }
   if (outside(o.states, 1, 16)) return fail("--states must be 1 .. 16");

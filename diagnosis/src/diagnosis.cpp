@@ -615,19 +615,19 @@ sim::Expected<DiagnosisResult> diagnose_on_mesh(const Capture& capture, const Di
 sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisSettings& settings,
                                         const OtherPlacements& others) {
   auto first = diagnose_on_mesh(capture, settings, others);
-  const int finer = settings.confirm_resolution;
-  if (!first || finer <= 0 || finer == settings.fit.resolution || first->within_floors || !settings.attribute) {
+  const int confirm = settings.confirm_resolution;  // the confirming mesh's vertices per side
+  if (!first || confirm <= 0 || confirm == settings.fit.resolution || first->within_floors || !settings.attribute) {
     return first;
   }
   sim::logger()->info("diagnosis: the gap above the floors on the {0}x{0} mesh; diagnosing again on {1}x{1}",
-                      settings.fit.resolution, finer);
+                      settings.fit.resolution, confirm);
   DiagnosisSettings confirming = settings;
-  confirming.fit.resolution = finer;
+  confirming.fit.resolution = confirm;
   confirming.confirm_resolution = 0;
   auto second = diagnose_on_mesh(capture, confirming, others);
   if (!second) return second.error();
   const bool gap_found = !second->within_floors;
-  sim::logger()->info("diagnosis: the {0}x{0} mesh {1}: the verdict {2}", finer,
+  sim::logger()->info("diagnosis: the {0}x{0} mesh {1}: the verdict {2}", confirm,
                       gap_found ? "finds the gap too" : "leaves it within its floors", gap_found ? second->verdict
                                                                                                 : first->verdict);
   const double seconds = first->seconds + second->seconds, cpu_seconds = first->cpu_seconds + second->cpu_seconds;
@@ -637,7 +637,7 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
   reported.seconds = seconds;
   reported.cpu_seconds = cpu_seconds;
   reported.simulations = simulations;
-  reported.mesh_confirmation = DiagnosisResult::MeshConfirmation{finer, gap_found, std::move(other)};
+  reported.mesh_confirmation = DiagnosisResult::MeshConfirmation{confirm, gap_found, std::move(other)};
   return reported;
 }
 
