@@ -15,8 +15,9 @@
 #                                                            # session 70; lanes may join a running diagnose)
 #   scripts/diagnosis_set.sh arm ARM BASE OPTIONS...         # ARM: an arm of the generated set BASE (its build,
 #                                                            # captures, truth and screen linked), diagnosed with
-#                                                            # these diagnose options added (kept in ARM/arm.args);
-#                                                            # then `diagnose ARM` and `scripts/compare_arms.py`
+#                                                            # these diagnose options added (kept in ARM/arm.args;
+#                                                            # none: scripts/first_mesh.py's default arm); then
+#                                                            # `diagnose ARM` and `scripts/compare_arms.py`
 #   scripts/diagnosis_set.sh score OUT...                    # each set's summary, then the verdict and region tables
 #
 # BENCH-OPTIONS choose the captures (drapegen_diagnosis_bench --help): e.g.
@@ -83,7 +84,7 @@ case $step in
     wait
     ;;
   arm)
-    [ $# -ge 2 ] || usage
+    [ $# -ge 1 ] || usage
     base=$1
     shift
     [ -f "$base/generated" ] || { echo "diagnosis_set: $base is not generated yet ($base/generated)" >&2; exit 1; }

@@ -9,6 +9,7 @@ arm. A report without "mesh_confirmation" (the first mesh left the gap within it
 """
 import json
 import os
+import subprocess
 import sys
 
 
@@ -27,12 +28,11 @@ def first_mesh(report):
 
 
 def main(arm, out):
-    if os.path.exists(out):
-        sys.exit(f"first_mesh: {out} exists")
+    # OUT: an arm of ARM's set with no options added (its build, captures, truth and screen linked)
+    setscript = os.path.join(os.path.dirname(os.path.abspath(__file__)), "diagnosis_set.sh")
+    if subprocess.run([setscript, "arm", os.path.abspath(out), os.path.abspath(arm)]).returncode != 0:
+        sys.exit(1)
     os.makedirs(os.path.join(out, "diagnoses"))
-    for f in ("bin", "captures", "truth", "screen", "set.args", "generated"):
-        if os.path.exists(os.path.join(arm, f)):
-            os.symlink(os.path.realpath(os.path.join(arm, f)), os.path.join(out, f))
     n = 0
     for name in sorted(os.listdir(os.path.join(arm, "diagnoses"))):
         if not name.endswith(".json"):
