@@ -40,6 +40,7 @@ struct DiagnoseOptions {
   // Unset options keep the settings' value (default, --quick or --fine).
   std::optional<int> resolution;
   int confirm_resolution = 0;
+  double confirm_placement_rise = 0.0;
   std::optional<int> states;
   std::optional<int> evaluations;
   std::optional<int> refit_evaluations;
@@ -123,6 +124,16 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (!(o.placement_drape_floor >= 0.0 && o.placement_drape_floor < 1.0)) {
     return fail("--placement-drape-floor must be 0 (the model's range) .. 1 (a drape-coefficient difference)");
   }
+  if (!(o.confirm_placement_rise >= 0.0 && o.confirm_placement_rise < 1.0)) {
+    return fail("--confirm-placement-rise must be 0 (off) .. 1 (a drape-coefficient difference)");
+  }
+  if (o.confirm_placement_rise > 0.0 && o.second.empty()) {
+    return fail("--confirm-placement-rise compares the turned placement with the capture: give --second-capture");
+  }
+  if (o.confirm_placement_rise > 0.0 && o.placement_drape_test) {
+    return fail("--confirm-placement-rise diagnoses again with the placement drape test: leave out "
+                "--placement-drape-test");
+  }
   if (!(o.held_out_tolerance >= 0.0 && o.held_out_tolerance <= 1.0)) return fail("--held-out-tolerance must be 0 .. 1");
   if (outside(o.starts, 0, 100)) return fail("--starts must be 0 (the guess alone) .. 100");
   if (bad_scan(o.refit_scan, 100)) return fail("--refit-scan must be 0 (off) or 2 .. 100");
@@ -196,6 +207,7 @@ int run_diagnose(const DiagnoseOptions& o) {
                                                     : diagnosis::DiagnosisSettings{};
   if (o.resolution) settings.fit.resolution = *o.resolution;
   settings.confirm_resolution = o.confirm_resolution;
+  settings.confirm_placement_rise = o.confirm_placement_rise;
   if (o.states) settings.fit.initial_states = *o.states;
   if (o.evaluations) settings.baseline_optimiser.max_evaluations = *o.evaluations;
   if (o.refit_evaluations) settings.attribution.optimiser.max_evaluations = *o.refit_evaluations;
@@ -324,6 +336,12 @@ int run_diagnose(const DiagnoseOptions& o) {
                                                "floors: the {1}x{1} mesh's diagnosis here\n",
                                                m->resolution, first));
     }
+    if (const auto& p = r.placement_confirmation) {
+      std::cout << fmt::format("  placement confirmation: the verdict {} without the placement drape test, but the "
+                               "turned placement drapes {:.4f} stiffer (at least {:g}): the diagnosis with the test "
+                               "here\n",
+                               p->other->verdict, p->rise, p->floor);
+    }
     if (r.verdict == "none") {
       std::cout << fmt::format("  verdict: within the floors{} (no effect named)\n",
                                r.attribution.bending_within_floors() ? " once the bending is refitted" : "");
@@ -376,6 +394,13 @@ Runner add_diagnose_command(CLI::App& app) {
                  "Where the gap is found above the floors, diagnose again on a fitting mesh of this many vertices per "
                  "side and report that diagnosis where it finds the gap too, else the first (both in report.json "
                  "\"mesh_confirmation\"; an experiment, default 0: off)")
+      ->capture_default_str();
+  app.add_option("--confirm-placement-rise", o->confirm_placement_rise,
+                 "Where the verdict names no effect (none or unexplained) and the second capture, turned over, drapes "
+                 "with a drape coefficient at least this much (F) above the capture's, diagnose again with "
+                 "--placement-drape-test --placement-drape-floor F --placement-drape-when-seen and report that "
+                 "diagnosis (both in report.json \"placement_confirmation\"; needs --second-capture; an experiment, "
+                 "default 0: off)")
       ->capture_default_str();
   app.add_option("--states", o->states, "Initial states per evaluation (default 3; quick and fine 2)");
   app.add_option("--evaluations", o->evaluations,

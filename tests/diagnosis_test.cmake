@@ -1556,6 +1556,80 @@ expect_failure(1 "--placement-drape-floor must be" diagnose --capture ${WORK}/ca
                ${WORK}/capture.p1 --placement-drape-test --placement-drape-floor -0.1)
 expect_failure(1 "--placement-drape-floor requires --placement-drape-test" diagnose --capture ${WORK}/capture
                --second-capture ${WORK}/capture.p1 --placement-drape-floor 0.02)
+# --confirm-placement-rise F: where the verdict names no effect and the second capture, turned over, drapes with a
+# drape coefficient at least F above the capture's, the diagnosis runs again with the placement drape test at F (when
+# the captures show it) and reports that one, the first whole in placement_confirmation. A control laid twice, turned
+# over in between: the placement that drapes stiffer is the second capture, the other order shows a fall (no rise).
+run_ok(out reality ${FABRIC} --resolution 14 --seed 5 --turn-over --out ${WORK}/rise)
+run_ok(out reality ${FABRIC} --resolution 14 --seed 5 --turn-over --placement 1 --out ${WORK}/rise.p1)
+file(REMOVE ${WORK}/rise/truth.json ${WORK}/rise.p1/truth.json)
+set(rise_args --quick --resolution 6 --states 1 --evaluations 2 --refit-evaluations 2 --sensor-evaluations 2
+              --candidates yield --json)
+run_ok(seen diagnose --capture ${WORK}/rise --second-capture ${WORK}/rise.p1 --quick --resolution 6 --states 1
+       --evaluations 2 --json --gap-only --placement-drape-test)
+json_number(c_up "${seen}" gap_tests capture drape_coefficient)
+json_number(c_down "${seen}" gap_tests second_capture drape_coefficient)
+json_nano(up_n "${c_up}")
+json_nano(down_n "${c_down}")
+if(down_n GREATER up_n)
+  set(lower ${WORK}/rise)
+  set(stiffer ${WORK}/rise.p1)
+  math(EXPR rise_n "${down_n} - ${up_n}")
+else()
+  set(lower ${WORK}/rise.p1)
+  set(stiffer ${WORK}/rise)
+  math(EXPR rise_n "${up_n} - ${down_n}")
+endif()
+if(rise_n LESS 1000)
+  message(FATAL_ERROR "the two placements' drape coefficients ${c_up} and ${c_down} differ by less than 1e-6: no rise "
+                      "to test --confirm-placement-rise on (take another seed)")
+endif()
+run_ok(rose diagnose --capture ${lower} --second-capture ${stiffer} ${rise_args} --confirm-placement-rise 0.000001)
+json_number(rose_rise "${rose}" placement_confirmation rise)
+json_number(rose_floor "${rose}" placement_confirmation floor)
+string(JSON untested_verdict GET "${rose}" placement_confirmation other verdict)
+json_number(untested_floor "${rose}" placement_confirmation other gap_tests placement_dc_floor)
+string(JSON nested ERROR_VARIABLE no_nested GET "${rose}" placement_confirmation other placement_confirmation)
+json_number(tested_floor "${rose}" gap_tests placement_dc_floor)
+json_number(tested_term "${rose}" gap_tests placement_dc)
+json_number(rose_cpu "${rose}" runtime cpu_seconds)
+json_number(untested_cpu "${rose}" placement_confirmation other runtime cpu_seconds)
+json_nano(rose_n "${rose_rise}")
+math(EXPR rise_off "${rose_n} - ${rise_n}")
+set(floor_ok FALSE)
+if((tested_term GREATER 0.000001 AND tested_floor EQUAL 0.000001) OR (NOT tested_term GREATER 0.000001 AND
+                                                                     tested_floor EQUAL 0))
+  set(floor_ok TRUE)
+endif()
+if(rise_off GREATER 4 OR rise_off LESS -4 OR NOT rose_floor EQUAL 0.000001
+   OR NOT untested_verdict MATCHES "^(none|unexplained)$" OR NOT untested_floor EQUAL 0 OR NOT no_nested
+   OR NOT floor_ok OR NOT rose_cpu GREATER untested_cpu)
+  message(FATAL_ERROR "--confirm-placement-rise 0.000001: rise ${rose_rise} (the placements' drape coefficients "
+                      "${c_up}, ${c_down}), floor ${rose_floor}; without the test: verdict ${untested_verdict}, "
+                      "placement floor ${untested_floor}, nested '${nested}'; with it: term ${tested_term} against "
+                      "${tested_floor}; CPU ${rose_cpu} s against ${untested_cpu} s")
+endif()
+# No rise at the floor, or a fall: the first diagnosis alone (its verdict names no effect: the rise alone
+# decides).
+foreach(case "${lower};${stiffer};0.5" "${stiffer};${lower};0.000001")
+  list(GET case 0 first)
+  list(GET case 1 second)
+  list(GET case 2 floor)
+  run_ok(flat diagnose --capture ${first} --second-capture ${second} ${rise_args} --confirm-placement-rise ${floor})
+  string(JSON flat_confirmation ERROR_VARIABLE no_confirmation GET "${flat}" placement_confirmation)
+  json_number(flat_floor "${flat}" gap_tests placement_dc_floor)
+  string(JSON flat_verdict GET "${flat}" verdict)
+  if(NOT no_confirmation OR NOT flat_floor EQUAL 0 OR NOT flat_verdict MATCHES "^(none|unexplained)$")
+    message(FATAL_ERROR "--confirm-placement-rise ${floor} on ${first} then ${second}: verdict ${flat_verdict}, "
+                        "placement_confirmation '${flat_confirmation}', placement floor ${flat_floor}")
+  endif()
+endforeach()
+expect_failure(1 "--confirm-placement-rise must be 0 (off) .. 1" diagnose --capture ${WORK}/rise --second-capture
+               ${WORK}/rise.p1 --confirm-placement-rise -0.01)
+expect_failure(1 "give --second-capture" diagnose --capture ${WORK}/rise --held-out-capture ${WORK}/rise.p1
+               --confirm-placement-rise 0.02)
+expect_failure(1 "leave out --placement-drape-test" diagnose --capture ${WORK}/rise --second-capture ${WORK}/rise.p1
+               --placement-drape-test --confirm-placement-rise 0.02)
 
 # The sensor candidate held to the rigid surfaces: a multipath error leaves the platform top and the bare side where
 # the tester puts them (the camera they show moves the platform's centre less than 3 mm), so the candidate keeps their

@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 
 #include "drapegen/diagnosis/bending_json.hpp"
+#include "drapegen/diagnosis/hem_profile.hpp"
 #include "drapegen/sim/logging.hpp"
 
 namespace drapegen::diagnosis {
@@ -610,10 +611,17 @@ sim::Expected<DiagnosisResult> diagnose_on_mesh(const Capture& capture, const Di
   return r;
 }
 
-}  // namespace
+/// `reported` takes on `other`'s runtime too (both diagnoses together); returns `other`, whole, to keep beside it.
+std::shared_ptr<const DiagnosisResult> runtimes_together(DiagnosisResult& reported, DiagnosisResult&& other) {
+  reported.seconds += other.seconds;
+  reported.cpu_seconds += other.cpu_seconds;
+  reported.simulations += other.simulations;
+  return std::make_shared<const DiagnosisResult>(std::move(other));
+}
 
-sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisSettings& settings,
-                                        const OtherPlacements& others) {
+/// The diagnosis on the settings' mesh, and with DiagnosisSettings::confirm_resolution its confirmation on the other.
+sim::Expected<DiagnosisResult> diagnose_confirming_mesh(const Capture& capture, const DiagnosisSettings& settings,
+                                                        const OtherPlacements& others) {
   auto first = diagnose_on_mesh(capture, settings, others);
   const int confirm = settings.confirm_resolution;  // the confirming mesh's vertices per side
   if (!first || confirm <= 0 || confirm == settings.fit.resolution || first->within_floors || !settings.attribute) {
@@ -630,14 +638,40 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
   sim::logger()->info("diagnosis: the {0}x{0} mesh {1}: the verdict {2}", confirm,
                       gap_found ? "finds the gap too" : "leaves it within its floors", gap_found ? second->verdict
                                                                                                 : first->verdict);
-  const double seconds = first->seconds + second->seconds, cpu_seconds = first->cpu_seconds + second->cpu_seconds;
-  const int simulations = first->simulations + second->simulations;
   DiagnosisResult reported = std::move(gap_found ? *second : *first);
-  auto other = std::make_shared<const DiagnosisResult>(std::move(gap_found ? *first : *second));
-  reported.seconds = seconds;
-  reported.cpu_seconds = cpu_seconds;
-  reported.simulations = simulations;
+  auto other = runtimes_together(reported, std::move(gap_found ? *first : *second));
   reported.mesh_confirmation = DiagnosisResult::MeshConfirmation{confirm, gap_found, std::move(other)};
+  return reported;
+}
+
+}  // namespace
+
+sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisSettings& settings,
+                                        const OtherPlacements& others) {
+  auto first = diagnose_confirming_mesh(capture, settings, others);
+  const double floor = settings.confirm_placement_rise;
+  const Capture* turned = others.second;  // laid after the capture, turned over
+  if (!first || floor <= 0.0 || settings.floors.placement_drape_coefficient || !turned ||
+      turned->face_down == capture.face_down || (first->verdict != "none" && first->verdict != "unexplained")) {
+    return first;
+  }
+  const double rise = drape_coefficient(hem_profile_from_capture(*turned), turned->specimen) -
+                      drape_coefficient(hem_profile_from_capture(capture), capture.specimen);
+  if (!(rise >= floor)) return first;
+  sim::logger()->info("diagnosis: verdict {} but the turned placement drapes {:.4f} stiffer (drape coefficient); "
+                      "diagnosing again with the placement drape test at {:g}",
+                      first->verdict, rise, floor);
+  DiagnosisSettings tested = settings;
+  tested.confirm_placement_rise = 0.0;
+  tested.floors.placement_drape_coefficient = true;
+  tested.floors.placement_drape_floor = floor;
+  tested.floors.placement_drape_when_seen = true;
+  auto second = diagnose_confirming_mesh(capture, tested, others);
+  if (!second) return second.error();
+  sim::logger()->info("diagnosis: with the placement drape test, the verdict {}", second->verdict);
+  DiagnosisResult reported = std::move(*second);
+  auto other = runtimes_together(reported, std::move(*first));
+  reported.placement_confirmation = DiagnosisResult::PlacementConfirmation{rise, floor, std::move(other)};
   return reported;
 }
 
@@ -869,6 +903,11 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                               {"gap_found", m->gap_found},
                               {"reported", m->gap_found ? "confirming mesh" : "first mesh"},
                               {"other", m->other ? to_json(*m->other, capture) : nlohmann::json(nullptr)}};
+  }
+  if (const auto& p = r.placement_confirmation) {
+    j["placement_confirmation"] = {{"rise", p->rise},
+                                   {"floor", p->floor},
+                                   {"other", p->other ? to_json(*p->other, capture) : nlohmann::json(nullptr)}};
   }
   j["runtime"] = {{"seconds", r.seconds},
                   {"cpu_seconds", r.cpu_seconds},

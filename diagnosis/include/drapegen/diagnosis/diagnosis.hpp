@@ -73,6 +73,14 @@ struct DiagnosisSettings {
   /// gate's verdict staying the first mesh's): a finer mesh refits the effects closer, while the floors are
   /// calibrated on the preset's (docs/DIAGNOSIS_RESULTS.md, "Session 76"). 0: off (an experiment, not the default).
   int confirm_resolution = 0;
+  /// Where the verdict names no effect ("none" or "unexplained") and the second capture, laid turned over after the
+  /// capture, drapes with a drape coefficient (of the outline its views see) at least this much above the capture's,
+  /// diagnose again with the placement drape test at this floor where the captures show the change
+  /// (FloorSettings::placement_drape_coefficient, placement_drape_floor, placement_drape_when_seen) and report that
+  /// diagnosis: an elastic specimen has no face, while the plastic set a drape leaves opposes the turned placement's
+  /// folds and stiffens its drape (rule Y, docs/DIAGNOSIS_RESULTS.md, "Session 77"). Skipped where the settings test
+  /// the placements' drape coefficients already. 0: off (an experiment, not the default).
+  double confirm_placement_rise = 0.0;
 
   /// Small budgets for tests and the --quick benchmark.
   [[nodiscard]] static DiagnosisSettings quick();
@@ -181,6 +189,15 @@ struct DiagnosisResult {
     std::shared_ptr<const DiagnosisResult> other;
   };
   std::optional<MeshConfirmation> mesh_confirmation;
+  /// With DiagnosisSettings::confirm_placement_rise where it fired: this diagnosis is the one with the placement
+  /// drape test; `other`, whole, the one without it, whose verdict named no effect. `seconds`, `cpu_seconds` and
+  /// `simulations` above are both diagnoses' together.
+  struct PlacementConfirmation {
+    double rise = 0.0;   // the second capture's drape coefficient less the capture's
+    double floor = 0.0;  // DiagnosisSettings::confirm_placement_rise
+    std::shared_ptr<const DiagnosisResult> other;
+  };
+  std::optional<PlacementConfirmation> placement_confirmation;
 };
 
 /// Other placements of the capture's specimen on the tester (attribution.hpp, OtherCaptures); either may be null.
