@@ -677,6 +677,12 @@ json_number(both_cpu "${confirmed}" runtime cpu_seconds)
 json_number(first_cpu "${confirmed}" mesh_confirmation other runtime cpu_seconds)
 file(READ ${WORK}/report_confirmed/report.json confirmed_file)
 string(JSON file_resolution GET "${confirmed_file}" settings resolution)
+file(READ ${WORK}/report_confirmed/report.md confirmed_md)
+string(CONCAT says_mesh "This is the diagnosis on the 7x7 confirming mesh, which finds the gap above its floors too; "
+                        "on the first mesh \\(6x6\\) the verdict was ${first_verdict} ")
+if(NOT confirmed_md MATCHES "${says_mesh}" OR NOT confirmed_md MATCHES "Runtime and CPU are both diagnoses' together")
+  message(FATAL_ERROR "--confirm-resolution 7: report.md does not say which mesh's diagnosis it is:\n${confirmed_md}")
+endif()
 if(NOT reported_resolution EQUAL 7 OR NOT confirm_resolution EQUAL 7 OR NOT confirm_found
    OR NOT confirm_reported STREQUAL "confirming mesh" OR NOT first_resolution EQUAL 6 OR first_within
    OR first_verdict STREQUAL "none" OR NOT no_nested OR NOT both_cpu GREATER first_cpu OR NOT file_resolution EQUAL 7)
@@ -1584,7 +1590,8 @@ if(rise_n LESS 1000)
   message(FATAL_ERROR "the two placements' drape coefficients ${c_up} and ${c_down} differ by less than 1e-6: no rise "
                       "to test --confirm-placement-rise on (take another seed)")
 endif()
-run_ok(rose diagnose --capture ${lower} --second-capture ${stiffer} ${rise_args} --confirm-placement-rise 0.000001)
+run_ok(rose diagnose --capture ${lower} --second-capture ${stiffer} ${rise_args} --confirm-placement-rise 0.000001
+       --report ${WORK}/report_rose)
 json_number(rose_rise "${rose}" placement_confirmation rise)
 json_number(rose_floor "${rose}" placement_confirmation floor)
 string(JSON untested_verdict GET "${rose}" placement_confirmation other verdict)
@@ -1608,6 +1615,12 @@ if(rise_off GREATER 4 OR rise_off LESS -4 OR NOT rose_floor EQUAL 0.000001
                       "${c_up}, ${c_down}), floor ${rose_floor}; without the test: verdict ${untested_verdict}, "
                       "placement floor ${untested_floor}, nested '${nested}'; with it: term ${tested_term} against "
                       "${tested_floor}; CPU ${rose_cpu} s against ${untested_cpu} s")
+endif()
+file(READ ${WORK}/report_rose/report.md rose_md)
+string(CONCAT says_rise "Without the placement drape test the verdict was ${untested_verdict}, but the turned "
+                        "placement drapes 0\\.[0-9]+ stiffer than the capture")
+if(NOT rose_md MATCHES "${says_rise}")
+  message(FATAL_ERROR "--confirm-placement-rise: report.md does not say which diagnosis it is:\n${rose_md}")
 endif()
 # No rise at the floor, or a fall: the first diagnosis alone (its verdict names no effect: the rise alone
 # decides).

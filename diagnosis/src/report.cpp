@@ -99,6 +99,28 @@ std::string leading_feature_text(const Localisation& L) {
   return fmt::format("led by {}", led);
 }
 
+/// Which of two diagnoses of the same captures this is (--confirm-resolution, --confirm-placement-rise), and the
+/// other's verdict (report.json holds the other whole).
+std::string confirmations_markdown(const DiagnosisResult& r) {
+  std::string md;
+  if (const auto& m = r.mesh_confirmation; m && m->other) {
+    md += m->gap_found ? fmt::format("This is the diagnosis on the {0}x{0} confirming mesh, which finds the gap above "
+                                     "its floors too; on the first mesh ({1}x{1}) the verdict was {2} (report.json "
+                                     "`mesh_confirmation`).\n\n",
+                                     m->resolution, m->other->budgets.resolution, m->other->verdict)
+                       : fmt::format("The {0}x{0} confirming mesh leaves the gap within its floors (its verdict {1}): "
+                                     "this is the first mesh's diagnosis (report.json `mesh_confirmation`).\n\n",
+                                     m->resolution, m->other->verdict);
+  }
+  if (const auto& p = r.placement_confirmation; p && p->other) {
+    md += fmt::format("Without the placement drape test the verdict was {}, but the turned placement drapes {:.4f} "
+                      "stiffer than the capture (drape coefficient; at least {:g}): this is the diagnosis with the "
+                      "test at that floor (report.json `placement_confirmation`).\n\n",
+                      p->other->verdict, p->rise, p->floor);
+  }
+  return md;
+}
+
 }  // namespace
 
 std::string verdict_markdown(const DiagnosisResult& r) {
@@ -220,6 +242,7 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
     md += "\n";
   }
   md += verdict_markdown(r);
+  md += confirmations_markdown(r);
   md += "## Gap and floors (score in mm: stable-region RMS + 4 mm x shape-feature distance)\n\n";
   md += "| | all views | held-out view |\n|---|---|---|\n";
   md += fmt::format("| gap (baseline fit) | {:.2f} | {:.2f} |\n", r.gap_all * 1e3, r.gap_held_out * 1e3);
@@ -373,6 +396,7 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
                     "{} thread{}.\n",
                     r.seconds, r.seconds_fit, r.seconds_floors, r.seconds_attribution, r.cpu_seconds, r.jobs,
                     r.jobs == 1 ? "" : "s");
+  if (r.mesh_confirmation || r.placement_confirmation) md += "Runtime and CPU are both diagnoses' together.\n";
   if (sim::Status s = storage::write_file_atomic((dir / "report.md").string(), md); !s) return s;
   return storage::write_file_atomic((dir / "report.json").string(), storage::json_text(to_json(r, capture)) + "\n");
 }
