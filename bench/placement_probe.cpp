@@ -89,8 +89,7 @@ int main(int argc, char** argv) {
           std::cerr << capture.error().message << "\n";
           return 1;
         }
-        const double dc = diagnosis::drape_coefficient(diagnosis::hem_profile_from_capture(*capture),
-                                                       capture->specimen);
+        const double dc = diagnosis::drape_coefficient(*capture);
         double truth = std::nan("");
         if (const auto t = bench::read_json(fs::path(run) / "truth" / (name + ".json"))) {
           family = t->value("family", "none");

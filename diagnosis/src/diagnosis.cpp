@@ -655,8 +655,7 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
       turned->face_down == capture.face_down || (first->verdict != "none" && first->verdict != "unexplained")) {
     return first;
   }
-  const double rise = drape_coefficient(hem_profile_from_capture(*turned), turned->specimen) -
-                      drape_coefficient(hem_profile_from_capture(capture), capture.specimen);
+  const double rise = drape_coefficient(*turned) - drape_coefficient(capture);
   if (!(rise >= floor)) return first;
   sim::logger()->info("diagnosis: verdict {} but the turned placement drapes {:.4f} stiffer (drape coefficient); "
                       "diagnosing again with the placement drape test at {:g}",

@@ -178,13 +178,6 @@ double ForwardModel::held_out_mean(const std::vector<ViewComparison>& views) con
   return n > 0 ? s / n : 0.0;
 }
 
-namespace {
-/// Cusick's drape coefficient of the outline a capture's views see (hem_profile_from_capture).
-double seen_drape_coefficient(const Capture& seen) {
-  return drape_coefficient(hem_profile_from_capture(seen), seen.specimen);
-}
-}  // namespace
-
 Capture ForwardModel::with_views(const std::vector<renderer::DepthImage>& depth) const {
   Capture c = capture_;
   for (std::size_t v = 0; v < depth.size(); ++v) c.views[v].depth = depth[v];
@@ -192,7 +185,7 @@ Capture ForwardModel::with_views(const std::vector<renderer::DepthImage>& depth)
 }
 
 double ForwardModel::views_drape_coefficient(const std::vector<renderer::DepthImage>& depth) const {
-  return seen_drape_coefficient(with_views(depth));
+  return drape_coefficient(with_views(depth));
 }
 
 ShapeSet ForwardModel::shape_set(const std::vector<renderer::DepthImage>& depth) const {
@@ -222,7 +215,7 @@ Target ForwardModel::make_target(const std::vector<renderer::DepthImage>& depth)
   }
   t.outline = hem_profile_from_views(c, settings_.fit_views);
   t.shape = shape_set(depth);
-  t.drape_coefficient = seen_drape_coefficient(c);
+  t.drape_coefficient = drape_coefficient(c);
   return t;
 }
 
@@ -246,7 +239,7 @@ sim::Expected<ScoredDrape> ForwardModel::score(const sim::ClothMesh& mesh, const
   }
   const Capture seen = with_views(noisy);  // the drape as the capture's views would see it
   d.shape = shape_set(seen);
-  d.drape_coefficient = seen_drape_coefficient(seen);
+  d.drape_coefficient = drape_coefficient(seen);
   d.median_drape_coefficient = d.drape_coefficient;
   const std::vector<double> scales = default_feature_scales();
   d.shape_fit = feature_distance(target.shape.fit, d.shape.fit, scales);

@@ -265,6 +265,10 @@ double drape_coefficient(const HemProfile& profile, const SpecimenFacts& specime
   return (enclosed_area(profile) - disk) / (specimen.size_x * specimen.size_y - disk);
 }
 
+double drape_coefficient(const Capture& capture) {
+  return drape_coefficient(hem_profile_from_capture(capture), capture.specimen);
+}
+
 RadialProfile radial_profile(const Eigen::Matrix3Xd& points, double cylinder_radius) {
   constexpr double kStep = 0.005, kOuter = 0.23;
   const double r0 = cylinder_radius + 0.005;

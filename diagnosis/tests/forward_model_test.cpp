@@ -212,6 +212,7 @@ TEST(ForwardModel, EveryDrapeCarriesItsDrapeCoefficientTheCapturesAndTheEvaluati
   const double capture = drape_coefficient(hem_profile_from_capture(model->capture()), specimen);
   EXPECT_GT(capture, 0.0);
   EXPECT_LT(capture, 1.0);
+  EXPECT_EQ(drape_coefficient(model->capture()), capture);  // the capture's overload: the outline its views see
   std::vector<renderer::DepthImage> own_views;
   for (const auto& view : model->capture().views) own_views.push_back(view.depth);
   EXPECT_EQ(model->views_drape_coefficient(own_views), capture);

@@ -70,6 +70,8 @@ struct Harmonic {
 /// size Lx x Ly on a cylinder of radius R.
 [[nodiscard]] double enclosed_area(const HemProfile& profile);
 [[nodiscard]] double drape_coefficient(const HemProfile& profile, const SpecimenFacts& specimen);
+/// The drape coefficient of the outline a capture's views see (hem_profile_from_capture) on its specimen.
+[[nodiscard]] double drape_coefficient(const Capture& capture);
 
 /// The skirt's mean height against the radius: per 5 mm annulus from the cylinder radius + 5 mm outwards (to
 /// 230 mm), the mean z of the points below the top, NaN with fewer than 10 points. Turning the drape or moving its
