@@ -99,6 +99,15 @@ std::string leading_feature_text(const Localisation& L) {
   return fmt::format("led by {}", led);
 }
 
+/// How many diagnoses of the same captures this result's runtime holds (itself and the ones it confirmed; with both
+/// --confirm-resolution and --confirm-placement-rise, up to four).
+int diagnoses_in(const DiagnosisResult& r) {
+  int n = 1;
+  if (r.mesh_confirmation && r.mesh_confirmation->other) n += diagnoses_in(*r.mesh_confirmation->other);
+  if (r.placement_confirmation && r.placement_confirmation->other) n += diagnoses_in(*r.placement_confirmation->other);
+  return n;
+}
+
 /// Which of two diagnoses of the same captures this is (--confirm-resolution, --confirm-placement-rise), and the
 /// other's verdict (report.json holds the other whole).
 std::string confirmations_markdown(const DiagnosisResult& r) {
@@ -122,6 +131,18 @@ std::string confirmations_markdown(const DiagnosisResult& r) {
 }
 
 }  // namespace
+
+std::string runtime_markdown(const DiagnosisResult& r) {
+  std::string md = fmt::format("Runtime {:.0f} s (fit {:.0f} s, floors {:.0f} s, attribution {:.0f} s); CPU {:.0f} s; "
+                               "up to {} thread{}.\n",
+                               r.seconds, r.seconds_fit, r.seconds_floors, r.seconds_attribution, r.cpu_seconds,
+                               r.jobs, r.jobs == 1 ? "" : "s");
+  if (const int n = diagnoses_in(r); n > 1) {
+    md += fmt::format("Runtime and CPU are {} diagnoses' together (fit, floors and attribution: this one's).\n",
+                      n == 2 ? "both" : fmt::format("all {}", n));
+  }
+  return md;
+}
 
 std::string verdict_markdown(const DiagnosisResult& r) {
   std::string md;
@@ -392,11 +413,7 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
                           : "");
     if (after) md += "\n![after](residual_after.png)\n\nResidual after adding the named effect.\n";
   }
-  md += fmt::format("\nRuntime {:.0f} s (fit {:.0f} s, floors {:.0f} s, attribution {:.0f} s); CPU {:.0f} s; up to "
-                    "{} thread{}.\n",
-                    r.seconds, r.seconds_fit, r.seconds_floors, r.seconds_attribution, r.cpu_seconds, r.jobs,
-                    r.jobs == 1 ? "" : "s");
-  if (r.mesh_confirmation || r.placement_confirmation) md += "Runtime and CPU are both diagnoses' together.\n";
+  md += "\n" + runtime_markdown(r);
   if (sim::Status s = storage::write_file_atomic((dir / "report.md").string(), md); !s) return s;
   return storage::write_file_atomic((dir / "report.json").string(), storage::json_text(to_json(r, capture)) + "\n");
 }

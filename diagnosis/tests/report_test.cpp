@@ -91,6 +91,36 @@ TEST(VerdictMarkdown, AGapAboveTheFloorsHasNoCaveat) {
   EXPECT_FALSE(contains(verdict_markdown(unexplained), kCaveat));
 }
 
+TEST(RuntimeMarkdown, CountsEveryDiagnosisTheRuntimeHolds) {
+  // With --confirm-resolution and --confirm-placement-rise both on, the reported diagnosis holds the one without the
+  // placement test, and each of the two may hold its other mesh's: up to four diagnoses' runtime together.
+  DiagnosisResult alone;
+  alone.seconds = 120.4;
+  alone.cpu_seconds = 118.0;
+  alone.jobs = 1;
+  const std::string one = runtime_markdown(alone);
+  EXPECT_TRUE(contains(one, "Runtime 120 s (fit 0 s, floors 0 s, attribution 0 s); CPU 118 s; up to 1 thread.")) << one;
+  EXPECT_FALSE(contains(one, "together")) << one;
+
+  DiagnosisResult meshes = alone;
+  meshes.mesh_confirmation = DiagnosisResult::MeshConfirmation{40, true, std::make_shared<const DiagnosisResult>()};
+  EXPECT_TRUE(contains(runtime_markdown(meshes), "Runtime and CPU are both diagnoses' together"));
+
+  DiagnosisResult placed = meshes;  // the placement test's diagnosis on two meshes, holding the first's on two
+  placed.placement_confirmation =
+      DiagnosisResult::PlacementConfirmation{0.03, 0.02, std::make_shared<const DiagnosisResult>(meshes)};
+  const std::string four = runtime_markdown(placed);
+  EXPECT_TRUE(contains(four, "Runtime and CPU are all 4 diagnoses' together")) << four;
+  placed.mesh_confirmation.reset();  // the placement test's diagnosis on one mesh, holding the first's on two
+  EXPECT_TRUE(contains(runtime_markdown(placed), "Runtime and CPU are all 3 diagnoses' together"));
+  const DiagnosisResult no_other = [] {  // a confirmation without the other diagnosis kept adds nothing
+    DiagnosisResult r;
+    r.mesh_confirmation = DiagnosisResult::MeshConfirmation{40, false, nullptr};
+    return r;
+  }();
+  EXPECT_FALSE(contains(runtime_markdown(no_other), "together"));
+}
+
 TEST(ReportImages, ViewsOfDifferentSizesEachTakeACellOfTheLargestSize) {
   // A capture's views may differ in size (docs/CAPTURE.md): the residual maps and the views' preview draw each at
   // its own size in cells of the largest, instead of failing once the whole diagnosis has run.

@@ -25,6 +25,10 @@ struct ResidualImage {
 /// under a verdict within the floors ("none") what it does not rule out.
 [[nodiscard]] std::string verdict_markdown(const DiagnosisResult& result);
 
+/// report.md's runtime: wall and CPU seconds, and where the result confirmed other diagnoses of the same captures
+/// (--confirm-resolution, --confirm-placement-rise; up to four with both) that these are all of theirs together.
+[[nodiscard]] std::string runtime_markdown(const DiagnosisResult& result);
+
 /// Writes DIR/report.json, DIR/report.md, DIR/residual.png (capture - fitted baseline per view), DIR/views.png
 /// (capture over fitted drape) and DIR/residual_after.png (after adding the named effect, if any). An earlier
 /// report's files in DIR are removed first; report.json comes last (present only beside a complete report).
