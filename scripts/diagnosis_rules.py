@@ -47,6 +47,10 @@ score. Hypotheses for the next evaluation, not the diagnosis's rule (docs/DIAGNO
   attribute()'s verdict recomputed with the held-out tolerance 0.2 (`--held-out-tolerance 0.2`) instead of the
   run's 0.1 (`reattribute`: the whole ranking, near ties and promotions as attribute() runs them; `--wide T` sets
   another tolerance; `--check-reattribute DIR...` checks that the run's own tolerance gives every verdict as run);
+- rise_yield (rule U, session 78, pre-registered for fresh seeds 103-104: docs/preregistrations/session79.md):
+  "yield" where the verdict as run names no effect (none or unexplained) and the first turn-over raised the drape
+  coefficient by 0.02 or more (gap_tests.second_capture less gap_tests.capture, the second placement on the other
+  face); elsewhere the verdict as run;
 - min_objective: the candidate whose refit objective (in-sample: the capture and the second capture) is the smallest;
   it ignores the held-out data, which the issue's attribution must use: a diagnostic of the refits, not a rule.
 
@@ -108,7 +112,7 @@ TOLERANCE = 0.1  # AttributionSettings::held_out_tolerance (sessions 23-73; 0.2 
 RULES = ["current", "strict", "tolerance", "objective_ties", "parsimony", "tie_objective", "no_bar", "no_bar_unconfirmed",
          "mean3", "held_out_excess", "held_out_rank", "min_objective", "without_ablation", "reach", "reach_objective",
          "tie_held_out_view", "tie_held_out", "no_near_tie",
-         "common4", "views_sensor", "views_camera", "tie_region", "wide_tolerance"]
+         "common4", "views_sensor", "views_camera", "tie_region", "wide_tolerance", "rise_yield"]
 PARAMETERS = {"sensor": 9, "misalignment": 2}  # effect_space's dimension; the others have 1
 # How each rule orders candidates of equal shrinkage before their objectives (confirmation_rule).
 TIES = {"physical_first": lambda effect: effect == "sensor",  # attribute() since session 25 (needs_simulation)
@@ -355,9 +359,34 @@ def tie_region(j):
     return min(tied, key=lambda c: c["objective_mm"])["effect"] if tied else named_effect
 
 
+RISE = 0.02  # rule U's rise of the drape coefficient (docs/preregistrations/session79.md)
+
+
+def turn_over_rise(report):
+    """The second capture's drape coefficient less the capture's (gap_tests.*.drape_coefficient, the outlines their
+    views see), where the second capture lies on the other face (report placements[].face); None otherwise."""
+    faces = {p["role"]: p["face"] for p in report.get("placements", [])}
+    if "second_capture" not in faces or faces.get("capture") == faces["second_capture"]:
+        return None
+    g = report.get("gap_tests") or {}
+    c0 = (g.get("capture") or {}).get("drape_coefficient")
+    c1 = (g.get("second_capture") or {}).get("drape_coefficient")
+    return None if c0 is None or c1 is None else c1 - c0
+
+
+def rise_yield(j):
+    """Rule U (pre-registered in session 78 for seeds 103-104: docs/preregistrations/session79.md): "yield" where the
+    verdict as run names no effect ("none", within the floors or once the bending is refitted, or "unexplained") and
+    the first turn-over raised the drape coefficient by RISE or more: a plastic set makes the specimen, turned over,
+    drape stiffer, which an elastic one does not (none of the 72 controls of seeds 80-102 rose by 0.02); else the
+    verdict as run."""
+    rise = turn_over_rise(j)
+    return "yield" if j["verdict"] in ("none", "unexplained") and rise is not None and rise >= RISE else j["verdict"]
+
+
 # The rules read off the verdict as run and one more field of the report, with or without candidates.
 REPORT_RULES = {"views_sensor": views_sensor, "views_camera": views_camera, "tie_region": tie_region,
-                "wide_tolerance": wide_tolerance}
+                "wide_tolerance": wide_tolerance, "rise_yield": rise_yield}
 
 
 def verdicts(j):
