@@ -41,6 +41,7 @@ struct DiagnoseOptions {
   std::optional<int> resolution;
   int confirm_resolution = 0;
   double confirm_placement_rise = 0.0;
+  std::optional<double> turn_over_yield;
   std::optional<int> states;
   std::optional<int> evaluations;
   std::optional<int> refit_evaluations;
@@ -134,6 +135,12 @@ int run_diagnose(const DiagnoseOptions& o) {
     return fail("--confirm-placement-rise diagnoses again with the placement drape test: leave out "
                 "--placement-drape-test");
   }
+  if (o.turn_over_yield && !(*o.turn_over_yield >= 0.0 && *o.turn_over_yield < 1.0)) {
+    return fail("--turn-over-yield must be 0 (off) .. 1 (a drape-coefficient difference)");
+  }
+  if (o.turn_over_yield.value_or(0.0) > 0.0 && o.second.empty()) {
+    return fail("--turn-over-yield compares the turned placement with the capture: give --second-capture");
+  }
   if (!(o.held_out_tolerance >= 0.0 && o.held_out_tolerance <= 1.0)) return fail("--held-out-tolerance must be 0 .. 1");
   if (outside(o.starts, 0, 100)) return fail("--starts must be 0 (the guess alone) .. 100");
   if (bad_scan(o.refit_scan, 100)) return fail("--refit-scan must be 0 (off) or 2 .. 100");
@@ -208,6 +215,7 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (o.resolution) settings.fit.resolution = *o.resolution;
   settings.confirm_resolution = o.confirm_resolution;
   settings.confirm_placement_rise = o.confirm_placement_rise;
+  if (o.turn_over_yield) settings.turn_over_yield = *o.turn_over_yield;
   if (o.states) settings.fit.initial_states = *o.states;
   if (o.evaluations) settings.baseline_optimiser.max_evaluations = *o.evaluations;
   if (o.refit_evaluations) settings.attribution.optimiser.max_evaluations = *o.refit_evaluations;
@@ -342,7 +350,15 @@ int run_diagnose(const DiagnoseOptions& o) {
                                "here\n",
                                p->other->verdict, p->rise, p->floor);
     }
-    if (r.verdict == "none") {
+    if (const auto& t = r.turn_over) {
+      std::cout << fmt::format("  turn-over: the refits' verdict {}, but the turned placement drapes {:.4f} stiffer (at "
+                               "least {:g}): yield\n",
+                               t->refits_verdict, t->rise, t->floor);
+    }
+    if (r.turn_over) {
+      std::cout << fmt::format("  verdict: yield, from the turn-over (the yield refit's shrinkage {:.0f}%)\n",
+                               100 * r.named_shrinkage());
+    } else if (r.verdict == "none") {
       std::cout << fmt::format("  verdict: within the floors{} (no effect named)\n",
                                r.attribution.bending_within_floors() ? " once the bending is refitted" : "");
     } else if (r.verdict == "unexplained") {
@@ -402,6 +418,11 @@ Runner add_diagnose_command(CLI::App& app) {
                  "diagnosis (both in report.json \"placement_confirmation\"; needs --second-capture; an experiment, "
                  "default 0: off)")
       ->capture_default_str();
+  app.add_option("--turn-over-yield", o->turn_over_yield,
+                 "Where the verdict names no effect (none or unexplained; after --confirm-placement-rise) and the "
+                 "second capture, turned over, drapes with a drape coefficient at least this much above the "
+                 "capture's, name yield, from the turn-over: a plastic set stiffens the turned drape, an elastic "
+                 "specimen has no face (report.json \"turn_over\"; needs --second-capture; default 0: off)");
   app.add_option("--states", o->states, "Initial states per evaluation (default 3; quick and fine 2)");
   app.add_option("--evaluations", o->evaluations,
                  "Baseline fit evaluations per simplex (default 40; quick and fine 20; a second one with --starts)");

@@ -1623,20 +1623,62 @@ if(NOT rose_md MATCHES "${says_rise}")
   message(FATAL_ERROR "--confirm-placement-rise: report.md does not say which diagnosis it is:\n${rose_md}")
 endif()
 # No rise at the floor, or a fall: the first diagnosis alone (its verdict names no effect: the rise alone
-# decides).
+# decides); --turn-over-yield at the same floor names nothing either.
 foreach(case "${lower};${stiffer};0.5" "${stiffer};${lower};0.000001")
   list(GET case 0 first)
   list(GET case 1 second)
   list(GET case 2 floor)
-  run_ok(flat diagnose --capture ${first} --second-capture ${second} ${rise_args} --confirm-placement-rise ${floor})
+  run_ok(flat diagnose --capture ${first} --second-capture ${second} ${rise_args} --confirm-placement-rise ${floor}
+         --turn-over-yield ${floor})
   string(JSON flat_confirmation ERROR_VARIABLE no_confirmation GET "${flat}" placement_confirmation)
+  string(JSON flat_turn_over ERROR_VARIABLE no_turn_over GET "${flat}" turn_over)
   json_number(flat_floor "${flat}" gap_tests placement_dc_floor)
   string(JSON flat_verdict GET "${flat}" verdict)
-  if(NOT no_confirmation OR NOT flat_floor EQUAL 0 OR NOT flat_verdict MATCHES "^(none|unexplained)$")
-    message(FATAL_ERROR "--confirm-placement-rise ${floor} on ${first} then ${second}: verdict ${flat_verdict}, "
-                        "placement_confirmation '${flat_confirmation}', placement floor ${flat_floor}")
+  if(NOT no_confirmation OR NOT no_turn_over OR NOT flat_floor EQUAL 0
+     OR NOT flat_verdict MATCHES "^(none|unexplained)$")
+    message(FATAL_ERROR "--confirm-placement-rise and --turn-over-yield ${floor} on ${first} then ${second}: verdict "
+                        "${flat_verdict}, placement_confirmation '${flat_confirmation}', turn_over '${flat_turn_over}', "
+                        "placement floor ${flat_floor}")
+  endif()
+  if(first STREQUAL lower)
+    set(lower_verdict ${flat_verdict})
+    # The yield refit's shrinkage (the only candidate), 0 where the attribution did not run.
+    string(JSON refitted LENGTH "${flat}" attribution candidates)
+    set(lower_yield_shrinkage 0)
+    if(refitted GREATER 0)
+      json_number(lower_yield_shrinkage "${flat}" attribution candidates 0 shrinkage)
+    endif()
   endif()
 endforeach()
+# --turn-over-yield F (rule U): where the verdict names no effect and the turned placement drapes at least F stiffer,
+# the verdict is yield, from the turn-over; the refits stand as they ran (the same verdict as without the option, the
+# yield refit's shrinkage reported).
+run_ok(turned diagnose --capture ${lower} --second-capture ${stiffer} ${rise_args} --turn-over-yield 0.000001
+       --report ${WORK}/report_turned)
+string(JSON turned_verdict GET "${turned}" verdict)
+string(JSON refits_verdict GET "${turned}" turn_over refits_verdict)
+json_number(turned_rise "${turned}" turn_over rise)
+json_number(turned_floor "${turned}" turn_over floor)
+json_number(turned_shrinkage "${turned}" shrinkage)
+json_nano(turned_n "${turned_rise}")
+math(EXPR turned_off "${turned_n} - ${rise_n}")
+if(NOT turned_verdict STREQUAL "yield" OR NOT refits_verdict STREQUAL lower_verdict OR NOT turned_floor EQUAL 0.000001
+   OR turned_off GREATER 4 OR turned_off LESS -4 OR NOT turned_shrinkage EQUAL lower_yield_shrinkage)
+  message(FATAL_ERROR "--turn-over-yield 0.000001 on ${lower} then ${stiffer}: verdict ${turned_verdict} (the refits' "
+                      "${refits_verdict}, without the option ${lower_verdict}), rise ${turned_rise} against "
+                      "${c_up} / ${c_down}, floor ${turned_floor}, shrinkage ${turned_shrinkage} (the yield refit's "
+                      "${lower_yield_shrinkage})")
+endif()
+file(READ ${WORK}/report_turned/report.md turned_md)
+string(CONCAT says_turn_over "Verdict: yield, from the turn-over\\*\\*: the second capture, laid on the specimen's "
+                             "other face, drapes 0\\.[0-9]+ stiffer")
+if(NOT turned_md MATCHES "${says_turn_over}" OR NOT turned_md MATCHES "The refits' verdict: ")
+  message(FATAL_ERROR "--turn-over-yield: report.md does not say where the verdict comes from:\n${turned_md}")
+endif()
+expect_failure(1 "--turn-over-yield must be 0 (off) .. 1" diagnose --capture ${WORK}/rise --second-capture
+               ${WORK}/rise.p1 --turn-over-yield 1)
+expect_failure(1 "--turn-over-yield compares the turned placement" diagnose --capture ${WORK}/rise
+               --held-out-capture ${WORK}/rise.p1 --turn-over-yield 0.02)
 expect_failure(1 "--confirm-placement-rise must be 0 (off) .. 1" diagnose --capture ${WORK}/rise --second-capture
                ${WORK}/rise.p1 --confirm-placement-rise -0.01)
 expect_failure(1 "give --second-capture" diagnose --capture ${WORK}/rise --held-out-capture ${WORK}/rise.p1

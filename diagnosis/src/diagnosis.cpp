@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <nlohmann/json.hpp>
 
 #include <fmt/format.h>
@@ -644,19 +645,25 @@ sim::Expected<DiagnosisResult> diagnose_confirming_mesh(const Capture& capture, 
   return reported;
 }
 
-}  // namespace
+/// The verdict "none" or "unexplained": the refits name no effect.
+bool names_no_effect(const DiagnosisResult& r) { return r.verdict == "none" || r.verdict == "unexplained"; }
 
-sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisSettings& settings,
-                                        const OtherPlacements& others) {
+/// The second capture's drape coefficient less the capture's where the second lay on the other face (laid after the
+/// capture, turned over); nothing otherwise.
+std::optional<double> turn_over_rise(const Capture& capture, const OtherPlacements& others) {
+  if (!others.second || others.second->face_down == capture.face_down) return std::nullopt;
+  return drape_coefficient(*others.second) - drape_coefficient(capture);
+}
+
+/// The diagnosis with DiagnosisSettings::confirm_resolution's and confirm_placement_rise's confirmations.
+sim::Expected<DiagnosisResult> diagnose_confirming_placement(const Capture& capture, const DiagnosisSettings& settings,
+                                                              const OtherPlacements& others) {
   auto first = diagnose_confirming_mesh(capture, settings, others);
   const double floor = settings.confirm_placement_rise;
-  const Capture* turned = others.second;  // laid after the capture, turned over
-  if (!first || floor <= 0.0 || settings.floors.placement_drape_coefficient || !turned ||
-      turned->face_down == capture.face_down || (first->verdict != "none" && first->verdict != "unexplained")) {
-    return first;
-  }
-  const double rise = drape_coefficient(*turned) - drape_coefficient(capture);
-  if (!(rise >= floor)) return first;
+  if (!first || floor <= 0.0 || settings.floors.placement_drape_coefficient || !names_no_effect(*first)) return first;
+  const std::optional<double> rise_or = turn_over_rise(capture, others);
+  if (!rise_or || !(*rise_or >= floor)) return first;
+  const double rise = *rise_or;
   sim::logger()->info("diagnosis: verdict {} but the turned placement drapes {:.4f} stiffer (drape coefficient); "
                       "diagnosing again with the placement drape test at {:g}",
                       first->verdict, rise, floor);
@@ -672,6 +679,30 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
   auto other = runtimes_together(reported, std::move(*first));
   reported.placement_confirmation = DiagnosisResult::PlacementConfirmation{rise, floor, std::move(other)};
   return reported;
+}
+
+}  // namespace
+
+sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisSettings& settings,
+                                        const OtherPlacements& others) {
+  auto result = diagnose_confirming_placement(capture, settings, others);
+  const double floor = settings.turn_over_yield;
+  if (!result || floor <= 0.0 || !names_no_effect(*result)) return result;
+  const std::optional<double> rise = turn_over_rise(capture, others);
+  if (!rise || !(*rise >= floor)) return result;
+  sim::logger()->info("diagnosis: verdict {} but the turned placement drapes {:.4f} stiffer (drape coefficient, at "
+                      "least {:g}): yield, from the turn-over",
+                      result->verdict, *rise, floor);
+  result->turn_over = DiagnosisResult::TurnOverYield{*rise, floor, result->verdict};
+  result->verdict = "yield";
+  return result;
+}
+
+double DiagnosisResult::named_shrinkage() const {
+  const auto& candidates = attribution.candidates;
+  if (!turn_over) return candidates.empty() ? 0.0 : candidates.front().shrinkage;
+  const auto yield = std::ranges::find(candidates, Effect::kYield, &CandidateResult::effect);
+  return yield == candidates.end() ? 0.0 : yield->shrinkage;
 }
 
 nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
@@ -892,7 +923,7 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                       {"named", r.attribution.named},
                       {"confidence", r.attribution.confidence},
                       {"candidates", candidates}};
-  j["shrinkage"] = r.attribution.candidates.empty() ? 0.0 : r.attribution.candidates[0].shrinkage;
+  j["shrinkage"] = r.named_shrinkage();
   j["settings"] = {{"resolution", r.budgets.resolution},
                    {"initial_states", r.budgets.initial_states},
                    {"max_baseline_evaluations", r.budgets.max_baseline_evaluations},
@@ -907,6 +938,9 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
     j["placement_confirmation"] = {{"rise", p->rise},
                                    {"floor", p->floor},
                                    {"other", p->other ? to_json(*p->other, capture) : nlohmann::json(nullptr)}};
+  }
+  if (const auto& t = r.turn_over) {
+    j["turn_over"] = {{"rise", t->rise}, {"floor", t->floor}, {"refits_verdict", t->refits_verdict}};
   }
   j["runtime"] = {{"seconds", r.seconds},
                   {"cpu_seconds", r.cpu_seconds},

@@ -144,27 +144,31 @@ std::string runtime_markdown(const DiagnosisResult& r) {
   return md;
 }
 
-std::string verdict_markdown(const DiagnosisResult& r) {
+namespace {
+
+/// The verdict line for `verdict` (the result's, or the refits' where the turn-over named yield) and why a named
+/// effect was put ahead of another where that happened.
+std::string refits_markdown(const DiagnosisResult& r, std::string_view verdict) {
   std::string md;
-  if (r.verdict == "none" && r.attribution.bar_within_floors) {
+  if (verdict == "none" && r.attribution.bar_within_floors) {
     md += "**Verdict: within the floors once the bending is refitted** (the baseline fit had stopped short of the "
           "fabric's bending; the refit of the bending alone is within sensor noise and multiple stable drapes); no "
           "effect is named.\n\n";
-  } else if (r.verdict == "none" && r.attribution.common_within_floors) {
+  } else if (verdict == "none" && r.attribution.common_within_floors) {
     std::string effects;
     for (Effect e : r.attribution.common_effects) effects += std::string(effects.empty() ? "" : ", ") += effect_name(e);
     md += fmt::format("**Verdict: within the floors once the bending is refitted** ({} unlike effects each brought the "
                       "gap within the floors: {}; what they share, the baseline's bending at x{:.2f}, does as well); "
                       "no effect is named.\n\n",
                       r.attribution.common_effects.size(), effects, r.attribution.common_bending->alpha_scale);
-  } else if (r.verdict == "none") {
+  } else if (verdict == "none") {
     md +=
         "**Verdict: the gap is within the floors** (sensor noise and multiple stable drapes); no effect is named.\n\n";
-  } else if (r.verdict == "not attributed") {
+  } else if (verdict == "not attributed") {
     md += "**Verdict: a gap above the floors; attribution was not run** (`--gap-only`).\n\n";
-  } else if (r.verdict == "unexplained" && r.attribution.candidates.empty()) {
+  } else if (verdict == "unexplained" && r.attribution.candidates.empty()) {
     md += "**Verdict: a gap above the floors; no candidate effect was refitted.**\n\n";
-  } else if (r.verdict == "unexplained") {
+  } else if (verdict == "unexplained") {
     // The ranking puts confirmed candidates first: the best is unconfirmed only if none is confirmed.
     const auto& best = r.attribution.candidates.front();
     md += fmt::format("**Verdict: a gap above the floors that no candidate effect both shrinks by {:.0f}% or more and "
@@ -184,7 +188,7 @@ std::string verdict_markdown(const DiagnosisResult& r) {
             : fmt::format("confidence {:.2f} against the runner-up, {}", r.attribution.confidence, r.runner_up);
     md += fmt::format("**Verdict: {}** ({}); adding it shrinks the gap's excess above the floors by {:.0f}% ({} drapes "
                       "from fresh initial states) and the score on the held-out {} by {:.0f}%.\n\n",
-                      r.verdict, against, 100.0 * c.shrinkage, drapes,
+                      verdict, against, 100.0 * c.shrinkage, drapes,
                       r.validated_held_out ? "capture" : "view", 100.0 * c.held_out_shrinkage);
     if (c.confirmation == Confirmation::kWithinFloors)
       md += fmt::format("It is confirmed by its drape on the held-out capture lying within the floors "
@@ -203,6 +207,29 @@ std::string verdict_markdown(const DiagnosisResult& r) {
       md += "Curl is named ahead of the candidate its shrinkage ranks first: the capture's placements fold less "
             "alike than the fitted model's drapes do (fold repeatability, below), as rolled edges settle differently "
             "on every placement.\n\n";
+  }
+  return md;
+}
+
+}  // namespace
+
+std::string verdict_markdown(const DiagnosisResult& r) {
+  std::string md;
+  if (const auto& t = r.turn_over) {
+    const bool refitted = std::ranges::any_of(r.attribution.candidates,
+                                              [](const CandidateResult& c) { return c.effect == Effect::kYield; });
+    md += fmt::format("**Verdict: yield, from the turn-over**: the second capture, laid on the specimen's other face, "
+                      "drapes {:.4f} stiffer than the capture (drape coefficient; at least {:g}), as the plastic set of "
+                      "a drape makes a specimen drape turned over and an elastic specimen does not (`--turn-over-yield`; "
+                      "{}). The refits alone named no effect:\n\n",
+                      t->rise, t->floor,
+                      refitted ? fmt::format("the yield refit shrinks the excess by {:.0f}%", 100.0 * r.named_shrinkage())
+                               : std::string("no yield refit ran"));
+    std::string refits = refits_markdown(r, t->refits_verdict);
+    if (refits.starts_with("**Verdict: ")) refits.replace(2, 7, "The refits' verdict");
+    md += refits;
+  } else {
+    md += refits_markdown(r, r.verdict);
   }
   if (r.verdict == "none") {
     // What the verdict does not say (docs/DIAGNOSIS.md, "What keeps top-1 down").

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <fstream>
 #include <string>
+#include <utility>
 
 #include "drapegen/renderer/preview.hpp"
 
@@ -89,6 +90,43 @@ TEST(VerdictMarkdown, AGapAboveTheFloorsHasNoCaveat) {
   unexplained.verdict = "unexplained";
   EXPECT_TRUE(contains(verdict_markdown(unexplained), "no candidate effect was refitted"));
   EXPECT_FALSE(contains(verdict_markdown(unexplained), kCaveat));
+}
+
+TEST(VerdictMarkdown, YieldFromTheTurnOverSaysSoAndKeepsTheRefitsVerdict) {
+  // The refits named no effect (the best, shear, unconfirmed); the turned placement drapes stiffer: yield, with the
+  // yield refit's shrinkage, not the first candidate's.
+  DiagnosisResult r;
+  r.verdict = "yield";
+  r.turn_over = DiagnosisResult::TurnOverYield{0.0312, 0.02, "unexplained"};
+  r.attribution.significant_shrinkage = 0.25;
+  for (auto [effect, shrinkage] : {std::pair{Effect::kShear, 0.4}, std::pair{Effect::kYield, 0.3}}) {
+    r.attribution.candidates.emplace_back();
+    r.attribution.candidates.back().effect = effect;
+    r.attribution.candidates.back().shrinkage = shrinkage;
+  }
+  EXPECT_DOUBLE_EQ(r.named_shrinkage(), 0.3);
+  const std::string md = verdict_markdown(r);
+  EXPECT_TRUE(contains(md, "**Verdict: yield, from the turn-over**: the second capture, laid on the specimen's other "
+                           "face, drapes 0.0312 stiffer than the capture (drape coefficient; at least 0.02)"))
+      << md;
+  EXPECT_TRUE(contains(md, "the yield refit shrinks the excess by 30%")) << md;
+  EXPECT_TRUE(contains(md, "**The refits' verdict: a gap above the floors that no candidate effect both shrinks by "
+                           "25% or more and holds on the held-out data** (best: shear, shrinkage 40%, not confirmed)"))
+      << md;
+  EXPECT_FALSE(contains(md, kCaveat)) << md;
+
+  // Within the floors at the gate: no refit ran; the gate's verdict stays in the report under the refits'.
+  DiagnosisResult gate;
+  gate.verdict = "yield";
+  gate.turn_over = DiagnosisResult::TurnOverYield{0.05, 0.02, "none"};
+  EXPECT_DOUBLE_EQ(gate.named_shrinkage(), 0.0);
+  const std::string within = verdict_markdown(gate);
+  EXPECT_TRUE(contains(within, "no yield refit ran")) << within;
+  EXPECT_TRUE(contains(within, "**The refits' verdict: the gap is within the floors**")) << within;
+
+  // Without the turn-over, the first candidate's shrinkage is the named effect's.
+  r.turn_over.reset();
+  EXPECT_DOUBLE_EQ(r.named_shrinkage(), 0.4);
 }
 
 TEST(RuntimeMarkdown, CountsEveryDiagnosisTheRuntimeHolds) {

@@ -81,6 +81,12 @@ struct DiagnosisSettings {
   /// folds and stiffens its drape (rule Y, docs/DIAGNOSIS_RESULTS.md, "Session 77"). Skipped where the settings test
   /// the placements' drape coefficients already. 0: off (an experiment, not the default).
   double confirm_placement_rise = 0.0;
+  /// Where the verdict (after confirm_placement_rise) names no effect ("none" or "unexplained") and the second
+  /// capture, laid turned over after the capture, drapes with a drape coefficient at least this much above the
+  /// capture's, name yield (DiagnosisResult::turn_over): a plastic set makes the specimen laid on its other face drape
+  /// stiffer, an elastic one drapes alike on both faces up to its multistability (rule U, docs/DIAGNOSIS_RESULTS.md,
+  /// "Session 79"). The refits stand as they ran. 0: off.
+  double turn_over_yield = 0.0;
 
   /// Small budgets for tests and the --quick benchmark.
   [[nodiscard]] static DiagnosisSettings quick();
@@ -198,6 +204,17 @@ struct DiagnosisResult {
     std::shared_ptr<const DiagnosisResult> other;
   };
   std::optional<PlacementConfirmation> placement_confirmation;
+  /// With DiagnosisSettings::turn_over_yield where it fired: the verdict is "yield" from the turn-over, not from the
+  /// refits, whose verdict was `refits_verdict` (the attribution above stands as it ran).
+  struct TurnOverYield {
+    double rise = 0.0;           // the second capture's drape coefficient less the capture's
+    double floor = 0.0;          // DiagnosisSettings::turn_over_yield
+    std::string refits_verdict;  // "none" or "unexplained"
+  };
+  std::optional<TurnOverYield> turn_over;
+  /// How much adding the named effect shrinks the gap's excess above the floors (report.json "shrinkage"): the first
+  /// candidate's; with turn_over, the yield refit's; 0 where no such refit ran.
+  [[nodiscard]] double named_shrinkage() const;
 };
 
 /// Other placements of the capture's specimen on the tester (attribution.hpp, OtherCaptures); either may be null.
