@@ -487,7 +487,8 @@ int main(int argc, char** argv) {
   const std::array<double, 2> excess_edges{0.1, 0.3};
   std::array<std::pair<int, int>, 3> by_excess{};
   // Detection and attribution apart: effect captures reported within the floors at the gate, within them once the
-  // bending alone is refitted (verdict "none" either way), and the rest (detected) with their correct verdicts.
+  // bending alone is refitted (the refits' verdict "none" either way, whatever the turn-over named), and the rest
+  // (detected) with their correct verdicts.
   int within_at_gate = 0, within_after_bending = 0, detected_correct = 0;
   // The region over the detected captures alone: within the floors a report localises noise, not an effect.
   int detected_region_match = 0;
@@ -513,6 +514,10 @@ int main(int argc, char** argv) {
       continue;
     }
     const std::string verdict = d.value("verdict", "?");
+    // The refits' own verdict where the turn-over named yield (drapegen diagnose --turn-over-yield): whether the gap
+    // was found above the floors is theirs.
+    const bool turned = d.contains("turn_over") && d["turn_over"].is_object();
+    const std::string refits_verdict = turned ? d["turn_over"].value("refits_verdict", "?") : verdict;
     const std::string family = t.value("family", "none");
     nlohmann::json screened = nullptr;  // the kept draw passed the screen (visible, settled), if it was screened
     if (const fs::path log = fs::path(out) / "screen" / (c.name + ".json"); fs::exists(log)) {
@@ -553,12 +558,12 @@ int main(int argc, char** argv) {
     } else {
       ++effect_total;
       effect_correct += verdict == family;
-      if (verdict == "none") {
+      if (refits_verdict == "none") {
         (d.value("within_floors", false) ? within_at_gate : within_after_bending)++;
       } else {
         detected_correct += verdict == family;
       }
-      // Shrinkage once the named effect is added: the top candidate's (0 when nothing is named).
+      // Shrinkage once the named effect is added: its refit's (0 when nothing is named).
       shrink = verdict != "none" && verdict != "unexplained" ? d.value("shrinkage", 0.0) : 0.0;
       shrinkages.push_back(shrink);
       if (verdict == family) named_shrinkages.push_back(shrink);
@@ -570,7 +575,7 @@ int main(int argc, char** argv) {
       ++region_total;
       region_ok = is_true_region(region);
       region_match += region_ok;
-      if (verdict != "none") detected_region_match += region_ok;
+      if (refits_verdict != "none") detected_region_match += region_ok;
       region_by_family[family].first += region_ok;
       region_by_family[family].second++;
       if (d["localisation"].contains("floor_region")) {
@@ -587,8 +592,9 @@ int main(int argc, char** argv) {
       strength = t["effects"][0].value("strength", 0.0);
     }
     per_case.push_back({{"case", c.name}, {"family", family}, {"effect", effect}, {"strength", strength},
-                        {"verdict", verdict}, {"runner_up", d.value("runner_up", "")},
-                        {"confidence", d.value("confidence", 0.0)}, {"region", region}, {"region_ok", region_ok},
+                        {"verdict", verdict}, {"turn_over", turned}, {"runner_up", d.value("runner_up", "")},
+                        {"confidence", d.value("confidence", nlohmann::json())}, {"region", region},
+                        {"region_ok", region_ok},
                         {"gap_mm", d["gap_mm"]["all_views"]}, {"floor_mm", d["floors"]["all_views_mm"]},
                         {"tests", d.value("gap_tests", nlohmann::json::object())},
                         {"shrinkage", family == "none" ? nlohmann::json(nullptr) : nlohmann::json(shrink)},
@@ -679,7 +685,9 @@ int main(int argc, char** argv) {
     const std::string effect = c["effect"].get<std::string>();
     md += fmt::format("| {} | {} | {:.3g} | {} | {:.1f} / {:.1f} | {:.2f} / {:.2f} | {} | {} | {} | {:.0f} |\n",
                       c["case"].get<std::string>(), effect.empty() ? "-" : effect,
-                      c["strength"].get<double>(), c["verdict"].get<std::string>(), t.value("stable_mm", 0.0),
+                      c["strength"].get<double>(),
+                      c["verdict"].get<std::string>() + (c["turn_over"].get<bool>() ? " (turn-over)" : ""),
+                      t.value("stable_mm", 0.0),
                       t.value("stable_floor_mm", 0.0), t.value("shape", 0.0), t.value("shape_floor", 0.0),
                       c["region"].get<std::string>(), c["region_ok"].get<bool>() ? "yes" : "no", shrink,
                       c["seconds"].get<double>());

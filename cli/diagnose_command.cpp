@@ -351,13 +351,12 @@ int run_diagnose(const DiagnoseOptions& o) {
                                p->other->verdict, p->rise, p->floor);
     }
     if (const auto& t = r.turn_over) {
-      std::cout << fmt::format("  turn-over: the refits' verdict {}, but the turned placement drapes {:.4f} stiffer (at "
-                               "least {:g}): yield\n",
-                               t->refits_verdict, t->rise, t->floor);
-    }
-    if (r.turn_over) {
-      std::cout << fmt::format("  verdict: yield, from the turn-over (the yield refit's shrinkage {:.0f}%)\n",
-                               100 * r.named_shrinkage());
+      const diagnosis::CandidateResult* yield = r.named_refit();
+      std::cout << fmt::format("  verdict: yield, from the turn-over: the turned placement drapes {:.4f} stiffer (at "
+                               "least {:g}); the refits' verdict {}; {}\n",
+                               t->rise, t->floor, t->refits_verdict,
+                               yield ? fmt::format("the yield refit's shrinkage {:.0f}%", 100 * yield->shrinkage)
+                                     : std::string("no yield refit ran"));
     } else if (r.verdict == "none") {
       std::cout << fmt::format("  verdict: within the floors{} (no effect named)\n",
                                r.attribution.bending_within_floors() ? " once the bending is refitted" : "");
@@ -422,7 +421,8 @@ Runner add_diagnose_command(CLI::App& app) {
                  "Where the verdict names no effect (none or unexplained; after --confirm-placement-rise) and the "
                  "second capture, turned over, drapes with a drape coefficient at least this much above the "
                  "capture's, name yield, from the turn-over: a plastic set stiffens the turned drape, an elastic "
-                 "specimen has no face (report.json \"turn_over\"; needs --second-capture; default 0: off)");
+                 "specimen has no face (report.json \"turn_over\"; within the floors too; not with --gap-only; needs "
+                 "--second-capture; default 0: off)");
   app.add_option("--states", o->states, "Initial states per evaluation (default 3; quick and fine 2)");
   app.add_option("--evaluations", o->evaluations,
                  "Baseline fit evaluations per simplex (default 40; quick and fine 20; a second one with --starts)");

@@ -108,9 +108,10 @@ def main(dirs):
             default, widened = verdict(report, False), verdict(report, True)
             total += 1
             as_run = widened if ran_widened else default
-            reproduced += as_run == report["verdict"]
-            if as_run != report["verdict"]:
-                print(f"MISMATCH {path}: run {report['verdict']}, recomputed {as_run}")
+            refits = (report.get("turn_over") or {}).get("refits_verdict", report["verdict"])  # before the turn-over
+            reproduced += as_run == refits
+            if as_run != refits:
+                print(f"MISMATCH {path}: run {refits}, recomputed {as_run}")
             for arm, value in (("default", default), ("widened", widened)):
                 if value is None:
                     unknown += 1

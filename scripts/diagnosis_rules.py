@@ -396,7 +396,7 @@ def verdicts(j):
     if not cands:
         v = {r: j["verdict"] for r in RULES}
         v.update({rule: f(j) for rule, f in REPORT_RULES.items()})
-        return v
+        return turn_over_applied(j, v)
     sf, shf = g["stable_floor_mm"], g["shape_floor"]
     within = j.get("within_floors_after_bending_refit", False)
     v = {"current": j["verdict"], "strict": confirmation_rule(j, 0.0), "tolerance": confirmation_rule(j, TOLERANCE),
@@ -456,10 +456,29 @@ def verdicts(j):
     for rule in ("without_ablation", "reach", "reach_objective"):
         v[rule] = reference_rule(j, rule)
     v.update({rule: f(j) for rule, f in REPORT_RULES.items()})
-    return v
+    return turn_over_applied(j, v)
 
 
 COLUMNS = ["none", "unexplained", "not attributed", "yield", "shear", "curl", "friction", "misalignment", "sensor"]
+
+
+def refits_report(j):
+    """The report with the refits' verdict as its verdict where the turn-over named yield (`drapegen diagnose
+    --turn-over-yield`, rule U, report.json turn_over), the reported one kept as verdict_reported: the rules recompute
+    the refits' verdict, and verdicts() lays the turn-over on every rule's as the run did."""
+    if not j.get("turn_over"):
+        return j
+    return dict(j, verdict=j["turn_over"]["refits_verdict"], verdict_reported=j["verdict"])
+
+
+def turn_over_applied(j, v):
+    """Every rule's verdict with the run's turn-over (settings.turn_over_yield > 0) laid on it as diagnose() does:
+    yield where the rule names no effect and the first turn-over raised the drape coefficient by the run's floor."""
+    floor = (j.get("settings") or {}).get("turn_over_yield", 0.0)
+    rise = turn_over_rise(j)
+    if floor <= 0.0 or rise is None or rise < floor:
+        return v
+    return {r: "yield" if x in ("none", "unexplained") else x for r, x in v.items()}
 
 
 def reports(root, truth_root=None):
@@ -471,7 +490,7 @@ def reports(root, truth_root=None):
             j = json.load(fh)
         with open(os.path.join(truth_root or root, "truth", name + ".json")) as fh:
             truth = json.load(fh)
-        yield name, FAMILY.get(truth["family"], truth["family"]) or "none", j
+        yield name, FAMILY.get(truth["family"], truth["family"]) or "none", refits_report(j)
 
 
 def within_floors(candidates):

@@ -1675,6 +1675,38 @@ string(CONCAT says_turn_over "Verdict: yield, from the turn-over\\*\\*: the seco
 if(NOT turned_md MATCHES "${says_turn_over}" OR NOT turned_md MATCHES "The refits' verdict: ")
   message(FATAL_ERROR "--turn-over-yield: report.md does not say where the verdict comes from:\n${turned_md}")
 endif()
+# Not in a screening run (--gap-only names no effect), and not where both placements lie on one face (no turn-over):
+# a third placement laid on the capture's face, ordered so that the later one drapes stiffer.
+run_ok(screened diagnose --capture ${lower} --second-capture ${stiffer} --quick --resolution 6 --states 1
+       --evaluations 2 --json --gap-only --turn-over-yield 0.000001)
+string(JSON screened_turn_over ERROR_VARIABLE no_screened_turn_over GET "${screened}" turn_over)
+string(JSON screened_verdict GET "${screened}" verdict)
+if(NOT no_screened_turn_over OR NOT screened_verdict MATCHES "^(none|not attributed)$")
+  message(FATAL_ERROR "--gap-only --turn-over-yield: verdict ${screened_verdict}, turn_over '${screened_turn_over}'")
+endif()
+run_ok(out reality ${FABRIC} --resolution 14 --seed 5 --placement 1 --out ${WORK}/rise.same)
+file(REMOVE ${WORK}/rise.same/truth.json)
+run_ok(same_face diagnose --capture ${WORK}/rise --second-capture ${WORK}/rise.same --quick --resolution 6 --states 1
+       --evaluations 2 --json --gap-only)
+json_number(c_same "${same_face}" gap_tests second_capture drape_coefficient)
+json_nano(same_n "${c_same}")
+if(same_n GREATER up_n)
+  set(same_pair --capture ${WORK}/rise --second-capture ${WORK}/rise.same)
+else()
+  set(same_pair --capture ${WORK}/rise.same --second-capture ${WORK}/rise)
+endif()
+if(same_n EQUAL up_n)
+  message(FATAL_ERROR "the same-face placements drape alike (${c_up}, ${c_same}): no rise to test on")
+endif()
+# The shear candidate alone, which names no effect here (the yield refit names yield on one of the two orders).
+run_ok(same_face diagnose ${same_pair} --quick --resolution 6 --states 1 --evaluations 2 --refit-evaluations 2
+       --sensor-evaluations 2 --candidates shear --json --turn-over-yield 0.000001)
+string(JSON same_turn_over ERROR_VARIABLE no_same_turn_over GET "${same_face}" turn_over)
+string(JSON same_verdict GET "${same_face}" verdict)
+if(NOT no_same_turn_over OR NOT same_verdict MATCHES "^(none|unexplained)$")
+  message(FATAL_ERROR "--turn-over-yield on placements of one face (${same_pair}): verdict ${same_verdict}, "
+                      "turn_over '${same_turn_over}'")
+endif()
 expect_failure(1 "--turn-over-yield must be 0 (off) .. 1" diagnose --capture ${WORK}/rise --second-capture
                ${WORK}/rise.p1 --turn-over-yield 1)
 expect_failure(1 "--turn-over-yield compares the turned placement" diagnose --capture ${WORK}/rise

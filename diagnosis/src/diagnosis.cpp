@@ -686,23 +686,42 @@ sim::Expected<DiagnosisResult> diagnose_confirming_placement(const Capture& capt
 sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisSettings& settings,
                                         const OtherPlacements& others) {
   auto result = diagnose_confirming_placement(capture, settings, others);
-  const double floor = settings.turn_over_yield;
-  if (!result || floor <= 0.0 || !names_no_effect(*result)) return result;
+  const double floor = settings.attribute ? settings.turn_over_yield : 0.0;  // a screening run names no effect
+  if (!result) return result;
+  result->budgets.turn_over_yield = floor;
+  if (floor <= 0.0 || !names_no_effect(*result) || !others.second) return result;
   const std::optional<double> rise = turn_over_rise(capture, others);
-  if (!rise || !(*rise >= floor)) return result;
+  if (!rise) {
+    sim::logger()->info("diagnosis: the second capture lies on the capture's face: no turn-over to name yield by");
+    return result;
+  }
+  if (!(*rise >= floor)) return result;
   sim::logger()->info("diagnosis: verdict {} but the turned placement drapes {:.4f} stiffer (drape coefficient, at "
                       "least {:g}): yield, from the turn-over",
                       result->verdict, *rise, floor);
   result->turn_over = DiagnosisResult::TurnOverYield{*rise, floor, result->verdict};
   result->verdict = "yield";
+  result->runner_up.clear();  // the refits ranked no yield first: nothing stands second to the turn-over
   return result;
 }
 
+const CandidateResult* DiagnosisResult::refit(Effect effect) const {
+  const auto found = std::ranges::find(attribution.candidates, effect, &CandidateResult::effect);
+  return found == attribution.candidates.end() ? nullptr : &*found;
+}
+
+const CandidateResult* DiagnosisResult::named_refit() const {
+  if (turn_over) return refit(Effect::kYield);
+  return attribution.named && !attribution.candidates.empty() ? &attribution.candidates.front() : nullptr;
+}
+
 double DiagnosisResult::named_shrinkage() const {
-  const auto& candidates = attribution.candidates;
-  if (!turn_over) return candidates.empty() ? 0.0 : candidates.front().shrinkage;
-  const auto yield = std::ranges::find(candidates, Effect::kYield, &CandidateResult::effect);
-  return yield == candidates.end() ? 0.0 : yield->shrinkage;
+  if (turn_over) {
+    const CandidateResult* yield = named_refit();
+    return yield ? yield->shrinkage : 0.0;
+  }
+  // Without a named effect, the best candidate's (an "unexplained" verdict's, below the bar).
+  return attribution.candidates.empty() ? 0.0 : attribution.candidates.front().shrinkage;
 }
 
 nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
@@ -714,7 +733,7 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
   j["placements"] = std::move(placements);
   j["verdict"] = r.verdict;
   j["runner_up"] = r.runner_up;
-  j["confidence"] = r.attribution.confidence;
+  j["confidence"] = r.turn_over ? nlohmann::json(nullptr) : nlohmann::json(r.attribution.confidence);
   j["within_floors"] = r.within_floors;
   j["within_floors_after_bending_refit"] = r.attribution.bending_within_floors();
   j["gap_mm"] = {
@@ -927,7 +946,8 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
   j["settings"] = {{"resolution", r.budgets.resolution},
                    {"initial_states", r.budgets.initial_states},
                    {"max_baseline_evaluations", r.budgets.max_baseline_evaluations},
-                   {"attribution", r.budgets.attribution}};
+                   {"attribution", r.budgets.attribution},
+                   {"turn_over_yield", r.budgets.turn_over_yield}};
   if (const auto& m = r.mesh_confirmation) {
     j["mesh_confirmation"] = {{"resolution", m->resolution},
                               {"gap_found", m->gap_found},

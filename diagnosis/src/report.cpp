@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <string>
+#include <string_view>
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
@@ -146,34 +148,36 @@ std::string runtime_markdown(const DiagnosisResult& r) {
 
 namespace {
 
-/// The verdict line for `verdict` (the result's, or the refits' where the turn-over named yield) and why a named
-/// effect was put ahead of another where that happened.
-std::string refits_markdown(const DiagnosisResult& r, std::string_view verdict) {
+/// The verdict line for `verdict` (the result's, or the refits' under `label` where the turn-over named yield) and
+/// why a named effect was put ahead of another where that happened.
+std::string refits_markdown(const DiagnosisResult& r, std::string_view verdict, std::string_view label = "Verdict") {
   std::string md;
   if (verdict == "none" && r.attribution.bar_within_floors) {
-    md += "**Verdict: within the floors once the bending is refitted** (the baseline fit had stopped short of the "
-          "fabric's bending; the refit of the bending alone is within sensor noise and multiple stable drapes); no "
-          "effect is named.\n\n";
+    md += fmt::format("**{}: within the floors once the bending is refitted** (the baseline fit had stopped short of "
+                      "the fabric's bending; the refit of the bending alone is within sensor noise and multiple stable "
+                      "drapes); no effect is named.\n\n",
+                      label);
   } else if (verdict == "none" && r.attribution.common_within_floors) {
     std::string effects;
     for (Effect e : r.attribution.common_effects) effects += std::string(effects.empty() ? "" : ", ") += effect_name(e);
-    md += fmt::format("**Verdict: within the floors once the bending is refitted** ({} unlike effects each brought the "
-                      "gap within the floors: {}; what they share, the baseline's bending at x{:.2f}, does as well); "
-                      "no effect is named.\n\n",
-                      r.attribution.common_effects.size(), effects, r.attribution.common_bending->alpha_scale);
+    md += fmt::format("**{}: within the floors once the bending is refitted** ({} unlike effects each brought the gap "
+                      "within the floors: {}; what they share, the baseline's bending at x{:.2f}, does as well); no "
+                      "effect is named.\n\n",
+                      label, r.attribution.common_effects.size(), effects, r.attribution.common_bending->alpha_scale);
   } else if (verdict == "none") {
-    md +=
-        "**Verdict: the gap is within the floors** (sensor noise and multiple stable drapes); no effect is named.\n\n";
+    md += fmt::format("**{}: the gap is within the floors** (sensor noise and multiple stable drapes); no effect is "
+                      "named.\n\n",
+                      label);
   } else if (verdict == "not attributed") {
-    md += "**Verdict: a gap above the floors; attribution was not run** (`--gap-only`).\n\n";
+    md += fmt::format("**{}: a gap above the floors; attribution was not run** (`--gap-only`).\n\n", label);
   } else if (verdict == "unexplained" && r.attribution.candidates.empty()) {
-    md += "**Verdict: a gap above the floors; no candidate effect was refitted.**\n\n";
+    md += fmt::format("**{}: a gap above the floors; no candidate effect was refitted.**\n\n", label);
   } else if (verdict == "unexplained") {
     // The ranking puts confirmed candidates first: the best is unconfirmed only if none is confirmed.
     const auto& best = r.attribution.candidates.front();
-    md += fmt::format("**Verdict: a gap above the floors that no candidate effect both shrinks by {:.0f}% or more and "
-                      "holds on the held-out data** (best: {}, shrinkage {:.0f}%, {}).\n\n",
-                      100 * r.attribution.significant_shrinkage, effect_name(best.effect), 100 * best.shrinkage,
+    md += fmt::format("**{}: a gap above the floors that no candidate effect both shrinks by {:.0f}% or more and holds "
+                      "on the held-out data** (best: {}, shrinkage {:.0f}%, {}).\n\n",
+                      label, 100 * r.attribution.significant_shrinkage, effect_name(best.effect), 100 * best.shrinkage,
                       best.confirmed() ? "confirmed" : "not confirmed");
   } else {
     const auto& c = r.attribution.candidates[0];
@@ -186,9 +190,9 @@ std::string refits_markdown(const DiagnosisResult& r, std::string_view verdict) 
         r.runner_up.empty()
             ? std::string("the only candidate refitted")
             : fmt::format("confidence {:.2f} against the runner-up, {}", r.attribution.confidence, r.runner_up);
-    md += fmt::format("**Verdict: {}** ({}); adding it shrinks the gap's excess above the floors by {:.0f}% ({} drapes "
+    md += fmt::format("**{}: {}** ({}); adding it shrinks the gap's excess above the floors by {:.0f}% ({} drapes "
                       "from fresh initial states) and the score on the held-out {} by {:.0f}%.\n\n",
-                      verdict, against, 100.0 * c.shrinkage, drapes,
+                      label, verdict, against, 100.0 * c.shrinkage, drapes,
                       r.validated_held_out ? "capture" : "view", 100.0 * c.held_out_shrinkage);
     if (c.confirmation == Confirmation::kWithinFloors)
       md += fmt::format("It is confirmed by its drape on the held-out capture lying within the floors "
@@ -216,18 +220,15 @@ std::string refits_markdown(const DiagnosisResult& r, std::string_view verdict) 
 std::string verdict_markdown(const DiagnosisResult& r) {
   std::string md;
   if (const auto& t = r.turn_over) {
-    const bool refitted = std::ranges::any_of(r.attribution.candidates,
-                                              [](const CandidateResult& c) { return c.effect == Effect::kYield; });
+    const CandidateResult* yield = r.named_refit();
     md += fmt::format("**Verdict: yield, from the turn-over**: the second capture, laid on the specimen's other face, "
-                      "drapes {:.4f} stiffer than the capture (drape coefficient; at least {:g}), as the plastic set of "
-                      "a drape makes a specimen drape turned over and an elastic specimen does not (`--turn-over-yield`; "
-                      "{}). The refits alone named no effect:\n\n",
+                      "drapes {:.4f} stiffer than the capture (drape coefficient; at least {:g}), as the plastic set "
+                      "of a drape makes a specimen drape stiffer turned over and an elastic specimen does not "
+                      "(`--turn-over-yield`; {}). The refits alone named no effect:\n\n",
                       t->rise, t->floor,
-                      refitted ? fmt::format("the yield refit shrinks the excess by {:.0f}%", 100.0 * r.named_shrinkage())
-                               : std::string("no yield refit ran"));
-    std::string refits = refits_markdown(r, t->refits_verdict);
-    if (refits.starts_with("**Verdict: ")) refits.replace(2, 7, "The refits' verdict");
-    md += refits;
+                      yield ? fmt::format("the yield refit shrinks the excess by {:.0f}%", 100.0 * yield->shrinkage)
+                            : std::string("no yield refit ran"));
+    md += refits_markdown(r, t->refits_verdict, "The refits' verdict");
   } else {
     md += refits_markdown(r, r.verdict);
   }
@@ -264,10 +265,10 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
   };
   if (sim::Status s = write_residual_png((dir / "residual.png").string(), residuals(r.gap_drape()), range); !s)
     return s;
-  const bool after = r.attribution.named && !r.attribution.candidates.empty();
+  const CandidateResult* named = r.named_refit();
+  const bool after = named != nullptr && !named->validated.views.empty();
   if (after) {
-    if (sim::Status s = write_residual_png((dir / "residual_after.png").string(),
-                                           residuals(r.attribution.candidates[0].validated), range);
+    if (sim::Status s = write_residual_png((dir / "residual_after.png").string(), residuals(named->validated), range);
         !s) {
       return s;
     }
@@ -440,7 +441,8 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
                           : "");
     if (after) md += "\n![after](residual_after.png)\n\nResidual after adding the named effect.\n";
   }
-  md += "\n" + runtime_markdown(r);
+  md += '\n';
+  md += runtime_markdown(r);
   if (sim::Status s = storage::write_file_atomic((dir / "report.md").string(), md); !s) return s;
   return storage::write_file_atomic((dir / "report.json").string(), storage::json_text(to_json(r, capture)) + "\n");
 }

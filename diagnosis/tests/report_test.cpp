@@ -105,6 +105,8 @@ TEST(VerdictMarkdown, YieldFromTheTurnOverSaysSoAndKeepsTheRefitsVerdict) {
     r.attribution.candidates.back().shrinkage = shrinkage;
   }
   EXPECT_DOUBLE_EQ(r.named_shrinkage(), 0.3);
+  ASSERT_NE(r.named_refit(), nullptr);
+  EXPECT_EQ(r.named_refit()->effect, Effect::kYield);
   const std::string md = verdict_markdown(r);
   EXPECT_TRUE(contains(md, "**Verdict: yield, from the turn-over**: the second capture, laid on the specimen's other "
                            "face, drapes 0.0312 stiffer than the capture (drape coefficient; at least 0.02)"))
@@ -120,13 +122,18 @@ TEST(VerdictMarkdown, YieldFromTheTurnOverSaysSoAndKeepsTheRefitsVerdict) {
   gate.verdict = "yield";
   gate.turn_over = DiagnosisResult::TurnOverYield{0.05, 0.02, "none"};
   EXPECT_DOUBLE_EQ(gate.named_shrinkage(), 0.0);
+  EXPECT_EQ(gate.named_refit(), nullptr);
   const std::string within = verdict_markdown(gate);
   EXPECT_TRUE(contains(within, "no yield refit ran")) << within;
   EXPECT_TRUE(contains(within, "**The refits' verdict: the gap is within the floors**")) << within;
 
-  // Without the turn-over, the first candidate's shrinkage is the named effect's.
+  // Without the turn-over: the first candidate's shrinkage, its refit the named effect's only where it was named.
   r.turn_over.reset();
   EXPECT_DOUBLE_EQ(r.named_shrinkage(), 0.4);
+  EXPECT_EQ(r.named_refit(), nullptr);
+  r.attribution.named = true;
+  ASSERT_NE(r.named_refit(), nullptr);
+  EXPECT_EQ(r.named_refit()->effect, Effect::kShear);
 }
 
 TEST(RuntimeMarkdown, CountsEveryDiagnosisTheRuntimeHolds) {

@@ -84,8 +84,9 @@ struct DiagnosisSettings {
   /// Where the verdict (after confirm_placement_rise) names no effect ("none" or "unexplained") and the second
   /// capture, laid turned over after the capture, drapes with a drape coefficient at least this much above the
   /// capture's, name yield (DiagnosisResult::turn_over): a plastic set makes the specimen laid on its other face drape
-  /// stiffer, an elastic one drapes alike on both faces up to its multistability (rule U, docs/DIAGNOSIS_RESULTS.md,
-  /// "Session 79"). The refits stand as they ran. 0: off.
+  /// stiffer, an elastic one drapes alike on both faces up to its multistability (rule U,
+  /// docs/preregistrations/session79.md). Within the floors too, where no refit ran; not with attribute false (a
+  /// screening run names no effect). The refits stand as they ran. 0: off.
   double turn_over_yield = 0.0;
 
   /// Small budgets for tests and the --quick benchmark.
@@ -110,6 +111,7 @@ struct DiagnosisResult {
     int initial_states = 0;            // of the fit
     int max_baseline_evaluations = 0;  // per simplex of the baseline fit
     bool attribution = true;           // false: gap, floors and localisation only
+    double turn_over_yield = 0.0;      // DiagnosisSettings::turn_over_yield where it could name yield (0: off)
   } budgets;
   /// Each capture it read (report.json "placements"): its directory and the face the specimen lay on (a turned
   /// specimen's rest shape, a curl or a yield's creases, bends the other way face down).
@@ -173,8 +175,10 @@ struct DiagnosisResult {
   /// alpha and beta) where the attribution ran.
   double refit_scale_lower = 0.0, refit_scale_upper = 0.0;
   /// The verdict: the named effect ("none" within the floors, "unexplained" if no candidate shrinks it enough,
-  /// "not attributed" above the floors when DiagnosisSettings::attribute is false).
+  /// "not attributed" above the floors when DiagnosisSettings::attribute is false; "yield" from the turn-over where
+  /// turn_over is set, whatever the refits named).
   std::string verdict;
+  /// Second to the named effect (with "unexplained", the best candidate); empty where the turn-over named yield.
   std::string runner_up;
   int simulations = 0;
   double seconds = 0.0;
@@ -212,6 +216,11 @@ struct DiagnosisResult {
     std::string refits_verdict;  // "none" or "unexplained"
   };
   std::optional<TurnOverYield> turn_over;
+  /// The candidate refit of `effect` (attribution.candidates), null where none ran.
+  [[nodiscard]] const CandidateResult* refit(Effect effect) const;
+  /// The named effect's refit: the first candidate where the attribution named it, the yield refit where the
+  /// turn-over named yield; null where no effect is named or its refit did not run.
+  [[nodiscard]] const CandidateResult* named_refit() const;
   /// How much adding the named effect shrinks the gap's excess above the floors (report.json "shrinkage"): the first
   /// candidate's; with turn_over, the yield refit's; 0 where no such refit ran.
   [[nodiscard]] double named_shrinkage() const;
