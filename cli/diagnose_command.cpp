@@ -399,8 +399,10 @@ Runner add_diagnose_command(CLI::App& app) {
   app.add_flag("--json", o->json, "Print the result as JSON");
   auto* quick = app.add_flag("--quick", o->quick, "Small budgets (16x16 mesh, 2 initial states, fewer evaluations)");
   app.add_flag("--fine", o->fine,
-               fmt::format("--quick's budgets on a {0}x{0} fitting mesh, with the shape floor calibrated for it",
-                           diagnosis::DiagnosisSettings::kFineResolution))
+               fmt::format("--quick's budgets on a {0}x{0} fitting mesh, with the shape floor calibrated for it, and "
+                           "--turn-over-yield {1:g}",
+                           diagnosis::DiagnosisSettings::kFineResolution,
+                           diagnosis::DiagnosisSettings::kFineTurnOverYield))
       ->excludes(quick);
   app.add_option("--resolution", o->resolution,
                  "Fitting mesh vertices per side (default 20; quick 16; fine " +
@@ -422,7 +424,8 @@ Runner add_diagnose_command(CLI::App& app) {
                  "second capture, turned over, drapes with a drape coefficient at least this much above the "
                  "capture's, name yield, from the turn-over: a plastic set stiffens the turned drape, an elastic "
                  "specimen has no face (report.json \"turn_over\"; within the floors too; not with --gap-only; needs "
-                 "--second-capture; default 0: off)");
+                 "--second-capture; default 0: off; --fine " +
+                     fmt::format("{:g}", diagnosis::DiagnosisSettings::kFineTurnOverYield) + ")");
   app.add_option("--states", o->states, "Initial states per evaluation (default 3; quick and fine 2)");
   app.add_option("--evaluations", o->evaluations,
                  "Baseline fit evaluations per simplex (default 40; quick and fine 20; a second one with --starts)");

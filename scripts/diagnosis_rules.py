@@ -47,10 +47,13 @@ score. Hypotheses for the next evaluation, not the diagnosis's rule (docs/DIAGNO
   attribute()'s verdict recomputed with the held-out tolerance 0.2 (`--held-out-tolerance 0.2`) instead of the
   run's 0.1 (`reattribute`: the whole ranking, near ties and promotions as attribute() runs them; `--wide T` sets
   another tolerance; `--check-reattribute DIR...` checks that the run's own tolerance gives every verdict as run);
-- rise_yield (rule U, session 78, pre-registered for fresh seeds 103-104: docs/preregistrations/session79.md):
-  "yield" where the verdict as run names no effect (none or unexplained) and the first turn-over raised the drape
+- rise_yield (rule U, session 78, pre-registered for fresh seeds 103-104: docs/preregistrations/session79.md; adopted
+  in session 79, `drapegen diagnose --turn-over-yield 0.02` in the --fine preset: on reports since, the verdict as
+  run, and on every rule's verdict where settings.turn_over_yield is set, `turn_over_applied`): "yield" where the verdict as run names no effect (none or unexplained) and the first turn-over raised the drape
   coefficient by 0.02 or more (gap_tests.second_capture less gap_tests.capture, the second placement on the other
   face); elsewhere the verdict as run;
+- rise_yield_015 (rule U15, session 79, pre-registered for fresh seeds 105-106: docs/preregistrations/session80.md):
+  rule U with a rise of 0.015 instead of 0.02;
 - min_objective: the candidate whose refit objective (in-sample: the capture and the second capture) is the smallest;
   it ignores the held-out data, which the issue's attribution must use: a diagnostic of the refits, not a rule.
 
@@ -112,7 +115,7 @@ TOLERANCE = 0.1  # AttributionSettings::held_out_tolerance (sessions 23-73; 0.2 
 RULES = ["current", "strict", "tolerance", "objective_ties", "parsimony", "tie_objective", "no_bar", "no_bar_unconfirmed",
          "mean3", "held_out_excess", "held_out_rank", "min_objective", "without_ablation", "reach", "reach_objective",
          "tie_held_out_view", "tie_held_out", "no_near_tie",
-         "common4", "views_sensor", "views_camera", "tie_region", "wide_tolerance", "rise_yield"]
+         "common4", "views_sensor", "views_camera", "tie_region", "wide_tolerance", "rise_yield", "rise_yield_015"]
 PARAMETERS = {"sensor": 9, "misalignment": 2}  # effect_space's dimension; the others have 1
 # How each rule orders candidates of equal shrinkage before their objectives (confirmation_rule).
 TIES = {"physical_first": lambda effect: effect == "sensor",  # attribute() since session 25 (needs_simulation)
@@ -374,6 +377,16 @@ def turn_over_rise(report):
     return None if c0 is None or c1 is None else c1 - c0
 
 
+RISE_015 = 0.015  # rule U15's (docs/preregistrations/session80.md)
+
+
+def rise_yield_015(j):
+    """Rule U15 (registered in session 79 for seeds 105-106: docs/preregistrations/session80.md): rule U with a rise of
+    RISE_015 instead of RISE (the run's own rule U laid on it afterwards, as on every rule)."""
+    rise = turn_over_rise(j)
+    return "yield" if j["verdict"] in ("none", "unexplained") and rise is not None and rise >= RISE_015 else j["verdict"]
+
+
 def rise_yield(j):
     """Rule U (pre-registered in session 78 for seeds 103-104: docs/preregistrations/session79.md): "yield" where the
     verdict as run names no effect ("none", within the floors or once the bending is refitted, or "unexplained") and
@@ -386,7 +399,7 @@ def rise_yield(j):
 
 # The rules read off the verdict as run and one more field of the report, with or without candidates.
 REPORT_RULES = {"views_sensor": views_sensor, "views_camera": views_camera, "tie_region": tie_region,
-                "wide_tolerance": wide_tolerance, "rise_yield": rise_yield}
+                "wide_tolerance": wide_tolerance, "rise_yield": rise_yield, "rise_yield_015": rise_yield_015}
 
 
 def verdicts(j):

@@ -1675,6 +1675,15 @@ string(CONCAT says_turn_over "Verdict: yield, from the turn-over\\*\\*: the seco
 if(NOT turned_md MATCHES "${says_turn_over}" OR NOT turned_md MATCHES "The refits' verdict: ")
   message(FATAL_ERROR "--turn-over-yield: report.md does not say where the verdict comes from:\n${turned_md}")
 endif()
+# On in the --fine preset at 0.02 (report.json settings.turn_over_yield), above this pair's rise.
+run_ok(fine_turned diagnose --capture ${lower} --second-capture ${stiffer} --fine --resolution 6 --states 1
+       --evaluations 2 --refit-evaluations 2 --candidates yield --json)
+json_number(fine_floor "${fine_turned}" settings turn_over_yield)
+string(JSON fine_turn_over ERROR_VARIABLE no_fine_turn_over GET "${fine_turned}" turn_over)
+if(NOT fine_floor EQUAL 0.02 OR NOT no_fine_turn_over OR NOT turned_rise LESS 0.02)
+  message(FATAL_ERROR "--fine: settings.turn_over_yield ${fine_floor}, turn_over '${fine_turn_over}' (the rise "
+                      "${turned_rise})")
+endif()
 # Not in a screening run (--gap-only names no effect), and not where both placements lie on one face (no turn-over):
 # a third placement laid on the capture's face, ordered so that the later one drapes stiffer.
 run_ok(screened diagnose --capture ${lower} --second-capture ${stiffer} --quick --resolution 6 --states 1

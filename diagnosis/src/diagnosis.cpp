@@ -275,6 +275,7 @@ DiagnosisSettings DiagnosisSettings::fine() {
   s.fit.resolution = kFineResolution;
   s.floors.shape_threshold = kFineShapeFloor;
   s.held_out_shape_threshold = kFineHeldOutShapeFloor;
+  s.turn_over_yield = kFineTurnOverYield;
   return s;
 }
 
