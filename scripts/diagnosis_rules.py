@@ -49,9 +49,10 @@ score. Hypotheses for the next evaluation, not the diagnosis's rule (docs/DIAGNO
   another tolerance; `--check-reattribute DIR...` checks that the run's own tolerance gives every verdict as run);
 - rise_yield (rule U, session 78, pre-registered for fresh seeds 103-104: docs/preregistrations/session79.md; adopted
   in session 79, `drapegen diagnose --turn-over-yield 0.02` in the --fine preset: on reports since, the verdict as
-  run, and on every rule's verdict where settings.turn_over_yield is set, `turn_over_applied`): "yield" where the verdict as run names no effect (none or unexplained) and the first turn-over raised the drape
-  coefficient by 0.02 or more (gap_tests.second_capture less gap_tests.capture, the second placement on the other
-  face); elsewhere the verdict as run;
+  run, and on every rule's verdict where settings.turn_over_yield is set, `turn_over_applied`): "yield" where the
+  verdict as run names no effect (none or unexplained) and the first turn-over raised the drape coefficient by 0.02 or
+  more (gap_tests.second_capture less gap_tests.capture, the second placement on the other face); elsewhere the
+  verdict as run;
 - rise_yield_015 (rule U15, session 79, pre-registered for fresh seeds 105-106: docs/preregistrations/session80.md):
   rule U with a rise of 0.015 instead of 0.02;
 - min_objective: the candidate whose refit objective (in-sample: the capture and the second capture) is the smallest;
@@ -384,7 +385,8 @@ def rise_yield_015(j):
     """Rule U15 (registered in session 79 for seeds 105-106: docs/preregistrations/session80.md): rule U with a rise of
     RISE_015 instead of RISE (the run's own rule U laid on it afterwards, as on every rule)."""
     rise = turn_over_rise(j)
-    return "yield" if j["verdict"] in ("none", "unexplained") and rise is not None and rise >= RISE_015 else j["verdict"]
+    fires = j["verdict"] in ("none", "unexplained") and rise is not None and rise >= RISE_015
+    return "yield" if fires else j["verdict"]
 
 
 def rise_yield(j):

@@ -1637,8 +1637,8 @@ foreach(case "${lower};${stiffer};0.5" "${stiffer};${lower};0.000001")
   if(NOT no_confirmation OR NOT no_turn_over OR NOT flat_floor EQUAL 0
      OR NOT flat_verdict MATCHES "^(none|unexplained)$")
     message(FATAL_ERROR "--confirm-placement-rise and --turn-over-yield ${floor} on ${first} then ${second}: verdict "
-                        "${flat_verdict}, placement_confirmation '${flat_confirmation}', turn_over '${flat_turn_over}', "
-                        "placement floor ${flat_floor}")
+                        "${flat_verdict}, placement_confirmation '${flat_confirmation}', turn_over "
+                        "'${flat_turn_over}', placement floor ${flat_floor}")
   endif()
   if(first STREQUAL lower)
     set(lower_verdict ${flat_verdict})
