@@ -55,6 +55,8 @@ score. Hypotheses for the next evaluation, not the diagnosis's rule (docs/DIAGNO
   verdict as run;
 - rise_yield_015 (rule U15, session 79, pre-registered for fresh seeds 105-106: docs/preregistrations/session80.md):
   rule U with a rise of 0.015 instead of 0.02;
+- rise_later_yield (rule U2, session 79, an addendum registered for seeds 105-106: docs/preregistrations/session80.md):
+  rule U on the larger rise of the two later placements (the turned second capture, the held-out third face up again);
 - min_objective: the candidate whose refit objective (in-sample: the capture and the second capture) is the smallest;
   it ignores the held-out data, which the issue's attribution must use: a diagnostic of the refits, not a rule.
 
@@ -116,7 +118,8 @@ TOLERANCE = 0.1  # AttributionSettings::held_out_tolerance (sessions 23-73; 0.2 
 RULES = ["current", "strict", "tolerance", "objective_ties", "parsimony", "tie_objective", "no_bar", "no_bar_unconfirmed",
          "mean3", "held_out_excess", "held_out_rank", "min_objective", "without_ablation", "reach", "reach_objective",
          "tie_held_out_view", "tie_held_out", "no_near_tie",
-         "common4", "views_sensor", "views_camera", "tie_region", "wide_tolerance", "rise_yield", "rise_yield_015"]
+         "common4", "views_sensor", "views_camera", "tie_region", "wide_tolerance", "rise_yield", "rise_yield_015",
+         "rise_later_yield"]
 PARAMETERS = {"sensor": 9, "misalignment": 2}  # effect_space's dimension; the others have 1
 # How each rule orders candidates of equal shrinkage before their objectives (confirmation_rule).
 TIES = {"physical_first": lambda effect: effect == "sensor",  # attribute() since session 25 (needs_simulation)
@@ -389,6 +392,27 @@ def rise_yield_015(j):
     return "yield" if fires else j["verdict"]
 
 
+def later_rise(report):
+    """The larger of the second and the held-out capture's drape coefficients less the capture's, where the second lies
+    on the other face (the turned placement, and the third laid as the first): None otherwise."""
+    rise = turn_over_rise(report)
+    c2 = ((report.get("gap_tests") or {}).get("held_out_capture") or {}).get("drape_coefficient")
+    c0 = ((report.get("gap_tests") or {}).get("capture") or {}).get("drape_coefficient")
+    if rise is None or c2 is None or c0 is None:
+        return rise
+    return max(rise, c2 - c0)
+
+
+def rise_later_yield(j):
+    """Rule U2 (registered in session 79 for seeds 105-106, an addendum: docs/preregistrations/session80.md): rule U on
+    either later placement: "yield" where the verdict names no effect and the turned second capture or the third,
+    laid face up again, drapes with a drape coefficient RISE or more above the capture's (the run's rule U laid on it
+    afterwards, as on every rule)."""
+    rise = later_rise(j)
+    fires = j["verdict"] in ("none", "unexplained") and rise is not None and rise >= RISE
+    return "yield" if fires else j["verdict"]
+
+
 def rise_yield(j):
     """Rule U (pre-registered in session 78 for seeds 103-104: docs/preregistrations/session79.md): "yield" where the
     verdict as run names no effect ("none", within the floors or once the bending is refitted, or "unexplained") and
@@ -401,7 +425,8 @@ def rise_yield(j):
 
 # The rules read off the verdict as run and one more field of the report, with or without candidates.
 REPORT_RULES = {"views_sensor": views_sensor, "views_camera": views_camera, "tie_region": tie_region,
-                "wide_tolerance": wide_tolerance, "rise_yield": rise_yield, "rise_yield_015": rise_yield_015}
+                "wide_tolerance": wide_tolerance, "rise_yield": rise_yield, "rise_yield_015": rise_yield_015,
+                "rise_later_yield": rise_later_yield}
 
 
 def verdicts(j):
