@@ -1,0 +1,74 @@
+#!/usr/bin/env python3
+"""The turn-over rules of scripts/diagnosis_rules.py (rules U, U15 and U2) on hand-written reports: they decide what
+is adopted (docs/preregistrations/), so a slip here would mislead a registered test."""
+import importlib.util
+import os
+import unittest
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+spec = importlib.util.spec_from_file_location("diagnosis_rules", os.path.join(HERE, "..", "diagnosis_rules.py"))
+rules = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(rules)
+
+
+def report(verdict, c0, c1, c2=None, second_face="down", turn_over=None, floor=0.0):
+    """A report.json without candidates: the verdict, the placements' drape coefficients and faces, the run's rule U
+    (settings.turn_over_yield) and, where it named yield, its turn_over record."""
+    g = {"capture": {"drape_coefficient": c0}, "second_capture": {"drape_coefficient": c1}}
+    if c2 is not None:
+        g["held_out_capture"] = {"drape_coefficient": c2}
+    j = {"verdict": verdict, "gap_tests": g, "attribution": {}, "settings": {"turn_over_yield": floor},
+         "placements": [{"role": "capture", "face": "up"}, {"role": "second_capture", "face": second_face},
+                        {"role": "held_out_capture", "face": "up"}]}
+    if turn_over:
+        j["turn_over"] = turn_over
+    return j
+
+
+class TurnOverRules(unittest.TestCase):
+    def test_rise_needs_the_other_face(self):
+        self.assertAlmostEqual(rules.turn_over_rise(report("none", 0.20, 0.23)), 0.03)
+        self.assertIsNone(rules.turn_over_rise(report("none", 0.20, 0.23, second_face="up")))
+
+    def test_rule_u_names_yield_only_where_no_effect_is_named(self):
+        self.assertEqual(rules.rise_yield(report("none", 0.20, 0.225)), "yield")
+        self.assertEqual(rules.rise_yield(report("unexplained", 0.20, 0.225)), "yield")
+        self.assertEqual(rules.rise_yield(report("shear", 0.20, 0.225)), "shear")
+        self.assertEqual(rules.rise_yield(report("none", 0.20, 0.219)), "none")
+        self.assertEqual(rules.rise_yield(report("none", 0.20, 0.24, second_face="up")), "none")
+
+    def test_u15_and_u2(self):
+        self.assertEqual(rules.rise_yield_015(report("none", 0.20, 0.216)), "yield")
+        self.assertEqual(rules.rise_yield_015(report("none", 0.20, 0.214)), "none")
+        # U2: the larger of the two later rises (the third placement's here), not the first alone.
+        self.assertEqual(rules.rise_later_yield(report("none", 0.20, 0.205, c2=0.225)), "yield")
+        self.assertEqual(rules.rise_later_yield(report("none", 0.20, 0.205, c2=0.215)), "none")
+        self.assertEqual(rules.rise_later_yield(report("curl", 0.20, 0.205, c2=0.25)), "curl")
+        # Without a turn-over there is no later rise to read.
+        self.assertEqual(rules.rise_later_yield(report("none", 0.20, 0.25, c2=0.25, second_face="up")), "none")
+
+    def test_a_run_with_rule_u_is_read_as_its_refits_then_the_turn_over(self):
+        # The run named yield from the turn-over: every rule starts from the refits' verdict and gets the turn-over
+        # laid on it, so the verdict as run is reproduced.
+        run = rules.refits_report(report("yield", 0.20, 0.23, floor=0.02,
+                                         turn_over={"rise": 0.03, "floor": 0.02, "refits_verdict": "none"}))
+        self.assertEqual(run["verdict"], "none")
+        self.assertEqual(run["verdict_reported"], "yield")
+        v = rules.verdicts(run)
+        self.assertEqual(v["current"], "yield")
+        self.assertTrue(all(x == "yield" for x in v.values()), v)
+        # Below the run's floor nothing is laid on; a run without rule U (floor 0) lays nothing on either.
+        below = rules.verdicts(rules.refits_report(report("none", 0.20, 0.21, floor=0.02)))
+        self.assertEqual(below["current"], "none")
+        self.assertEqual(below["rise_yield"], "none")
+        off = rules.verdicts(rules.refits_report(report("none", 0.20, 0.23)))
+        self.assertEqual(off["current"], "none")
+        self.assertEqual(off["rise_yield"], "yield")
+
+    def test_a_report_without_a_turn_over_is_unchanged(self):
+        j = report("shear", 0.20, 0.23)
+        self.assertIs(rules.refits_report(j), j)
+
+
+if __name__ == "__main__":
+    unittest.main()
