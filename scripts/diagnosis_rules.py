@@ -730,6 +730,9 @@ def pooled_matrix(rule, roots):
 
 def main(roots):
     global TOLERANCE, WIDE_TOLERANCE
+    if roots[:1] in (["--help"], ["-h"]):
+        print(__doc__)
+        return None
     if roots[:1] == ["--check-reattribute"]:
         return check_reattribute(roots[1:])
     if roots[:1] == ["--wide"]:
@@ -766,6 +769,9 @@ def main(roots):
             return pooled_matrix(matrix_rule, roots[1:])
     if not roots:
         sys.exit(__doc__)
+    for root in roots:
+        if not os.path.isdir(os.path.join(root, "diagnoses")):
+            sys.exit(f"diagnosis_rules: {root} is not a benchmark run (no diagnoses/ in it)")
     for root in roots:
         rows = [(name, family, verdicts(j)) for name, family, j in reports(root)]
         if matrix_rule:
