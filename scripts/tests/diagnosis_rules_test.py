@@ -47,6 +47,18 @@ class TurnOverRules(unittest.TestCase):
         # Without a turn-over there is no later rise to read.
         self.assertEqual(rules.rise_later_yield(report("none", 0.20, 0.25, c2=0.25, second_face="up")), "none")
 
+    def test_rule_k_withdraws_a_yield_without_the_rise(self):
+        self.assertEqual(rules.yield_needs_rise(report("yield", 0.20, 0.21)), "unexplained")
+        self.assertEqual(rules.yield_needs_rise(report("yield", 0.20, 0.19)), "unexplained")
+        self.assertEqual(rules.yield_needs_rise(report("yield", 0.20, 0.225)), "yield")
+        self.assertEqual(rules.yield_needs_rise(report("shear", 0.20, 0.20)), "shear")
+        # Without a turn-over (both placements on one face) there is no rise to ask for.
+        self.assertEqual(rules.yield_needs_rise(report("yield", 0.20, 0.20, second_face="up")), "yield")
+        # A yield the run's turn-over named stays: the refits named no effect there.
+        run = rules.refits_report(report("yield", 0.20, 0.23, floor=0.02,
+                                         turn_over={"rise": 0.03, "floor": 0.02, "refits_verdict": "none"}))
+        self.assertEqual(rules.verdicts(run)["yield_needs_rise"], "yield")
+
     def test_a_run_with_rule_u_is_read_as_its_refits_then_the_turn_over(self):
         # The run named yield from the turn-over: every rule starts from the refits' verdict and gets the turn-over
         # laid on it, so the verdict as run is reproduced.
