@@ -57,6 +57,9 @@ score. Hypotheses for the next evaluation, not the diagnosis's rule (docs/DIAGNO
   rule U with a rise of 0.015 instead of 0.02;
 - rise_later_yield (rule U2, session 79, an addendum registered for seeds 105-106: docs/preregistrations/session80.md):
   rule U on the larger rise of the two later placements (the turned second capture, the held-out third face up again);
+- yield_needs_rise (rule K, session 80, pre-registered for fresh seeds 107-108: docs/preregistrations/session81.md):
+  "unexplained" where the verdict as run is yield and the first turn-over raised the drape coefficient by less than
+  0.02; elsewhere the verdict as run;
 - min_objective: the candidate whose refit objective (in-sample: the capture and the second capture) is the smallest;
   it ignores the held-out data, which the issue's attribution must use: a diagnostic of the refits, not a rule.
 
@@ -384,12 +387,17 @@ def turn_over_rise(report):
 RISE_015 = 0.015  # rule U15's (docs/preregistrations/session80.md)
 
 
+def yield_where_risen(j, rise, floor):
+    """"yield" where the verdict as run names no effect (none or unexplained) and `rise` is at least `floor`; else the
+    verdict as run: rules U, U15 and U2, which differ in the rise they read and its floor."""
+    fires = j["verdict"] in ("none", "unexplained") and rise is not None and rise >= floor
+    return "yield" if fires else j["verdict"]
+
+
 def rise_yield_015(j):
     """Rule U15 (registered in session 79 for seeds 105-106: docs/preregistrations/session80.md): rule U with a rise of
     RISE_015 instead of RISE (the run's own rule U laid on it afterwards, as on every rule)."""
-    rise = turn_over_rise(j)
-    fires = j["verdict"] in ("none", "unexplained") and rise is not None and rise >= RISE_015
-    return "yield" if fires else j["verdict"]
+    return yield_where_risen(j, turn_over_rise(j), RISE_015)
 
 
 def later_rise(report):
@@ -408,9 +416,7 @@ def rise_later_yield(j):
     either later placement: "yield" where the verdict names no effect and the turned second capture or the third,
     laid face up again, drapes with a drape coefficient RISE or more above the capture's (the run's rule U laid on it
     afterwards, as on every rule)."""
-    rise = later_rise(j)
-    fires = j["verdict"] in ("none", "unexplained") and rise is not None and rise >= RISE
-    return "yield" if fires else j["verdict"]
+    return yield_where_risen(j, later_rise(j), RISE)
 
 
 def rise_yield(j):
@@ -419,8 +425,7 @@ def rise_yield(j):
     the first turn-over raised the drape coefficient by RISE or more: a plastic set makes the specimen, turned over,
     drape stiffer, which an elastic one does not (none of the 72 controls of seeds 80-102 rose by 0.02); else the
     verdict as run."""
-    rise = turn_over_rise(j)
-    return "yield" if j["verdict"] in ("none", "unexplained") and rise is not None and rise >= RISE else j["verdict"]
+    return yield_where_risen(j, turn_over_rise(j), RISE)
 
 
 def yield_needs_rise(j):

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The turn-over rules of scripts/diagnosis_rules.py (rules U, U15 and U2) on hand-written reports: they decide what
+"""The turn-over rules of scripts/diagnosis_rules.py (rules U, U15, U2 and K) on hand-written reports: they decide what
 is adopted (docs/preregistrations/), so a slip here would mislead a registered test."""
 import importlib.util
 import os
