@@ -60,6 +60,10 @@ score. Hypotheses for the next evaluation, not the diagnosis's rule (docs/DIAGNO
 - yield_needs_rise (rule K, session 80, pre-registered for fresh seeds 107-108: docs/preregistrations/session81.md):
   "unexplained" where the verdict as run is yield and the first turn-over raised the drape coefficient by less than
   0.02; elsewhere the verdict as run;
+- alternation_yield (rule A, a candidate for session 82): rule U and rule K on the turn-over's alternation, the
+  turned second capture's drape coefficient less the mean of the first and the third's, at 0.015;
+- off_centre (rule E, a candidate for session 82): "misalignment" where the verdict names no effect, the
+  run's rule U names no yield, and the hem's centre offset is 2.5 times its floor or more; else the verdict as run;
 - min_objective: the candidate whose refit objective (in-sample: the capture and the second capture) is the smallest;
   it ignores the held-out data, which the issue's attribution must use: a diagnostic of the refits, not a rule.
 
@@ -122,7 +126,7 @@ RULES = ["current", "strict", "tolerance", "objective_ties", "parsimony", "tie_o
          "mean3", "held_out_excess", "held_out_rank", "min_objective", "without_ablation", "reach", "reach_objective",
          "tie_held_out_view", "tie_held_out", "no_near_tie",
          "common4", "views_sensor", "views_camera", "tie_region", "wide_tolerance", "rise_yield", "rise_yield_015",
-         "rise_later_yield", "yield_needs_rise"]
+         "rise_later_yield", "yield_needs_rise", "alternation_yield", "off_centre"]
 PARAMETERS = {"sensor": 9, "misalignment": 2}  # effect_space's dimension; the others have 1
 # How each rule orders candidates of equal shrinkage before their objectives (confirmation_rule).
 TIES = {"physical_first": lambda effect: effect == "sensor",  # attribute() since session 25 (needs_simulation)
@@ -439,10 +443,61 @@ def yield_needs_rise(j):
     return "unexplained" if j["verdict"] == "yield" and rise is not None and rise < RISE else j["verdict"]
 
 
+ALTERNATION = 0.015  # rule A's floor (a candidate for session 82)
+
+
+def turn_over_alternation(report):
+    """The turned second capture's drape coefficient less the mean of the first and the third (both laid face up):
+    the set a plastic fabric takes on one face stiffens the drape on the other and relaxes on the first again, while
+    an elastic fabric's three drapes differ by the noise; None where the second capture is not turned or a placement
+    lacks its drape coefficient."""
+    rise = turn_over_rise(report)
+    g = report.get("gap_tests") or {}
+    c2 = (g.get("held_out_capture") or {}).get("drape_coefficient")
+    c0 = (g.get("capture") or {}).get("drape_coefficient")
+    if rise is None or c2 is None:
+        return None
+    return rise - (c2 - c0) / 2.0
+
+
+def alternation_yield(j):
+    """Rule A (a candidate for session 82): rule U on the turn-over's alternation (turn_over_alternation) at
+    ALTERNATION instead of the first rise at RISE; where rule K's test withdraws a yield, on the alternation too."""
+    alt = turn_over_alternation(j)
+    if j["verdict"] == "yield" and alt is not None and alt < ALTERNATION:
+        return "unexplained"
+    return yield_where_risen(j, alt, ALTERNATION)
+
+
+OFF_CENTRE = 2.5  # rule E's ratio of the hem's centre offset to its floor (a candidate for session 82)
+
+
+def off_centre_ratio(report):
+    """The hem's centre offset against its floor (localisation.feature_groups.off_centre.ratio: the order-1 harmonic
+    of the hem's radius and height, capture less model, over its noise floor); None where the report lacks it."""
+    group = ((report.get("localisation") or {}).get("feature_groups") or {}).get("off_centre") or {}
+    return group.get("ratio")
+
+
+def off_centre_misalignment(j):
+    """Rule E (a candidate for session 82): "misalignment" where the verdict names no effect (none or unexplained),
+    the run's rule U does not name yield, and the hem's centre lies OFF_CENTRE times its floor or more off the model's:
+    a specimen laid off centre hangs longer on one side, which no elastic fabric's drape on a centred specimen does
+    (the 24 controls of seeds 101-106 reached 1.77; 10 of their 12 misalignments 2.5 or more); else the verdict."""
+    floor = (j.get("settings") or {}).get("turn_over_yield", 0.0)
+    rise = turn_over_rise(j)
+    if floor > 0.0 and rise is not None and rise >= floor:
+        return j["verdict"]
+    ratio = off_centre_ratio(j)
+    fires = j["verdict"] in ("none", "unexplained") and ratio is not None and ratio >= OFF_CENTRE
+    return "misalignment" if fires else j["verdict"]
+
+
 # The rules read off the verdict as run and one more field of the report, with or without candidates.
 REPORT_RULES = {"views_sensor": views_sensor, "views_camera": views_camera, "tie_region": tie_region,
                 "wide_tolerance": wide_tolerance, "rise_yield": rise_yield, "rise_yield_015": rise_yield_015,
-                "rise_later_yield": rise_later_yield, "yield_needs_rise": yield_needs_rise}
+                "rise_later_yield": rise_later_yield, "yield_needs_rise": yield_needs_rise,
+                "alternation_yield": alternation_yield, "off_centre": off_centre_misalignment}
 
 
 def verdicts(j):

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""The turn-over rules of scripts/diagnosis_rules.py (rules U, U15, U2 and K) on hand-written reports: they decide what
-is adopted (docs/preregistrations/), so a slip here would mislead a registered test."""
+"""The turn-over rules of scripts/diagnosis_rules.py (rules U, U15, U2, K and A) and rule E on hand-written reports:
+they decide what is adopted (docs/preregistrations/), so a slip here would mislead a registered test."""
 import importlib.util
 import os
 import unittest
@@ -58,6 +58,35 @@ class TurnOverRules(unittest.TestCase):
         run = rules.refits_report(report("yield", 0.20, 0.23, floor=0.02,
                                          turn_over={"rise": 0.03, "floor": 0.02, "refits_verdict": "none"}))
         self.assertEqual(rules.verdicts(run)["yield_needs_rise"], "yield")
+
+    def test_rule_a_reads_the_alternation(self):
+        # c1 - (c0 + c2) / 2: 0.216 - 0.20 = 0.016 over a third placement back at 0.20.
+        self.assertAlmostEqual(rules.turn_over_alternation(report("none", 0.20, 0.216, c2=0.20)), 0.016)
+        self.assertEqual(rules.alternation_yield(report("none", 0.20, 0.216, c2=0.20)), "yield")
+        # The same first rise with the third placement risen as far is no alternation.
+        self.assertEqual(rules.alternation_yield(report("none", 0.20, 0.216, c2=0.216)), "none")
+        # A yield the refits named without the alternation is withdrawn, with it kept; other verdicts stay.
+        self.assertEqual(rules.alternation_yield(report("yield", 0.20, 0.21, c2=0.20)), "unexplained")
+        self.assertEqual(rules.alternation_yield(report("yield", 0.20, 0.23, c2=0.21)), "yield")
+        self.assertEqual(rules.alternation_yield(report("curl", 0.20, 0.25, c2=0.20)), "curl")
+        # Without a turn-over or a third placement there is nothing to read.
+        self.assertIsNone(rules.turn_over_alternation(report("none", 0.20, 0.25)))
+        self.assertEqual(rules.alternation_yield(report("none", 0.20, 0.25, c2=0.20, second_face="up")), "none")
+
+    def test_rule_e_names_misalignment_from_the_hem_centre(self):
+        def off(verdict, ratio, c1=0.20, floor=0.0):
+            j = report(verdict, 0.20, c1, c2=0.20, floor=floor)
+            j["localisation"] = {"feature_groups": {"off_centre": {"ratio": ratio}}}
+            return j
+        self.assertEqual(rules.off_centre_misalignment(off("none", 2.5)), "misalignment")
+        self.assertEqual(rules.off_centre_misalignment(off("unexplained", 3.0)), "misalignment")
+        self.assertEqual(rules.off_centre_misalignment(off("none", 2.4)), "none")
+        self.assertEqual(rules.off_centre_misalignment(off("curl", 5.0)), "curl")
+        self.assertEqual(rules.off_centre_misalignment(report("none", 0.20, 0.20)), "none")  # no localisation
+        # Where the run's rule U names yield, rule E leaves it (its verdict as run, then the turn-over laid on it).
+        self.assertEqual(rules.off_centre_misalignment(off("none", 3.0, c1=0.23, floor=0.02)), "none")
+        self.assertEqual(rules.verdicts(off("none", 3.0, c1=0.23, floor=0.02))["off_centre"], "yield")
+        self.assertEqual(rules.off_centre_misalignment(off("none", 3.0, c1=0.23)), "misalignment")
 
     def test_a_run_with_rule_u_is_read_as_its_refits_then_the_turn_over(self):
         # The run named yield from the turn-over: every rule starts from the refits' verdict and gets the turn-over
