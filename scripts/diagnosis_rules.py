@@ -398,6 +398,13 @@ def yield_where_risen(j, rise, floor):
     return "yield" if fires else j["verdict"]
 
 
+def yield_unless_risen(j, rise, floor):
+    """"unexplained" where the verdict as run is yield and `rise` is below `floor`; else the verdict as run: rules K
+    and A's withdrawal, which differ in the rise they read and its floor."""
+    withdrawn = j["verdict"] == "yield" and rise is not None and rise < floor
+    return "unexplained" if withdrawn else j["verdict"]
+
+
 def rise_yield_015(j):
     """Rule U15 (registered in session 79 for seeds 105-106: docs/preregistrations/session80.md): rule U with a rise of
     RISE_015 instead of RISE (the run's own rule U laid on it afterwards, as on every rule)."""
@@ -439,8 +446,7 @@ def yield_needs_rise(j):
     the 9 yields the refits named yield on seeds 101-106 by +0.029 or more), while the 3 controls the refits named
     yield there rose by +0.010 to +0.016, the yield refit standing for a softer elastic fabric. Else the verdict as
     run (the refits', the run's turn-over laid on it afterwards, as on every rule)."""
-    rise = turn_over_rise(j)
-    return "unexplained" if j["verdict"] == "yield" and rise is not None and rise < RISE else j["verdict"]
+    return yield_unless_risen(j, turn_over_rise(j), RISE)
 
 
 ALTERNATION = 0.015  # rule A's floor (a candidate for session 82)
@@ -464,8 +470,8 @@ def alternation_yield(j):
     """Rule A (a candidate for session 82): rule U on the turn-over's alternation (turn_over_alternation) at
     ALTERNATION instead of the first rise at RISE; where rule K's test withdraws a yield, on the alternation too."""
     alt = turn_over_alternation(j)
-    if j["verdict"] == "yield" and alt is not None and alt < ALTERNATION:
-        return "unexplained"
+    if j["verdict"] == "yield":
+        return yield_unless_risen(j, alt, ALTERNATION)
     return yield_where_risen(j, alt, ALTERNATION)
 
 
