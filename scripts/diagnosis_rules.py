@@ -573,23 +573,35 @@ def verdicts(j):
 COLUMNS = ["none", "unexplained", "not attributed", "yield", "shear", "curl", "friction", "misalignment", "sensor"]
 
 
+SIGNATURES = ("turn_over", "off_centre")  # report.json's records of rules U and E, where they named the effect
+
+
 def refits_report(j):
-    """The report with the refits' verdict as its verdict where the turn-over named yield (`drapegen diagnose
-    --turn-over-yield`, rule U, report.json turn_over), the reported one kept as verdict_reported: the rules recompute
-    the refits' verdict, and verdicts() lays the turn-over on every rule's as the run did."""
-    if not j.get("turn_over"):
-        return j
-    return dict(j, verdict=j["turn_over"]["refits_verdict"], verdict_reported=j["verdict"])
+    """The report with the refits' verdict as its verdict where a signature named the effect (`drapegen diagnose
+    --turn-over-yield`, rule U, report.json turn_over; `--off-centre-misalignment`, rule E, off_centre), the reported
+    one kept as verdict_reported: the rules recompute the refits' verdict, and verdicts() lays the signatures on every
+    rule's as the run did."""
+    for key in SIGNATURES:
+        if j.get(key):
+            return dict(j, verdict=j[key]["refits_verdict"], verdict_reported=j["verdict"])
+    return j
 
 
 def turn_over_applied(j, v):
-    """Every rule's verdict with the run's turn-over (settings.turn_over_yield > 0) laid on it as diagnose() does:
-    yield where the rule names no effect and the first turn-over raised the drape coefficient by the run's floor."""
-    floor = (j.get("settings") or {}).get("turn_over_yield", 0.0)
+    """Every rule's verdict with the run's signatures laid on it as diagnose() does: the turn-over's
+    (settings.turn_over_yield > 0), yield where the rule names no effect and the first turn-over raised the drape
+    coefficient by the run's floor; then the hem's centre's (settings.off_centre_misalignment > 0), misalignment where
+    the rule still names no effect and the hem's centre offset reaches the run's ratio."""
+    settings = j.get("settings") or {}
+    floor = settings.get("turn_over_yield", 0.0)
     rise = turn_over_rise(j)
-    if floor <= 0.0 or rise is None or rise < floor:
-        return v
-    return {r: "yield" if x in ("none", "unexplained") else x for r, x in v.items()}
+    if floor > 0.0 and rise is not None and rise >= floor:
+        v = {r: "yield" if x in ("none", "unexplained") else x for r, x in v.items()}
+    ratio_floor = settings.get("off_centre_misalignment", 0.0)
+    ratio = off_centre_ratio(j)
+    if ratio_floor > 0.0 and ratio is not None and ratio >= ratio_floor:
+        v = {r: "misalignment" if x in ("none", "unexplained") else x for r, x in v.items()}
+    return v
 
 
 def reports(root, truth_root=None):

@@ -229,6 +229,17 @@ std::string verdict_markdown(const DiagnosisResult& r) {
                       yield ? fmt::format("the yield refit shrinks the excess by {:.0f}%", 100.0 * yield->shrinkage)
                             : std::string("no yield refit ran"));
     md += refits_markdown(r, t->refits_verdict, "The refits' verdict");
+  } else if (const auto& o = r.off_centre) {
+    const CandidateResult* misalignment = r.named_refit();
+    md += fmt::format("**Verdict: misalignment, from the hem's centre**: the hem's centre lies {:.2f} times its floor "
+                      "off the fitted drape's (the order-1 harmonic of the hem's radius and height; at least {:g}), as "
+                      "a specimen laid off centre hangs longer on one side and an elastic fabric's drape on a centred "
+                      "specimen does not (`--off-centre-misalignment`; {}). The refits alone named no effect:\n\n",
+                      o->ratio, o->floor,
+                      misalignment ? fmt::format("the misalignment refit shrinks the excess by {:.0f}%",
+                                                 100.0 * misalignment->shrinkage)
+                                   : std::string("no misalignment refit ran"));
+    md += refits_markdown(r, o->refits_verdict, "The refits' verdict");
   } else {
     md += refits_markdown(r, r.verdict);
   }
