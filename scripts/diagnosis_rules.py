@@ -49,7 +49,7 @@ score. Hypotheses for the next evaluation, not the diagnosis's rule (docs/DIAGNO
   another tolerance; `--check-reattribute DIR...` checks that the run's own tolerance gives every verdict as run);
 - rise_yield (rule U, session 78, pre-registered for fresh seeds 103-104: docs/preregistrations/session79.md; adopted
   in session 79, `drapegen diagnose --turn-over-yield 0.02` in the --fine preset: on reports since, the verdict as
-  run, and on every rule's verdict where settings.turn_over_yield is set, `turn_over_applied`): "yield" where the
+  run, and on every rule's verdict where settings.turn_over_yield is set, `signatures_applied`): "yield" where the
   verdict as run names no effect (none or unexplained) and the first turn-over raised the drape coefficient by 0.02 or
   more (gap_tests.second_capture less gap_tests.capture, the second placement on the other face); elsewhere the
   verdict as run;
@@ -507,7 +507,7 @@ def verdicts(j):
     if not cands:
         v = {r: j["verdict"] for r in RULES}
         v.update({rule: f(j) for rule, f in REPORT_RULES.items()})
-        return turn_over_applied(j, v)
+        return signatures_applied(j, v)
     sf, shf = g["stable_floor_mm"], g["shape_floor"]
     within = j.get("within_floors_after_bending_refit", False)
     v = {"current": j["verdict"], "strict": confirmation_rule(j, 0.0), "tolerance": confirmation_rule(j, TOLERANCE),
@@ -567,7 +567,7 @@ def verdicts(j):
     for rule in ("without_ablation", "reach", "reach_objective"):
         v[rule] = reference_rule(j, rule)
     v.update({rule: f(j) for rule, f in REPORT_RULES.items()})
-    return turn_over_applied(j, v)
+    return signatures_applied(j, v)
 
 
 COLUMNS = ["none", "unexplained", "not attributed", "yield", "shear", "curl", "friction", "misalignment", "sensor"]
@@ -587,7 +587,7 @@ def refits_report(j):
     return j
 
 
-def turn_over_applied(j, v):
+def signatures_applied(j, v):
     """Every rule's verdict with the run's signatures laid on it as diagnose() does: the turn-over's
     (settings.turn_over_yield > 0), yield where the rule names no effect and the first turn-over raised the drape
     coefficient by the run's floor; then the hem's centre's (settings.off_centre_misalignment > 0), misalignment where

@@ -1735,6 +1735,12 @@ json_number(centred_group "${centred}" localisation feature_groups off_centre ra
 json_number(centred_floor "${centred}" off_centre floor)
 json_number(centred_setting "${centred}" settings off_centre_misalignment)
 json_number(centred_shrinkage "${centred}" shrinkage)
+# The yield refit's shrinkage, where it ran: the reported one is the misalignment refit's, none here (0).
+string(JSON centred_refits_ran LENGTH "${centred}" attribution candidates)
+set(centred_yield_shrinkage "no refit")
+if(centred_refits_ran GREATER 0)
+  json_number(centred_yield_shrinkage "${centred}" attribution candidates 0 shrinkage)
+endif()
 if(NOT centred_verdict STREQUAL "misalignment" OR NOT centred_refits MATCHES "^(none|unexplained)$"
    OR NOT no_centred_turn_over OR NOT centred_confidence STREQUAL "NULL" OR NOT centred_ratio EQUAL centred_group
    OR NOT centred_ratio GREATER 0 OR NOT centred_floor EQUAL 0.000001 OR NOT centred_setting EQUAL 0.000001
@@ -1742,7 +1748,7 @@ if(NOT centred_verdict STREQUAL "misalignment" OR NOT centred_refits MATCHES "^(
   message(FATAL_ERROR "--off-centre-misalignment 0.000001: verdict ${centred_verdict} (the refits' ${centred_refits}), "
                       "turn_over '${centred_turn_over}', confidence ${centred_confidence}, ratio ${centred_ratio} "
                       "(the localisation's ${centred_group}), floor ${centred_floor}, setting ${centred_setting}, "
-                      "shrinkage ${centred_shrinkage}")
+                      "shrinkage ${centred_shrinkage} (the yield refit's ${centred_yield_shrinkage})")
 endif()
 file(READ ${WORK}/report_centred/report.md centred_md)
 if(NOT centred_md MATCHES "Verdict: misalignment, from the hem's centre\\*\\*: the hem's centre lies [0-9.]+ times"

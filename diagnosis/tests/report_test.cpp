@@ -137,8 +137,8 @@ TEST(VerdictMarkdown, YieldFromTheTurnOverSaysSoAndKeepsTheRefitsVerdict) {
 }
 
 TEST(VerdictMarkdown, MisalignmentFromTheHemCentreSaysSoAndKeepsTheRefitsVerdict) {
-  // The refits named no effect (within the floors once the bending was refitted); the hem's centre lies 3.49 times
-  // its floor off the fitted drape's: misalignment, with the misalignment refit's shrinkage.
+  // The refits named no effect (curl first, unconfirmed); the hem's centre lies 3.49 times its floor off the fitted
+  // drape's: misalignment, with the misalignment refit's shrinkage, not the first candidate's.
   DiagnosisResult r;
   r.verdict = "misalignment";
   r.off_centre = DiagnosisResult::OffCentreMisalignment{3.49, 2.5, "none"};
