@@ -514,10 +514,14 @@ int main(int argc, char** argv) {
       continue;
     }
     const std::string verdict = d.value("verdict", "?");
-    // The refits' own verdict where the turn-over named yield (drapegen diagnose --turn-over-yield): whether the gap
-    // was found above the floors is theirs.
-    const bool turned = d.contains("turn_over") && d["turn_over"].is_object();
-    const std::string refits_verdict = turned ? d["turn_over"].value("refits_verdict", "?") : verdict;
+    // The refits' own verdict where a signature named the effect (drapegen diagnose --turn-over-yield: "turn_over";
+    // --off-centre-misalignment: "off_centre"): whether the gap was found above the floors is theirs.
+    std::string signature, refits_verdict = verdict;
+    for (const auto& [key, label] : {std::pair{"turn_over", "turn-over"}, std::pair{"off_centre", "hem centre"}}) {
+      if (!d.contains(key) || !d[key].is_object()) continue;
+      signature = label;
+      refits_verdict = d[key].value("refits_verdict", "?");
+    }
     const std::string family = t.value("family", "none");
     nlohmann::json screened = nullptr;  // the kept draw passed the screen (visible, settled), if it was screened
     if (const fs::path log = fs::path(out) / "screen" / (c.name + ".json"); fs::exists(log)) {
@@ -592,7 +596,7 @@ int main(int argc, char** argv) {
       strength = t["effects"][0].value("strength", 0.0);
     }
     per_case.push_back({{"case", c.name}, {"family", family}, {"effect", effect}, {"strength", strength},
-                        {"verdict", verdict}, {"turn_over", turned}, {"runner_up", d.value("runner_up", "")},
+                        {"verdict", verdict}, {"signature", signature}, {"runner_up", d.value("runner_up", "")},
                         {"confidence", d.value("confidence", nlohmann::json())}, {"region", region},
                         {"region_ok", region_ok},
                         {"gap_mm", d["gap_mm"]["all_views"]}, {"floor_mm", d["floors"]["all_views_mm"]},
@@ -683,10 +687,11 @@ int main(int argc, char** argv) {
     const std::string shrink =
         c["shrinkage"].is_null() ? "-" : fmt::format("{:.0f}%", 100.0 * c["shrinkage"].get<double>());
     const std::string effect = c["effect"].get<std::string>();
+    const std::string signature = c["signature"].get<std::string>();  // what named the effect, where not the refits
     md += fmt::format("| {} | {} | {:.3g} | {} | {:.1f} / {:.1f} | {:.2f} / {:.2f} | {} | {} | {} | {:.0f} |\n",
                       c["case"].get<std::string>(), effect.empty() ? "-" : effect,
                       c["strength"].get<double>(),
-                      c["verdict"].get<std::string>() + (c["turn_over"].get<bool>() ? " (turn-over)" : ""),
+                      c["verdict"].get<std::string>() + (signature.empty() ? "" : " (" + signature + ")"),
                       t.value("stable_mm", 0.0),
                       t.value("stable_floor_mm", 0.0), t.value("shape", 0.0), t.value("shape_floor", 0.0),
                       c["region"].get<std::string>(), c["region_ok"].get<bool>() ? "yes" : "no", shrink,

@@ -42,6 +42,7 @@ struct DiagnoseOptions {
   int confirm_resolution = 0;
   double confirm_placement_rise = 0.0;
   std::optional<double> turn_over_yield;
+  std::optional<double> off_centre_misalignment;
   std::optional<int> states;
   std::optional<int> evaluations;
   std::optional<int> refit_evaluations;
@@ -141,6 +142,9 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (o.turn_over_yield.value_or(0.0) > 0.0 && o.second.empty()) {
     return fail("--turn-over-yield compares the turned placement with the capture: give --second-capture");
   }
+  if (o.off_centre_misalignment && !(*o.off_centre_misalignment >= 0.0)) {
+    return fail("--off-centre-misalignment must be 0 (off) or more (a ratio to the off-centre floor)");
+  }
   if (!(o.held_out_tolerance >= 0.0 && o.held_out_tolerance <= 1.0)) return fail("--held-out-tolerance must be 0 .. 1");
   if (outside(o.starts, 0, 100)) return fail("--starts must be 0 (the guess alone) .. 100");
   if (bad_scan(o.refit_scan, 100)) return fail("--refit-scan must be 0 (off) or 2 .. 100");
@@ -216,6 +220,7 @@ int run_diagnose(const DiagnoseOptions& o) {
   settings.confirm_resolution = o.confirm_resolution;
   settings.confirm_placement_rise = o.confirm_placement_rise;
   if (o.turn_over_yield) settings.turn_over_yield = *o.turn_over_yield;
+  if (o.off_centre_misalignment) settings.off_centre_misalignment = *o.off_centre_misalignment;
   if (o.states) settings.fit.initial_states = *o.states;
   if (o.evaluations) settings.baseline_optimiser.max_evaluations = *o.evaluations;
   if (o.refit_evaluations) settings.attribution.optimiser.max_evaluations = *o.refit_evaluations;
@@ -357,6 +362,14 @@ int run_diagnose(const DiagnoseOptions& o) {
                                t->rise, t->floor, t->refits_verdict,
                                yield ? fmt::format("the yield refit's shrinkage {:.0f}%", 100 * yield->shrinkage)
                                      : std::string("no yield refit ran"));
+    } else if (const auto& c = r.off_centre) {
+      const diagnosis::CandidateResult* misalignment = r.named_refit();
+      std::cout << fmt::format("  verdict: misalignment, from the hem's centre: {:.2f} times its floor off the fitted "
+                               "drape's (at least {:g}); the refits' verdict {}; {}\n",
+                               c->ratio, c->floor, c->refits_verdict,
+                               misalignment ? fmt::format("the misalignment refit's shrinkage {:.0f}%",
+                                                          100 * misalignment->shrinkage)
+                                            : std::string("no misalignment refit ran"));
     } else if (r.verdict == "none") {
       std::cout << fmt::format("  verdict: within the floors{} (no effect named)\n",
                                r.attribution.bending_within_floors() ? " once the bending is refitted" : "");
@@ -426,6 +439,12 @@ Runner add_diagnose_command(CLI::App& app) {
                  "specimen has no face (report.json \"turn_over\"; within the floors too; not with --gap-only; needs "
                  "--second-capture; default 0: off; --fine " +
                      fmt::format("{:g}", diagnosis::DiagnosisSettings::kFineTurnOverYield) + ")");
+  app.add_option("--off-centre-misalignment", o->off_centre_misalignment,
+                 "Where the verdict names no effect (none or unexplained; after --turn-over-yield) and the hem's "
+                 "centre lies at least this many times its floor off the fitted drape's (localisation.feature_groups."
+                 "off_centre.ratio), name misalignment, from the hem's centre: a specimen laid off centre hangs "
+                 "longer on one side (report.json \"off_centre\"; within the floors too; not with --gap-only; "
+                 "default 0: off)");
   app.add_option("--states", o->states, "Initial states per evaluation (default 3; quick and fine 2)");
   app.add_option("--evaluations", o->evaluations,
                  "Baseline fit evaluations per simplex (default 40; quick and fine 20; a second one with --starts)");

@@ -108,7 +108,8 @@ def main(dirs):
             default, widened = verdict(report, False), verdict(report, True)
             total += 1
             as_run = widened if ran_widened else default
-            refits = (report.get("turn_over") or {}).get("refits_verdict", report["verdict"])  # before the turn-over
+            signature = report.get("turn_over") or report.get("off_centre") or {}  # rules U and E, where they named
+            refits = signature.get("refits_verdict", report["verdict"])
             reproduced += as_run == refits
             if as_run != refits:
                 print(f"MISMATCH {path}: run {refits}, recomputed {as_run}")

@@ -49,7 +49,7 @@ score. Hypotheses for the next evaluation, not the diagnosis's rule (docs/DIAGNO
   another tolerance; `--check-reattribute DIR...` checks that the run's own tolerance gives every verdict as run);
 - rise_yield (rule U, session 78, pre-registered for fresh seeds 103-104: docs/preregistrations/session79.md; adopted
   in session 79, `drapegen diagnose --turn-over-yield 0.02` in the --fine preset: on reports since, the verdict as
-  run, and on every rule's verdict where settings.turn_over_yield is set, `turn_over_applied`): "yield" where the
+  run, and on every rule's verdict where settings.turn_over_yield is set, `signatures_applied`): "yield" where the
   verdict as run names no effect (none or unexplained) and the first turn-over raised the drape coefficient by 0.02 or
   more (gap_tests.second_capture less gap_tests.capture, the second placement on the other face); elsewhere the
   verdict as run;
@@ -513,7 +513,7 @@ def verdicts(j):
     if not cands:
         v = {r: j["verdict"] for r in RULES}
         v.update({rule: f(j) for rule, f in REPORT_RULES.items()})
-        return turn_over_applied(j, v)
+        return signatures_applied(j, v)
     sf, shf = g["stable_floor_mm"], g["shape_floor"]
     within = j.get("within_floors_after_bending_refit", False)
     v = {"current": j["verdict"], "strict": confirmation_rule(j, 0.0), "tolerance": confirmation_rule(j, TOLERANCE),
@@ -573,29 +573,41 @@ def verdicts(j):
     for rule in ("without_ablation", "reach", "reach_objective"):
         v[rule] = reference_rule(j, rule)
     v.update({rule: f(j) for rule, f in REPORT_RULES.items()})
-    return turn_over_applied(j, v)
+    return signatures_applied(j, v)
 
 
 COLUMNS = ["none", "unexplained", "not attributed", "yield", "shear", "curl", "friction", "misalignment", "sensor"]
 
 
+SIGNATURES = ("turn_over", "off_centre")  # report.json's records of rules U and E, where they named the effect
+
+
 def refits_report(j):
-    """The report with the refits' verdict as its verdict where the turn-over named yield (`drapegen diagnose
-    --turn-over-yield`, rule U, report.json turn_over), the reported one kept as verdict_reported: the rules recompute
-    the refits' verdict, and verdicts() lays the turn-over on every rule's as the run did."""
-    if not j.get("turn_over"):
-        return j
-    return dict(j, verdict=j["turn_over"]["refits_verdict"], verdict_reported=j["verdict"])
+    """The report with the refits' verdict as its verdict where a signature named the effect (`drapegen diagnose
+    --turn-over-yield`, rule U, report.json turn_over; `--off-centre-misalignment`, rule E, off_centre), the reported
+    one kept as verdict_reported: the rules recompute the refits' verdict, and verdicts() lays the signatures on every
+    rule's as the run did."""
+    for key in SIGNATURES:
+        if j.get(key):
+            return dict(j, verdict=j[key]["refits_verdict"], verdict_reported=j["verdict"])
+    return j
 
 
-def turn_over_applied(j, v):
-    """Every rule's verdict with the run's turn-over (settings.turn_over_yield > 0) laid on it as diagnose() does:
-    yield where the rule names no effect and the first turn-over raised the drape coefficient by the run's floor."""
-    floor = (j.get("settings") or {}).get("turn_over_yield", 0.0)
+def signatures_applied(j, v):
+    """Every rule's verdict with the run's signatures laid on it as diagnose() does: the turn-over's
+    (settings.turn_over_yield > 0), yield where the rule names no effect and the first turn-over raised the drape
+    coefficient by the run's floor; then the hem's centre's (settings.off_centre_misalignment > 0), misalignment where
+    the rule still names no effect and the hem's centre offset reaches the run's ratio."""
+    settings = j.get("settings") or {}
+    floor = settings.get("turn_over_yield", 0.0)
     rise = turn_over_rise(j)
-    if floor <= 0.0 or rise is None or rise < floor:
-        return v
-    return {r: "yield" if x in ("none", "unexplained") else x for r, x in v.items()}
+    if floor > 0.0 and rise is not None and rise >= floor:
+        v = {r: "yield" if x in ("none", "unexplained") else x for r, x in v.items()}
+    ratio_floor = settings.get("off_centre_misalignment", 0.0)
+    ratio = off_centre_ratio(j)
+    if ratio_floor > 0.0 and ratio is not None and ratio >= ratio_floor:
+        v = {r: "misalignment" if x in ("none", "unexplained") else x for r, x in v.items()}
+    return v
 
 
 def reports(root, truth_root=None):

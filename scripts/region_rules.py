@@ -155,13 +155,15 @@ def folds_deeper_than_mean(loc, factor):
 
 def named_localisation(report):
     """The named candidate's refit localisation (None: nothing named, or a report without refit localisations); the
-    yield refit's where the turn-over named yield (report.json turn_over)."""
+    yield refit's where the turn-over named yield (report.json turn_over), the misalignment refit's where the hem's
+    centre named misalignment (off_centre)."""
     a = report.get("attribution") or {}
     if report["verdict"] in ("none", "unexplained", "not attributed") or not a.get("candidates"):
         return None
-    if report.get("turn_over"):
-        named = [c for c in a["candidates"] if c["effect"] == "yield"]
-        return named[0].get("localisation") if named else None
+    for key, effect in (("turn_over", "yield"), ("off_centre", "misalignment")):
+        if report.get(key):
+            named = [c for c in a["candidates"] if c["effect"] == effect]
+            return named[0].get("localisation") if named else None
     return a["candidates"][0].get("localisation")
 
 

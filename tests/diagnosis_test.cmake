@@ -1720,6 +1720,64 @@ expect_failure(1 "--turn-over-yield must be 0 (off) .. 1" diagnose --capture ${W
                ${WORK}/rise.p1 --turn-over-yield 1)
 expect_failure(1 "--turn-over-yield compares the turned placement" diagnose --capture ${WORK}/rise
                --held-out-capture ${WORK}/rise.p1 --turn-over-yield 0.02)
+# --off-centre-misalignment R (rule E): where the verdict names no effect (after the turn-over) and the hem's centre
+# lies at least R times its floor off the fitted drape's, the verdict is misalignment, from the hem's centre; the
+# refits stand as they ran. The fall order, where the turn-over names nothing; the yield candidate alone, so no
+# misalignment refit ran.
+run_ok(centred diagnose --capture ${stiffer} --second-capture ${lower} ${rise_args} --turn-over-yield 0.000001
+       --off-centre-misalignment 0.000001 --report ${WORK}/report_centred)
+string(JSON centred_verdict GET "${centred}" verdict)
+string(JSON centred_refits GET "${centred}" off_centre refits_verdict)
+string(JSON centred_turn_over ERROR_VARIABLE no_centred_turn_over GET "${centred}" turn_over)
+string(JSON centred_confidence TYPE "${centred}" confidence)
+json_number(centred_ratio "${centred}" off_centre ratio)
+json_number(centred_group "${centred}" localisation feature_groups off_centre ratio)
+json_number(centred_floor "${centred}" off_centre floor)
+json_number(centred_setting "${centred}" settings off_centre_misalignment)
+json_number(centred_shrinkage "${centred}" shrinkage)
+# The yield refit's shrinkage, where it ran: the reported one is the misalignment refit's, none here (0).
+string(JSON centred_refits_ran LENGTH "${centred}" attribution candidates)
+set(centred_yield_shrinkage "no refit")
+if(centred_refits_ran GREATER 0)
+  json_number(centred_yield_shrinkage "${centred}" attribution candidates 0 shrinkage)
+endif()
+if(NOT centred_verdict STREQUAL "misalignment" OR NOT centred_refits MATCHES "^(none|unexplained)$"
+   OR NOT no_centred_turn_over OR NOT centred_confidence STREQUAL "NULL" OR NOT centred_ratio EQUAL centred_group
+   OR NOT centred_ratio GREATER 0 OR NOT centred_floor EQUAL 0.000001 OR NOT centred_setting EQUAL 0.000001
+   OR NOT centred_shrinkage EQUAL 0)
+  message(FATAL_ERROR "--off-centre-misalignment 0.000001: verdict ${centred_verdict} (the refits' ${centred_refits}), "
+                      "turn_over '${centred_turn_over}', confidence ${centred_confidence}, ratio ${centred_ratio} "
+                      "(the localisation's ${centred_group}), floor ${centred_floor}, setting ${centred_setting}, "
+                      "shrinkage ${centred_shrinkage} (the yield refit's ${centred_yield_shrinkage})")
+endif()
+file(READ ${WORK}/report_centred/report.md centred_md)
+if(NOT centred_md MATCHES "Verdict: misalignment, from the hem's centre\\*\\*: the hem's centre lies [0-9.]+ times"
+   OR NOT centred_md MATCHES "no misalignment refit ran" OR NOT centred_md MATCHES "The refits' verdict: ")
+  message(FATAL_ERROR "--off-centre-misalignment: report.md does not say where the verdict comes from:\n${centred_md}")
+endif()
+# Below the ratio: nothing named. The turn-over first: where it names yield, the hem's centre names nothing. Not in a
+# screening run (settings.off_centre_misalignment 0 there).
+run_ok(uncentred diagnose --capture ${stiffer} --second-capture ${lower} ${rise_args}
+       --off-centre-misalignment 1000000)
+run_ok(both_signatures diagnose --capture ${lower} --second-capture ${stiffer} ${rise_args}
+       --turn-over-yield 0.000001 --off-centre-misalignment 0.000001)
+run_ok(screened_centre diagnose --capture ${stiffer} --second-capture ${lower} --quick --resolution 6 --states 1
+       --evaluations 2 --json --gap-only --off-centre-misalignment 0.000001)
+string(JSON uncentred_verdict GET "${uncentred}" verdict)
+string(JSON uncentred_off ERROR_VARIABLE no_uncentred_off GET "${uncentred}" off_centre)
+string(JSON both_verdict GET "${both_signatures}" verdict)
+string(JSON both_off ERROR_VARIABLE no_both_off GET "${both_signatures}" off_centre)
+string(JSON both_turn_over ERROR_VARIABLE no_both_turn_over GET "${both_signatures}" turn_over)
+string(JSON screened_off ERROR_VARIABLE no_screened_off GET "${screened_centre}" off_centre)
+json_number(screened_setting "${screened_centre}" settings off_centre_misalignment)
+if(NOT uncentred_verdict MATCHES "^(none|unexplained)$" OR NOT no_uncentred_off OR NOT both_verdict STREQUAL "yield"
+   OR no_both_turn_over OR NOT no_both_off OR NOT no_screened_off OR NOT screened_setting EQUAL 0)
+  message(FATAL_ERROR "--off-centre-misalignment: at 1000000 verdict ${uncentred_verdict}, off_centre "
+                      "'${uncentred_off}'; after the turn-over verdict ${both_verdict}, off_centre '${both_off}'; "
+                      "--gap-only off_centre '${screened_off}', setting ${screened_setting}")
+endif()
+expect_failure(1 "--off-centre-misalignment must be 0 (off) or more" diagnose --capture ${WORK}/rise
+               --off-centre-misalignment -1)
 expect_failure(1 "--confirm-placement-rise must be 0 (off) .. 1" diagnose --capture ${WORK}/rise --second-capture
                ${WORK}/rise.p1 --confirm-placement-rise -0.01)
 expect_failure(1 "give --second-capture" diagnose --capture ${WORK}/rise --held-out-capture ${WORK}/rise.p1

@@ -682,27 +682,52 @@ sim::Expected<DiagnosisResult> diagnose_confirming_placement(const Capture& capt
   return reported;
 }
 
+/// DiagnosisSettings::turn_over_yield (rule U): yield where the refits name no effect and the turned placement
+/// drapes at least budgets.turn_over_yield stiffer.
+void name_yield_from_turn_over(DiagnosisResult& r, const Capture& capture, const OtherPlacements& others) {
+  const double floor = r.budgets.turn_over_yield;
+  if (floor <= 0.0 || !names_no_effect(r) || !others.second) return;
+  const std::optional<double> rise = turn_over_rise(capture, others);
+  if (!rise) {
+    sim::logger()->info("diagnosis: the second capture lies on the capture's face: no turn-over to name yield by");
+    return;
+  }
+  if (!(*rise >= floor)) return;
+  sim::logger()->info("diagnosis: verdict {} but the turned placement drapes {:.4f} stiffer (drape coefficient, at "
+                      "least {:g}): yield, from the turn-over",
+                      r.verdict, *rise, floor);
+  r.turn_over = DiagnosisResult::TurnOverYield{*rise, floor, r.verdict};
+  r.verdict = "yield";
+  r.runner_up.clear();  // the refits ranked no yield first: nothing stands second to the turn-over
+}
+
+/// DiagnosisSettings::off_centre_misalignment (rule E): misalignment where no effect is named (after the turn-over)
+/// and the hem's centre lies at least budgets.off_centre_misalignment times its floor off the fitted drape's.
+void name_misalignment_from_off_centre(DiagnosisResult& r) {
+  const double floor = r.budgets.off_centre_misalignment;
+  constexpr auto kOffCentre = static_cast<std::size_t>(FeatureGroup::kOffCentre);
+  if (floor <= 0.0 || !names_no_effect(r) || r.localisation.group_ratio.size() <= kOffCentre) return;
+  const double ratio = r.localisation.group_ratio[kOffCentre];
+  if (!(ratio >= floor)) return;
+  sim::logger()->info("diagnosis: verdict {} but the hem's centre lies {:.2f} times its floor off the fitted drape's "
+                      "(at least {:g}): misalignment, from the hem's centre",
+                      r.verdict, ratio, floor);
+  r.off_centre = DiagnosisResult::OffCentreMisalignment{ratio, floor, r.verdict};
+  r.verdict = "misalignment";
+  r.runner_up.clear();  // the refits ranked no misalignment first: nothing stands second to the hem's centre
+}
+
 }  // namespace
 
 sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisSettings& settings,
                                         const OtherPlacements& others) {
   auto result = diagnose_confirming_placement(capture, settings, others);
-  const double floor = settings.attribute ? settings.turn_over_yield : 0.0;  // a screening run names no effect
   if (!result) return result;
-  result->budgets.turn_over_yield = floor;
-  if (floor <= 0.0 || !names_no_effect(*result) || !others.second) return result;
-  const std::optional<double> rise = turn_over_rise(capture, others);
-  if (!rise) {
-    sim::logger()->info("diagnosis: the second capture lies on the capture's face: no turn-over to name yield by");
-    return result;
-  }
-  if (!(*rise >= floor)) return result;
-  sim::logger()->info("diagnosis: verdict {} but the turned placement drapes {:.4f} stiffer (drape coefficient, at "
-                      "least {:g}): yield, from the turn-over",
-                      result->verdict, *rise, floor);
-  result->turn_over = DiagnosisResult::TurnOverYield{*rise, floor, result->verdict};
-  result->verdict = "yield";
-  result->runner_up.clear();  // the refits ranked no yield first: nothing stands second to the turn-over
+  // A screening run names no effect, so neither signature names one there.
+  result->budgets.turn_over_yield = settings.attribute ? settings.turn_over_yield : 0.0;
+  result->budgets.off_centre_misalignment = settings.attribute ? settings.off_centre_misalignment : 0.0;
+  name_yield_from_turn_over(*result, capture, others);
+  name_misalignment_from_off_centre(*result);
   return result;
 }
 
@@ -713,13 +738,14 @@ const CandidateResult* DiagnosisResult::refit(Effect effect) const {
 
 const CandidateResult* DiagnosisResult::named_refit() const {
   if (turn_over) return refit(Effect::kYield);
+  if (off_centre) return refit(Effect::kMisalignment);
   return attribution.named && !attribution.candidates.empty() ? &attribution.candidates.front() : nullptr;
 }
 
 double DiagnosisResult::named_shrinkage() const {
-  if (turn_over) {
-    const CandidateResult* yield = named_refit();
-    return yield ? yield->shrinkage : 0.0;
+  if (turn_over || off_centre) {
+    const CandidateResult* named = named_refit();
+    return named ? named->shrinkage : 0.0;
   }
   // Without a named effect, the best candidate's (an "unexplained" verdict's, below the bar).
   return attribution.candidates.empty() ? 0.0 : attribution.candidates.front().shrinkage;
@@ -734,7 +760,8 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
   j["placements"] = std::move(placements);
   j["verdict"] = r.verdict;
   j["runner_up"] = r.runner_up;
-  j["confidence"] = r.turn_over ? nlohmann::json(nullptr) : nlohmann::json(r.attribution.confidence);
+  j["confidence"] =
+      r.turn_over || r.off_centre ? nlohmann::json(nullptr) : nlohmann::json(r.attribution.confidence);
   j["within_floors"] = r.within_floors;
   j["within_floors_after_bending_refit"] = r.attribution.bending_within_floors();
   j["gap_mm"] = {
@@ -948,7 +975,8 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                    {"initial_states", r.budgets.initial_states},
                    {"max_baseline_evaluations", r.budgets.max_baseline_evaluations},
                    {"attribution", r.budgets.attribution},
-                   {"turn_over_yield", r.budgets.turn_over_yield}};
+                   {"turn_over_yield", r.budgets.turn_over_yield},
+                   {"off_centre_misalignment", r.budgets.off_centre_misalignment}};
   if (const auto& m = r.mesh_confirmation) {
     j["mesh_confirmation"] = {{"resolution", m->resolution},
                               {"gap_found", m->gap_found},
@@ -962,6 +990,9 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
   }
   if (const auto& t = r.turn_over) {
     j["turn_over"] = {{"rise", t->rise}, {"floor", t->floor}, {"refits_verdict", t->refits_verdict}};
+  }
+  if (const auto& o = r.off_centre) {
+    j["off_centre"] = {{"ratio", o->ratio}, {"floor", o->floor}, {"refits_verdict", o->refits_verdict}};
   }
   j["runtime"] = {{"seconds", r.seconds},
                   {"cpu_seconds", r.cpu_seconds},

@@ -219,16 +219,31 @@ std::string refits_markdown(const DiagnosisResult& r, std::string_view verdict, 
 
 std::string verdict_markdown(const DiagnosisResult& r) {
   std::string md;
+  // A signature of its own named the effect where the refits named none (rules U and E): what it read (an open
+  // parenthesis at its end, naming the option), the named effect's refit, then the refits' verdict.
+  const auto signature = [&r](std::string_view effect, const std::string& reading, std::string_view refits_verdict) {
+    const CandidateResult* refit = r.named_refit();
+    const std::string shrinks = refit ? fmt::format("the {} refit shrinks the excess by {:.0f}%", effect,
+                                                    100.0 * refit->shrinkage)
+                                      : fmt::format("no {} refit ran", effect);
+    return fmt::format("{}; {}). The refits alone named no effect:\n\n", reading, shrinks) +
+           refits_markdown(r, refits_verdict, "The refits' verdict");
+  };
   if (const auto& t = r.turn_over) {
-    const CandidateResult* yield = r.named_refit();
-    md += fmt::format("**Verdict: yield, from the turn-over**: the second capture, laid on the specimen's other face, "
-                      "drapes {:.4f} stiffer than the capture (drape coefficient; at least {:g}), as the plastic set "
-                      "of a drape makes a specimen drape stiffer turned over and an elastic specimen does not "
-                      "(`--turn-over-yield`; {}). The refits alone named no effect:\n\n",
-                      t->rise, t->floor,
-                      yield ? fmt::format("the yield refit shrinks the excess by {:.0f}%", 100.0 * yield->shrinkage)
-                            : std::string("no yield refit ran"));
-    md += refits_markdown(r, t->refits_verdict, "The refits' verdict");
+    const std::string reading = fmt::format(
+        "**Verdict: yield, from the turn-over**: the second capture, laid on the specimen's other face, drapes {:.4f} "
+        "stiffer than the capture (drape coefficient; at least {:g}), as the plastic set of a drape makes a specimen "
+        "drape stiffer turned over and an elastic specimen does not (`--turn-over-yield`",
+        t->rise, t->floor);
+    md += signature("yield", reading, t->refits_verdict);
+  } else if (const auto& o = r.off_centre) {
+    const std::string reading = fmt::format(
+        "**Verdict: misalignment, from the hem's centre**: the hem's centre lies {:.2f} times its floor off the fitted "
+        "drape's (the order-1 harmonic of the hem's radius and height; at least {:g}), as a specimen laid off centre "
+        "hangs longer on one side and an elastic fabric's drape on a centred specimen does not "
+        "(`--off-centre-misalignment`",
+        o->ratio, o->floor);
+    md += signature("misalignment", reading, o->refits_verdict);
   } else {
     md += refits_markdown(r, r.verdict);
   }

@@ -136,6 +136,40 @@ TEST(VerdictMarkdown, YieldFromTheTurnOverSaysSoAndKeepsTheRefitsVerdict) {
   EXPECT_EQ(r.named_refit()->effect, Effect::kShear);
 }
 
+TEST(VerdictMarkdown, MisalignmentFromTheHemCentreSaysSoAndKeepsTheRefitsVerdict) {
+  // The refits named no effect (curl first, unconfirmed); the hem's centre lies 3.49 times its floor off the fitted
+  // drape's: misalignment, with the misalignment refit's shrinkage, not the first candidate's.
+  DiagnosisResult r;
+  r.verdict = "misalignment";
+  r.off_centre = DiagnosisResult::OffCentreMisalignment{3.49, 2.5, "none"};
+  for (auto [effect, shrinkage] : {std::pair{Effect::kCurl, 0.5}, std::pair{Effect::kMisalignment, 0.2}}) {
+    r.attribution.candidates.emplace_back();
+    r.attribution.candidates.back().effect = effect;
+    r.attribution.candidates.back().shrinkage = shrinkage;
+  }
+  EXPECT_DOUBLE_EQ(r.named_shrinkage(), 0.2);
+  ASSERT_NE(r.named_refit(), nullptr);
+  EXPECT_EQ(r.named_refit()->effect, Effect::kMisalignment);
+  const std::string md = verdict_markdown(r);
+  EXPECT_TRUE(contains(md, "**Verdict: misalignment, from the hem's centre**: the hem's centre lies 3.49 times its "
+                           "floor off the fitted drape's (the order-1 harmonic of the hem's radius and height; at "
+                           "least 2.5)"))
+      << md;
+  EXPECT_TRUE(contains(md, "the misalignment refit shrinks the excess by 20%")) << md;
+  EXPECT_TRUE(contains(md, "**The refits' verdict: ")) << md;
+  EXPECT_FALSE(contains(md, kCaveat)) << md;
+
+  // Within the floors at the gate: no refit ran.
+  DiagnosisResult gate;
+  gate.verdict = "misalignment";
+  gate.off_centre = DiagnosisResult::OffCentreMisalignment{2.7, 2.5, "none"};
+  EXPECT_DOUBLE_EQ(gate.named_shrinkage(), 0.0);
+  EXPECT_EQ(gate.named_refit(), nullptr);
+  const std::string within = verdict_markdown(gate);
+  EXPECT_TRUE(contains(within, "no misalignment refit ran")) << within;
+  EXPECT_TRUE(contains(within, "**The refits' verdict: the gap is within the floors**")) << within;
+}
+
 TEST(RuntimeMarkdown, CountsEveryDiagnosisTheRuntimeHolds) {
   // With --confirm-resolution and --confirm-placement-rise both on, the reported diagnosis holds the one without the
   // placement test, and each of the two may hold its other mesh's: up to four diagnoses' runtime together.

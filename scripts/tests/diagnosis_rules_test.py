@@ -88,6 +88,23 @@ class TurnOverRules(unittest.TestCase):
         self.assertEqual(rules.verdicts(off("none", 3.0, c1=0.23, floor=0.02))["off_centre"], "yield")
         self.assertEqual(rules.off_centre_misalignment(off("none", 3.0, c1=0.23)), "misalignment")
 
+    def test_a_run_with_rule_e_is_read_as_its_refits_then_the_hem_centre(self):
+        # drapegen diagnose --off-centre-misalignment 2.5 named misalignment where the refits named none: every rule
+        # starts from the refits' verdict and gets the hem's centre laid on it, reproducing the verdict as run.
+        j = report("misalignment", 0.20, 0.20, c2=0.20)
+        j["settings"]["off_centre_misalignment"] = 2.5
+        j["localisation"] = {"feature_groups": {"off_centre": {"ratio": 3.0}}}
+        j["off_centre"] = {"ratio": 3.0, "floor": 2.5, "refits_verdict": "none"}
+        run = rules.refits_report(j)
+        self.assertEqual(run["verdict"], "none")
+        self.assertEqual(run["verdict_reported"], "misalignment")
+        v = rules.verdicts(run)
+        self.assertTrue(all(x == "misalignment" for x in v.values()), v)
+        # The turn-over first: where the run's rule U names yield, the hem's centre finds no verdict without an effect.
+        j["gap_tests"]["second_capture"]["drape_coefficient"] = 0.23
+        j["settings"]["turn_over_yield"] = 0.02
+        self.assertEqual(rules.verdicts(rules.refits_report(j))["current"], "yield")
+
     def test_a_run_with_rule_u_is_read_as_its_refits_then_the_turn_over(self):
         # The run named yield from the turn-over: every rule starts from the refits' verdict and gets the turn-over
         # laid on it, so the verdict as run is reproduced.

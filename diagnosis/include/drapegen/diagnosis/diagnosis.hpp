@@ -88,6 +88,14 @@ struct DiagnosisSettings {
   /// docs/preregistrations/session79.md). Within the floors too, where no refit ran; not with attribute false (a
   /// screening run names no effect). The refits stand as they ran. 0: off (the --fine preset: kFineTurnOverYield).
   double turn_over_yield = 0.0;
+  /// Where the verdict (after turn_over_yield) names no effect ("none" or "unexplained") and the hem's centre lies at
+  /// least this many times its floor off the fitted drape's (the off-centre feature group's ratio,
+  /// Localisation::group_ratio, FeatureGroup::kOffCentre: the order-1 harmonic of the hem's radius and height), name
+  /// misalignment (DiagnosisResult::off_centre): a specimen laid off centre hangs longer on one side, which no elastic
+  /// fabric's drape on a centred specimen does (rule E, docs/preregistrations/session82.md: on seeds 101-108 the ratio
+  /// reached 2.5 on 14 of 16 misalignments and on none of 36 controls, at most 1.77). Within the floors too, where no
+  /// refit ran; not with attribute false. The refits stand as they ran. 0: off.
+  double off_centre_misalignment = 0.0;
 
   /// Small budgets for tests and the --quick benchmark.
   [[nodiscard]] static DiagnosisSettings quick();
@@ -117,6 +125,7 @@ struct DiagnosisResult {
     int max_baseline_evaluations = 0;  // per simplex of the baseline fit
     bool attribution = true;           // false: gap, floors and localisation only
     double turn_over_yield = 0.0;      // DiagnosisSettings::turn_over_yield where it could name yield (0: off)
+    double off_centre_misalignment = 0.0;  // DiagnosisSettings::off_centre_misalignment where it could (0: off)
   } budgets;
   /// Each capture it read (report.json "placements"): its directory and the face the specimen lay on (a turned
   /// specimen's rest shape, a curl or a yield's creases, bends the other way face down).
@@ -181,9 +190,10 @@ struct DiagnosisResult {
   double refit_scale_lower = 0.0, refit_scale_upper = 0.0;
   /// The verdict: the named effect ("none" within the floors, "unexplained" if no candidate shrinks it enough,
   /// "not attributed" above the floors when DiagnosisSettings::attribute is false; "yield" from the turn-over where
-  /// turn_over is set, whatever the refits named).
+  /// turn_over is set, "misalignment" from the hem's centre where off_centre is set, whatever the refits named).
   std::string verdict;
-  /// Second to the named effect (with "unexplained", the best candidate); empty where the turn-over named yield.
+  /// Second to the named effect (with "unexplained", the best candidate); empty where the turn-over or the hem's
+  /// centre named the effect.
   std::string runner_up;
   int simulations = 0;
   double seconds = 0.0;
@@ -221,13 +231,22 @@ struct DiagnosisResult {
     std::string refits_verdict;  // "none" or "unexplained"
   };
   std::optional<TurnOverYield> turn_over;
+  /// With DiagnosisSettings::off_centre_misalignment where it fired: the verdict is "misalignment" from the hem's
+  /// centre, not from the refits, whose verdict was `refits_verdict` (the attribution above stands as it ran).
+  struct OffCentreMisalignment {
+    double ratio = 0.0;          // the off-centre feature group's difference over its floor
+    double floor = 0.0;          // DiagnosisSettings::off_centre_misalignment
+    std::string refits_verdict;  // "none" or "unexplained"
+  };
+  std::optional<OffCentreMisalignment> off_centre;
   /// The candidate refit of `effect` (attribution.candidates), null where none ran.
   [[nodiscard]] const CandidateResult* refit(Effect effect) const;
   /// The named effect's refit: the first candidate where the attribution named it, the yield refit where the
-  /// turn-over named yield; null where no effect is named or its refit did not run.
+  /// turn-over named yield, the misalignment refit where the hem's centre named misalignment; null where no effect is
+  /// named or its refit did not run.
   [[nodiscard]] const CandidateResult* named_refit() const;
   /// How much adding the named effect shrinks the gap's excess above the floors (report.json "shrinkage"): the first
-  /// candidate's; with turn_over, the yield refit's; 0 where no such refit ran.
+  /// candidate's; with turn_over or off_centre, the named effect's refit's; 0 where no such refit ran.
   [[nodiscard]] double named_shrinkage() const;
 };
 
