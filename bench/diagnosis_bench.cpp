@@ -514,13 +514,16 @@ int main(int argc, char** argv) {
       continue;
     }
     const std::string verdict = d.value("verdict", "?");
-    // The refits' own verdict where a signature named the effect (drapegen diagnose --turn-over-yield: "turn_over";
-    // --off-centre-misalignment: "off_centre"): whether the gap was found above the floors is theirs.
+    // The refits' own verdict where a signature set the verdict (drapegen diagnose --turn-over-yield: "turn_over";
+    // --turn-over-alternation: "alternation"; --off-centre-misalignment: "off_centre", in the order diagnose() lays
+    // them): the first one's refits_verdict; whether the gap was found above the floors is theirs. The label is the
+    // last one's, which set the verdict.
     std::string signature, refits_verdict = verdict;
-    for (const auto& [key, label] : {std::pair{"turn_over", "turn-over"}, std::pair{"off_centre", "hem centre"}}) {
+    for (const auto& [key, label] : {std::pair{"turn_over", "turn-over"}, std::pair{"alternation", "alternation"},
+                                     std::pair{"off_centre", "hem centre"}}) {
       if (!d.contains(key) || !d[key].is_object()) continue;
+      if (signature.empty()) refits_verdict = d[key].value("refits_verdict", "?");
       signature = label;
-      refits_verdict = d[key].value("refits_verdict", "?");
     }
     const std::string family = t.value("family", "none");
     nlohmann::json screened = nullptr;  // the kept draw passed the screen (visible, settled), if it was screened

@@ -42,6 +42,7 @@ struct DiagnoseOptions {
   int confirm_resolution = 0;
   double confirm_placement_rise = 0.0;
   std::optional<double> turn_over_yield;
+  std::optional<double> turn_over_alternation;
   std::optional<double> off_centre_misalignment;
   std::optional<int> states;
   std::optional<int> evaluations;
@@ -142,6 +143,13 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (o.turn_over_yield.value_or(0.0) > 0.0 && o.second.empty()) {
     return fail("--turn-over-yield compares the turned placement with the capture: give --second-capture");
   }
+  if (o.turn_over_alternation && !(*o.turn_over_alternation >= 0.0 && *o.turn_over_alternation < 1.0)) {
+    return fail("--turn-over-alternation must be 0 (off) .. 1 (a drape-coefficient difference)");
+  }
+  if (o.turn_over_alternation.value_or(0.0) > 0.0 && (o.second.empty() || o.held_out.empty())) {
+    return fail("--turn-over-alternation compares the turned placement with the two on the capture's face: give "
+                "--second-capture and --held-out-capture");
+  }
   if (o.off_centre_misalignment && !(*o.off_centre_misalignment >= 0.0)) {
     return fail("--off-centre-misalignment must be 0 (off) or more (a ratio to the off-centre floor)");
   }
@@ -220,6 +228,7 @@ int run_diagnose(const DiagnoseOptions& o) {
   settings.confirm_resolution = o.confirm_resolution;
   settings.confirm_placement_rise = o.confirm_placement_rise;
   if (o.turn_over_yield) settings.turn_over_yield = *o.turn_over_yield;
+  if (o.turn_over_alternation) settings.turn_over_alternation = *o.turn_over_alternation;
   if (o.off_centre_misalignment) settings.off_centre_misalignment = *o.off_centre_misalignment;
   if (o.states) settings.fit.initial_states = *o.states;
   if (o.evaluations) settings.baseline_optimiser.max_evaluations = *o.evaluations;
@@ -355,21 +364,28 @@ int run_diagnose(const DiagnoseOptions& o) {
                                "here\n",
                                p->other->verdict, p->rise, p->floor);
     }
+    // A signature of its own set the verdict (rules U, A and E): what it read, the refits' verdict, the named refit.
+    const auto named_by = [&r](std::string_view effect, const std::string& reading) {
+      const diagnosis::CandidateResult* refit = r.named_refit();
+      std::cout << fmt::format("  verdict: {}, {}; the refits' verdict {}; {}\n", effect, reading, r.refits_verdict(),
+                               refit ? fmt::format("the {} refit's shrinkage {:.0f}%", effect, 100 * refit->shrinkage)
+                                     : fmt::format("no {} refit ran", effect));
+    };
     if (const auto& t = r.turn_over) {
-      const diagnosis::CandidateResult* yield = r.named_refit();
-      std::cout << fmt::format("  verdict: yield, from the turn-over: the turned placement drapes {:.4f} stiffer (at "
-                               "least {:g}); the refits' verdict {}; {}\n",
-                               t->rise, t->floor, t->refits_verdict,
-                               yield ? fmt::format("the yield refit's shrinkage {:.0f}%", 100 * yield->shrinkage)
-                                     : std::string("no yield refit ran"));
+      named_by("yield", fmt::format("from the turn-over: the turned placement drapes {:.4f} stiffer (at least {:g})",
+                                    t->rise, t->floor));
     } else if (const auto& c = r.off_centre) {
-      const diagnosis::CandidateResult* misalignment = r.named_refit();
-      std::cout << fmt::format("  verdict: misalignment, from the hem's centre: {:.2f} times its floor off the fitted "
-                               "drape's (at least {:g}); the refits' verdict {}; {}\n",
-                               c->ratio, c->floor, c->refits_verdict,
-                               misalignment ? fmt::format("the misalignment refit's shrinkage {:.0f}%",
-                                                          100 * misalignment->shrinkage)
-                                            : std::string("no misalignment refit ran"));
+      named_by("misalignment", fmt::format("from the hem's centre: {:.2f} times its floor off the fitted drape's (at "
+                                           "least {:g})",
+                                           c->ratio, c->floor));
+    } else if (const auto& a = r.alternation; a && !a->withdrew()) {
+      named_by("yield", fmt::format("from the turn-over's alternation: the turned placement drapes {:.4f} stiffer than "
+                                    "the mean of the others (at least {:g})",
+                                    a->alternation, a->floor));
+    } else if (a) {
+      std::cout << fmt::format("  verdict: unexplained, the refits' yield withdrawn: the turned placement drapes {:.4f} "
+                               "against the mean of the others (under {:g})\n",
+                               a->alternation, a->floor);
     } else if (r.verdict == "none") {
       std::cout << fmt::format("  verdict: within the floors{} (no effect named)\n",
                                r.attribution.bending_within_floors() ? " once the bending is refitted" : "");
@@ -412,10 +428,12 @@ Runner add_diagnose_command(CLI::App& app) {
   app.add_flag("--json", o->json, "Print the result as JSON");
   auto* quick = app.add_flag("--quick", o->quick, "Small budgets (16x16 mesh, 2 initial states, fewer evaluations)");
   app.add_flag("--fine", o->fine,
-               fmt::format("--quick's budgets on a {0}x{0} fitting mesh, with the shape floor calibrated for it, and "
-                           "--turn-over-yield {1:g}",
+               fmt::format("--quick's budgets on a {0}x{0} fitting mesh, with the shape floor calibrated for it, "
+                           "--turn-over-yield {1:g}, --turn-over-alternation {2:g} and --off-centre-misalignment {3:g}",
                            diagnosis::DiagnosisSettings::kFineResolution,
-                           diagnosis::DiagnosisSettings::kFineTurnOverYield))
+                           diagnosis::DiagnosisSettings::kFineTurnOverYield,
+                           diagnosis::DiagnosisSettings::kFineTurnOverAlternation,
+                           diagnosis::DiagnosisSettings::kFineOffCentreMisalignment))
       ->excludes(quick);
   app.add_option("--resolution", o->resolution,
                  "Fitting mesh vertices per side (default 20; quick 16; fine " +
@@ -439,12 +457,21 @@ Runner add_diagnose_command(CLI::App& app) {
                  "specimen has no face (report.json \"turn_over\"; within the floors too; not with --gap-only; needs "
                  "--second-capture; default 0: off; --fine " +
                      fmt::format("{:g}", diagnosis::DiagnosisSettings::kFineTurnOverYield) + ")");
+  app.add_option("--turn-over-alternation", o->turn_over_alternation,
+                 "After --turn-over-yield, weigh yield by the turn-over's alternation (A: the turned second capture's "
+                 "drape coefficient less the mean of the capture's and the held-out capture's, laid on the capture's "
+                 "face): where the verdict names no effect and A is at least this, name yield; where the refits named "
+                 "yield and A is below this (and the turn-over alone names no yield), unexplained (report.json "
+                 "\"alternation\"; within the floors too; not with --gap-only; needs --second-capture and "
+                 "--held-out-capture; default 0: off; --fine " +
+                     fmt::format("{:g}", diagnosis::DiagnosisSettings::kFineTurnOverAlternation) + ")");
   app.add_option("--off-centre-misalignment", o->off_centre_misalignment,
-                 "Where the verdict names no effect (none or unexplained; after --turn-over-yield) and the hem's "
-                 "centre lies at least this many times its floor off the fitted drape's (localisation.feature_groups."
-                 "off_centre.ratio), name misalignment, from the hem's centre: a specimen laid off centre hangs "
-                 "longer on one side (report.json \"off_centre\"; within the floors too; not with --gap-only; "
-                 "default 0: off)");
+                 "Where the verdict names no effect (none or unexplained; after --turn-over-alternation) and the "
+                 "hem's centre lies at least this many times its floor off the fitted drape's (localisation."
+                 "feature_groups.off_centre.ratio), name misalignment, from the hem's centre: a specimen laid off "
+                 "centre hangs longer on one side (report.json \"off_centre\"; within the floors too; not with "
+                 "--gap-only; default 0: off; --fine " +
+                     fmt::format("{:g}", diagnosis::DiagnosisSettings::kFineOffCentreMisalignment) + ")");
   app.add_option("--states", o->states, "Initial states per evaluation (default 3; quick and fine 2)");
   app.add_option("--evaluations", o->evaluations,
                  "Baseline fit evaluations per simplex (default 40; quick and fine 20; a second one with --starts)");

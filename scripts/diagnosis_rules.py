@@ -60,10 +60,14 @@ score. Hypotheses for the next evaluation, not the diagnosis's rule (docs/DIAGNO
 - yield_needs_rise (rule K, session 80, pre-registered for fresh seeds 107-108: docs/preregistrations/session81.md):
   "unexplained" where the verdict as run is yield and the first turn-over raised the drape coefficient by less than
   0.02; elsewhere the verdict as run;
-- alternation_yield (rule A, a candidate for session 82): rule U and rule K on the turn-over's alternation, the
-  turned second capture's drape coefficient less the mean of the first and the third's, at 0.015;
-- off_centre (rule E, a candidate for session 82): "misalignment" where the verdict names no effect, the
-  run's rule U names no yield, and the hem's centre offset is 2.5 times its floor or more; else the verdict as run;
+- alternation_yield (rule A, registered in session 81 for seeds 109-110: docs/preregistrations/session82.md; adopted
+  in session 82, `drapegen diagnose --turn-over-alternation 0.015` in the --fine preset: on reports since, the verdict
+  as run, and on every rule's verdict where settings.turn_over_alternation is set, `signatures_applied`): rule U and
+  rule K on the turn-over's alternation, the turned second capture's drape coefficient less the mean of the first and
+  the third's, at 0.015;
+- off_centre (rule E, registered in session 81 for seeds 109-110; adopted in session 82, `--off-centre-misalignment
+  2.5` in the --fine preset): "misalignment" where the verdict names no effect, the run's rule U names no yield, and
+  the hem's centre offset is 2.5 times its floor or more; else the verdict as run;
 - min_objective: the candidate whose refit objective (in-sample: the capture and the second capture) is the smallest;
   it ignores the held-out data, which the issue's attribution must use: a diagnostic of the refits, not a rule.
 
@@ -449,19 +453,21 @@ def yield_needs_rise(j):
     return yield_unless_risen(j, turn_over_rise(j), RISE)
 
 
-ALTERNATION = 0.015  # rule A's floor (a candidate for session 82)
+ALTERNATION = 0.015  # rule A's floor (adopted in session 82: --turn-over-alternation in the --fine preset)
 
 
 def turn_over_alternation(report):
     """The turned second capture's drape coefficient less the mean of the first and the third (both laid face up):
     the set a plastic fabric takes on one face stiffens the drape on the other and relaxes on the first again, while
     an elastic fabric's three drapes differ by the noise; None where the second capture is not turned or a placement
-    lacks its drape coefficient."""
+    lacks its drape coefficient or the third lies on the other face (drapegen diagnose --turn-over-alternation reads
+    the same)."""
     rise = turn_over_rise(report)
     g = report.get("gap_tests") or {}
     c2 = (g.get("held_out_capture") or {}).get("drape_coefficient")
     c0 = (g.get("capture") or {}).get("drape_coefficient")
-    if rise is None or c2 is None:
+    faces = {p["role"]: p["face"] for p in report.get("placements", [])}
+    if rise is None or c2 is None or faces.get("held_out_capture") != faces.get("capture"):
         return None
     return rise - (c2 - c0) / 2.0
 
@@ -473,6 +479,14 @@ def alternation_yield(j):
     if j["verdict"] == "yield":
         return yield_unless_risen(j, alt, ALTERNATION)
     return yield_where_risen(j, alt, ALTERNATION)
+
+
+def run_turn_over_names(j):
+    """Whether the run's rule U (settings.turn_over_yield > 0) names yield wherever a verdict names no effect: the
+    first turn-over raised the drape coefficient by its floor or more."""
+    floor = (j.get("settings") or {}).get("turn_over_yield", 0.0)
+    rise = turn_over_rise(j)
+    return floor > 0.0 and rise is not None and rise >= floor
 
 
 OFF_CENTRE = 2.5  # rule E's ratio of the hem's centre offset to its floor (a candidate for session 82)
@@ -490,9 +504,7 @@ def off_centre_misalignment(j):
     the run's rule U does not name yield, and the hem's centre lies OFF_CENTRE times its floor or more off the model's:
     a specimen laid off centre hangs longer on one side, which no elastic fabric's drape on a centred specimen does
     (the 24 controls of seeds 101-106 reached 1.77; 10 of their 12 misalignments 2.5 or more); else the verdict."""
-    floor = (j.get("settings") or {}).get("turn_over_yield", 0.0)
-    rise = turn_over_rise(j)
-    if floor > 0.0 and rise is not None and rise >= floor:
+    if run_turn_over_names(j):
         return j["verdict"]
     ratio = off_centre_ratio(j)
     fires = j["verdict"] in ("none", "unexplained") and ratio is not None and ratio >= OFF_CENTRE
@@ -579,14 +591,16 @@ def verdicts(j):
 COLUMNS = ["none", "unexplained", "not attributed", "yield", "shear", "curl", "friction", "misalignment", "sensor"]
 
 
-SIGNATURES = ("turn_over", "off_centre")  # report.json's records of rules U and E, where they named the effect
+# report.json's records of rules U, A and E where they set the verdict, in the order diagnose() lays them.
+SIGNATURES = ("turn_over", "alternation", "off_centre")
 
 
 def refits_report(j):
-    """The report with the refits' verdict as its verdict where a signature named the effect (`drapegen diagnose
-    --turn-over-yield`, rule U, report.json turn_over; `--off-centre-misalignment`, rule E, off_centre), the reported
-    one kept as verdict_reported: the rules recompute the refits' verdict, and verdicts() lays the signatures on every
-    rule's as the run did."""
+    """The report with the refits' verdict as its verdict where a signature set the verdict (`drapegen diagnose
+    --turn-over-yield`, rule U, report.json turn_over; `--turn-over-alternation`, rule A, alternation;
+    `--off-centre-misalignment`, rule E, off_centre: the first one's refits_verdict), the reported one kept as
+    verdict_reported: the rules recompute the refits' verdict, and verdicts() lays the signatures on every rule's as
+    the run did."""
     for key in SIGNATURES:
         if j.get(key):
             return dict(j, verdict=j[key]["refits_verdict"], verdict_reported=j["verdict"])
@@ -596,13 +610,21 @@ def refits_report(j):
 def signatures_applied(j, v):
     """Every rule's verdict with the run's signatures laid on it as diagnose() does: the turn-over's
     (settings.turn_over_yield > 0), yield where the rule names no effect and the first turn-over raised the drape
-    coefficient by the run's floor; then the hem's centre's (settings.off_centre_misalignment > 0), misalignment where
-    the rule still names no effect and the hem's centre offset reaches the run's ratio."""
+    coefficient by the run's floor; then the alternation's (settings.turn_over_alternation > 0), yield where the rule
+    names no effect and the alternation reaches the run's floor, unexplained where the rule names yield, the
+    alternation is below it and the turn-over named nothing; then the hem's centre's (settings.off_centre_misalignment
+    > 0), misalignment where the rule still names no effect and the hem's centre offset reaches the run's ratio."""
     settings = j.get("settings") or {}
-    floor = settings.get("turn_over_yield", 0.0)
-    rise = turn_over_rise(j)
-    if floor > 0.0 and rise is not None and rise >= floor:
+    turned = run_turn_over_names(j)
+    if turned:
         v = {r: "yield" if x in ("none", "unexplained") else x for r, x in v.items()}
+    alternation_floor = settings.get("turn_over_alternation", 0.0)
+    alternation = turn_over_alternation(j)
+    if alternation_floor > 0.0 and alternation is not None:
+        if alternation >= alternation_floor:
+            v = {r: "yield" if x in ("none", "unexplained") else x for r, x in v.items()}
+        elif not turned:
+            v = {r: "unexplained" if x == "yield" else x for r, x in v.items()}
     ratio_floor = settings.get("off_centre_misalignment", 0.0)
     ratio = off_centre_ratio(j)
     if ratio_floor > 0.0 and ratio is not None and ratio >= ratio_floor:

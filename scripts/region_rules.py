@@ -155,15 +155,14 @@ def folds_deeper_than_mean(loc, factor):
 
 def named_localisation(report):
     """The named candidate's refit localisation (None: nothing named, or a report without refit localisations); the
-    yield refit's where the turn-over named yield (report.json turn_over), the misalignment refit's where the hem's
-    centre named misalignment (off_centre)."""
+    refit of the effect a signature named where one set the verdict (report.json turn_over or alternation: yield;
+    off_centre: misalignment)."""
     a = report.get("attribution") or {}
     if report["verdict"] in ("none", "unexplained", "not attributed") or not a.get("candidates"):
         return None
-    for key, effect in (("turn_over", "yield"), ("off_centre", "misalignment")):
-        if report.get(key):
-            named = [c for c in a["candidates"] if c["effect"] == effect]
-            return named[0].get("localisation") if named else None
+    if any(report.get(key) for key in ("turn_over", "alternation", "off_centre")):
+        named = [c for c in a["candidates"] if c["effect"] == report["verdict"]]
+        return named[0].get("localisation") if named else None
     return a["candidates"][0].get("localisation")
 
 

@@ -1778,6 +1778,131 @@ if(NOT uncentred_verdict MATCHES "^(none|unexplained)$" OR NOT no_uncentred_off 
 endif()
 expect_failure(1 "--off-centre-misalignment must be 0 (off) or more" diagnose --capture ${WORK}/rise
                --off-centre-misalignment -1)
+# --turn-over-alternation F (rule A): after the turn-over, yield where the verdict names no effect and the turned
+# second capture drapes at least F stiffer than the mean of the capture and the held-out capture (on the capture's
+# face); the refits' yield withdrawn (unexplained) where it drapes less. Four orders of four placements (faces up,
+# down, up, down), each with its alternation: the floor just past it on the side that changes the verdict (the refits'
+# without the option), and on the other side, where nothing changes.
+foreach(p 2 3)
+  run_ok(out reality ${FABRIC} --resolution 14 --seed 5 --turn-over --placement ${p} --out ${WORK}/rise.p${p})
+  file(REMOVE ${WORK}/rise.p${p}/truth.json)
+endforeach()
+set(alternation_named 0)
+set(alternation_withdrawn 0)
+foreach(order "rise.p2;rise.p3;rise" "rise.p2;rise.p1;rise" "rise;rise.p1;rise.p2" "rise;rise.p3;rise.p2")
+  list(TRANSFORM order PREPEND ${WORK}/)
+  list(GET order 0 first)
+  list(GET order 1 second)
+  list(GET order 2 third)
+  set(three --capture ${first} --second-capture ${second} --held-out-capture ${third})
+  run_ok(plain diagnose ${three} ${rise_args})
+  string(JSON plain_verdict GET "${plain}" verdict)
+  set(roles capture second_capture held_out_capture)
+  foreach(i 0 1 2)
+    list(GET roles ${i} role)
+    json_number(c${i} "${plain}" gap_tests ${role} drape_coefficient)
+    json_nano(c${i}_n "${c${i}}")
+  endforeach()
+  math(EXPR alt_n "${c1_n} - (${c0_n} + ${c2_n}) / 2")
+  math(EXPR rise_n "${c1_n} - ${c0_n}")
+  if(plain_verdict STREQUAL "yield")
+    set(expected unexplained)
+    math(EXPR change_n "${alt_n} + 1000")
+    math(EXPR keep_n "${alt_n} - 1000")
+    math(EXPR alternation_withdrawn "${alternation_withdrawn} + 1")
+  elseif(plain_verdict MATCHES "^(none|unexplained)$" AND alt_n GREATER 2000)
+    set(expected yield)
+    math(EXPR change_n "${alt_n} - 1000")
+    math(EXPR keep_n "${alt_n} + 1000")
+    math(EXPR alternation_named "${alternation_named} + 1")
+  else()
+    continue()  # no rise to name yield by
+  endif()
+  if(change_n LESS 1000)
+    set(change_n 1000)
+  endif()
+  nano_decimal(change "${change_n}")
+  run_ok(changed diagnose ${three} ${rise_args} --turn-over-alternation ${change} --report ${WORK}/report_alt)
+  string(JSON changed_verdict GET "${changed}" verdict)
+  string(JSON changed_refits GET "${changed}" alternation refits_verdict)
+  string(JSON changed_confidence TYPE "${changed}" confidence)
+  json_number(changed_alt "${changed}" alternation alternation)
+  json_number(changed_floor "${changed}" alternation floor)
+  json_number(changed_setting "${changed}" settings turn_over_alternation)
+  json_nano(changed_alt_n "${changed_alt}")
+  json_nano(changed_floor_n "${changed_floor}")
+  math(EXPR alt_off "${changed_alt_n} - ${alt_n}")
+  math(EXPR floor_off "${changed_floor_n} - ${change_n}")  # json_nano truncates the floor's binary value
+  file(READ ${WORK}/report_alt/report.md alt_md)
+  if(expected STREQUAL "yield")
+    set(says "Verdict: yield, from the turn-over's alternation\\*\\*: the second capture, laid on the specimen's other")
+  else()
+    set(says "Verdict: unexplained, a yield without its turn-over\\*\\*: the refits named yield, but the turned")
+  endif()
+  if(NOT changed_verdict STREQUAL expected OR NOT changed_refits STREQUAL plain_verdict
+     OR NOT changed_confidence STREQUAL "NULL" OR alt_off GREATER 4 OR alt_off LESS -4
+     OR floor_off GREATER 2 OR floor_off LESS -2 OR NOT changed_setting EQUAL changed_floor
+     OR NOT alt_md MATCHES "${says}"
+     OR NOT alt_md MATCHES "The refits' verdict: "
+     OR (expected STREQUAL "unexplained" AND EXISTS ${WORK}/report_alt/residual_after.png))
+    message(FATAL_ERROR "--turn-over-alternation ${change} on ${order} (the placements' drape coefficients ${c0}, "
+                        "${c1}, ${c2}): verdict ${changed_verdict} (the refits' ${changed_refits}, without the option "
+                        "${plain_verdict}), confidence ${changed_confidence}, alternation ${changed_alt}, floor "
+                        "${changed_floor}, setting ${changed_setting}; report.md:\n${alt_md}")
+  endif()
+  file(REMOVE_RECURSE ${WORK}/report_alt)
+  # The floor on the other side of the alternation: the verdict as without the option, no record.
+  if(keep_n GREATER 0)
+    nano_decimal(keep "${keep_n}")
+    run_ok(kept diagnose ${three} ${rise_args} --turn-over-alternation ${keep})
+    string(JSON kept_verdict GET "${kept}" verdict)
+    string(JSON kept_record ERROR_VARIABLE no_kept_record GET "${kept}" alternation)
+    if(NOT kept_verdict STREQUAL plain_verdict OR NOT no_kept_record)
+      message(FATAL_ERROR "--turn-over-alternation ${keep} on ${order}: verdict ${kept_verdict} (without the option "
+                          "${plain_verdict}), alternation '${kept_record}'")
+    endif()
+  endif()
+  # A yield the first turn-over alone names again is not withdrawn: the turn-over's floor at the rise.
+  if(expected STREQUAL "unexplained" AND rise_n GREATER 2000)
+    math(EXPR turned_n "${rise_n} - 1000")
+    nano_decimal(turned "${turned_n}")
+    run_ok(rised diagnose ${three} ${rise_args} --turn-over-alternation ${change} --turn-over-yield ${turned})
+    string(JSON rised_verdict GET "${rised}" verdict)
+    string(JSON rised_record ERROR_VARIABLE no_rised_record GET "${rised}" alternation)
+    if(NOT rised_verdict STREQUAL "yield" OR NOT no_rised_record)
+      message(FATAL_ERROR "--turn-over-alternation ${change} --turn-over-yield ${turned} on ${order}: verdict "
+                          "${rised_verdict}, alternation '${rised_record}'")
+    endif()
+  endif()
+endforeach()
+if(alternation_named EQUAL 0 OR alternation_withdrawn EQUAL 0)
+  message(FATAL_ERROR "--turn-over-alternation: ${alternation_named} orders named yield by it, "
+                      "${alternation_withdrawn} withdrew the refits' yield: one side untested (take other placements)")
+endif()
+# Not with the third placement on the turned face (no alternation); not in a screening run; in the --fine preset at
+# 0.015, with the hem's centre at 2.5.
+run_ok(other_face diagnose --capture ${WORK}/rise --second-capture ${WORK}/rise.p1 --held-out-capture
+       ${WORK}/rise.p3 ${rise_args} --turn-over-alternation 0.000001)
+string(JSON other_face_record ERROR_VARIABLE no_other_face_record GET "${other_face}" alternation)
+run_ok(screened_alt diagnose --capture ${WORK}/rise --second-capture ${WORK}/rise.p1 --held-out-capture
+       ${WORK}/rise.p2 --quick --resolution 6 --states 1 --evaluations 2 --json --gap-only
+       --turn-over-alternation 0.000001)
+string(JSON screened_alt_record ERROR_VARIABLE no_screened_alt_record GET "${screened_alt}" alternation)
+json_number(screened_alt_setting "${screened_alt}" settings turn_over_alternation)
+run_ok(fine_alt diagnose --capture ${WORK}/rise --second-capture ${WORK}/rise.p1 --held-out-capture ${WORK}/rise.p2
+       --fine --resolution 6 --states 1 --evaluations 2 --refit-evaluations 2 --candidates yield --json)
+json_number(fine_alt_setting "${fine_alt}" settings turn_over_alternation)
+json_number(fine_centre_setting "${fine_alt}" settings off_centre_misalignment)
+if(NOT no_other_face_record OR NOT no_screened_alt_record OR NOT screened_alt_setting EQUAL 0
+   OR NOT fine_alt_setting EQUAL 0.015 OR NOT fine_centre_setting EQUAL 2.5)
+  message(FATAL_ERROR "--turn-over-alternation: third placement turned: alternation '${other_face_record}'; "
+                      "--gap-only: '${screened_alt_record}', setting ${screened_alt_setting}; --fine: settings "
+                      "${fine_alt_setting} and off-centre ${fine_centre_setting}")
+endif()
+expect_failure(1 "--turn-over-alternation must be 0 (off) .. 1" diagnose --capture ${WORK}/rise --second-capture
+               ${WORK}/rise.p1 --held-out-capture ${WORK}/rise.p2 --turn-over-alternation -0.1)
+expect_failure(1 "give --second-capture and --held-out-capture" diagnose --capture ${WORK}/rise --second-capture
+               ${WORK}/rise.p1 --turn-over-alternation 0.015)
 expect_failure(1 "--confirm-placement-rise must be 0 (off) .. 1" diagnose --capture ${WORK}/rise --second-capture
                ${WORK}/rise.p1 --confirm-placement-rise -0.01)
 expect_failure(1 "give --second-capture" diagnose --capture ${WORK}/rise --held-out-capture ${WORK}/rise.p1

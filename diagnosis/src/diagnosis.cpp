@@ -276,6 +276,8 @@ DiagnosisSettings DiagnosisSettings::fine() {
   s.floors.shape_threshold = kFineShapeFloor;
   s.held_out_shape_threshold = kFineHeldOutShapeFloor;
   s.turn_over_yield = kFineTurnOverYield;
+  s.turn_over_alternation = kFineTurnOverAlternation;
+  s.off_centre_misalignment = kFineOffCentreMisalignment;
   return s;
 }
 
@@ -701,6 +703,47 @@ void name_yield_from_turn_over(DiagnosisResult& r, const Capture& capture, const
   r.runner_up.clear();  // the refits ranked no yield first: nothing stands second to the turn-over
 }
 
+/// The turn-over's alternation: the second capture's drape coefficient less the mean of the capture's and the held-out
+/// capture's, where the second lies on the other face and the held-out one on the capture's; nothing otherwise.
+std::optional<double> turn_over_alternation(const Capture& capture, const OtherPlacements& others) {
+  const std::optional<double> rise = turn_over_rise(capture, others);
+  if (!rise || !others.held_out || others.held_out->face_down != capture.face_down) return std::nullopt;
+  return *rise - 0.5 * (drape_coefficient(*others.held_out) - drape_coefficient(capture));
+}
+
+/// DiagnosisSettings::turn_over_alternation (rule A), after the turn-over's rule U: yield where no effect is named
+/// and the alternation reaches budgets.turn_over_alternation; the refits' yield withdrawn ("unexplained") where it
+/// does not, unless the first turn-over alone reaches budgets.turn_over_yield (rule U would name it again).
+void weigh_yield_by_alternation(DiagnosisResult& r, const Capture& capture, const OtherPlacements& others) {
+  const double floor = r.budgets.turn_over_alternation;
+  const bool refits_yield = r.verdict == "yield" && !r.turn_over;
+  if (floor <= 0.0 || !(names_no_effect(r) || refits_yield)) return;
+  const std::optional<double> alternation = turn_over_alternation(capture, others);
+  if (!alternation) {
+    sim::logger()->info("diagnosis: no turned second capture between two placements on the capture's face: no "
+                        "alternation to weigh yield by");
+    return;
+  }
+  if (names_no_effect(r) && *alternation >= floor) {
+    sim::logger()->info("diagnosis: verdict {} but the turned placement drapes {:.4f} stiffer than the mean of the "
+                        "others (drape coefficient, at least {:g}): yield, from the turn-over's alternation",
+                        r.verdict, *alternation, floor);
+    r.alternation = DiagnosisResult::TurnOverAlternation{*alternation, floor, r.verdict};
+    r.verdict = "yield";
+    r.runner_up.clear();
+    return;
+  }
+  const std::optional<double> rise = turn_over_rise(capture, others);
+  const bool turn_over_names = r.budgets.turn_over_yield > 0.0 && *rise >= r.budgets.turn_over_yield;
+  if (!refits_yield || *alternation >= floor || turn_over_names) return;
+  sim::logger()->info("diagnosis: the refits name yield but the turned placement drapes {:.4f} against the mean of "
+                      "the others (drape coefficient, under {:g}): unexplained, the yield withdrawn",
+                      *alternation, floor);
+  r.alternation = DiagnosisResult::TurnOverAlternation{*alternation, floor, r.verdict};
+  r.verdict = "unexplained";
+  r.runner_up = "yield";  // the best candidate, as with the refits' own "unexplained"
+}
+
 /// DiagnosisSettings::off_centre_misalignment (rule E): misalignment where no effect is named (after the turn-over)
 /// and the hem's centre lies at least budgets.off_centre_misalignment times its floor off the fitted drape's.
 void name_misalignment_from_off_centre(DiagnosisResult& r) {
@@ -725,8 +768,10 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
   if (!result) return result;
   // A screening run names no effect, so neither signature names one there.
   result->budgets.turn_over_yield = settings.attribute ? settings.turn_over_yield : 0.0;
+  result->budgets.turn_over_alternation = settings.attribute ? settings.turn_over_alternation : 0.0;
   result->budgets.off_centre_misalignment = settings.attribute ? settings.off_centre_misalignment : 0.0;
   name_yield_from_turn_over(*result, capture, others);
+  weigh_yield_by_alternation(*result, capture, others);
   name_misalignment_from_off_centre(*result);
   return result;
 }
@@ -736,14 +781,23 @@ const CandidateResult* DiagnosisResult::refit(Effect effect) const {
   return found == attribution.candidates.end() ? nullptr : &*found;
 }
 
+const std::string& DiagnosisResult::refits_verdict() const {
+  if (turn_over) return turn_over->refits_verdict;
+  if (alternation) return alternation->refits_verdict;
+  if (off_centre) return off_centre->refits_verdict;
+  return verdict;
+}
+
 const CandidateResult* DiagnosisResult::named_refit() const {
-  if (turn_over) return refit(Effect::kYield);
-  if (off_centre) return refit(Effect::kMisalignment);
+  if (signature_set()) {
+    const std::optional<Effect> named = parse_effect(verdict);
+    return named ? refit(*named) : nullptr;
+  }
   return attribution.named && !attribution.candidates.empty() ? &attribution.candidates.front() : nullptr;
 }
 
 double DiagnosisResult::named_shrinkage() const {
-  if (turn_over || off_centre) {
+  if (signature_set() && !names_no_effect(*this)) {
     const CandidateResult* named = named_refit();
     return named ? named->shrinkage : 0.0;
   }
@@ -761,7 +815,7 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
   j["verdict"] = r.verdict;
   j["runner_up"] = r.runner_up;
   j["confidence"] =
-      r.turn_over || r.off_centre ? nlohmann::json(nullptr) : nlohmann::json(r.attribution.confidence);
+      r.signature_set() ? nlohmann::json(nullptr) : nlohmann::json(r.attribution.confidence);
   j["within_floors"] = r.within_floors;
   j["within_floors_after_bending_refit"] = r.attribution.bending_within_floors();
   j["gap_mm"] = {
@@ -976,6 +1030,7 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                    {"max_baseline_evaluations", r.budgets.max_baseline_evaluations},
                    {"attribution", r.budgets.attribution},
                    {"turn_over_yield", r.budgets.turn_over_yield},
+                   {"turn_over_alternation", r.budgets.turn_over_alternation},
                    {"off_centre_misalignment", r.budgets.off_centre_misalignment}};
   if (const auto& m = r.mesh_confirmation) {
     j["mesh_confirmation"] = {{"resolution", m->resolution},
@@ -990,6 +1045,9 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
   }
   if (const auto& t = r.turn_over) {
     j["turn_over"] = {{"rise", t->rise}, {"floor", t->floor}, {"refits_verdict", t->refits_verdict}};
+  }
+  if (const auto& a = r.alternation) {
+    j["alternation"] = {{"alternation", a->alternation}, {"floor", a->floor}, {"refits_verdict", a->refits_verdict}};
   }
   if (const auto& o = r.off_centre) {
     j["off_centre"] = {{"ratio", o->ratio}, {"floor", o->floor}, {"refits_verdict", o->refits_verdict}};

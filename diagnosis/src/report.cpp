@@ -219,14 +219,26 @@ std::string refits_markdown(const DiagnosisResult& r, std::string_view verdict, 
 
 std::string verdict_markdown(const DiagnosisResult& r) {
   std::string md;
-  // A signature of its own named the effect where the refits named none (rules U and E): what it read (an open
-  // parenthesis at its end, naming the option), the named effect's refit, then the refits' verdict.
-  const auto signature = [&r](std::string_view effect, const std::string& reading, std::string_view refits_verdict) {
+  // A signature of its own set the verdict (rules U, A and E): what it read (an open parenthesis at its end, naming
+  // the option), the named effect's refit, then the refits' verdict (with the alternation's withdrawal where the hem's
+  // centre named misalignment after it).
+  const std::string& refits_verdict = r.refits_verdict();
+  const auto withdrawal = [&r] {
+    const auto& a = *r.alternation;
+    return fmt::format("the turned second capture drapes {:.4f} against the mean of the capture and the third "
+                       "placement, laid on the capture's face again (drape coefficient; under {:g}), as an elastic "
+                       "specimen's placements differ by their noise and a plastic set stiffens the turned drape "
+                       "(`--turn-over-alternation`)",
+                       a.alternation, a.floor);
+  };
+  const auto signature = [&](std::string_view effect, const std::string& reading) {
     const CandidateResult* refit = r.named_refit();
     const std::string shrinks = refit ? fmt::format("the {} refit shrinks the excess by {:.0f}%", effect,
                                                     100.0 * refit->shrinkage)
                                       : fmt::format("no {} refit ran", effect);
-    return fmt::format("{}; {}). The refits alone named no effect:\n\n", reading, shrinks) +
+    const std::string refits = refits_verdict == "yield" ? "The refits named yield, withdrawn: " + withdrawal() + "."
+                                                         : std::string("The refits alone named no effect:");
+    return fmt::format("{}; {}). {}\n\n", reading, shrinks, refits) +
            refits_markdown(r, refits_verdict, "The refits' verdict");
   };
   if (const auto& t = r.turn_over) {
@@ -235,7 +247,7 @@ std::string verdict_markdown(const DiagnosisResult& r) {
         "stiffer than the capture (drape coefficient; at least {:g}), as the plastic set of a drape makes a specimen "
         "drape stiffer turned over and an elastic specimen does not (`--turn-over-yield`",
         t->rise, t->floor);
-    md += signature("yield", reading, t->refits_verdict);
+    md += signature("yield", reading);
   } else if (const auto& o = r.off_centre) {
     const std::string reading = fmt::format(
         "**Verdict: misalignment, from the hem's centre**: the hem's centre lies {:.2f} times its floor off the fitted "
@@ -243,7 +255,19 @@ std::string verdict_markdown(const DiagnosisResult& r) {
         "hangs longer on one side and an elastic fabric's drape on a centred specimen does not "
         "(`--off-centre-misalignment`",
         o->ratio, o->floor);
-    md += signature("misalignment", reading, o->refits_verdict);
+    md += signature("misalignment", reading);
+  } else if (const auto& a = r.alternation; a && !a->withdrew()) {
+    const std::string reading = fmt::format(
+        "**Verdict: yield, from the turn-over's alternation**: the second capture, laid on the specimen's other face, "
+        "drapes {:.4f} stiffer than the mean of the capture and the third placement, laid on the capture's face again "
+        "(drape coefficient; at least {:g}), as the plastic set of a drape stiffens the turned drape and eases on the "
+        "first face again while an elastic specimen's placements differ by their noise (`--turn-over-alternation`",
+        a->alternation, a->floor);
+    md += signature("yield", reading);
+  } else if (a) {
+    md += "**Verdict: unexplained, a yield without its turn-over**: the refits named yield, but " + withdrawal() +
+          "; the yield refit may stand for a softer elastic fabric.\n\n" +
+          refits_markdown(r, refits_verdict, "The refits' verdict");
   } else {
     md += refits_markdown(r, r.verdict);
   }

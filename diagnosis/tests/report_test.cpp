@@ -170,6 +170,63 @@ TEST(VerdictMarkdown, MisalignmentFromTheHemCentreSaysSoAndKeepsTheRefitsVerdict
   EXPECT_TRUE(contains(within, "**The refits' verdict: the gap is within the floors**")) << within;
 }
 
+TEST(VerdictMarkdown, TheAlternationNamesOrWithdrawsYieldAndSaysSo) {
+  // The refits named no effect; the turned placement drapes 0.0213 stiffer than the mean of the other two: yield, with
+  // the yield refit's shrinkage.
+  DiagnosisResult r;
+  r.verdict = "yield";
+  r.alternation = DiagnosisResult::TurnOverAlternation{0.0213, 0.015, "unexplained"};
+  for (auto [effect, shrinkage] : {std::pair{Effect::kShear, 0.2}, std::pair{Effect::kYield, 0.1}}) {
+    r.attribution.candidates.emplace_back();
+    r.attribution.candidates.back().effect = effect;
+    r.attribution.candidates.back().shrinkage = shrinkage;
+  }
+  EXPECT_FALSE(r.alternation->withdrew());
+  EXPECT_EQ(r.refits_verdict(), "unexplained");
+  EXPECT_DOUBLE_EQ(r.named_shrinkage(), 0.1);
+  ASSERT_NE(r.named_refit(), nullptr);
+  EXPECT_EQ(r.named_refit()->effect, Effect::kYield);
+  const std::string named = verdict_markdown(r);
+  EXPECT_TRUE(contains(named, "**Verdict: yield, from the turn-over's alternation**: the second capture, laid on the "
+                              "specimen's other face, drapes 0.0213 stiffer than the mean of the capture and the "
+                              "third placement"))
+      << named;
+  EXPECT_TRUE(contains(named, "the yield refit shrinks the excess by 10%). The refits alone named no effect:")) << named;
+  EXPECT_TRUE(contains(named, "**The refits' verdict: ")) << named;
+
+  // The refits named yield (first, 40%) without the alternation (0.0042): unexplained, no effect's refit named, the
+  // shrinkage the best candidate's as with the refits' own "unexplained".
+  DiagnosisResult withdrawn;
+  withdrawn.verdict = "unexplained";
+  withdrawn.alternation = DiagnosisResult::TurnOverAlternation{0.0042, 0.015, "yield"};
+  withdrawn.attribution.named = true;
+  withdrawn.attribution.candidates.emplace_back();
+  withdrawn.attribution.candidates.back().effect = Effect::kYield;
+  withdrawn.attribution.candidates.back().shrinkage = 0.4;
+  EXPECT_TRUE(withdrawn.alternation->withdrew());
+  EXPECT_EQ(withdrawn.refits_verdict(), "yield");
+  EXPECT_EQ(withdrawn.named_refit(), nullptr);
+  EXPECT_DOUBLE_EQ(withdrawn.named_shrinkage(), 0.4);
+  const std::string md = verdict_markdown(withdrawn);
+  EXPECT_TRUE(contains(md, "**Verdict: unexplained, a yield without its turn-over**: the refits named yield, but the "
+                           "turned second capture drapes 0.0042 against the mean of the capture and the third "
+                           "placement"))
+      << md;
+  EXPECT_TRUE(contains(md, "**The refits' verdict: yield**")) << md;
+
+  // The hem's centre then named misalignment: its paragraph, with the withdrawal as the refits' verdict.
+  withdrawn.verdict = "misalignment";
+  withdrawn.off_centre = DiagnosisResult::OffCentreMisalignment{3.0, 2.5, "unexplained"};
+  EXPECT_EQ(withdrawn.refits_verdict(), "yield");
+  EXPECT_EQ(withdrawn.named_refit(), nullptr);  // no misalignment refit ran
+  const std::string centred = verdict_markdown(withdrawn);
+  EXPECT_TRUE(contains(centred, "**Verdict: misalignment, from the hem's centre**")) << centred;
+  EXPECT_TRUE(contains(centred, "no misalignment refit ran). The refits named yield, withdrawn: the turned second "
+                                "capture drapes 0.0042"))
+      << centred;
+  EXPECT_TRUE(contains(centred, "**The refits' verdict: yield**")) << centred;
+}
+
 TEST(RuntimeMarkdown, CountsEveryDiagnosisTheRuntimeHolds) {
   // With --confirm-resolution and --confirm-placement-rise both on, the reported diagnosis holds the one without the
   // placement test, and each of the two may hold its other mesh's: up to four diagnoses' runtime together.

@@ -105,6 +105,37 @@ class TurnOverRules(unittest.TestCase):
         j["settings"]["turn_over_yield"] = 0.02
         self.assertEqual(rules.verdicts(rules.refits_report(j))["current"], "yield")
 
+    def test_a_run_with_rule_a_is_read_as_its_refits_then_the_alternation(self):
+        # drapegen diagnose --turn-over-alternation 0.015 named yield where the refits named none (alternation 0.016):
+        # every rule starts from the refits' verdict and gets the alternation laid on it.
+        j = report("yield", 0.20, 0.216, c2=0.20)
+        j["settings"]["turn_over_alternation"] = 0.015
+        j["alternation"] = {"alternation": 0.016, "floor": 0.015, "refits_verdict": "none"}
+        run = rules.refits_report(j)
+        self.assertEqual(run["verdict"], "none")
+        v = rules.verdicts(run)
+        self.assertTrue(all(x == "yield" for x in v.values()), v)
+        # It withdrew the refits' yield (alternation 0.005): unexplained, unless the run's rule U names it again.
+        j = report("unexplained", 0.20, 0.21, c2=0.21)
+        j["settings"]["turn_over_alternation"] = 0.015
+        j["alternation"] = {"alternation": 0.005, "floor": 0.015, "refits_verdict": "yield"}
+        self.assertEqual(rules.refits_report(j)["verdict"], "yield")
+        self.assertEqual(rules.verdicts(rules.refits_report(j))["current"], "unexplained")
+        j["settings"]["turn_over_yield"] = 0.005
+        self.assertEqual(rules.verdicts(rules.refits_report(j))["current"], "yield")
+        # Then the hem's centre on the withdrawn yield: the first record holds the refits' verdict.
+        j = report("misalignment", 0.20, 0.21, c2=0.21)
+        j["settings"].update(turn_over_alternation=0.015, off_centre_misalignment=2.5)
+        j["localisation"] = {"feature_groups": {"off_centre": {"ratio": 3.0}}}
+        j["alternation"] = {"alternation": 0.005, "floor": 0.015, "refits_verdict": "yield"}
+        j["off_centre"] = {"ratio": 3.0, "floor": 2.5, "refits_verdict": "unexplained"}
+        self.assertEqual(rules.refits_report(j)["verdict"], "yield")
+        self.assertEqual(rules.verdicts(rules.refits_report(j))["current"], "misalignment")
+        # A third placement on the other face gives no alternation.
+        j = report("none", 0.20, 0.216, c2=0.20)
+        j["placements"][2]["face"] = "down"
+        self.assertIsNone(rules.turn_over_alternation(j))
+
     def test_a_run_with_rule_u_is_read_as_its_refits_then_the_turn_over(self):
         # The run named yield from the turn-over: every rule starts from the refits' verdict and gets the turn-over
         # laid on it, so the verdict as run is reproduced.

@@ -88,13 +88,24 @@ struct DiagnosisSettings {
   /// docs/preregistrations/session79.md). Within the floors too, where no refit ran; not with attribute false (a
   /// screening run names no effect). The refits stand as they ran. 0: off (the --fine preset: kFineTurnOverYield).
   double turn_over_yield = 0.0;
-  /// Where the verdict (after turn_over_yield) names no effect ("none" or "unexplained") and the hem's centre lies at
+  /// The turn-over's alternation: the second capture, laid turned over after the capture, less the mean of the
+  /// capture and the held-out capture (laid on the capture's face again), in drape coefficient. A plastic set stiffens
+  /// the turned drape and eases on the first face again; an elastic fabric's three drapes differ by their noise. After
+  /// turn_over_yield: where the verdict names no effect ("none" or "unexplained") and the alternation is at least
+  /// this, name yield; where the refits named yield and the alternation is below this (and the first turn-over alone
+  /// is below turn_over_yield, which would name yield again), withdraw it: "unexplained", the refits' yield kept in
+  /// the report (DiagnosisResult::alternation; rule A, docs/preregistrations/session82.md: +1 -0 on fresh seeds
+  /// 109-110). Needs a turned second capture and a held-out capture on the capture's face; not with attribute false.
+  /// The refits stand as they ran. 0: off (the --fine preset: kFineTurnOverAlternation).
+  double turn_over_alternation = 0.0;
+  /// Where the verdict (after turn_over_alternation) names no effect ("none" or "unexplained") and the hem's centre lies at
   /// least this many times its floor off the fitted drape's (the off-centre feature group's ratio,
   /// Localisation::group_ratio, FeatureGroup::kOffCentre: the order-1 harmonic of the hem's radius and height), name
   /// misalignment (DiagnosisResult::off_centre): a specimen laid off centre hangs longer on one side, which no elastic
   /// fabric's drape on a centred specimen does (rule E, docs/preregistrations/session82.md: on seeds 101-108 the ratio
   /// reached 2.5 on 14 of 16 misalignments and on none of 36 controls, at most 1.77). Within the floors too, where no
-  /// refit ran; not with attribute false. The refits stand as they ran. 0: off.
+  /// refit ran; not with attribute false. The refits stand as they ran. 0: off (the --fine preset:
+  /// kFineOffCentreMisalignment).
   double off_centre_misalignment = 0.0;
 
   /// Small budgets for tests and the --quick benchmark.
@@ -115,6 +126,12 @@ struct DiagnosisSettings {
   /// raised the drape coefficient by 0.02 or more on 41 of 53 yields, 7 of 56 curls and none of 81 controls (at most
   /// +0.0161) nor of 191 other captures.
   static constexpr double kFineTurnOverYield = 0.02;
+  /// The --fine preset's turn_over_alternation (rule A, registered in session 81 for fresh seeds 109-110: +1 -0, no
+  /// control named; adopted in session 82, docs/DIAGNOSIS_RESULTS.md, "Session 82").
+  static constexpr double kFineTurnOverAlternation = 0.015;
+  /// The --fine preset's off_centre_misalignment (rule E, registered in session 81 for fresh seeds 109-110: +1 -0, no
+  /// control named; adopted in session 82).
+  static constexpr double kFineOffCentreMisalignment = 2.5;
 };
 
 struct DiagnosisResult {
@@ -125,6 +142,7 @@ struct DiagnosisResult {
     int max_baseline_evaluations = 0;  // per simplex of the baseline fit
     bool attribution = true;           // false: gap, floors and localisation only
     double turn_over_yield = 0.0;      // DiagnosisSettings::turn_over_yield where it could name yield (0: off)
+    double turn_over_alternation = 0.0;    // DiagnosisSettings::turn_over_alternation where it could (0: off)
     double off_centre_misalignment = 0.0;  // DiagnosisSettings::off_centre_misalignment where it could (0: off)
   } budgets;
   /// Each capture it read (report.json "placements"): its directory and the face the specimen lay on (a turned
@@ -190,10 +208,11 @@ struct DiagnosisResult {
   double refit_scale_lower = 0.0, refit_scale_upper = 0.0;
   /// The verdict: the named effect ("none" within the floors, "unexplained" if no candidate shrinks it enough,
   /// "not attributed" above the floors when DiagnosisSettings::attribute is false; "yield" from the turn-over where
-  /// turn_over is set, "misalignment" from the hem's centre where off_centre is set, whatever the refits named).
+  /// turn_over is set, "yield" or "unexplained" from its alternation where alternation is set, "misalignment" from the
+  /// hem's centre where off_centre is set, whatever the refits named).
   std::string verdict;
-  /// Second to the named effect (with "unexplained", the best candidate); empty where the turn-over or the hem's
-  /// centre named the effect.
+  /// Second to the named effect (with "unexplained", the best candidate: the withdrawn yield where the alternation
+  /// withdrew it); empty where the turn-over, its alternation or the hem's centre named the effect.
   std::string runner_up;
   int simulations = 0;
   double seconds = 0.0;
@@ -231,6 +250,16 @@ struct DiagnosisResult {
     std::string refits_verdict;  // "none" or "unexplained"
   };
   std::optional<TurnOverYield> turn_over;
+  /// With DiagnosisSettings::turn_over_alternation where it fired: the verdict is "yield" from the turn-over's
+  /// alternation where the refits named no effect (`refits_verdict` "none" or "unexplained"), or "unexplained" where
+  /// the refits' yield was withdrawn (`refits_verdict` "yield"); the attribution above stands as it ran.
+  struct TurnOverAlternation {
+    double alternation = 0.0;    // the second capture's drape coefficient less the mean of the other two's
+    double floor = 0.0;          // DiagnosisSettings::turn_over_alternation
+    std::string refits_verdict;  // the verdict before it
+    [[nodiscard]] bool withdrew() const { return refits_verdict == "yield"; }
+  };
+  std::optional<TurnOverAlternation> alternation;
   /// With DiagnosisSettings::off_centre_misalignment where it fired: the verdict is "misalignment" from the hem's
   /// centre, not from the refits, whose verdict was `refits_verdict` (the attribution above stands as it ran).
   struct OffCentreMisalignment {
@@ -239,14 +268,21 @@ struct DiagnosisResult {
     std::string refits_verdict;  // "none" or "unexplained"
   };
   std::optional<OffCentreMisalignment> off_centre;
+  /// The refits' own verdict: the verdict before the first signature that changed it (turn_over, alternation,
+  /// off_centre, in the order diagnose() lays them), else the verdict.
+  [[nodiscard]] const std::string& refits_verdict() const;
   /// The candidate refit of `effect` (attribution.candidates), null where none ran.
   [[nodiscard]] const CandidateResult* refit(Effect effect) const;
-  /// The named effect's refit: the first candidate where the attribution named it, the yield refit where the
-  /// turn-over named yield, the misalignment refit where the hem's centre named misalignment; null where no effect is
-  /// named or its refit did not run.
+  /// Whether a signature (turn_over, alternation, off_centre) set the verdict rather than the refits.
+  [[nodiscard]] bool signature_set() const { return turn_over || alternation || off_centre; }
+  /// The named effect's refit: the first candidate where the attribution named it; where a signature set the verdict,
+  /// the refit of the effect it named (the yield refit where the turn-over or its alternation named yield, the
+  /// misalignment refit where the hem's centre named misalignment); null where no effect is named (the alternation's
+  /// withdrawal included) or its refit did not run.
   [[nodiscard]] const CandidateResult* named_refit() const;
   /// How much adding the named effect shrinks the gap's excess above the floors (report.json "shrinkage"): the first
-  /// candidate's; with turn_over or off_centre, the named effect's refit's; 0 where no such refit ran.
+  /// candidate's (with "unexplained", the best one's); where a signature named an effect, its refit's; 0 where no
+  /// such refit ran.
   [[nodiscard]] double named_shrinkage() const;
 };
 
