@@ -68,6 +68,11 @@ score. Hypotheses for the next evaluation, not the diagnosis's rule (docs/DIAGNO
 - off_centre (rule E, registered in session 81 for seeds 109-110; adopted in session 82, `--off-centre-misalignment
   2.5` in the --fine preset): "misalignment" where the verdict names no effect, the run's rule U names no yield, and
   the hem's centre offset is 2.5 times its floor or more; else the verdict as run;
+- later_yield (rule L, registered in session 82 for fresh seeds 111-112, an addendum:
+  docs/preregistrations/session83.md): after the run's signatures (rules U, A and E as run), "yield" where the
+  verdict names no effect and the third placement, laid on the capture's face again, drapes with a drape coefficient
+  LATER or more above the capture's (gap_tests.held_out_capture less gap_tests.capture): the set two drapes leave
+  stiffens the next one, an elastic fabric has no memory;
 - min_objective: the candidate whose refit objective (in-sample: the capture and the second capture) is the smallest;
   it ignores the held-out data, which the issue's attribution must use: a diagnostic of the refits, not a rule.
 
@@ -130,7 +135,7 @@ RULES = ["current", "strict", "tolerance", "objective_ties", "parsimony", "tie_o
          "mean3", "held_out_excess", "held_out_rank", "min_objective", "without_ablation", "reach", "reach_objective",
          "tie_held_out_view", "tie_held_out", "no_near_tie",
          "common4", "views_sensor", "views_camera", "tie_region", "wide_tolerance", "rise_yield", "rise_yield_015",
-         "rise_later_yield", "yield_needs_rise", "alternation_yield", "off_centre"]
+         "rise_later_yield", "yield_needs_rise", "alternation_yield", "off_centre", "later_yield"]
 PARAMETERS = {"sensor": 9, "misalignment": 2}  # effect_space's dimension; the others have 1
 # How each rule orders candidates of equal shrinkage before their objectives (confirmation_rule).
 TIES = {"physical_first": lambda effect: effect == "sensor",  # attribute() since session 25 (needs_simulation)
@@ -511,6 +516,32 @@ def off_centre_misalignment(j):
     return "misalignment" if fires else j["verdict"]
 
 
+LATER = 0.02  # rule L's floor on the third placement's rise (docs/preregistrations/session83.md)
+
+
+def third_rise(report):
+    """The held-out (third) capture's drape coefficient less the capture's where it lies on the capture's face; None
+    otherwise."""
+    faces = {p["role"]: p["face"] for p in report.get("placements", [])}
+    g = report.get("gap_tests") or {}
+    c0 = (g.get("capture") or {}).get("drape_coefficient")
+    c2 = (g.get("held_out_capture") or {}).get("drape_coefficient")
+    if c0 is None or c2 is None or faces.get("held_out_capture") != faces.get("capture"):
+        return None
+    return c2 - c0
+
+
+def later_yield(j, verdict):
+    """Rule L (an addendum registered in session 82 for seeds 111-112): laid after the run's signatures, on `verdict`
+    (the default's with them): "yield" where it names no effect and the third placement rose LATER or more."""
+    rise = third_rise(j)
+    return "yield" if verdict in ("none", "unexplained") and rise is not None and rise >= LATER else verdict
+
+
+# The rules laid on the default's verdict after the run's signatures (signatures_applied), reading it.
+AFTER_SIGNATURES = {"later_yield": later_yield}
+
+
 # The rules read off the verdict as run and one more field of the report, with or without candidates.
 REPORT_RULES = {"views_sensor": views_sensor, "views_camera": views_camera, "tie_region": tie_region,
                 "wide_tolerance": wide_tolerance, "rise_yield": rise_yield, "rise_yield_015": rise_yield_015,
@@ -525,7 +556,7 @@ def verdicts(j):
     if not cands:
         v = {r: j["verdict"] for r in RULES}
         v.update({rule: f(j) for rule, f in REPORT_RULES.items()})
-        return signatures_applied(j, v)
+        return after_signatures(j, signatures_applied(j, v))
     sf, shf = g["stable_floor_mm"], g["shape_floor"]
     within = j.get("within_floors_after_bending_refit", False)
     v = {"current": j["verdict"], "strict": confirmation_rule(j, 0.0), "tolerance": confirmation_rule(j, TOLERANCE),
@@ -585,7 +616,7 @@ def verdicts(j):
     for rule in ("without_ablation", "reach", "reach_objective"):
         v[rule] = reference_rule(j, rule)
     v.update({rule: f(j) for rule, f in REPORT_RULES.items()})
-    return signatures_applied(j, v)
+    return after_signatures(j, signatures_applied(j, v))
 
 
 COLUMNS = ["none", "unexplained", "not attributed", "yield", "shear", "curl", "friction", "misalignment", "sensor"]
@@ -629,6 +660,12 @@ def signatures_applied(j, v):
     ratio = off_centre_ratio(j)
     if ratio_floor > 0.0 and ratio is not None and ratio >= ratio_floor:
         v = {r: "misalignment" if x in ("none", "unexplained") else x for r, x in v.items()}
+    return v
+
+
+def after_signatures(j, v):
+    """`v` with the AFTER_SIGNATURES rules' columns: each laid on the default's verdict with the run's signatures."""
+    v.update({rule: f(j, v["current"]) for rule, f in AFTER_SIGNATURES.items()})
     return v
 
 

@@ -766,7 +766,7 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
                                         const OtherPlacements& others) {
   auto result = diagnose_confirming_placement(capture, settings, others);
   if (!result) return result;
-  // A screening run names no effect, so neither signature names one there.
+  // A screening run names no effect, so no signature names one there.
   result->budgets.turn_over_yield = settings.attribute ? settings.turn_over_yield : 0.0;
   result->budgets.turn_over_alternation = settings.attribute ? settings.turn_over_alternation : 0.0;
   result->budgets.off_centre_misalignment = settings.attribute ? settings.off_centre_misalignment : 0.0;

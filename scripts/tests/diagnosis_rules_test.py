@@ -136,6 +136,22 @@ class TurnOverRules(unittest.TestCase):
         j["placements"][2]["face"] = "down"
         self.assertIsNone(rules.turn_over_alternation(j))
 
+    def test_rule_l_names_yield_by_the_third_placement_after_the_signatures(self):
+        # The third placement, face up again, 0.03 above the first: yield where nothing is named, after rule A.
+        self.assertAlmostEqual(rules.third_rise(report("none", 0.20, 0.20, c2=0.23)), 0.03)
+        self.assertEqual(rules.later_yield(report("none", 0.20, 0.20, c2=0.23), "none"), "yield")
+        self.assertEqual(rules.later_yield(report("none", 0.20, 0.20, c2=0.219), "unexplained"), "unexplained")
+        self.assertEqual(rules.later_yield(report("curl", 0.20, 0.20, c2=0.30), "curl"), "curl")
+        # Laid on the default's verdict with the run's signatures: rule A's withdrawal does not undo it.
+        j = report("none", 0.20, 0.20, c2=0.23)
+        j["settings"]["turn_over_alternation"] = 0.015
+        v = rules.verdicts(j)
+        self.assertEqual(v["current"], "none")
+        self.assertEqual(v["later_yield"], "yield")
+        # Not with the third placement on the other face.
+        j["placements"][2]["face"] = "down"
+        self.assertIsNone(rules.third_rise(j))
+
     def test_a_run_with_rule_u_is_read_as_its_refits_then_the_turn_over(self):
         # The run named yield from the turn-over: every rule starts from the refits' verdict and gets the turn-over
         # laid on it, so the verdict as run is reproduced.
