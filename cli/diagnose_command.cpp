@@ -383,8 +383,8 @@ int run_diagnose(const DiagnoseOptions& o) {
                                     "the mean of the others (at least {:g})",
                                     a->alternation, a->floor));
     } else if (a) {
-      std::cout << fmt::format("  verdict: unexplained, the refits' yield withdrawn: the turned placement drapes {:.4f} "
-                               "against the mean of the others (under {:g})\n",
+      std::cout << fmt::format("  verdict: unexplained, the refits' yield withdrawn: the turned placement drapes "
+                               "{:.4f} against the mean of the others (under {:g})\n",
                                a->alternation, a->floor);
     } else if (r.verdict == "none") {
       std::cout << fmt::format("  verdict: within the floors{} (no effect named)\n",

@@ -1789,6 +1789,8 @@ foreach(p 2 3)
 endforeach()
 set(alternation_named 0)
 set(alternation_withdrawn 0)
+set(alternation_kept 0)  # floors on the other side of the alternation, where nothing changes
+set(alternation_rised 0)  # withdrawals rule U's rise prevents
 foreach(order "rise.p2;rise.p3;rise" "rise.p2;rise.p1;rise" "rise;rise.p1;rise.p2" "rise;rise.p3;rise.p2")
   list(TRANSFORM order PREPEND ${WORK}/)
   list(GET order 0 first)
@@ -1861,6 +1863,7 @@ foreach(order "rise.p2;rise.p3;rise" "rise.p2;rise.p1;rise" "rise;rise.p1;rise.p
       message(FATAL_ERROR "--turn-over-alternation ${keep} on ${order}: verdict ${kept_verdict} (without the option "
                           "${plain_verdict}), alternation '${kept_record}'")
     endif()
+    math(EXPR alternation_kept "${alternation_kept} + 1")
   endif()
   # A yield the first turn-over alone names again is not withdrawn: the turn-over's floor at the rise.
   if(expected STREQUAL "unexplained" AND rise_n GREATER 2000)
@@ -1873,17 +1876,39 @@ foreach(order "rise.p2;rise.p3;rise" "rise.p2;rise.p1;rise" "rise;rise.p1;rise.p
       message(FATAL_ERROR "--turn-over-alternation ${change} --turn-over-yield ${turned} on ${order}: verdict "
                           "${rised_verdict}, alternation '${rised_record}'")
     endif()
+    math(EXPR alternation_rised "${alternation_rised} + 1")
   endif()
 endforeach()
-if(alternation_named EQUAL 0 OR alternation_withdrawn EQUAL 0)
+if(alternation_named EQUAL 0 OR alternation_withdrawn EQUAL 0 OR alternation_kept EQUAL 0
+   OR alternation_rised EQUAL 0)
   message(FATAL_ERROR "--turn-over-alternation: ${alternation_named} orders named yield by it, "
-                      "${alternation_withdrawn} withdrew the refits' yield: one side untested (take other placements)")
+                      "${alternation_withdrawn} withdrew the refits' yield, ${alternation_kept} kept the verdict on the "
+                      "other side, ${alternation_rised} kept a yield rule U names: a case untested (take other "
+                      "placements)")
 endif()
 # Not with the third placement on the turned face (no alternation); not in a screening run; in the --fine preset at
 # 0.015, with the hem's centre at 2.5.
 run_ok(other_face diagnose --capture ${WORK}/rise --second-capture ${WORK}/rise.p1 --held-out-capture
        ${WORK}/rise.p3 ${rise_args} --turn-over-alternation 0.000001)
 string(JSON other_face_record ERROR_VARIABLE no_other_face_record GET "${other_face}" alternation)
+# Without the face check the rule would act here: it names yield where the refits name none and the turned placement
+# drapes above the mean of the others, and withdraws the refits' yield where it does not.
+string(JSON other_face_verdict GET "${other_face}" verdict)
+set(other_dc)
+foreach(role capture second_capture held_out_capture)
+  json_number(dc "${other_face}" gap_tests ${role} drape_coefficient)
+  json_nano(dc_n "${dc}")
+  list(APPEND other_dc ${dc_n})
+endforeach()
+list(GET other_dc 0 o0)
+list(GET other_dc 1 o1)
+list(GET other_dc 2 o2)
+math(EXPR other_alt_n "${o1} - (${o0} + ${o2}) / 2")
+if(NOT ((other_face_verdict MATCHES "^(none|unexplained)$" AND other_alt_n GREATER 1000)
+        OR (other_face_verdict STREQUAL "yield" AND other_alt_n LESS 1000)))
+  message(FATAL_ERROR "the turned third placement: verdict ${other_face_verdict}, alternation ${other_alt_n} nano: "
+                      "the rule would not act even on the capture's face, so the face check is untested")
+endif()
 run_ok(screened_alt diagnose --capture ${WORK}/rise --second-capture ${WORK}/rise.p1 --held-out-capture
        ${WORK}/rise.p2 --quick --resolution 6 --states 1 --evaluations 2 --json --gap-only
        --turn-over-alternation 0.000001)

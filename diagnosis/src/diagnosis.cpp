@@ -735,7 +735,7 @@ void weigh_yield_by_alternation(DiagnosisResult& r, const Capture& capture, cons
   }
   const std::optional<double> rise = turn_over_rise(capture, others);
   const bool turn_over_names = r.budgets.turn_over_yield > 0.0 && *rise >= r.budgets.turn_over_yield;
-  if (!refits_yield || *alternation >= floor || turn_over_names) return;
+  if (!refits_yield || !(*alternation < floor) || turn_over_names) return;
   sim::logger()->info("diagnosis: the refits name yield but the turned placement drapes {:.4f} against the mean of "
                       "the others (drape coefficient, under {:g}): unexplained, the yield withdrawn",
                       *alternation, floor);

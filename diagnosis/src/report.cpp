@@ -185,11 +185,13 @@ std::string refits_markdown(const DiagnosisResult& r, std::string_view verdict, 
     const char* drapes = r.validated_second     ? "the capture's and the second capture's"
                          : r.validated_held_out ? "the capture's and the held-out capture's"
                                                 : "the capture's";
-    // One candidate (--candidates): nothing to be confident against.
+    // One candidate (--candidates): nothing to be confident against. The refits' runner-up, the second candidate
+    // (r.runner_up is the verdict's: the turn-over's alternation may have withdrawn this one).
+    const auto& cs = r.attribution.candidates;
     const std::string against =
-        r.runner_up.empty()
-            ? std::string("the only candidate refitted")
-            : fmt::format("confidence {:.2f} against the runner-up, {}", r.attribution.confidence, r.runner_up);
+        cs.size() < 2 ? std::string("the only candidate refitted")
+                      : fmt::format("confidence {:.2f} against the runner-up, {}", r.attribution.confidence,
+                                    effect_name(cs[1].effect));
     md += fmt::format("**{}: {}** ({}); adding it shrinks the gap's excess above the floors by {:.0f}% ({} drapes "
                       "from fresh initial states) and the score on the held-out {} by {:.0f}%.\n\n",
                       label, verdict, against, 100.0 * c.shrinkage, drapes,
@@ -236,8 +238,9 @@ std::string verdict_markdown(const DiagnosisResult& r) {
     const std::string shrinks = refit ? fmt::format("the {} refit shrinks the excess by {:.0f}%", effect,
                                                     100.0 * refit->shrinkage)
                                       : fmt::format("no {} refit ran", effect);
-    const std::string refits = refits_verdict == "yield" ? "The refits named yield, withdrawn: " + withdrawal() + "."
-                                                         : std::string("The refits alone named no effect:");
+    const std::string refits = refits_verdict == "yield" && r.alternation
+                                   ? "The refits named yield, withdrawn: " + withdrawal() + "."
+                                   : std::string("The refits alone named no effect:");
     return fmt::format("{}; {}). {}\n\n", reading, shrinks, refits) +
            refits_markdown(r, refits_verdict, "The refits' verdict");
   };

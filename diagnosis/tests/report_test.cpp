@@ -69,6 +69,8 @@ TEST(VerdictMarkdown, AGapAboveTheFloorsHasNoCaveat) {
   named.attribution.candidates.emplace_back();
   named.attribution.candidates.back().shrinkage = 0.8;
   named.attribution.candidates.back().held_out_shrinkage = 0.6;
+  named.attribution.candidates.emplace_back();
+  named.attribution.candidates.back().effect = Effect::kCurl;
   const std::string md = verdict_markdown(named);
   EXPECT_TRUE(contains(md, "**Verdict: yield** (confidence 0.90 against the runner-up, curl)")) << md;
   EXPECT_TRUE(contains(md, "by 80% (the capture's drapes from fresh initial states)")) << md;
@@ -78,8 +80,8 @@ TEST(VerdictMarkdown, AGapAboveTheFloorsHasNoCaveat) {
   // lies above the reference's.
   named.validated_held_out = Evaluation{};
   named.attribution.held_out_tolerance = 0.1;
-  named.attribution.candidates.back().confirmation = Confirmation::kWithinFloors;
-  named.attribution.candidates.back().held_out_shrinkage = -0.22;
+  named.attribution.candidates.front().confirmation = Confirmation::kWithinFloors;
+  named.attribution.candidates.front().held_out_shrinkage = -0.22;
   const std::string within = verdict_markdown(named);
   EXPECT_TRUE(contains(within, "It is confirmed by its drape on the held-out capture lying within the floors "
                                "(`--confirm-within-floors`); its score there is 22% above the reference's, more than "
@@ -191,7 +193,8 @@ TEST(VerdictMarkdown, TheAlternationNamesOrWithdrawsYieldAndSaysSo) {
                               "specimen's other face, drapes 0.0213 stiffer than the mean of the capture and the "
                               "third placement"))
       << named;
-  EXPECT_TRUE(contains(named, "the yield refit shrinks the excess by 10%). The refits alone named no effect:")) << named;
+  EXPECT_TRUE(contains(named, "the yield refit shrinks the excess by 10%). The refits alone named no effect:"))
+      << named;
   EXPECT_TRUE(contains(named, "**The refits' verdict: ")) << named;
 
   // The refits named yield (first, 40%) without the alternation (0.0042): unexplained, no effect's refit named, the
@@ -203,6 +206,10 @@ TEST(VerdictMarkdown, TheAlternationNamesOrWithdrawsYieldAndSaysSo) {
   withdrawn.attribution.candidates.emplace_back();
   withdrawn.attribution.candidates.back().effect = Effect::kYield;
   withdrawn.attribution.candidates.back().shrinkage = 0.4;
+  withdrawn.attribution.candidates.emplace_back();
+  withdrawn.attribution.candidates.back().effect = Effect::kShear;
+  withdrawn.attribution.confidence = 0.7;
+  withdrawn.runner_up = "yield";  // the verdict's, as diagnose() sets it: the best candidate of an "unexplained"
   EXPECT_TRUE(withdrawn.alternation->withdrew());
   EXPECT_EQ(withdrawn.refits_verdict(), "yield");
   EXPECT_EQ(withdrawn.named_refit(), nullptr);
@@ -212,7 +219,7 @@ TEST(VerdictMarkdown, TheAlternationNamesOrWithdrawsYieldAndSaysSo) {
                            "turned second capture drapes 0.0042 against the mean of the capture and the third "
                            "placement"))
       << md;
-  EXPECT_TRUE(contains(md, "**The refits' verdict: yield**")) << md;
+  EXPECT_TRUE(contains(md, "**The refits' verdict: yield** (confidence 0.70 against the runner-up, shear)")) << md;
 
   // The hem's centre then named misalignment: its paragraph, with the withdrawal as the refits' verdict.
   withdrawn.verdict = "misalignment";

@@ -98,8 +98,8 @@ struct DiagnosisSettings {
   /// 109-110). Needs a turned second capture and a held-out capture on the capture's face; not with attribute false.
   /// The refits stand as they ran. 0: off (the --fine preset: kFineTurnOverAlternation).
   double turn_over_alternation = 0.0;
-  /// Where the verdict (after turn_over_alternation) names no effect ("none" or "unexplained") and the hem's centre lies at
-  /// least this many times its floor off the fitted drape's (the off-centre feature group's ratio,
+  /// Where the verdict (after turn_over_alternation) names no effect ("none" or "unexplained") and the hem's centre
+  /// lies at least this many times its floor off the fitted drape's (the off-centre feature group's ratio,
   /// Localisation::group_ratio, FeatureGroup::kOffCentre: the order-1 harmonic of the hem's radius and height), name
   /// misalignment (DiagnosisResult::off_centre): a specimen laid off centre hangs longer on one side, which no elastic
   /// fabric's drape on a centred specimen does (rule E, docs/preregistrations/session82.md: on seeds 101-108 the ratio
@@ -265,7 +265,7 @@ struct DiagnosisResult {
   struct OffCentreMisalignment {
     double ratio = 0.0;          // the off-centre feature group's difference over its floor
     double floor = 0.0;          // DiagnosisSettings::off_centre_misalignment
-    std::string refits_verdict;  // "none" or "unexplained"
+    std::string refits_verdict;  // the verdict before it: "none" or "unexplained"
   };
   std::optional<OffCentreMisalignment> off_centre;
   /// The refits' own verdict: the verdict before the first signature that changed it (turn_over, alternation,
