@@ -1882,9 +1882,9 @@ endforeach()
 if(alternation_named EQUAL 0 OR alternation_withdrawn EQUAL 0 OR alternation_kept EQUAL 0
    OR alternation_rised EQUAL 0)
   message(FATAL_ERROR "--turn-over-alternation: ${alternation_named} orders named yield by it, "
-                      "${alternation_withdrawn} withdrew the refits' yield, ${alternation_kept} kept the verdict on the "
-                      "other side, ${alternation_rised} kept a yield rule U names: a case untested (take other "
-                      "placements)")
+                      "${alternation_withdrawn} withdrew the refits' yield, ${alternation_kept} kept the verdict "
+                      "on the other side, ${alternation_rised} kept a yield rule U names: a case untested (take "
+                      "other placements)")
 endif()
 # Not with the third placement on the turned face (no alternation); not in a screening run; in the --fine preset at
 # 0.015, with the hem's centre at 2.5.
