@@ -69,7 +69,7 @@ score. Hypotheses for the next evaluation, not the diagnosis's rule (docs/DIAGNO
   2.5` in the --fine preset): "misalignment" where the verdict names no effect, the run's rule U names no yield, and
   the hem's centre offset is 2.5 times its floor or more; else the verdict as run;
 - later_yield (rule L, registered in session 82 for fresh seeds 111-112, an addendum:
-  docs/preregistrations/session83.md): after the run's signatures (rules U, A and E as run), "yield" where the
+  docs/preregistrations/session83.md; +1 -1 there, a misalignment named yield: not adopted): after the run's signatures (rules U, A and E as run), "yield" where the
   verdict names no effect and the third placement, laid on the capture's face again, drapes with a drape coefficient
   LATER or more above the capture's (gap_tests.held_out_capture less gap_tests.capture): the set two drapes leave
   stiffens the next one, an elastic fabric has no memory;
@@ -516,7 +516,7 @@ def off_centre_misalignment(j):
     return "misalignment" if fires else j["verdict"]
 
 
-LATER = 0.02  # rule L's floor on the third placement's rise (docs/preregistrations/session83.md)
+LATER = 0.02  # rule L's floor on the third placement's rise (docs/preregistrations/session83.md; not adopted)
 
 
 def third_rise(report):
