@@ -69,8 +69,8 @@ score. Hypotheses for the next evaluation, not the diagnosis's rule (docs/DIAGNO
   2.5` in the --fine preset): "misalignment" where the verdict names no effect, the run's rule U names no yield, and
   the hem's centre offset is 2.5 times its floor or more; else the verdict as run;
 - later_yield (rule L, registered in session 82 for fresh seeds 111-112, an addendum:
-  docs/preregistrations/session83.md; +1 -1 there, a misalignment named yield: not adopted): after the run's signatures (rules U, A and E as run), "yield" where the
-  verdict names no effect and the third placement, laid on the capture's face again, drapes with a drape coefficient
+  docs/preregistrations/session83.md; +1 -1 there, a misalignment named yield: not adopted): after the run's
+  signatures (rules U, A and E as run), "yield" where the verdict names no effect and the third placement, laid on the capture's face again, drapes with a drape coefficient
   LATER or more above the capture's (gap_tests.held_out_capture less gap_tests.capture): the set two drapes leave
   stiffens the next one, an elastic fabric has no memory;
 - min_objective: the candidate whose refit objective (in-sample: the capture and the second capture) is the smallest;
