@@ -70,9 +70,12 @@ score. Hypotheses for the next evaluation, not the diagnosis's rule (docs/DIAGNO
   the hem's centre offset is 2.5 times its floor or more; else the verdict as run;
 - later_yield (rule L, registered in session 82 for fresh seeds 111-112, an addendum:
   docs/preregistrations/session83.md; +1 -1 there, a misalignment named yield: not adopted): after the run's
-  signatures (rules U, A and E as run), "yield" where the verdict names no effect and the third placement, laid on the capture's face again, drapes with a drape coefficient
-  LATER or more above the capture's (gap_tests.held_out_capture less gap_tests.capture): the set two drapes leave
-  stiffens the next one, an elastic fabric has no memory;
+  signatures (rules U, A and E as run), "yield" where the verdict names no effect and the third placement, laid on the
+  capture's face again, drapes with a drape coefficient LATER or more above the capture's (gap_tests.held_out_capture
+  less gap_tests.capture): the set two drapes leave stiffens the next one, an elastic fabric has no memory;
+- alternation_veto (rule A2, registered in session 82 for fresh seeds 113-114: docs/preregistrations/session84.md):
+  after the run's signatures, "unexplained" where the refits named yield and the verdict is still theirs, the
+  turn-over's alternation is below VETO (0.02; rule A withdraws below 0.015) and the run's rule U names nothing;
 - min_objective: the candidate whose refit objective (in-sample: the capture and the second capture) is the smallest;
   it ignores the held-out data, which the issue's attribution must use: a diagnostic of the refits, not a rule.
 
@@ -135,7 +138,7 @@ RULES = ["current", "strict", "tolerance", "objective_ties", "parsimony", "tie_o
          "mean3", "held_out_excess", "held_out_rank", "min_objective", "without_ablation", "reach", "reach_objective",
          "tie_held_out_view", "tie_held_out", "no_near_tie",
          "common4", "views_sensor", "views_camera", "tie_region", "wide_tolerance", "rise_yield", "rise_yield_015",
-         "rise_later_yield", "yield_needs_rise", "alternation_yield", "off_centre", "later_yield"]
+         "rise_later_yield", "yield_needs_rise", "alternation_yield", "off_centre", "later_yield", "alternation_veto"]
 PARAMETERS = {"sensor": 9, "misalignment": 2}  # effect_space's dimension; the others have 1
 # How each rule orders candidates of equal shrinkage before their objectives (confirmation_rule).
 TIES = {"physical_first": lambda effect: effect == "sensor",  # attribute() since session 25 (needs_simulation)
@@ -538,8 +541,22 @@ def later_yield(j, verdict):
     return "yield" if verdict in ("none", "unexplained") and rise is not None and rise >= LATER else verdict
 
 
+VETO = 0.02  # rule A2's withdrawal floor on the alternation (docs/preregistrations/session84.md)
+
+
+def alternation_veto(j, verdict):
+    """Rule A2 (registered in session 82 for seeds 113-114): laid after the run's signatures, on `verdict` (the
+    default's with them): "unexplained" where it is the refits' yield (`j`'s verdict, refits_report's), the turn-over's
+    alternation is below VETO and the run's rule U does not name yield; else `verdict`. On seeds 101-112 the 17 yields
+    the refits named alternated by +0.0257 or more, the 7 other captures they named yield by +0.0156 at most."""
+    alternation = turn_over_alternation(j)
+    vetoed = (verdict == "yield" and j["verdict"] == "yield" and alternation is not None and alternation < VETO
+              and not run_turn_over_names(j))
+    return "unexplained" if vetoed else verdict
+
+
 # The rules laid on the default's verdict after the run's signatures (signatures_applied), reading it.
-AFTER_SIGNATURES = {"later_yield": later_yield}
+AFTER_SIGNATURES = {"later_yield": later_yield, "alternation_veto": alternation_veto}
 
 
 # The rules read off the verdict as run and one more field of the report, with or without candidates.

@@ -152,6 +152,21 @@ class TurnOverRules(unittest.TestCase):
         j["placements"][2]["face"] = "down"
         self.assertIsNone(rules.third_rise(j))
 
+    def test_rule_a2_withdraws_the_refits_yield_below_its_veto(self):
+        # The refits named yield; the alternation 0.016: rule A (0.015) keeps it, rule A2 (0.02) withdraws it.
+        j = report("yield", 0.20, 0.216, c2=0.20)
+        j["settings"]["turn_over_alternation"] = 0.015
+        v = rules.verdicts(j)
+        self.assertEqual(v["current"], "yield")
+        self.assertEqual(v["alternation_veto"], "unexplained")
+        # At 0.02 or more it stays; a yield a signature named stays; rule U's rise protects it.
+        self.assertEqual(rules.verdicts(report("yield", 0.20, 0.221, c2=0.20))["alternation_veto"], "yield")
+        named = report("none", 0.20, 0.216, c2=0.20)
+        named["settings"]["turn_over_alternation"] = 0.015
+        self.assertEqual(rules.verdicts(named)["alternation_veto"], "yield")
+        turned = report("yield", 0.20, 0.225, c2=0.215, floor=0.02)
+        self.assertEqual(rules.verdicts(turned)["alternation_veto"], "yield")
+
     def test_a_run_with_rule_u_is_read_as_its_refits_then_the_turn_over(self):
         # The run named yield from the turn-over: every rule starts from the refits' verdict and gets the turn-over
         # laid on it, so the verdict as run is reproduced.
