@@ -655,6 +655,11 @@ def refits_report(j):
     return j
 
 
+def named_where_none(v, effect):
+    """`v` with `effect` wherever a rule names no effect (none or unexplained): a signature laid on every rule."""
+    return {r: effect if x in ("none", "unexplained") else x for r, x in v.items()}
+
+
 def signatures_applied(j, v):
     """Every rule's verdict with the run's signatures laid on it as diagnose() does: the turn-over's
     (settings.turn_over_yield > 0), yield where the rule names no effect and the first turn-over raised the drape
@@ -665,18 +670,18 @@ def signatures_applied(j, v):
     settings = j.get("settings") or {}
     turned = run_turn_over_names(j)
     if turned:
-        v = {r: "yield" if x in ("none", "unexplained") else x for r, x in v.items()}
+        v = named_where_none(v, "yield")
     alternation_floor = settings.get("turn_over_alternation", 0.0)
     alternation = turn_over_alternation(j)
     if alternation_floor > 0.0 and alternation is not None:
         if alternation >= alternation_floor:
-            v = {r: "yield" if x in ("none", "unexplained") else x for r, x in v.items()}
+            v = named_where_none(v, "yield")
         elif not turned:
             v = {r: "unexplained" if x == "yield" else x for r, x in v.items()}
     ratio_floor = settings.get("off_centre_misalignment", 0.0)
     ratio = off_centre_ratio(j)
     if ratio_floor > 0.0 and ratio is not None and ratio >= ratio_floor:
-        v = {r: "misalignment" if x in ("none", "unexplained") else x for r, x in v.items()}
+        v = named_where_none(v, "misalignment")
     return v
 
 

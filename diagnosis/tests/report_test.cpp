@@ -17,6 +17,13 @@ constexpr const char* kCaveat = "rules out no effect whose drape an elastic fabr
 
 bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
+/// Appends a refitted candidate of `effect` with `shrinkage` to the result's attribution.
+void add_candidate(DiagnosisResult& r, Effect effect, double shrinkage) {
+  r.attribution.candidates.emplace_back();
+  r.attribution.candidates.back().effect = effect;
+  r.attribution.candidates.back().shrinkage = shrinkage;
+}
+
 /// A PNG's width and height from its IHDR chunk (big-endian, bytes 16-23).
 std::array<int, 2> png_size(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -101,11 +108,8 @@ TEST(VerdictMarkdown, YieldFromTheTurnOverSaysSoAndKeepsTheRefitsVerdict) {
   r.verdict = "yield";
   r.turn_over = DiagnosisResult::TurnOverYield{0.0312, 0.02, "unexplained"};
   r.attribution.significant_shrinkage = 0.25;
-  for (auto [effect, shrinkage] : {std::pair{Effect::kShear, 0.4}, std::pair{Effect::kYield, 0.3}}) {
-    r.attribution.candidates.emplace_back();
-    r.attribution.candidates.back().effect = effect;
-    r.attribution.candidates.back().shrinkage = shrinkage;
-  }
+  add_candidate(r, Effect::kShear, 0.4);
+  add_candidate(r, Effect::kYield, 0.3);
   EXPECT_DOUBLE_EQ(r.named_shrinkage(), 0.3);
   ASSERT_NE(r.named_refit(), nullptr);
   EXPECT_EQ(r.named_refit()->effect, Effect::kYield);
@@ -144,11 +148,8 @@ TEST(VerdictMarkdown, MisalignmentFromTheHemCentreSaysSoAndKeepsTheRefitsVerdict
   DiagnosisResult r;
   r.verdict = "misalignment";
   r.off_centre = DiagnosisResult::OffCentreMisalignment{3.49, 2.5, "none"};
-  for (auto [effect, shrinkage] : {std::pair{Effect::kCurl, 0.5}, std::pair{Effect::kMisalignment, 0.2}}) {
-    r.attribution.candidates.emplace_back();
-    r.attribution.candidates.back().effect = effect;
-    r.attribution.candidates.back().shrinkage = shrinkage;
-  }
+  add_candidate(r, Effect::kCurl, 0.5);
+  add_candidate(r, Effect::kMisalignment, 0.2);
   EXPECT_DOUBLE_EQ(r.named_shrinkage(), 0.2);
   ASSERT_NE(r.named_refit(), nullptr);
   EXPECT_EQ(r.named_refit()->effect, Effect::kMisalignment);
@@ -178,11 +179,8 @@ TEST(VerdictMarkdown, TheAlternationNamesOrWithdrawsYieldAndSaysSo) {
   DiagnosisResult r;
   r.verdict = "yield";
   r.alternation = DiagnosisResult::TurnOverAlternation{0.0213, 0.015, "unexplained"};
-  for (auto [effect, shrinkage] : {std::pair{Effect::kShear, 0.2}, std::pair{Effect::kYield, 0.1}}) {
-    r.attribution.candidates.emplace_back();
-    r.attribution.candidates.back().effect = effect;
-    r.attribution.candidates.back().shrinkage = shrinkage;
-  }
+  add_candidate(r, Effect::kShear, 0.2);
+  add_candidate(r, Effect::kYield, 0.1);
   EXPECT_FALSE(r.alternation->withdrew());
   EXPECT_EQ(r.refits_verdict(), "unexplained");
   EXPECT_DOUBLE_EQ(r.named_shrinkage(), 0.1);
@@ -203,11 +201,8 @@ TEST(VerdictMarkdown, TheAlternationNamesOrWithdrawsYieldAndSaysSo) {
   withdrawn.verdict = "unexplained";
   withdrawn.alternation = DiagnosisResult::TurnOverAlternation{0.0042, 0.015, "yield"};
   withdrawn.attribution.named = true;
-  withdrawn.attribution.candidates.emplace_back();
-  withdrawn.attribution.candidates.back().effect = Effect::kYield;
-  withdrawn.attribution.candidates.back().shrinkage = 0.4;
-  withdrawn.attribution.candidates.emplace_back();
-  withdrawn.attribution.candidates.back().effect = Effect::kShear;
+  add_candidate(withdrawn, Effect::kYield, 0.4);
+  add_candidate(withdrawn, Effect::kShear, 0.0);
   withdrawn.attribution.confidence = 0.7;
   withdrawn.runner_up = "yield";  // the verdict's, as diagnose() sets it: the best candidate of an "unexplained"
   EXPECT_TRUE(withdrawn.alternation->withdrew());
