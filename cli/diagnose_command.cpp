@@ -429,10 +429,9 @@ Runner add_diagnose_command(CLI::App& app) {
   auto* quick = app.add_flag("--quick", o->quick, "Small budgets (16x16 mesh, 2 initial states, fewer evaluations)");
   app.add_flag("--fine", o->fine,
                fmt::format("--quick's budgets on a {0}x{0} fitting mesh, with the shape floor calibrated for it, "
-                           "--turn-over-yield {1:g}, --turn-over-alternation {2:g} and --off-centre-misalignment {3:g}",
+                           "--turn-over-yield {1:g} and --off-centre-misalignment {2:g}",
                            diagnosis::DiagnosisSettings::kFineResolution,
                            diagnosis::DiagnosisSettings::kFineTurnOverYield,
-                           diagnosis::DiagnosisSettings::kFineTurnOverAlternation,
                            diagnosis::DiagnosisSettings::kFineOffCentreMisalignment))
       ->excludes(quick);
   app.add_option("--resolution", o->resolution,
@@ -463,8 +462,7 @@ Runner add_diagnose_command(CLI::App& app) {
                  "face): where the verdict names no effect and A is at least this, name yield; where the refits named "
                  "yield and A is below this (and the turn-over alone names no yield), unexplained (report.json "
                  "\"alternation\"; within the floors too; not with --gap-only; needs --second-capture and "
-                 "--held-out-capture; default 0: off; --fine " +
-                     fmt::format("{:g}", diagnosis::DiagnosisSettings::kFineTurnOverAlternation) + ")");
+                 "--held-out-capture; default 0: off, --fine too: it left that preset in session 83)");
   app.add_option("--off-centre-misalignment", o->off_centre_misalignment,
                  "Where the verdict names no effect (none or unexplained; after --turn-over-alternation) and the "
                  "hem's centre lies at least this many times its floor off the fitted drape's (localisation."

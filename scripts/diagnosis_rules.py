@@ -61,7 +61,8 @@ score. Hypotheses for the next evaluation, not the diagnosis's rule (docs/DIAGNO
   "unexplained" where the verdict as run is yield and the first turn-over raised the drape coefficient by less than
   0.02; elsewhere the verdict as run;
 - alternation_yield (rule A, registered in session 81 for seeds 109-110: docs/preregistrations/session82.md; adopted
-  in session 82, `drapegen diagnose --turn-over-alternation 0.015` in the --fine preset: on reports since, the verdict
+  in session 82, `drapegen diagnose --turn-over-alternation 0.015` in the --fine preset until session 83, when it left
+  it (docs/DIAGNOSIS_RESULTS.md, "Session 84"): on reports of sessions 83-84, the verdict
   as run, and on every rule's verdict where settings.turn_over_alternation is set, `signatures_applied`): rule U and
   rule K on the turn-over's alternation, the turned second capture's drape coefficient less the mean of the first and
   the third's, at 0.015;
@@ -75,7 +76,8 @@ score. Hypotheses for the next evaluation, not the diagnosis's rule (docs/DIAGNO
   less gap_tests.capture): the set two drapes leave stiffens the next one, an elastic fabric has no memory;
 - alternation_veto (rule A2, registered in session 82 for fresh seeds 113-114: docs/preregistrations/session84.md):
   after the run's signatures, "unexplained" where the refits named yield and the verdict is still theirs, the
-  turn-over's alternation is below VETO (0.02; rule A withdraws below 0.015) and the run's rule U names nothing;
+  turn-over's alternation is below VETO (0.02; rule A withdraws below 0.015) and the run's rule U names nothing
+  (+0 -0 on seeds 113-114: not adopted);
 - min_objective: the candidate whose refit objective (in-sample: the capture and the second capture) is the smallest;
   it ignores the held-out data, which the issue's attribution must use: a diagnostic of the refits, not a rule.
 
@@ -461,7 +463,7 @@ def yield_needs_rise(j):
     return yield_unless_risen(j, turn_over_rise(j), RISE)
 
 
-ALTERNATION = 0.015  # rule A's floor (adopted in session 82: --turn-over-alternation in the --fine preset)
+ALTERNATION = 0.015  # rule A's floor (--turn-over-alternation in the --fine preset in sessions 82-83)
 
 
 def turn_over_alternation(report):

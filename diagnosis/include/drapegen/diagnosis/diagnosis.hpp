@@ -96,7 +96,9 @@ struct DiagnosisSettings {
   /// is below turn_over_yield, which would name yield again), withdraw it: "unexplained", the refits' yield kept in
   /// the report (DiagnosisResult::alternation; rule A, docs/preregistrations/session82.md: +1 -0 on fresh seeds
   /// 109-110). Needs a turned second capture and a held-out capture on the capture's face; not with attribute false.
-  /// The refits stand as they ran. 0: off (the --fine preset: kFineTurnOverAlternation).
+  /// The refits stand as they ran. 0: off. Not in the --fine preset: there at 0.015 from session 82, it left in
+  /// session 83 (fresh seeds 113-114: of the three verdicts it set, a control named yield and a yield the refits
+  /// named right withdrawn; docs/DIAGNOSIS_RESULTS.md, "Session 84").
   double turn_over_alternation = 0.0;
   /// Where the verdict (after turn_over_alternation) names no effect ("none" or "unexplained") and the hem's centre
   /// lies at least this many times its floor off the fitted drape's (the off-centre feature group's ratio,
@@ -126,9 +128,6 @@ struct DiagnosisSettings {
   /// raised the drape coefficient by 0.02 or more on 41 of 53 yields, 7 of 56 curls and none of 81 controls (at most
   /// +0.0161) nor of 191 other captures.
   static constexpr double kFineTurnOverYield = 0.02;
-  /// The --fine preset's turn_over_alternation (rule A, registered in session 81 for fresh seeds 109-110: +1 -0, no
-  /// control named; adopted in session 82, docs/DIAGNOSIS_RESULTS.md, "Session 82").
-  static constexpr double kFineTurnOverAlternation = 0.015;
   /// The --fine preset's off_centre_misalignment (rule E, registered in session 81 for fresh seeds 109-110: +1 -0, no
   /// control named; adopted in session 82).
   static constexpr double kFineOffCentreMisalignment = 2.5;
