@@ -78,6 +78,12 @@ score. Hypotheses for the next evaluation, not the diagnosis's rule (docs/DIAGNO
   after the run's signatures, "unexplained" where the refits named yield and the verdict is still theirs, the
   turn-over's alternation is below VETO (0.02; rule A withdraws below 0.015) and the run's rule U names nothing
   (+0 -0 on seeds 113-114: not adopted);
+- later_mean_yield (rule Y, written in session 83 before seeds 113-114 were read, not registered: a control of seed
+  114 reached +0.0181): after the run's signatures, "yield" where the verdict names no effect and the turned second
+  and the third placement drape LATER_MEAN (0.017) or more above the capture on average;
+- off_centre_mm (rule M, registered in session 83 for fresh seeds 115-116: docs/preregistrations/session85.md): after
+  the run's signatures, "misalignment" where the verdict names no effect and the hem's centre lies OFF_CENTRE_MM
+  (6.5 mm) or more off the fitted drape's, whatever its floor;
 - min_objective: the candidate whose refit objective (in-sample: the capture and the second capture) is the smallest;
   it ignores the held-out data, which the issue's attribution must use: a diagnostic of the refits, not a rule.
 
@@ -140,7 +146,8 @@ RULES = ["current", "strict", "tolerance", "objective_ties", "parsimony", "tie_o
          "mean3", "held_out_excess", "held_out_rank", "min_objective", "without_ablation", "reach", "reach_objective",
          "tie_held_out_view", "tie_held_out", "no_near_tie",
          "common4", "views_sensor", "views_camera", "tie_region", "wide_tolerance", "rise_yield", "rise_yield_015",
-         "rise_later_yield", "yield_needs_rise", "alternation_yield", "off_centre", "later_yield", "alternation_veto"]
+         "rise_later_yield", "yield_needs_rise", "alternation_yield", "off_centre", "later_yield", "alternation_veto",
+         "later_mean_yield", "off_centre_mm"]
 PARAMETERS = {"sensor": 9, "misalignment": 2}  # effect_space's dimension; the others have 1
 # How each rule orders candidates of equal shrinkage before their objectives (confirmation_rule).
 TIES = {"physical_first": lambda effect: effect == "sensor",  # attribute() since session 25 (needs_simulation)
@@ -557,8 +564,52 @@ def alternation_veto(j, verdict):
     return "unexplained" if vetoed else verdict
 
 
+LATER_MEAN = 0.017  # rule Y's floor on the later placements' mean rise (not registered)
+
+
+def later_mean_rise(report):
+    """The mean of the turned second and the third placement's drape coefficients less the capture's, where the second
+    lies on the other face and the third on the capture's; None otherwise."""
+    rise, third = turn_over_rise(report), third_rise(report)
+    return None if rise is None or third is None else 0.5 * (rise + third)
+
+
+def later_mean_yield(j, verdict):
+    """Rule Y (written in session 83, not registered: on seeds 113-114 a control reached +0.0181): laid after the
+    run's signatures, on `verdict`: "yield" where it names no effect and the two later placements drape LATER_MEAN or
+    more above the capture on average: the set every drape leaves stiffens each later one, on either face, while an
+    elastic fabric's placements differ by their noise. Seeds 101-112 (in sample, read off them): 5 of the 11 yields
+    the default left unnamed reached 0.0193 or more, no control (at most 0.0138) nor other unnamed capture (at most
+    0.0148)."""
+    rise = later_mean_rise(j)
+    fires = verdict in ("none", "unexplained") and rise is not None and rise >= LATER_MEAN
+    return "yield" if fires else verdict
+
+
+OFF_CENTRE_MM = 6.5  # rule M's floor on the hem's centre offset in mm (docs/preregistrations/session85.md)
+
+
+def off_centre_mm(report):
+    """The hem's centre offset from the fitted drape's in mm (localisation.feature_groups.off_centre.difference_mm);
+    None where the report lacks it."""
+    group = ((report.get("localisation") or {}).get("feature_groups") or {}).get("off_centre") or {}
+    return group.get("difference_mm")
+
+
+def off_centre_mm_misalignment(j, verdict):
+    """Rule M (registered in session 83 for seeds 115-116): laid after the run's signatures, on `verdict`:
+    "misalignment" where it names no effect and the hem's centre lies OFF_CENTRE_MM or more off the fitted drape's,
+    whatever its floor (rule E reads the offset over its floor, which reached 4-6 mm where rule E missed). Seeds
+    101-112 (in sample): 3 of the 5 misalignments the default left unnamed reached 8.6 mm or more, no control (at most
+    4.84 mm) nor other unnamed capture (at most 3.69 mm)."""
+    mm = off_centre_mm(j)
+    fires = verdict in ("none", "unexplained") and mm is not None and mm >= OFF_CENTRE_MM
+    return "misalignment" if fires else verdict
+
+
 # The rules laid on the default's verdict after the run's signatures (signatures_applied), reading it.
-AFTER_SIGNATURES = {"later_yield": later_yield, "alternation_veto": alternation_veto}
+AFTER_SIGNATURES = {"later_yield": later_yield, "alternation_veto": alternation_veto,
+                    "later_mean_yield": later_mean_yield, "off_centre_mm": off_centre_mm_misalignment}
 
 
 # The rules read off the verdict as run and one more field of the report, with or without candidates.

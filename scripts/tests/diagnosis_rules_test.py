@@ -167,6 +167,32 @@ class TurnOverRules(unittest.TestCase):
         turned = report("yield", 0.20, 0.225, c2=0.215, floor=0.02)
         self.assertEqual(rules.verdicts(turned)["alternation_veto"], "yield")
 
+    def test_rule_y_names_yield_by_the_later_placements_mean_rise(self):
+        # The turned second 0.01 and the third 0.025 above the first: mean 0.0175, yield where nothing is named.
+        self.assertAlmostEqual(rules.later_mean_rise(report("none", 0.20, 0.21, c2=0.225)), 0.0175)
+        self.assertEqual(rules.later_mean_yield(report("none", 0.20, 0.21, c2=0.225), "none"), "yield")
+        self.assertEqual(rules.later_mean_yield(report("none", 0.20, 0.21, c2=0.222), "unexplained"), "unexplained")
+        self.assertEqual(rules.later_mean_yield(report("curl", 0.20, 0.25, c2=0.25), "curl"), "curl")
+        # Not without the turn-over (the second on the capture's face) nor with the third turned.
+        self.assertIsNone(rules.later_mean_rise(report("none", 0.20, 0.23, c2=0.23, second_face="up")))
+        turned_third = report("none", 0.20, 0.23, c2=0.23)
+        turned_third["placements"][2]["face"] = "down"
+        self.assertIsNone(rules.later_mean_rise(turned_third))
+        # Laid on the default's verdict with the run's signatures: a column of verdicts().
+        self.assertEqual(rules.verdicts(report("none", 0.20, 0.21, c2=0.225))["later_mean_yield"], "yield")
+
+    def test_rule_m_names_misalignment_by_the_hem_centre_in_mm(self):
+        j = report("unexplained", 0.20, 0.20, c2=0.20)
+        j["localisation"] = {"feature_groups": {"off_centre": {"ratio": 1.5, "difference_mm": 8.6}}}
+        self.assertEqual(rules.off_centre_mm(j), 8.6)
+        self.assertEqual(rules.off_centre_mm_misalignment(j, "unexplained"), "misalignment")
+        self.assertEqual(rules.off_centre_mm_misalignment(j, "shear"), "shear")
+        self.assertEqual(rules.verdicts(j)["off_centre_mm"], "misalignment")
+        self.assertEqual(rules.verdicts(j)["current"], "unexplained")  # rule E's ratio 1.5: not named as run
+        j["localisation"]["feature_groups"]["off_centre"]["difference_mm"] = 6.4
+        self.assertEqual(rules.verdicts(j)["off_centre_mm"], "unexplained")
+        self.assertIsNone(rules.off_centre_mm(report("none", 0.20, 0.20)))
+
     def test_a_run_with_rule_u_is_read_as_its_refits_then_the_turn_over(self):
         # The run named yield from the turn-over: every rule starts from the refits' verdict and gets the turn-over
         # laid on it, so the verdict as run is reproduced.
