@@ -84,6 +84,8 @@ score. Hypotheses for the next evaluation, not the diagnosis's rule (docs/DIAGNO
 - off_centre_mm (rule M, registered in session 83 for fresh seeds 115-116: docs/preregistrations/session85.md): after
   the run's signatures, "misalignment" where the verdict names no effect and the hem's centre lies OFF_CENTRE_MM
   (6.5 mm) or more off the fitted drape's, whatever its floor;
+- off_centre_mm_over_yield (rule M2, an addendum to session 85's registration): rule M, and "misalignment" too where
+  the verdict is the refits' yield, the run's rule U names nothing and the hem's centre lies OFF_CENTRE_MM or more off;
 - min_objective: the candidate whose refit objective (in-sample: the capture and the second capture) is the smallest;
   it ignores the held-out data, which the issue's attribution must use: a diagnostic of the refits, not a rule.
 
@@ -147,7 +149,7 @@ RULES = ["current", "strict", "tolerance", "objective_ties", "parsimony", "tie_o
          "tie_held_out_view", "tie_held_out", "no_near_tie",
          "common4", "views_sensor", "views_camera", "tie_region", "wide_tolerance", "rise_yield", "rise_yield_015",
          "rise_later_yield", "yield_needs_rise", "alternation_yield", "off_centre", "later_yield", "alternation_veto",
-         "later_mean_yield", "off_centre_mm"]
+         "later_mean_yield", "off_centre_mm", "off_centre_mm_over_yield"]
 PARAMETERS = {"sensor": 9, "misalignment": 2}  # effect_space's dimension; the others have 1
 # How each rule orders candidates of equal shrinkage before their objectives (confirmation_rule).
 TIES = {"physical_first": lambda effect: effect == "sensor",  # attribute() since session 25 (needs_simulation)
@@ -607,9 +609,23 @@ def off_centre_mm_misalignment(j, verdict):
     return "misalignment" if fires else verdict
 
 
+def off_centre_mm_over_yield(j, verdict):
+    """Rule M2 (an addendum to session 85's registration): rule M, and also where `verdict` is the refits' yield (no
+    signature set it) and the run's rule U would not name yield (the first rise below its floor): the yield refit can
+    stand in for an off-centre drape, which the hem's centre shows. Seeds 101-114 (in sample): of the 31 captures the
+    refits named yield, the 3 misalignments lay 6.71-8.60 mm off, the others at most 4.84 mm (a control; yields at
+    most 4.47 mm)."""
+    mm = off_centre_mm(j)
+    refits_yield = verdict == "yield" and j["verdict"] == "yield" and not run_turn_over_names(j)
+    if mm is not None and mm >= OFF_CENTRE_MM and refits_yield:
+        return "misalignment"
+    return off_centre_mm_misalignment(j, verdict)
+
+
 # The rules laid on the default's verdict after the run's signatures (signatures_applied), reading it.
 AFTER_SIGNATURES = {"later_yield": later_yield, "alternation_veto": alternation_veto,
-                    "later_mean_yield": later_mean_yield, "off_centre_mm": off_centre_mm_misalignment}
+                    "later_mean_yield": later_mean_yield, "off_centre_mm": off_centre_mm_misalignment,
+                    "off_centre_mm_over_yield": off_centre_mm_over_yield}
 
 
 # The rules read off the verdict as run and one more field of the report, with or without candidates.

@@ -193,6 +193,26 @@ class TurnOverRules(unittest.TestCase):
         self.assertEqual(rules.verdicts(j)["off_centre_mm"], "unexplained")
         self.assertIsNone(rules.off_centre_mm(report("none", 0.20, 0.20)))
 
+    def test_rule_m2_takes_the_refits_yield_too_unless_the_turn_over_names_it(self):
+        j = report("yield", 0.20, 0.203, c2=0.20, floor=0.02)
+        j["localisation"] = {"feature_groups": {"off_centre": {"ratio": 1.4, "difference_mm": 6.7}}}
+        v = rules.verdicts(j)
+        self.assertEqual(v["current"], "yield")
+        self.assertEqual(v["off_centre_mm"], "yield")  # rule M leaves a named effect
+        self.assertEqual(v["off_centre_mm_over_yield"], "misalignment")
+        # Where the first turn-over rose past rule U's floor, the yield stays; below 6.5 mm too.
+        j["gap_tests"]["second_capture"]["drape_coefficient"] = 0.225
+        self.assertEqual(rules.verdicts(j)["off_centre_mm_over_yield"], "yield")
+        j["gap_tests"]["second_capture"]["drape_coefficient"] = 0.203
+        j["localisation"]["feature_groups"]["off_centre"]["difference_mm"] = 6.4
+        self.assertEqual(rules.verdicts(j)["off_centre_mm_over_yield"], "yield")
+        # Other named effects stay; no effect named: as rule M.
+        shear = dict(j, verdict="shear")
+        shear["localisation"] = {"feature_groups": {"off_centre": {"ratio": 1.4, "difference_mm": 9.0}}}
+        self.assertEqual(rules.verdicts(shear)["off_centre_mm_over_yield"], "shear")
+        none = dict(shear, verdict="none")
+        self.assertEqual(rules.verdicts(none)["off_centre_mm_over_yield"], "misalignment")
+
     def test_a_run_with_rule_u_is_read_as_its_refits_then_the_turn_over(self):
         # The run named yield from the turn-over: every rule starts from the refits' verdict and gets the turn-over
         # laid on it, so the verdict as run is reproduced.
