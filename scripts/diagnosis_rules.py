@@ -78,13 +78,13 @@ score. Hypotheses for the next evaluation, not the diagnosis's rule (docs/DIAGNO
   after the run's signatures, "unexplained" where the refits named yield and the verdict is still theirs, the
   turn-over's alternation is below VETO (0.02; rule A withdraws below 0.015) and the run's rule U names nothing
   (+0 -0 on seeds 113-114: not adopted);
-- later_mean_yield (rule Y, written in session 83 before seeds 113-114 were read, not registered: a control of seed
+- later_mean_yield (rule L2, written in session 83 before seeds 113-114 were read, not registered: a control of seed
   114 reached +0.0181): after the run's signatures, "yield" where the verdict names no effect and the turned second
   and the third placement drape LATER_MEAN (0.017) or more above the capture on average;
-- off_centre_mm (rule M, registered in session 83 for fresh seeds 115-116: docs/preregistrations/session85.md): after
+- off_centre_mm (rule D, registered in session 83 for fresh seeds 115-116: docs/preregistrations/session85.md): after
   the run's signatures, "misalignment" where the verdict names no effect and the hem's centre lies OFF_CENTRE_MM
   (6.5 mm) or more off the fitted drape's, whatever its floor;
-- off_centre_mm_over_yield (rule M2, an addendum to session 85's registration): rule M, and "misalignment" too where
+- off_centre_mm_over_yield (rule D2, an addendum to session 85's registration): rule D, and "misalignment" too where
   the verdict is the refits' yield, the run's rule U names nothing and the hem's centre lies OFF_CENTRE_MM or more off;
 - min_objective: the candidate whose refit objective (in-sample: the capture and the second capture) is the smallest;
   it ignores the held-out data, which the issue's attribution must use: a diagnostic of the refits, not a rule.
@@ -566,7 +566,7 @@ def alternation_veto(j, verdict):
     return "unexplained" if vetoed else verdict
 
 
-LATER_MEAN = 0.017  # rule Y's floor on the later placements' mean rise (not registered)
+LATER_MEAN = 0.017  # rule L2's floor on the later placements' mean rise (not registered)
 
 
 def later_mean_rise(report):
@@ -577,7 +577,7 @@ def later_mean_rise(report):
 
 
 def later_mean_yield(j, verdict):
-    """Rule Y (written in session 83, not registered: on seeds 113-114 a control reached +0.0181): laid after the
+    """Rule L2 (written in session 83, not registered: on seeds 113-114 a control reached +0.0181): laid after the
     run's signatures, on `verdict`: "yield" where it names no effect and the two later placements drape LATER_MEAN or
     more above the capture on average: the set every drape leaves stiffens each later one, on either face, while an
     elastic fabric's placements differ by their noise. Seeds 101-112 (in sample, read off them): 5 of the 11 yields
@@ -588,7 +588,7 @@ def later_mean_yield(j, verdict):
     return "yield" if fires else verdict
 
 
-OFF_CENTRE_MM = 6.5  # rule M's floor on the hem's centre offset in mm (docs/preregistrations/session85.md)
+OFF_CENTRE_MM = 6.5  # rule D's floor on the hem's centre offset in mm (docs/preregistrations/session85.md)
 
 
 def off_centre_mm(report):
@@ -599,7 +599,7 @@ def off_centre_mm(report):
 
 
 def off_centre_mm_misalignment(j, verdict):
-    """Rule M (registered in session 83 for seeds 115-116): laid after the run's signatures, on `verdict`:
+    """Rule D (registered in session 83 for seeds 115-116): laid after the run's signatures, on `verdict`:
     "misalignment" where it names no effect and the hem's centre lies OFF_CENTRE_MM or more off the fitted drape's,
     whatever its floor (rule E reads the offset over its floor, which reached 4-6 mm where rule E missed). Seeds
     101-112 (in sample): 3 of the 5 misalignments the default left unnamed reached 8.6 mm or more, no control (at most
@@ -610,7 +610,7 @@ def off_centre_mm_misalignment(j, verdict):
 
 
 def off_centre_mm_over_yield(j, verdict):
-    """Rule M2 (an addendum to session 85's registration): rule M, and also where `verdict` is the refits' yield (no
+    """Rule D2 (an addendum to session 85's registration): rule D, and also where `verdict` is the refits' yield (no
     signature set it) and the run's rule U would not name yield (the first rise below its floor): the yield refit can
     stand in for an off-centre drape, which the hem's centre shows. Seeds 101-114 (in sample): of the 31 captures the
     refits named yield, the 3 misalignments lay 6.71-8.60 mm off, the others at most 4.84 mm (a control; yields at

@@ -167,7 +167,7 @@ class TurnOverRules(unittest.TestCase):
         turned = report("yield", 0.20, 0.225, c2=0.215, floor=0.02)
         self.assertEqual(rules.verdicts(turned)["alternation_veto"], "yield")
 
-    def test_rule_y_names_yield_by_the_later_placements_mean_rise(self):
+    def test_rule_l2_names_yield_by_the_later_placements_mean_rise(self):
         # The turned second 0.01 and the third 0.025 above the first: mean 0.0175, yield where nothing is named.
         self.assertAlmostEqual(rules.later_mean_rise(report("none", 0.20, 0.21, c2=0.225)), 0.0175)
         self.assertEqual(rules.later_mean_yield(report("none", 0.20, 0.21, c2=0.225), "none"), "yield")
@@ -181,7 +181,7 @@ class TurnOverRules(unittest.TestCase):
         # Laid on the default's verdict with the run's signatures: a column of verdicts().
         self.assertEqual(rules.verdicts(report("none", 0.20, 0.21, c2=0.225))["later_mean_yield"], "yield")
 
-    def test_rule_m_names_misalignment_by_the_hem_centre_in_mm(self):
+    def test_rule_d_names_misalignment_by_the_hem_centre_in_mm(self):
         j = report("unexplained", 0.20, 0.20, c2=0.20)
         j["localisation"] = {"feature_groups": {"off_centre": {"ratio": 1.5, "difference_mm": 8.6}}}
         self.assertEqual(rules.off_centre_mm(j), 8.6)
@@ -193,12 +193,12 @@ class TurnOverRules(unittest.TestCase):
         self.assertEqual(rules.verdicts(j)["off_centre_mm"], "unexplained")
         self.assertIsNone(rules.off_centre_mm(report("none", 0.20, 0.20)))
 
-    def test_rule_m2_takes_the_refits_yield_too_unless_the_turn_over_names_it(self):
+    def test_rule_d2_takes_the_refits_yield_too_unless_the_turn_over_names_it(self):
         j = report("yield", 0.20, 0.203, c2=0.20, floor=0.02)
         j["localisation"] = {"feature_groups": {"off_centre": {"ratio": 1.4, "difference_mm": 6.7}}}
         v = rules.verdicts(j)
         self.assertEqual(v["current"], "yield")
-        self.assertEqual(v["off_centre_mm"], "yield")  # rule M leaves a named effect
+        self.assertEqual(v["off_centre_mm"], "yield")  # rule D leaves a named effect
         self.assertEqual(v["off_centre_mm_over_yield"], "misalignment")
         # Where the first turn-over rose past rule U's floor, the yield stays; below 6.5 mm too.
         j["gap_tests"]["second_capture"]["drape_coefficient"] = 0.225
@@ -206,7 +206,7 @@ class TurnOverRules(unittest.TestCase):
         j["gap_tests"]["second_capture"]["drape_coefficient"] = 0.203
         j["localisation"]["feature_groups"]["off_centre"]["difference_mm"] = 6.4
         self.assertEqual(rules.verdicts(j)["off_centre_mm_over_yield"], "yield")
-        # Other named effects stay; no effect named: as rule M.
+        # Other named effects stay; no effect named: as rule D.
         shear = dict(j, verdict="shear")
         shear["localisation"] = {"feature_groups": {"off_centre": {"ratio": 1.4, "difference_mm": 9.0}}}
         self.assertEqual(rules.verdicts(shear)["off_centre_mm_over_yield"], "shear")
