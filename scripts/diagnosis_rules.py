@@ -511,11 +511,21 @@ def run_turn_over_names(j):
 OFF_CENTRE = 2.5  # rule E's ratio of the hem's centre offset to its floor (a candidate for session 82)
 
 
+def off_centre_group(report):
+    """The report's off-centre feature group (localisation.feature_groups.off_centre: the order-1 harmonic of the hem's
+    radius and height, capture less model); {} where the report lacks it."""
+    return ((report.get("localisation") or {}).get("feature_groups") or {}).get("off_centre") or {}
+
+
 def off_centre_ratio(report):
-    """The hem's centre offset against its floor (localisation.feature_groups.off_centre.ratio: the order-1 harmonic
-    of the hem's radius and height, capture less model, over its noise floor); None where the report lacks it."""
-    group = ((report.get("localisation") or {}).get("feature_groups") or {}).get("off_centre") or {}
-    return group.get("ratio")
+    """The hem's centre offset against its noise floor (off_centre_group's ratio); None where the report lacks it."""
+    return off_centre_group(report).get("ratio")
+
+
+def refits_yield_stands(j, verdict):
+    """Whether `verdict` is the refits' yield (`j`'s verdict, refits_report's; no signature set it) and the run's rule
+    U would not name yield by itself (rule A2's and rule D2's condition)."""
+    return verdict == "yield" and j["verdict"] == "yield" and not run_turn_over_names(j)
 
 
 def off_centre_misalignment(j):
@@ -561,8 +571,7 @@ def alternation_veto(j, verdict):
     alternation is below VETO and the run's rule U does not name yield; else `verdict`. On seeds 101-112 the 17 yields
     the refits named alternated by +0.0257 or more, the 7 other captures they named yield by +0.0156 at most."""
     alternation = turn_over_alternation(j)
-    vetoed = (verdict == "yield" and j["verdict"] == "yield" and alternation is not None and alternation < VETO
-              and not run_turn_over_names(j))
+    vetoed = refits_yield_stands(j, verdict) and alternation is not None and alternation < VETO
     return "unexplained" if vetoed else verdict
 
 
@@ -592,10 +601,9 @@ OFF_CENTRE_MM = 6.5  # rule D's floor on the hem's centre offset in mm (docs/pre
 
 
 def off_centre_mm(report):
-    """The hem's centre offset from the fitted drape's in mm (localisation.feature_groups.off_centre.difference_mm);
-    None where the report lacks it."""
-    group = ((report.get("localisation") or {}).get("feature_groups") or {}).get("off_centre") or {}
-    return group.get("difference_mm")
+    """The hem's centre offset from the fitted drape's in mm (off_centre_group's difference_mm); None where the report
+    lacks it."""
+    return off_centre_group(report).get("difference_mm")
 
 
 def off_centre_mm_misalignment(j, verdict):
@@ -616,8 +624,7 @@ def off_centre_mm_over_yield(j, verdict):
     refits named yield, the 3 misalignments lay 6.71-8.60 mm off, the others at most 4.84 mm (a control; yields at
     most 4.47 mm)."""
     mm = off_centre_mm(j)
-    refits_yield = verdict == "yield" and j["verdict"] == "yield" and not run_turn_over_names(j)
-    if mm is not None and mm >= OFF_CENTRE_MM and refits_yield:
+    if mm is not None and mm >= OFF_CENTRE_MM and refits_yield_stands(j, verdict):
         return "misalignment"
     return off_centre_mm_misalignment(j, verdict)
 
