@@ -149,7 +149,7 @@ RULES = ["current", "strict", "tolerance", "objective_ties", "parsimony", "tie_o
          "tie_held_out_view", "tie_held_out", "no_near_tie",
          "common4", "views_sensor", "views_camera", "tie_region", "wide_tolerance", "rise_yield", "rise_yield_015",
          "rise_later_yield", "yield_needs_rise", "alternation_yield", "off_centre", "later_yield", "alternation_veto",
-         "later_mean_yield", "off_centre_mm", "off_centre_mm_over_yield"]
+         "later_mean_yield", "off_centre_mm", "off_centre_mm_over_yield", "lifted_top"]
 PARAMETERS = {"sensor": 9, "misalignment": 2}  # effect_space's dimension; the others have 1
 # How each rule orders candidates of equal shrinkage before their objectives (confirmation_rule).
 TIES = {"physical_first": lambda effect: effect == "sensor",  # attribute() since session 25 (needs_simulation)
@@ -629,10 +629,32 @@ def off_centre_mm_over_yield(j, verdict):
     return off_centre_mm_misalignment(j, verdict)
 
 
+LIFTED_TOP_MM = 1.0  # rule F's floor on the platform top's lift (a candidate for session 86)
+
+
+def top_lift_mm(report):
+    """How far the cloth on the platform top lies above its contact offset where the rigid surfaces read it as lifted
+    (rigid_surfaces.top_lift_mm: the bare side shows the camera where its calibration says; 0 where the offset is read
+    as the camera's or under 0.5 mm); None where the report lacks it."""
+    return (report.get("rigid_surfaces") or {}).get("top_lift_mm")
+
+
+def lifted_top_friction(j, verdict):
+    """Rule F (a candidate for session 86's registration): laid after the run's signatures, on `verdict`: "friction"
+    where it is none, unexplained or yield and the cloth on the platform top lies LIFTED_TOP_MM or more above its
+    contact offset: a specimen held by friction alone slides on the top and buckles off it, where the fitted model's
+    specimen (the adhesive boundary) lies on it. Seeds 101-114 (in sample): 30 of the 31 frictions lifted 1.31-2.32 mm,
+    none of the 241 other captures (72 controls, 15 sensors); +3 -0 on the default (rules U and E): seed 105's
+    friction_02 (none) and seed 111's friction_01 and _03 (the refits' yield)."""
+    lift = top_lift_mm(j)
+    fires = verdict in ("none", "unexplained", "yield") and lift is not None and lift >= LIFTED_TOP_MM
+    return "friction" if fires else verdict
+
+
 # The rules laid on the default's verdict after the run's signatures (signatures_applied), reading it.
 AFTER_SIGNATURES = {"later_yield": later_yield, "alternation_veto": alternation_veto,
                     "later_mean_yield": later_mean_yield, "off_centre_mm": off_centre_mm_misalignment,
-                    "off_centre_mm_over_yield": off_centre_mm_over_yield}
+                    "off_centre_mm_over_yield": off_centre_mm_over_yield, "lifted_top": lifted_top_friction}
 
 
 # The rules read off the verdict as run and one more field of the report, with or without candidates.

@@ -213,6 +213,20 @@ class TurnOverRules(unittest.TestCase):
         none = dict(shear, verdict="none")
         self.assertEqual(rules.verdicts(none)["off_centre_mm_over_yield"], "misalignment")
 
+    def test_rule_f_names_friction_where_the_platform_top_is_lifted(self):
+        j = report("yield", 0.20, 0.21, c2=0.20)
+        j["rigid_surfaces"] = {"top_lift_mm": 1.6}
+        self.assertEqual(rules.top_lift_mm(j), 1.6)
+        self.assertEqual(rules.verdicts(j)["lifted_top"], "friction")  # over the refits' yield
+        for verdict in ("none", "unexplained"):
+            self.assertEqual(rules.lifted_top_friction(j, verdict), "friction")
+        for verdict in ("curl", "sensor", "misalignment"):  # another named effect stays
+            self.assertEqual(rules.lifted_top_friction(j, verdict), verdict)
+        j["rigid_surfaces"]["top_lift_mm"] = 0.9
+        self.assertEqual(rules.verdicts(j)["lifted_top"], "yield")
+        self.assertIsNone(rules.top_lift_mm(report("none", 0.20, 0.20)))
+        self.assertEqual(rules.lifted_top_friction(report("none", 0.20, 0.20), "none"), "none")
+
     def test_a_run_with_rule_u_is_read_as_its_refits_then_the_turn_over(self):
         # The run named yield from the turn-over: every rule starts from the refits' verdict and gets the turn-over
         # laid on it, so the verdict as run is reproduced.
