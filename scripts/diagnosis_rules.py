@@ -149,7 +149,7 @@ RULES = ["current", "strict", "tolerance", "objective_ties", "parsimony", "tie_o
          "tie_held_out_view", "tie_held_out", "no_near_tie",
          "common4", "views_sensor", "views_camera", "tie_region", "wide_tolerance", "rise_yield", "rise_yield_015",
          "rise_later_yield", "yield_needs_rise", "alternation_yield", "off_centre", "later_yield", "alternation_veto",
-         "later_mean_yield", "off_centre_mm", "off_centre_mm_over_yield", "lifted_top"]
+         "later_mean_yield", "off_centre_mm", "off_centre_mm_over_yield", "lifted_top_friction"]
 PARAMETERS = {"sensor": 9, "misalignment": 2}  # effect_space's dimension; the others have 1
 # How each rule orders candidates of equal shrinkage before their objectives (confirmation_rule).
 TIES = {"physical_first": lambda effect: effect == "sensor",  # attribute() since session 25 (needs_simulation)
@@ -629,7 +629,7 @@ def off_centre_mm_over_yield(j, verdict):
     return off_centre_mm_misalignment(j, verdict)
 
 
-LIFTED_TOP_MM = 1.0  # rule F's floor on the platform top's lift (a candidate for session 86)
+LIFTED_TOP_MM = 0.5  # rule F's floor on the platform top's lift (registered for session 86): any lift read at all
 
 
 def top_lift_mm(report):
@@ -640,12 +640,13 @@ def top_lift_mm(report):
 
 
 def lifted_top_friction(j, verdict):
-    """Rule F (a candidate for session 86's registration): laid after the run's signatures, on `verdict`: "friction"
-    where it is none, unexplained or yield and the cloth on the platform top lies LIFTED_TOP_MM or more above its
-    contact offset: a specimen held by friction alone slides on the top and buckles off it, where the fitted model's
-    specimen (the adhesive boundary) lies on it. Seeds 101-114 (in sample): 30 of the 31 frictions lifted 1.31-2.32 mm,
-    none of the 241 other captures (72 controls, 15 sensors); +3 -0 on the default (rules U and E): seed 105's
-    friction_02 (none) and seed 111's friction_01 and _03 (the refits' yield)."""
+    """Rule F (registered for session 86): laid after the run's signatures, on `verdict`: "friction" where it is
+    none, unexplained or yield and the cloth on the platform top lies LIFTED_TOP_MM or more above its contact offset
+    (the rigid surfaces read a lift from 0.5 mm, RigidPoseSettings::min_lift): a specimen held by friction alone slides
+    on the top and buckles off it, where the fitted model's specimen (the adhesive boundary) lies on it. Seeds 101-114
+    (in sample): 30 of the 31 frictions lifted 1.31-2.32 mm, none of the 241 other captures (72 controls, 15 sensors);
+    +3 -0 on the default (rules U and E): seed 105's friction_02 (none) and seed 111's friction_01 and _03 (the refits'
+    yield). Seeds 115-116 (read after it was written): the 4 frictions 1.12-1.66 mm, none of the 37 others."""
     lift = top_lift_mm(j)
     fires = verdict in ("none", "unexplained", "yield") and lift is not None and lift >= LIFTED_TOP_MM
     return "friction" if fires else verdict
@@ -654,7 +655,8 @@ def lifted_top_friction(j, verdict):
 # The rules laid on the default's verdict after the run's signatures (signatures_applied), reading it.
 AFTER_SIGNATURES = {"later_yield": later_yield, "alternation_veto": alternation_veto,
                     "later_mean_yield": later_mean_yield, "off_centre_mm": off_centre_mm_misalignment,
-                    "off_centre_mm_over_yield": off_centre_mm_over_yield, "lifted_top": lifted_top_friction}
+                    "off_centre_mm_over_yield": off_centre_mm_over_yield,
+                    "lifted_top_friction": lifted_top_friction}
 
 
 # The rules read off the verdict as run and one more field of the report, with or without candidates.

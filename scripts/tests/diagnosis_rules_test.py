@@ -217,13 +217,15 @@ class TurnOverRules(unittest.TestCase):
         j = report("yield", 0.20, 0.21, c2=0.20)
         j["rigid_surfaces"] = {"top_lift_mm": 1.6}
         self.assertEqual(rules.top_lift_mm(j), 1.6)
-        self.assertEqual(rules.verdicts(j)["lifted_top"], "friction")  # over the refits' yield
+        self.assertEqual(rules.verdicts(j)["lifted_top_friction"], "friction")  # over the refits' yield
         for verdict in ("none", "unexplained"):
             self.assertEqual(rules.lifted_top_friction(j, verdict), "friction")
         for verdict in ("curl", "sensor", "misalignment"):  # another named effect stays
             self.assertEqual(rules.lifted_top_friction(j, verdict), verdict)
-        j["rigid_surfaces"]["top_lift_mm"] = 0.9
-        self.assertEqual(rules.verdicts(j)["lifted_top"], "yield")
+        j["rigid_surfaces"]["top_lift_mm"] = 0.5  # the least lift the rigid surfaces read
+        self.assertEqual(rules.verdicts(j)["lifted_top_friction"], "friction")
+        j["rigid_surfaces"]["top_lift_mm"] = 0.0  # no lift read (under 0.5 mm)
+        self.assertEqual(rules.verdicts(j)["lifted_top_friction"], "yield")
         self.assertIsNone(rules.top_lift_mm(report("none", 0.20, 0.20)))
         self.assertEqual(rules.lifted_top_friction(report("none", 0.20, 0.20), "none"), "none")
 
