@@ -84,8 +84,12 @@ score. Hypotheses for the next evaluation, not the diagnosis's rule (docs/DIAGNO
 - off_centre_mm (rule D, registered in session 83 for fresh seeds 115-116: docs/preregistrations/session85.md): after
   the run's signatures, "misalignment" where the verdict names no effect and the hem's centre lies OFF_CENTRE_MM
   (6.5 mm) or more off the fitted drape's, whatever its floor;
-- off_centre_mm_over_yield (rule D2, an addendum to session 85's registration): rule D, and "misalignment" too where
-  the verdict is the refits' yield, the run's rule U names nothing and the hem's centre lies OFF_CENTRE_MM or more off;
+- off_centre_mm_over_yield (rule D2, an addendum to session 85's registration; +0 -0 on seeds 115-116, +1 -0 on
+  fresh seeds 117-118: adopted, its C++ to come): rule D, and "misalignment" too where the verdict is the refits'
+  yield, the run's rule U names nothing and the hem's centre lies OFF_CENTRE_MM or more off;
+- lifted_top_friction (rule F, registered in session 84 for fresh seeds 117-118: docs/preregistrations/session86.md;
+  +0 -0 there, not adopted): after the run's signatures, "friction" where the verdict is none, unexplained or yield
+  and the rigid surfaces read the platform top lifted by LIFTED_TOP_MM (0.5 mm) or more;
 - min_objective: the candidate whose refit objective (in-sample: the capture and the second capture) is the smallest;
   it ignores the held-out data, which the issue's attribution must use: a diagnostic of the refits, not a rule.
 
@@ -629,7 +633,7 @@ def off_centre_mm_over_yield(j, verdict):
     return off_centre_mm_misalignment(j, verdict)
 
 
-LIFTED_TOP_MM = 0.5  # rule F's floor on the platform top's lift (registered for session 86): any lift read at all
+LIFTED_TOP_MM = 0.5  # rule F's floor on the platform top's lift (session 86's test: not adopted): any lift read
 
 
 def top_lift_mm(report):
