@@ -44,6 +44,8 @@ struct DiagnoseOptions {
   std::optional<double> turn_over_yield;
   std::optional<double> turn_over_alternation;
   std::optional<double> off_centre_misalignment;
+  std::optional<double> off_centre_mm;
+  bool off_centre_mm_over_yield = false;
   std::optional<int> states;
   std::optional<int> evaluations;
   std::optional<int> refit_evaluations;
@@ -153,6 +155,13 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (o.off_centre_misalignment && !(*o.off_centre_misalignment >= 0.0)) {
     return fail("--off-centre-misalignment must be 0 (off) or more (a ratio to the off-centre floor)");
   }
+  if (o.off_centre_mm && !(*o.off_centre_mm >= 0.0 && *o.off_centre_mm <= 150.0)) {
+    return fail("--off-centre-mm must be 0 (off) .. 150 (the specimen's half width)");
+  }
+  if (o.off_centre_mm_over_yield && !(o.off_centre_mm && *o.off_centre_mm > 0.0)) {
+    return fail("--off-centre-mm-over-yield weighs the refits' yield by the hem's centre: give --off-centre-mm "
+                "above 0");
+  }
   if (!(o.held_out_tolerance >= 0.0 && o.held_out_tolerance <= 1.0)) return fail("--held-out-tolerance must be 0 .. 1");
   if (outside(o.starts, 0, 100)) return fail("--starts must be 0 (the guess alone) .. 100");
   if (bad_scan(o.refit_scan, 100)) return fail("--refit-scan must be 0 (off) or 2 .. 100");
@@ -230,6 +239,8 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (o.turn_over_yield) settings.turn_over_yield = *o.turn_over_yield;
   if (o.turn_over_alternation) settings.turn_over_alternation = *o.turn_over_alternation;
   if (o.off_centre_misalignment) settings.off_centre_misalignment = *o.off_centre_misalignment;
+  if (o.off_centre_mm) settings.off_centre_offset = *o.off_centre_mm * 1e-3;
+  if (o.off_centre_mm_over_yield) settings.off_centre_offset_over_yield = true;
   if (o.states) settings.fit.initial_states = *o.states;
   if (o.evaluations) settings.baseline_optimiser.max_evaluations = *o.evaluations;
   if (o.refit_evaluations) settings.attribution.optimiser.max_evaluations = *o.refit_evaluations;
@@ -470,6 +481,14 @@ Runner add_diagnose_command(CLI::App& app) {
                  "centre hangs longer on one side (report.json \"off_centre\"; within the floors too; not with "
                  "--gap-only; default 0: off; --fine " +
                      fmt::format("{:g}", diagnosis::DiagnosisSettings::kFineOffCentreMisalignment) + ")");
+  app.add_option("--off-centre-mm", o->off_centre_mm,
+                 "Where the verdict names no effect (after --off-centre-misalignment) and the hem's centre lies at "
+                 "least this many mm off the fitted drape's, whatever its floor (localisation.feature_groups."
+                 "off_centre.difference_mm), name misalignment, from the hem's centre (report.json \"off_centre\", "
+                 "\"by\": \"offset\"; within the floors too; not with --gap-only; default 0: off)");
+  app.add_flag("--off-centre-mm-over-yield", o->off_centre_mm_over_yield,
+               "With --off-centre-mm: also where the refits named yield and the turn-over does not "
+               "(--turn-over-yield): a yield refit can stand in for an off-centre drape");
   app.add_option("--states", o->states, "Initial states per evaluation (default 3; quick and fine 2)");
   app.add_option("--evaluations", o->evaluations,
                  "Baseline fit evaluations per simplex (default 40; quick and fine 20; a second one with --starts)");

@@ -770,8 +770,12 @@ def signatures_applied(j, v):
     coefficient by the run's floor; then the alternation's (settings.turn_over_alternation > 0), yield where the rule
     names no effect and the alternation reaches the run's floor, unexplained where the rule names yield, the
     alternation is below it and the turn-over named nothing; then the hem's centre's (settings.off_centre_misalignment
-    > 0), misalignment where the rule still names no effect and the hem's centre offset reaches the run's ratio."""
+    > 0), misalignment where the rule still names no effect and the hem's centre offset reaches the run's ratio, or
+    (settings.off_centre_offset_mm > 0) the run's offset in mm; with settings.off_centre_offset_over_yield also where
+    the rule's own yield stands (the turn-over named nothing, the alternation withdrew nothing) and the offset reaches
+    it."""
     settings = j.get("settings") or {}
+    own = dict(v)
     turned = run_turn_over_names(j)
     if turned:
         v = named_where_none(v, "yield")
@@ -786,6 +790,12 @@ def signatures_applied(j, v):
     ratio = off_centre_ratio(j)
     if ratio_floor > 0.0 and ratio is not None and ratio >= ratio_floor:
         v = named_where_none(v, "misalignment")
+    mm_floor = settings.get("off_centre_offset_mm", 0.0)
+    mm = off_centre_mm(j)
+    if mm_floor > 0.0 and mm is not None and mm >= mm_floor:
+        v = named_where_none(v, "misalignment")
+        if settings.get("off_centre_offset_over_yield", False) and not turned:
+            v = {r: "misalignment" if x == "yield" and own[r] == "yield" else x for r, x in v.items()}
     return v
 
 

@@ -1787,6 +1787,81 @@ foreach(p 2 3)
   run_ok(out reality ${FABRIC} --resolution 14 --seed 5 --turn-over --placement ${p} --out ${WORK}/rise.p${p})
   file(REMOVE ${WORK}/rise.p${p}/truth.json)
 endforeach()
+# --off-centre-mm D (rule D; after --off-centre-misalignment): where the verdict names no effect and the hem's centre
+# lies at least D mm off the fitted drape's, misalignment, from the hem's centre ("by": "offset"; the ratio's where
+# both read past their floors); with --off-centre-mm-over-yield (rule D2) also over the refits' yield unless the
+# turn-over names yield. Checked on each order of placements below (`three`, its run without the options `plain`, the
+# turn-over's rise in nano): the counters require every branch.
+set(offset_named 0)
+set(offset_over_yield 0)
+set(offset_turned 0)  # refits' yields rule U names again: the offset leaves them
+function(check_off_centre_mm three plain rise_n)
+  string(JSON verdict GET "${plain}" verdict)
+  json_number(mm "${plain}" localisation feature_groups off_centre difference_mm)
+  run_ok(near diagnose ${three} ${rise_args} --off-centre-mm 150)
+  string(JSON near_verdict GET "${near}" verdict)
+  string(JSON near_record ERROR_VARIABLE no_near_record GET "${near}" off_centre)
+  json_number(near_setting "${near}" settings off_centre_offset_mm)
+  if(NOT near_verdict STREQUAL verdict OR NOT no_near_record OR NOT near_setting EQUAL 150)
+    message(FATAL_ERROR "--off-centre-mm 150 on ${three} (the hem's centre ${mm} mm off): verdict ${near_verdict} "
+                        "(without it ${verdict}), off_centre '${near_record}', setting ${near_setting}")
+  endif()
+  if(verdict MATCHES "^(none|unexplained)$")
+    run_ok(far diagnose ${three} ${rise_args} --off-centre-mm 0.000001)
+    run_ok(both diagnose ${three} ${rise_args} --off-centre-mm 0.000001 --off-centre-misalignment 0.000001)
+    string(JSON far_verdict GET "${far}" verdict)
+    string(JSON far_by GET "${far}" off_centre by)
+    string(JSON far_refits GET "${far}" off_centre refits_verdict)
+    json_number(far_mm "${far}" off_centre offset_mm)
+    json_number(far_floor "${far}" off_centre offset_floor_mm)
+    string(JSON both_by GET "${both}" off_centre by)
+    if(NOT far_verdict STREQUAL "misalignment" OR NOT far_by STREQUAL "offset" OR NOT far_refits STREQUAL verdict
+       OR NOT far_mm EQUAL mm OR NOT far_floor EQUAL 0.000001 OR NOT both_by STREQUAL "ratio")
+      message(FATAL_ERROR "--off-centre-mm 0.000001 on ${three}: verdict ${far_verdict} by ${far_by} (the refits' "
+                          "${far_refits}, without it ${verdict}), offset ${far_mm} mm (${mm}), floor ${far_floor}; "
+                          "with the ratio too by ${both_by}")
+    endif()
+    math(EXPR offset_named "${offset_named} + 1")
+  elseif(verdict STREQUAL "yield")
+    # Rule D alone leaves the refits' yield; rule D2 names misalignment over it, unless the turn-over names yield.
+    run_ok(alone diagnose ${three} ${rise_args} --off-centre-mm 0.000001)
+    run_ok(over diagnose ${three} ${rise_args} --off-centre-mm 0.000001 --off-centre-mm-over-yield
+           --report ${WORK}/report_over)
+    string(JSON alone_verdict GET "${alone}" verdict)
+    string(JSON over_verdict GET "${over}" verdict)
+    string(JSON over_refits GET "${over}" off_centre refits_verdict)
+    string(JSON over_by GET "${over}" off_centre by)
+    string(JSON over_setting GET "${over}" settings off_centre_offset_over_yield)
+    file(READ ${WORK}/report_over/report.md over_md)
+    file(REMOVE_RECURSE ${WORK}/report_over)
+    set(says_over "Verdict: misalignment, from the hem's centre\\*\\*: the hem's centre lies [0-9.]+ mm off")
+    if(NOT alone_verdict STREQUAL "yield" OR NOT over_verdict STREQUAL "misalignment"
+       OR NOT over_refits STREQUAL "yield" OR NOT over_by STREQUAL "offset" OR NOT over_setting STREQUAL "ON"
+       OR NOT over_md MATCHES "${says_over}"
+       OR NOT over_md MATCHES "The refits named yield, which the turn-over does not name")
+      message(FATAL_ERROR "--off-centre-mm 0.000001 on ${three}, the refits' yield: alone verdict ${alone_verdict}; "
+                          "--off-centre-mm-over-yield verdict ${over_verdict} by ${over_by} (the refits' "
+                          "${over_refits}), setting ${over_setting}; report.md:\n${over_md}")
+    endif()
+    math(EXPR offset_over_yield "${offset_over_yield} + 1")
+    if(rise_n GREATER 2000)
+      math(EXPR turned_n "${rise_n} - 1000")
+      nano_decimal(turned "${turned_n}")
+      run_ok(turned diagnose ${three} ${rise_args} --off-centre-mm 0.000001 --off-centre-mm-over-yield
+             --turn-over-yield ${turned})
+      string(JSON turned_verdict GET "${turned}" verdict)
+      string(JSON turned_record ERROR_VARIABLE no_turned_record GET "${turned}" off_centre)
+      if(NOT turned_verdict STREQUAL "yield" OR NOT no_turned_record)
+        message(FATAL_ERROR "--off-centre-mm-over-yield --turn-over-yield ${turned} on ${three}: verdict "
+                            "${turned_verdict}, off_centre '${turned_record}'")
+      endif()
+      math(EXPR offset_turned "${offset_turned} + 1")
+    endif()
+  endif()
+  set(offset_named ${offset_named} PARENT_SCOPE)
+  set(offset_over_yield ${offset_over_yield} PARENT_SCOPE)
+  set(offset_turned ${offset_turned} PARENT_SCOPE)
+endfunction()
 set(alternation_named 0)
 set(alternation_withdrawn 0)
 set(alternation_kept 0)  # floors on the other side of the alternation, where nothing changes
@@ -1807,6 +1882,7 @@ foreach(order "rise.p2;rise.p3;rise" "rise.p2;rise.p1;rise" "rise;rise.p1;rise.p
   endforeach()
   math(EXPR alt_n "${c1_n} - (${c0_n} + ${c2_n}) / 2")
   math(EXPR rise_n "${c1_n} - ${c0_n}")
+  check_off_centre_mm("${three}" "${plain}" ${rise_n})
   if(plain_verdict STREQUAL "yield")
     set(expected unexplained)
     math(EXPR change_n "${alt_n} + 1000")
@@ -1886,6 +1962,13 @@ if(alternation_named EQUAL 0 OR alternation_withdrawn EQUAL 0 OR alternation_kep
                       "on the other side, ${alternation_rised} kept a yield rule U names: a case untested (take "
                       "other placements)")
 endif()
+if(offset_named EQUAL 0 OR offset_over_yield EQUAL 0 OR offset_turned EQUAL 0)
+  message(FATAL_ERROR "--off-centre-mm: ${offset_named} orders named misalignment where no effect was named, "
+                      "${offset_over_yield} over the refits' yield, ${offset_turned} left a yield rule U names: a "
+                      "case untested (take other placements)")
+endif()
+expect_failure(1 "--off-centre-mm must be 0 (off) .. 150" diagnose --capture ${WORK}/rise --off-centre-mm 151)
+expect_failure(1 "give --off-centre-mm above 0" diagnose --capture ${WORK}/rise --off-centre-mm-over-yield)
 # Not with the third placement on the turned face (no alternation); not in a screening run; not in the --fine preset
 # (it left it in session 83), where the hem's centre is at 2.5.
 run_ok(other_face diagnose --capture ${WORK}/rise --second-capture ${WORK}/rise.p1 --held-out-capture

@@ -743,18 +743,36 @@ void weigh_yield_by_alternation(DiagnosisResult& r, const Capture& capture, cons
   r.runner_up = "yield";  // the best candidate, as with the refits' own "unexplained"
 }
 
-/// DiagnosisSettings::off_centre_misalignment (rule E): misalignment where no effect is named (after the turn-over)
-/// and the hem's centre lies at least budgets.off_centre_misalignment times its floor off the fitted drape's.
-void name_misalignment_from_off_centre(DiagnosisResult& r) {
-  const double floor = r.budgets.off_centre_misalignment;
+/// DiagnosisSettings::off_centre_misalignment and off_centre_offset (rules E and D): misalignment where no effect is
+/// named (after the turn-over and its alternation) and the hem's centre lies at least budgets.off_centre_misalignment
+/// times its floor, or budgets.off_centre_offset, off the fitted drape's; with off_centre_offset_over_yield (rule D2)
+/// also by the offset where the refits named yield and the turn-over would not.
+void name_misalignment_from_off_centre(DiagnosisResult& r, const Capture& capture, const OtherPlacements& others) {
+  const auto& b = r.budgets;
   constexpr auto kOffCentre = static_cast<std::size_t>(FeatureGroup::kOffCentre);
-  if (floor <= 0.0 || !names_no_effect(r) || r.localisation.group_ratio.size() <= kOffCentre) return;
-  const double ratio = r.localisation.group_ratio[kOffCentre];
-  if (!(ratio >= floor)) return;
-  sim::logger()->info("diagnosis: verdict {} but the hem's centre lies {:.2f} times its floor off the fitted drape's "
-                      "(at least {:g}): misalignment, from the hem's centre",
-                      r.verdict, ratio, floor);
-  r.off_centre = DiagnosisResult::OffCentreMisalignment{ratio, floor, r.verdict};
+  const auto& L = r.localisation;
+  if (L.group_ratio.size() <= kOffCentre || L.group_difference.size() <= kOffCentre) return;
+  const double ratio = L.group_ratio[kOffCentre], offset = L.group_difference[kOffCentre];
+  const bool ratio_reaches = b.off_centre_misalignment > 0.0 && ratio >= b.off_centre_misalignment;
+  const bool offset_reaches = b.off_centre_offset > 0.0 && offset >= b.off_centre_offset;
+  const std::optional<double> rise = turn_over_rise(capture, others);
+  const bool turn_over_names = b.turn_over_yield > 0.0 && rise && *rise >= b.turn_over_yield;
+  const bool refits_yield = r.verdict == "yield" && !r.turn_over && !r.alternation && !turn_over_names;
+  const bool fires = names_no_effect(r) ? ratio_reaches || offset_reaches
+                                        : offset_reaches && b.off_centre_offset_over_yield && refits_yield;
+  if (!fires) return;
+  const bool by_offset = !(ratio_reaches && names_no_effect(r));
+  if (by_offset) {
+    sim::logger()->info("diagnosis: verdict {} but the hem's centre lies {:.2f} mm off the fitted drape's (at least "
+                        "{:g}): misalignment, from the hem's centre",
+                        r.verdict, offset * 1e3, b.off_centre_offset * 1e3);
+  } else {
+    sim::logger()->info("diagnosis: verdict {} but the hem's centre lies {:.2f} times its floor off the fitted "
+                        "drape's (at least {:g}): misalignment, from the hem's centre",
+                        r.verdict, ratio, b.off_centre_misalignment);
+  }
+  r.off_centre = DiagnosisResult::OffCentreMisalignment{ratio,     b.off_centre_misalignment, offset,
+                                                        b.off_centre_offset, by_offset, r.verdict};
   r.verdict = "misalignment";
   r.runner_up.clear();  // the refits ranked no misalignment first: nothing stands second to the hem's centre
 }
@@ -769,9 +787,11 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
   result->budgets.turn_over_yield = settings.attribute ? settings.turn_over_yield : 0.0;
   result->budgets.turn_over_alternation = settings.attribute ? settings.turn_over_alternation : 0.0;
   result->budgets.off_centre_misalignment = settings.attribute ? settings.off_centre_misalignment : 0.0;
+  result->budgets.off_centre_offset = settings.attribute ? settings.off_centre_offset : 0.0;
+  result->budgets.off_centre_offset_over_yield = settings.attribute && settings.off_centre_offset_over_yield;
   name_yield_from_turn_over(*result, capture, others);
   weigh_yield_by_alternation(*result, capture, others);
-  name_misalignment_from_off_centre(*result);
+  name_misalignment_from_off_centre(*result, capture, others);
   return result;
 }
 
@@ -925,12 +945,11 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
     harmonics.push_back({{"order", h.order}, {"amplitude_mm", h.amplitude * 1e3}, {"phase_rad", h.phase}});
   }
   nlohmann::json groups = nlohmann::json::object();
-  // The gap drape's differences, as localise_features's ratios (before session 67 the fit's best drape's).
-  const auto diff = group_differences(r.fit_target.all, r.gap_drape().shape.all);
+  // The gap drape's differences, localise_features's (before session 67 the fit's best drape's).
   const auto floor = r.floors.group_floor();
   for (std::size_t k = 0; k < L.group_ratio.size(); ++k) {
     groups[std::string(feature_group_name(kFeatureGroups[k]))] = {
-        {"difference_mm", diff[k] * 1e3},
+        {"difference_mm", L.group_difference.at(k) * 1e3},
         {"floor_mm", floor[k] * 1e3},
         {"ratio_floor_mm", group_ratio_floor(k, floor) * 1e3},
         {"ratio", L.group_ratio[k]}};
@@ -1030,7 +1049,9 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                    {"attribution", r.budgets.attribution},
                    {"turn_over_yield", r.budgets.turn_over_yield},
                    {"turn_over_alternation", r.budgets.turn_over_alternation},
-                   {"off_centre_misalignment", r.budgets.off_centre_misalignment}};
+                   {"off_centre_misalignment", r.budgets.off_centre_misalignment},
+                   {"off_centre_offset_mm", r.budgets.off_centre_offset * 1e3},
+                   {"off_centre_offset_over_yield", r.budgets.off_centre_offset_over_yield}};
   if (const auto& m = r.mesh_confirmation) {
     j["mesh_confirmation"] = {{"resolution", m->resolution},
                               {"gap_found", m->gap_found},
@@ -1049,7 +1070,12 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
     j["alternation"] = {{"alternation", a->alternation}, {"floor", a->floor}, {"refits_verdict", a->refits_verdict}};
   }
   if (const auto& o = r.off_centre) {
-    j["off_centre"] = {{"ratio", o->ratio}, {"floor", o->floor}, {"refits_verdict", o->refits_verdict}};
+    j["off_centre"] = {{"ratio", o->ratio},
+                       {"floor", o->floor},
+                       {"offset_mm", o->offset * 1e3},
+                       {"offset_floor_mm", o->offset_floor * 1e3},
+                       {"by", o->by_offset ? "offset" : "ratio"},
+                       {"refits_verdict", o->refits_verdict}};
   }
   j["runtime"] = {{"seconds", r.seconds},
                   {"cpu_seconds", r.cpu_seconds},

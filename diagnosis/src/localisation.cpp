@@ -50,6 +50,7 @@ double group_ratio_floor(std::size_t k, const std::vector<double>& group_floor) 
 void localise_features(Localisation& L, const ScoredDrape& drape, const Target& capture,
                        const std::vector<double>& group_floor, double stable_floor) {
   const auto diff = group_differences(capture.shape.all, drape.shape.all);
+  L.group_difference = diff;
   L.group_ratio.assign(diff.size(), 0.0);
   for (std::size_t k = 0; k < diff.size(); ++k) {
     if (diff[k] < 0.0) continue;

@@ -238,9 +238,14 @@ std::string verdict_markdown(const DiagnosisResult& r) {
     const std::string shrinks = refit ? fmt::format("the {} refit shrinks the excess by {:.0f}%", effect,
                                                     100.0 * refit->shrinkage)
                                       : fmt::format("no {} refit ran", effect);
-    const std::string refits = refits_verdict == "yield" && r.alternation
-                                   ? "The refits named yield, withdrawn: " + withdrawal() + "."
-                                   : std::string("The refits alone named no effect:");
+    std::string refits = "The refits alone named no effect:";
+    if (refits_verdict == "yield" && r.alternation) {
+      refits = "The refits named yield, withdrawn: " + withdrawal() + ".";
+    } else if (refits_verdict == "yield") {
+      refits = fmt::format("The refits named yield, which the turn-over does not name (`--turn-over-yield` {:g}): "
+                           "a yield refit can stand in for an off-centre drape (`--off-centre-mm-over-yield`).",
+                           r.budgets.turn_over_yield);
+    }
     return fmt::format("{}; {}). {}\n\n", reading, shrinks, refits) +
            refits_markdown(r, refits_verdict, "The refits' verdict");
   };
@@ -251,6 +256,14 @@ std::string verdict_markdown(const DiagnosisResult& r) {
         "drape stiffer turned over and an elastic specimen does not (`--turn-over-yield`",
         t->rise, t->floor);
     md += signature("yield", reading);
+  } else if (const auto& o = r.off_centre; o && o->by_offset) {
+    const std::string reading = fmt::format(
+        "**Verdict: misalignment, from the hem's centre**: the hem's centre lies {:.1f} mm off the fitted drape's "
+        "(the order-1 harmonic of the hem's radius and height; at least {:g} mm, whatever its floor), as a specimen "
+        "laid off centre hangs longer on one side and an elastic fabric's drape on a centred specimen does not "
+        "(`--off-centre-mm`",
+        o->offset * 1e3, o->offset_floor * 1e3);
+    md += signature("misalignment", reading);
   } else if (const auto& o = r.off_centre) {
     const std::string reading = fmt::format(
         "**Verdict: misalignment, from the hem's centre**: the hem's centre lies {:.2f} times its floor off the fitted "

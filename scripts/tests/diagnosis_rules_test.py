@@ -105,6 +105,31 @@ class TurnOverRules(unittest.TestCase):
         j["settings"]["turn_over_yield"] = 0.02
         self.assertEqual(rules.verdicts(rules.refits_report(j))["current"], "yield")
 
+    def test_a_run_with_rule_d_is_read_as_its_refits_then_the_hem_centre_in_mm(self):
+        # drapegen diagnose --off-centre-mm 6.5 named misalignment where the refits named none (7 mm off, ratio 2):
+        # every rule gets the offset laid on it; with --off-centre-mm-over-yield the refits' yield too, unless the
+        # run's rule U names yield.
+        j = report("misalignment", 0.20, 0.20, c2=0.20)
+        j["settings"].update(off_centre_misalignment=2.5, off_centre_offset_mm=6.5)
+        j["localisation"] = {"feature_groups": {"off_centre": {"ratio": 2.0, "difference_mm": 7.0}}}
+        j["off_centre"] = {"ratio": 2.0, "floor": 2.5, "offset_mm": 7.0, "offset_floor_mm": 6.5, "by": "offset",
+                           "refits_verdict": "none"}
+        self.assertEqual(rules.refits_report(j)["verdict"], "none")
+        self.assertEqual(rules.verdicts(rules.refits_report(j))["current"], "misalignment")
+        j["localisation"]["feature_groups"]["off_centre"]["difference_mm"] = 6.0
+        self.assertEqual(rules.verdicts(rules.refits_report(j))["current"], "none")
+        j = report("misalignment", 0.20, 0.21, c2=0.20)
+        j["settings"].update(off_centre_offset_mm=6.5, off_centre_offset_over_yield=True)
+        j["localisation"] = {"feature_groups": {"off_centre": {"ratio": 2.0, "difference_mm": 7.0}}}
+        j["off_centre"] = {"ratio": 2.0, "floor": 0.0, "offset_mm": 7.0, "offset_floor_mm": 6.5, "by": "offset",
+                           "refits_verdict": "yield"}
+        self.assertEqual(rules.refits_report(j)["verdict"], "yield")
+        self.assertEqual(rules.verdicts(rules.refits_report(j))["current"], "misalignment")
+        j["settings"]["off_centre_offset_over_yield"] = False
+        self.assertEqual(rules.verdicts(rules.refits_report(j))["current"], "yield")
+        j["settings"].update(off_centre_offset_over_yield=True, turn_over_yield=0.005)
+        self.assertEqual(rules.verdicts(rules.refits_report(j))["current"], "yield")
+
     def test_a_run_with_rule_a_is_read_as_its_refits_then_the_alternation(self):
         # drapegen diagnose --turn-over-alternation 0.015 named yield where the refits named none (alternation 0.016):
         # every rule starts from the refits' verdict and gets the alternation laid on it.
