@@ -239,8 +239,8 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (o.turn_over_yield) settings.turn_over_yield = *o.turn_over_yield;
   if (o.turn_over_alternation) settings.turn_over_alternation = *o.turn_over_alternation;
   if (o.off_centre_misalignment) settings.off_centre_misalignment = *o.off_centre_misalignment;
-  if (o.off_centre_mm) settings.off_centre_offset = *o.off_centre_mm * 1e-3;
-  if (o.off_centre_mm_over_yield) settings.off_centre_offset_over_yield = true;
+  if (o.off_centre_mm) settings.off_centre_mm = *o.off_centre_mm;
+  if (o.off_centre_mm_over_yield) settings.off_centre_mm_over_yield = true;
   if (o.states) settings.fit.initial_states = *o.states;
   if (o.evaluations) settings.baseline_optimiser.max_evaluations = *o.evaluations;
   if (o.refit_evaluations) settings.attribution.optimiser.max_evaluations = *o.refit_evaluations;
@@ -375,7 +375,7 @@ int run_diagnose(const DiagnoseOptions& o) {
                                "here\n",
                                p->other->verdict, p->rise, p->floor);
     }
-    // A signature of its own set the verdict (rules U, A and E): what it read, the refits' verdict, the named refit.
+    // A signature of its own set the verdict (rules U, A, E and D): what it read, the refits' verdict, the named refit.
     const auto named_by = [&r](std::string_view effect, const std::string& reading) {
       const diagnosis::CandidateResult* refit = r.named_refit();
       std::cout << fmt::format("  verdict: {}, {}; the refits' verdict {}; {}\n", effect, reading, r.refits_verdict(),
@@ -385,6 +385,9 @@ int run_diagnose(const DiagnoseOptions& o) {
     if (const auto& t = r.turn_over) {
       named_by("yield", fmt::format("from the turn-over: the turned placement drapes {:.4f} stiffer (at least {:g})",
                                     t->rise, t->floor));
+    } else if (const auto& c = r.off_centre; c && c->by_offset) {
+      named_by("misalignment", fmt::format("from the hem's centre: {:.2f} mm off the fitted drape's (at least {:g} mm)",
+                                           c->offset_mm, c->offset_floor_mm));
     } else if (const auto& c = r.off_centre) {
       named_by("misalignment", fmt::format("from the hem's centre: {:.2f} times its floor off the fitted drape's (at "
                                            "least {:g})",

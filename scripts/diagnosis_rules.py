@@ -743,14 +743,15 @@ def verdicts(j):
 COLUMNS = ["none", "unexplained", "not attributed", "yield", "shear", "curl", "friction", "misalignment", "sensor"]
 
 
-# report.json's records of rules U, A and E where they set the verdict, in the order diagnose() lays them.
+# report.json's records of rules U, A and E (D and D2 too: off_centre) where they set the verdict, in the order diagnose() lays them.
 SIGNATURES = ("turn_over", "alternation", "off_centre")
 
 
 def refits_report(j):
     """The report with the refits' verdict as its verdict where a signature set the verdict (`drapegen diagnose
     --turn-over-yield`, rule U, report.json turn_over; `--turn-over-alternation`, rule A, alternation;
-    `--off-centre-misalignment`, rule E, off_centre: the first one's refits_verdict), the reported one kept as
+    `--off-centre-misalignment` and `--off-centre-mm`, rules E, D and D2, off_centre: the first one's
+    refits_verdict), the reported one kept as
     verdict_reported: the rules recompute the refits' verdict, and verdicts() lays the signatures on every rule's as
     the run did."""
     for key in SIGNATURES:
@@ -771,9 +772,8 @@ def signatures_applied(j, v):
     names no effect and the alternation reaches the run's floor, unexplained where the rule names yield, the
     alternation is below it and the turn-over named nothing; then the hem's centre's (settings.off_centre_misalignment
     > 0), misalignment where the rule still names no effect and the hem's centre offset reaches the run's ratio, or
-    (settings.off_centre_offset_mm > 0) the run's offset in mm; with settings.off_centre_offset_over_yield also where
-    the rule's own yield stands (the turn-over named nothing, the alternation withdrew nothing) and the offset reaches
-    it."""
+    (settings.off_centre_mm > 0) the run's offset in mm; with settings.off_centre_mm_over_yield also where the rule's
+    own yield stands (the turn-over named nothing, the alternation withdrew nothing) and the offset reaches it."""
     settings = j.get("settings") or {}
     own = dict(v)
     turned = run_turn_over_names(j)
@@ -790,11 +790,11 @@ def signatures_applied(j, v):
     ratio = off_centre_ratio(j)
     if ratio_floor > 0.0 and ratio is not None and ratio >= ratio_floor:
         v = named_where_none(v, "misalignment")
-    mm_floor = settings.get("off_centre_offset_mm", 0.0)
+    mm_floor = settings.get("off_centre_mm", 0.0)
     mm = off_centre_mm(j)
     if mm_floor > 0.0 and mm is not None and mm >= mm_floor:
         v = named_where_none(v, "misalignment")
-        if settings.get("off_centre_offset_over_yield", False) and not turned:
+        if settings.get("off_centre_mm_over_yield", False) and not turned:
             v = {r: "misalignment" if x == "yield" and own[r] == "yield" else x for r, x in v.items()}
     return v
 

@@ -1791,55 +1791,68 @@ endforeach()
 # lies at least D mm off the fitted drape's, misalignment, from the hem's centre ("by": "offset"; the ratio's where
 # both read past their floors); with --off-centre-mm-over-yield (rule D2) also over the refits' yield unless the
 # turn-over names yield. Checked on each order of placements below (`three`, its run without the options `plain`, the
-# turn-over's rise in nano): the counters require every branch.
+# turn-over's rise in nano), with D just past the hem's centre's offset on either side: the counters require every
+# branch.
 set(offset_named 0)
 set(offset_over_yield 0)
 set(offset_turned 0)  # refits' yields rule U names again: the offset leaves them
 function(check_off_centre_mm three plain rise_n)
   string(JSON verdict GET "${plain}" verdict)
   json_number(mm "${plain}" localisation feature_groups off_centre difference_mm)
-  run_ok(near diagnose ${three} ${rise_args} --off-centre-mm 150)
+  json_nano(mm_n "${mm}")
+  if(mm_n LESS 2000)
+    message(FATAL_ERROR "the hem's centre lies ${mm} mm off the fitted drape's on ${three}: no offset to test on")
+  endif()
+  math(EXPR past_n "${mm_n} + 1000")
+  math(EXPR under_n "${mm_n} - 1000")
+  nano_decimal(past "${past_n}")  # a floor past the offset: nothing named
+  nano_decimal(under "${under_n}")  # one the offset reaches
+  run_ok(near diagnose ${three} ${rise_args} --off-centre-mm ${past} --off-centre-mm-over-yield)
   string(JSON near_verdict GET "${near}" verdict)
   string(JSON near_record ERROR_VARIABLE no_near_record GET "${near}" off_centre)
-  json_number(near_setting "${near}" settings off_centre_offset_mm)
-  if(NOT near_verdict STREQUAL verdict OR NOT no_near_record OR NOT near_setting EQUAL 150)
-    message(FATAL_ERROR "--off-centre-mm 150 on ${three} (the hem's centre ${mm} mm off): verdict ${near_verdict} "
-                        "(without it ${verdict}), off_centre '${near_record}', setting ${near_setting}")
+  json_number(near_setting "${near}" settings off_centre_mm)
+  json_nano(near_setting_n "${near_setting}")
+  math(EXPR near_off "${near_setting_n} - ${past_n}")  # json_nano truncates the floor's binary value
+  if(NOT near_verdict STREQUAL verdict OR NOT no_near_record OR near_off GREATER 2 OR near_off LESS -2)
+    message(FATAL_ERROR "--off-centre-mm ${past} on ${three} (the hem's centre ${mm} mm off): verdict "
+                        "${near_verdict} (without it ${verdict}), off_centre '${near_record}', setting ${near_setting}")
   endif()
   if(verdict MATCHES "^(none|unexplained)$")
-    run_ok(far diagnose ${three} ${rise_args} --off-centre-mm 0.000001)
-    run_ok(both diagnose ${three} ${rise_args} --off-centre-mm 0.000001 --off-centre-misalignment 0.000001)
+    run_ok(far diagnose ${three} ${rise_args} --off-centre-mm ${under})
+    run_ok(both diagnose ${three} ${rise_args} --off-centre-mm ${under} --off-centre-misalignment 0.000001)
     string(JSON far_verdict GET "${far}" verdict)
     string(JSON far_by GET "${far}" off_centre by)
     string(JSON far_refits GET "${far}" off_centre refits_verdict)
     json_number(far_mm "${far}" off_centre offset_mm)
     json_number(far_floor "${far}" off_centre offset_floor_mm)
+    json_nano(far_floor_n "${far_floor}")
+    math(EXPR far_off "${far_floor_n} - ${under_n}")
     string(JSON both_by GET "${both}" off_centre by)
     if(NOT far_verdict STREQUAL "misalignment" OR NOT far_by STREQUAL "offset" OR NOT far_refits STREQUAL verdict
-       OR NOT far_mm EQUAL mm OR NOT far_floor EQUAL 0.000001 OR NOT both_by STREQUAL "ratio")
-      message(FATAL_ERROR "--off-centre-mm 0.000001 on ${three}: verdict ${far_verdict} by ${far_by} (the refits' "
+       OR NOT far_mm EQUAL mm OR far_off GREATER 2 OR far_off LESS -2 OR NOT both_by STREQUAL "ratio")
+      message(FATAL_ERROR "--off-centre-mm ${under} on ${three}: verdict ${far_verdict} by ${far_by} (the refits' "
                           "${far_refits}, without it ${verdict}), offset ${far_mm} mm (${mm}), floor ${far_floor}; "
                           "with the ratio too by ${both_by}")
     endif()
     math(EXPR offset_named "${offset_named} + 1")
   elseif(verdict STREQUAL "yield")
     # Rule D alone leaves the refits' yield; rule D2 names misalignment over it, unless the turn-over names yield.
-    run_ok(alone diagnose ${three} ${rise_args} --off-centre-mm 0.000001)
-    run_ok(over diagnose ${three} ${rise_args} --off-centre-mm 0.000001 --off-centre-mm-over-yield
+    run_ok(alone diagnose ${three} ${rise_args} --off-centre-mm ${under})
+    run_ok(over diagnose ${three} ${rise_args} --off-centre-mm ${under} --off-centre-mm-over-yield
            --report ${WORK}/report_over)
     string(JSON alone_verdict GET "${alone}" verdict)
     string(JSON over_verdict GET "${over}" verdict)
     string(JSON over_refits GET "${over}" off_centre refits_verdict)
     string(JSON over_by GET "${over}" off_centre by)
-    string(JSON over_setting GET "${over}" settings off_centre_offset_over_yield)
+    string(JSON over_setting GET "${over}" settings off_centre_mm_over_yield)
     file(READ ${WORK}/report_over/report.md over_md)
     file(REMOVE_RECURSE ${WORK}/report_over)
     set(says_over "Verdict: misalignment, from the hem's centre\\*\\*: the hem's centre lies [0-9.]+ mm off")
     if(NOT alone_verdict STREQUAL "yield" OR NOT over_verdict STREQUAL "misalignment"
        OR NOT over_refits STREQUAL "yield" OR NOT over_by STREQUAL "offset" OR NOT over_setting STREQUAL "ON"
        OR NOT over_md MATCHES "${says_over}"
-       OR NOT over_md MATCHES "The refits named yield, which the turn-over does not name")
-      message(FATAL_ERROR "--off-centre-mm 0.000001 on ${three}, the refits' yield: alone verdict ${alone_verdict}; "
+       OR NOT over_md MATCHES "The refits named yield, rule U off .* off-centre drape")
+      message(FATAL_ERROR "--off-centre-mm ${under} on ${three}, the refits' yield: alone verdict ${alone_verdict}; "
                           "--off-centre-mm-over-yield verdict ${over_verdict} by ${over_by} (the refits' "
                           "${over_refits}), setting ${over_setting}; report.md:\n${over_md}")
     endif()
@@ -1847,10 +1860,10 @@ function(check_off_centre_mm three plain rise_n)
     if(rise_n GREATER 2000)
       math(EXPR turned_n "${rise_n} - 1000")
       nano_decimal(turned "${turned_n}")
-      run_ok(turned diagnose ${three} ${rise_args} --off-centre-mm 0.000001 --off-centre-mm-over-yield
+      run_ok(turned_run diagnose ${three} ${rise_args} --off-centre-mm ${under} --off-centre-mm-over-yield
              --turn-over-yield ${turned})
-      string(JSON turned_verdict GET "${turned}" verdict)
-      string(JSON turned_record ERROR_VARIABLE no_turned_record GET "${turned}" off_centre)
+      string(JSON turned_verdict GET "${turned_run}" verdict)
+      string(JSON turned_record ERROR_VARIABLE no_turned_record GET "${turned_run}" off_centre)
       if(NOT turned_verdict STREQUAL "yield" OR NOT no_turned_record)
         message(FATAL_ERROR "--off-centre-mm-over-yield --turn-over-yield ${turned} on ${three}: verdict "
                             "${turned_verdict}, off_centre '${turned_record}'")

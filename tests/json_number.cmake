@@ -74,13 +74,16 @@ function(json_nano var number)
   set(${var} "${sign}${digits}" PARENT_SCOPE)
 endfunction()
 
-# The decimal of a non-negative whole number of nano-units below 1e9 (json_nano's inverse): 21500000 -> 0.021500000.
+# The decimal of a non-negative whole number of nano-units (json_nano's inverse): 21500000 -> 0.021500000,
+# 6500000001 -> 6.500000001.
 function(nano_decimal var nano)
-  if(NOT nano MATCHES "^[0-9]+$" OR nano GREATER_EQUAL 1000000000)
-    message(FATAL_ERROR "nano_decimal: '${nano}' is not a whole number in 0 .. 999999999")
+  if(NOT nano MATCHES "^[0-9]+$")
+    message(FATAL_ERROR "nano_decimal: '${nano}' is not a non-negative whole number")
   endif()
-  string(LENGTH "${nano}" length)
+  math(EXPR whole "${nano} / 1000000000")
+  math(EXPR fraction "${nano} % 1000000000")
+  string(LENGTH "${fraction}" length)
   math(EXPR pad "9 - ${length}")
   string(REPEAT "0" ${pad} zeros)
-  set(${var} "0.${zeros}${nano}" PARENT_SCOPE)
+  set(${var} "${whole}.${zeros}${fraction}" PARENT_SCOPE)
 endfunction()

@@ -743,36 +743,37 @@ void weigh_yield_by_alternation(DiagnosisResult& r, const Capture& capture, cons
   r.runner_up = "yield";  // the best candidate, as with the refits' own "unexplained"
 }
 
-/// DiagnosisSettings::off_centre_misalignment and off_centre_offset (rules E and D): misalignment where no effect is
-/// named (after the turn-over and its alternation) and the hem's centre lies at least budgets.off_centre_misalignment
-/// times its floor, or budgets.off_centre_offset, off the fitted drape's; with off_centre_offset_over_yield (rule D2)
-/// also by the offset where the refits named yield and the turn-over would not.
+/// DiagnosisSettings::off_centre_misalignment and off_centre_mm (rules E and D): misalignment where no effect is named
+/// (after the turn-over and its alternation) and the hem's centre lies at least budgets.off_centre_misalignment times
+/// its floor, or budgets.off_centre_mm mm, off the fitted drape's; with off_centre_mm_over_yield (rule D2) also by the
+/// offset where the refits named yield and the turn-over would not.
 void name_misalignment_from_off_centre(DiagnosisResult& r, const Capture& capture, const OtherPlacements& others) {
   const auto& b = r.budgets;
   constexpr auto kOffCentre = static_cast<std::size_t>(FeatureGroup::kOffCentre);
   const auto& L = r.localisation;
   if (L.group_ratio.size() <= kOffCentre || L.group_difference.size() <= kOffCentre) return;
-  const double ratio = L.group_ratio[kOffCentre], offset = L.group_difference[kOffCentre];
+  // In mm as report.json gives it, which the rules were registered on.
+  const double ratio = L.group_ratio[kOffCentre], offset_mm = L.group_difference[kOffCentre] * 1e3;
   const bool ratio_reaches = b.off_centre_misalignment > 0.0 && ratio >= b.off_centre_misalignment;
-  const bool offset_reaches = b.off_centre_offset > 0.0 && offset >= b.off_centre_offset;
+  const bool offset_reaches = b.off_centre_mm > 0.0 && offset_mm >= b.off_centre_mm;
   const std::optional<double> rise = turn_over_rise(capture, others);
   const bool turn_over_names = b.turn_over_yield > 0.0 && rise && *rise >= b.turn_over_yield;
   const bool refits_yield = r.verdict == "yield" && !r.turn_over && !r.alternation && !turn_over_names;
   const bool fires = names_no_effect(r) ? ratio_reaches || offset_reaches
-                                        : offset_reaches && b.off_centre_offset_over_yield && refits_yield;
+                                        : offset_reaches && b.off_centre_mm_over_yield && refits_yield;
   if (!fires) return;
   const bool by_offset = !(ratio_reaches && names_no_effect(r));
   if (by_offset) {
     sim::logger()->info("diagnosis: verdict {} but the hem's centre lies {:.2f} mm off the fitted drape's (at least "
                         "{:g}): misalignment, from the hem's centre",
-                        r.verdict, offset * 1e3, b.off_centre_offset * 1e3);
+                        r.verdict, offset_mm, b.off_centre_mm);
   } else {
     sim::logger()->info("diagnosis: verdict {} but the hem's centre lies {:.2f} times its floor off the fitted "
                         "drape's (at least {:g}): misalignment, from the hem's centre",
                         r.verdict, ratio, b.off_centre_misalignment);
   }
-  r.off_centre = DiagnosisResult::OffCentreMisalignment{ratio,     b.off_centre_misalignment, offset,
-                                                        b.off_centre_offset, by_offset, r.verdict};
+  r.off_centre = DiagnosisResult::OffCentreMisalignment{ratio,          b.off_centre_misalignment, offset_mm,
+                                                        b.off_centre_mm, by_offset,                 r.verdict};
   r.verdict = "misalignment";
   r.runner_up.clear();  // the refits ranked no misalignment first: nothing stands second to the hem's centre
 }
@@ -787,8 +788,8 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
   result->budgets.turn_over_yield = settings.attribute ? settings.turn_over_yield : 0.0;
   result->budgets.turn_over_alternation = settings.attribute ? settings.turn_over_alternation : 0.0;
   result->budgets.off_centre_misalignment = settings.attribute ? settings.off_centre_misalignment : 0.0;
-  result->budgets.off_centre_offset = settings.attribute ? settings.off_centre_offset : 0.0;
-  result->budgets.off_centre_offset_over_yield = settings.attribute && settings.off_centre_offset_over_yield;
+  result->budgets.off_centre_mm = settings.attribute ? settings.off_centre_mm : 0.0;
+  result->budgets.off_centre_mm_over_yield = settings.attribute && settings.off_centre_mm_over_yield;
   name_yield_from_turn_over(*result, capture, others);
   weigh_yield_by_alternation(*result, capture, others);
   name_misalignment_from_off_centre(*result, capture, others);
@@ -1050,8 +1051,8 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                    {"turn_over_yield", r.budgets.turn_over_yield},
                    {"turn_over_alternation", r.budgets.turn_over_alternation},
                    {"off_centre_misalignment", r.budgets.off_centre_misalignment},
-                   {"off_centre_offset_mm", r.budgets.off_centre_offset * 1e3},
-                   {"off_centre_offset_over_yield", r.budgets.off_centre_offset_over_yield}};
+                   {"off_centre_mm", r.budgets.off_centre_mm},
+                   {"off_centre_mm_over_yield", r.budgets.off_centre_mm_over_yield}};
   if (const auto& m = r.mesh_confirmation) {
     j["mesh_confirmation"] = {{"resolution", m->resolution},
                               {"gap_found", m->gap_found},
@@ -1072,8 +1073,8 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
   if (const auto& o = r.off_centre) {
     j["off_centre"] = {{"ratio", o->ratio},
                        {"floor", o->floor},
-                       {"offset_mm", o->offset * 1e3},
-                       {"offset_floor_mm", o->offset_floor * 1e3},
+                       {"offset_mm", o->offset_mm},
+                       {"offset_floor_mm", o->offset_floor_mm},
                        {"by", o->by_offset ? "offset" : "ratio"},
                        {"refits_verdict", o->refits_verdict}};
   }

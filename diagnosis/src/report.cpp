@@ -221,7 +221,7 @@ std::string refits_markdown(const DiagnosisResult& r, std::string_view verdict, 
 
 std::string verdict_markdown(const DiagnosisResult& r) {
   std::string md;
-  // A signature of its own set the verdict (rules U, A and E): what it read (an open parenthesis at its end, naming
+  // A signature of its own set the verdict (rules U, A, E and D): what it read (an open parenthesis at its end, naming
   // the option), the named effect's refit, then the refits' verdict (with the alternation's withdrawal where the hem's
   // centre named misalignment after it).
   const std::string& refits_verdict = r.refits_verdict();
@@ -241,10 +241,15 @@ std::string verdict_markdown(const DiagnosisResult& r) {
     std::string refits = "The refits alone named no effect:";
     if (refits_verdict == "yield" && r.alternation) {
       refits = "The refits named yield, withdrawn: " + withdrawal() + ".";
-    } else if (refits_verdict == "yield") {
-      refits = fmt::format("The refits named yield, which the turn-over does not name (`--turn-over-yield` {:g}): "
-                           "a yield refit can stand in for an off-centre drape (`--off-centre-mm-over-yield`).",
-                           r.budgets.turn_over_yield);
+    } else if (refits_verdict == "yield") {  // rule D2
+      const std::string turn_over =
+          r.budgets.turn_over_yield > 0.0
+              ? fmt::format("which the turn-over does not name (no turned second capture drapes {:g} or more "
+                            "stiffer than the capture; `--turn-over-yield`)",
+                            r.budgets.turn_over_yield)
+              : std::string("rule U off (`--turn-over-yield` 0)");
+      refits = "The refits named yield, " + turn_over +
+               ": a yield refit can stand in for an off-centre drape (`--off-centre-mm-over-yield`).";
     }
     return fmt::format("{}; {}). {}\n\n", reading, shrinks, refits) +
            refits_markdown(r, refits_verdict, "The refits' verdict");
@@ -262,7 +267,7 @@ std::string verdict_markdown(const DiagnosisResult& r) {
         "(the order-1 harmonic of the hem's radius and height; at least {:g} mm, whatever its floor), as a specimen "
         "laid off centre hangs longer on one side and an elastic fabric's drape on a centred specimen does not "
         "(`--off-centre-mm`",
-        o->offset * 1e3, o->offset_floor * 1e3);
+        o->offset_mm, o->offset_floor_mm);
     md += signature("misalignment", reading);
   } else if (const auto& o = r.off_centre) {
     const std::string reading = fmt::format(

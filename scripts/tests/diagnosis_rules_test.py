@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The turn-over rules of scripts/diagnosis_rules.py (rules U, U15, U2, K and A) and rule E on hand-written reports:
+"""The turn-over rules of scripts/diagnosis_rules.py (rules U, U15, U2, K and A) and rules E, D and D2 on hand-written reports:
 they decide what is adopted (docs/preregistrations/), so a slip here would mislead a registered test."""
 import importlib.util
 import os
@@ -110,7 +110,7 @@ class TurnOverRules(unittest.TestCase):
         # every rule gets the offset laid on it; with --off-centre-mm-over-yield the refits' yield too, unless the
         # run's rule U names yield.
         j = report("misalignment", 0.20, 0.20, c2=0.20)
-        j["settings"].update(off_centre_misalignment=2.5, off_centre_offset_mm=6.5)
+        j["settings"].update(off_centre_misalignment=2.5, off_centre_mm=6.5)
         j["localisation"] = {"feature_groups": {"off_centre": {"ratio": 2.0, "difference_mm": 7.0}}}
         j["off_centre"] = {"ratio": 2.0, "floor": 2.5, "offset_mm": 7.0, "offset_floor_mm": 6.5, "by": "offset",
                            "refits_verdict": "none"}
@@ -119,15 +119,15 @@ class TurnOverRules(unittest.TestCase):
         j["localisation"]["feature_groups"]["off_centre"]["difference_mm"] = 6.0
         self.assertEqual(rules.verdicts(rules.refits_report(j))["current"], "none")
         j = report("misalignment", 0.20, 0.21, c2=0.20)
-        j["settings"].update(off_centre_offset_mm=6.5, off_centre_offset_over_yield=True)
+        j["settings"].update(off_centre_mm=6.5, off_centre_mm_over_yield=True)
         j["localisation"] = {"feature_groups": {"off_centre": {"ratio": 2.0, "difference_mm": 7.0}}}
         j["off_centre"] = {"ratio": 2.0, "floor": 0.0, "offset_mm": 7.0, "offset_floor_mm": 6.5, "by": "offset",
                            "refits_verdict": "yield"}
         self.assertEqual(rules.refits_report(j)["verdict"], "yield")
         self.assertEqual(rules.verdicts(rules.refits_report(j))["current"], "misalignment")
-        j["settings"]["off_centre_offset_over_yield"] = False
+        j["settings"]["off_centre_mm_over_yield"] = False
         self.assertEqual(rules.verdicts(rules.refits_report(j))["current"], "yield")
-        j["settings"].update(off_centre_offset_over_yield=True, turn_over_yield=0.005)
+        j["settings"].update(off_centre_mm_over_yield=True, turn_over_yield=0.005)
         self.assertEqual(rules.verdicts(rules.refits_report(j))["current"], "yield")
 
     def test_a_run_with_rule_a_is_read_as_its_refits_then_the_alternation(self):

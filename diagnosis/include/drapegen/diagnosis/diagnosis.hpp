@@ -109,16 +109,17 @@ struct DiagnosisSettings {
   /// refit ran; not with attribute false. The refits stand as they ran. 0: off (the --fine preset:
   /// kFineOffCentreMisalignment).
   double off_centre_misalignment = 0.0;
-  /// m. Where the verdict (after off_centre_misalignment) names no effect ("none" or "unexplained") and the hem's
-  /// centre lies at least this far off the fitted drape's, whatever its floor (the off-centre feature group's
-  /// difference, Localisation::group_difference), name misalignment (DiagnosisResult::off_centre): rule E reads the
-  /// offset over a floor which a misalignment's own refits can raise (rule D, docs/preregistrations/session85.md).
-  /// Within the floors too; not with attribute false. The refits stand as they ran. 0: off.
-  double off_centre_offset = 0.0;
-  /// With off_centre_offset: where the refits named yield and the turn-over does not (its first rise under
-  /// turn_over_yield), misalignment too where the hem's centre lies that far off: a yield refit can stand in for an
-  /// off-centre drape (rule D2, docs/preregistrations/session85.md).
-  bool off_centre_offset_over_yield = false;
+  /// mm. Where the verdict (after off_centre_misalignment) names no effect ("none" or "unexplained") and the hem's
+  /// centre lies at least this many mm off the fitted drape's, whatever its floor (the off-centre feature group's
+  /// difference, Localisation::group_difference, as report.json gives it), name misalignment
+  /// (DiagnosisResult::off_centre): rule E reads the offset over its floor, which stayed under 2.5 on misalignments
+  /// whose hem lay 4-9 mm off (rule D, docs/preregistrations/session85.md). Within the floors too; not with attribute
+  /// false. The refits stand as they ran. 0: off.
+  double off_centre_mm = 0.0;
+  /// With off_centre_mm: also where the refits named yield and the turn-over does not (rule U off, no turned second
+  /// capture, or its rise under turn_over_yield): a yield refit can stand in for an off-centre drape (rule D2,
+  /// docs/preregistrations/session85.md).
+  bool off_centre_mm_over_yield = false;
 
   /// Small budgets for tests and the --quick benchmark.
   [[nodiscard]] static DiagnosisSettings quick();
@@ -153,8 +154,8 @@ struct DiagnosisResult {
     double turn_over_yield = 0.0;      // DiagnosisSettings::turn_over_yield where it could name yield (0: off)
     double turn_over_alternation = 0.0;    // DiagnosisSettings::turn_over_alternation where it could (0: off)
     double off_centre_misalignment = 0.0;  // DiagnosisSettings::off_centre_misalignment where it could (0: off)
-    double off_centre_offset = 0.0;        // m, DiagnosisSettings::off_centre_offset where it could (0: off)
-    bool off_centre_offset_over_yield = false;  // DiagnosisSettings::off_centre_offset_over_yield where it could
+    double off_centre_mm = 0.0;            // DiagnosisSettings::off_centre_mm where it could (0: off)
+    bool off_centre_mm_over_yield = false;  // DiagnosisSettings::off_centre_mm_over_yield where it could
   } budgets;
   /// Each capture it read (report.json "placements"): its directory and the face the specimen lay on (a turned
   /// specimen's rest shape, a curl or a yield's creases, bends the other way face down).
@@ -271,14 +272,14 @@ struct DiagnosisResult {
     [[nodiscard]] bool withdrew() const { return refits_verdict == "yield"; }
   };
   std::optional<TurnOverAlternation> alternation;
-  /// With DiagnosisSettings::off_centre_misalignment or off_centre_offset where it fired: the verdict is
+  /// With DiagnosisSettings::off_centre_misalignment or off_centre_mm where it fired: the verdict is
   /// "misalignment" from the hem's centre, not from the refits, whose verdict was `refits_verdict` (the attribution
   /// above stands as it ran).
   struct OffCentreMisalignment {
     double ratio = 0.0;          // the off-centre feature group's difference over its floor
     double floor = 0.0;          // DiagnosisSettings::off_centre_misalignment (0: off)
-    double offset = 0.0;         // m, the off-centre feature group's difference
-    double offset_floor = 0.0;   // m, DiagnosisSettings::off_centre_offset (0: off)
+    double offset_mm = 0.0;      // the off-centre feature group's difference, mm
+    double offset_floor_mm = 0.0;  // DiagnosisSettings::off_centre_mm (0: off)
     bool by_offset = false;      // the offset named it (rules D and D2), else the ratio (rule E)
     std::string refits_verdict;  // the verdict before it: "none" or "unexplained" ("yield": rule D2)
   };

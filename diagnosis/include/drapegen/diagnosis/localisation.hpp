@@ -65,8 +65,8 @@ struct Localisation {
   /// Per feature group (kFeatureGroups order) and for the stable term: the capture's difference from the fitted
   /// drape over the largest floor sample's (at least half the group's scale).
   std::vector<double> group_ratio;
-  /// m: per feature group, the capture's difference from the fitted drape itself (group_differences), whose ratio
-  /// to the floor group_ratio is.
+  /// m: per feature group, the capture's difference from the fitted drape itself (group_differences; -1 where a
+  /// drape lacks the group), whose ratio to the floor group_ratio is.
   std::vector<double> group_difference;
   double stable_ratio = 0.0;
   /// The residual maps' most enriched region, kGlobal if none reaches kMinRegionEnrichment (pixel residuals: fold
