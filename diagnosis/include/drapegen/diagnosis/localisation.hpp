@@ -140,9 +140,9 @@ inline constexpr double kMinPixelShare = 0.02;
 /// What localise_features divides feature group k's difference by: its floor (`group_floor`, Floors::group_floor), at
 /// least half the group's scale (default_feature_scales).
 [[nodiscard]] double group_ratio_floor(std::size_t k, const std::vector<double>& group_floor);
-/// Sets group_ratio, stable_ratio (and, by place_gap, dominant) from the fitted drape's shape features against the
-/// capture's and the floors (floors.hpp) of each group. Call after localise_against_floors (stable_region reads the
-/// regions' floor ratios).
+/// Sets group_difference, group_ratio, stable_ratio (and, by place_gap, dominant) from the fitted drape's shape
+/// features against the capture's and the floors (floors.hpp) of each group. Call after localise_against_floors
+/// (stable_region reads the regions' floor ratios).
 void localise_features(Localisation& localisation, const ScoredDrape& drape, const Target& capture,
                        const std::vector<double>& group_floor, double stable_floor);
 
