@@ -1,6 +1,7 @@
 // drapegen diagnose: where the sim-to-real gap of a capture lies and which unmodelled effect explains it (issue 6).
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -45,7 +46,7 @@ struct DiagnoseOptions {
   std::optional<double> turn_over_alternation;
   std::optional<double> off_centre_misalignment;
   std::optional<double> off_centre_mm;
-  bool off_centre_mm_over_yield = false;
+  std::optional<bool> off_centre_mm_over_yield;  // unset: the preset's
   std::optional<int> states;
   std::optional<int> evaluations;
   std::optional<int> refit_evaluations;
@@ -158,7 +159,9 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (o.off_centre_mm && !(*o.off_centre_mm >= 0.0 && *o.off_centre_mm <= 150.0)) {
     return fail("--off-centre-mm must be 0 (off) .. 150 (the specimen's half width)");
   }
-  if (o.off_centre_mm_over_yield && !(o.off_centre_mm && *o.off_centre_mm > 0.0)) {
+  const double off_centre_mm =
+      o.off_centre_mm.value_or(o.fine ? diagnosis::DiagnosisSettings::kFineOffCentreMm : 0.0);
+  if (o.off_centre_mm_over_yield.value_or(false) && !(off_centre_mm > 0.0)) {
     return fail("--off-centre-mm-over-yield weighs the refits' yield by the hem's centre: give --off-centre-mm "
                 "above 0");
   }
@@ -240,7 +243,7 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (o.turn_over_alternation) settings.turn_over_alternation = *o.turn_over_alternation;
   if (o.off_centre_misalignment) settings.off_centre_misalignment = *o.off_centre_misalignment;
   if (o.off_centre_mm) settings.off_centre_mm = *o.off_centre_mm;
-  if (o.off_centre_mm_over_yield) settings.off_centre_mm_over_yield = true;
+  if (o.off_centre_mm_over_yield) settings.off_centre_mm_over_yield = *o.off_centre_mm_over_yield;
   if (o.states) settings.fit.initial_states = *o.states;
   if (o.evaluations) settings.baseline_optimiser.max_evaluations = *o.evaluations;
   if (o.refit_evaluations) settings.attribution.optimiser.max_evaluations = *o.refit_evaluations;
@@ -443,10 +446,12 @@ Runner add_diagnose_command(CLI::App& app) {
   auto* quick = app.add_flag("--quick", o->quick, "Small budgets (16x16 mesh, 2 initial states, fewer evaluations)");
   app.add_flag("--fine", o->fine,
                fmt::format("--quick's budgets on a {0}x{0} fitting mesh, with the shape floor calibrated for it, "
-                           "--turn-over-yield {1:g} and --off-centre-misalignment {2:g}",
+                           "--turn-over-yield {1:g}, --off-centre-misalignment {2:g}, --off-centre-mm {3:g} and "
+                           "--off-centre-mm-over-yield",
                            diagnosis::DiagnosisSettings::kFineResolution,
                            diagnosis::DiagnosisSettings::kFineTurnOverYield,
-                           diagnosis::DiagnosisSettings::kFineOffCentreMisalignment))
+                           diagnosis::DiagnosisSettings::kFineOffCentreMisalignment,
+                           diagnosis::DiagnosisSettings::kFineOffCentreMm))
       ->excludes(quick);
   app.add_option("--resolution", o->resolution,
                  "Fitting mesh vertices per side (default 20; quick 16; fine " +
@@ -488,10 +493,13 @@ Runner add_diagnose_command(CLI::App& app) {
                  "Where the verdict names no effect (after --off-centre-misalignment) and the hem's centre lies at "
                  "least this many mm off the fitted drape's, whatever its floor (localisation.feature_groups."
                  "off_centre.difference_mm), name misalignment, from the hem's centre (report.json \"off_centre\", "
-                 "\"by\": \"offset\"; within the floors too; not with --gap-only; default 0: off)");
-  app.add_flag("--off-centre-mm-over-yield", o->off_centre_mm_over_yield,
-               "With --off-centre-mm: also where the refits named yield and the turn-over does not "
-               "(--turn-over-yield): a yield refit can stand in for an off-centre drape");
+                 "\"by\": \"offset\"; within the floors too; not with --gap-only; default 0: off; --fine " +
+                     fmt::format("{:g}", diagnosis::DiagnosisSettings::kFineOffCentreMm) + ")");
+  app.add_flag_function(
+      "--off-centre-mm-over-yield,!--no-off-centre-mm-over-yield",
+      [o](std::int64_t count) { o->off_centre_mm_over_yield = count > 0; },
+      "With --off-centre-mm: also where the refits named yield and the turn-over does not (--turn-over-yield): a "
+      "yield refit can stand in for an off-centre drape (default off; --fine on; --no-off-centre-mm-over-yield: off)");
   app.add_option("--states", o->states, "Initial states per evaluation (default 3; quick and fine 2)");
   app.add_option("--evaluations", o->evaluations,
                  "Baseline fit evaluations per simplex (default 40; quick and fine 20; a second one with --starts)");

@@ -743,7 +743,8 @@ def verdicts(j):
 COLUMNS = ["none", "unexplained", "not attributed", "yield", "shear", "curl", "friction", "misalignment", "sensor"]
 
 
-# report.json's records of rules U, A and E (D and D2 too: off_centre) where they set the verdict, in the order diagnose() lays them.
+# report.json's records of rules U, A and E (D and D2 too: off_centre) where they set the verdict, in the order
+# diagnose() lays them.
 SIGNATURES = ("turn_over", "alternation", "off_centre")
 
 

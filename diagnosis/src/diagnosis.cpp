@@ -277,6 +277,8 @@ DiagnosisSettings DiagnosisSettings::fine() {
   s.held_out_shape_threshold = kFineHeldOutShapeFloor;
   s.turn_over_yield = kFineTurnOverYield;
   s.off_centre_misalignment = kFineOffCentreMisalignment;
+  s.off_centre_mm = kFineOffCentreMm;
+  s.off_centre_mm_over_yield = true;
   return s;
 }
 
@@ -789,7 +791,8 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
   result->budgets.turn_over_alternation = settings.attribute ? settings.turn_over_alternation : 0.0;
   result->budgets.off_centre_misalignment = settings.attribute ? settings.off_centre_misalignment : 0.0;
   result->budgets.off_centre_mm = settings.attribute ? settings.off_centre_mm : 0.0;
-  result->budgets.off_centre_mm_over_yield = settings.attribute && settings.off_centre_mm_over_yield;
+  result->budgets.off_centre_mm_over_yield =
+      settings.attribute && settings.off_centre_mm > 0.0 && settings.off_centre_mm_over_yield;
   name_yield_from_turn_over(*result, capture, others);
   weigh_yield_by_alternation(*result, capture, others);
   name_misalignment_from_off_centre(*result, capture, others);

@@ -147,7 +147,7 @@ TEST(VerdictMarkdown, MisalignmentFromTheHemCentreSaysSoAndKeepsTheRefitsVerdict
   // drape's: misalignment, with the misalignment refit's shrinkage, not the first candidate's.
   DiagnosisResult r;
   r.verdict = "misalignment";
-  r.off_centre = DiagnosisResult::OffCentreMisalignment{3.49, 2.5, "none"};
+  r.off_centre = DiagnosisResult::OffCentreMisalignment{.ratio = 3.49, .floor = 2.5, .refits_verdict = "none"};
   add_candidate(r, Effect::kCurl, 0.5);
   add_candidate(r, Effect::kMisalignment, 0.2);
   EXPECT_DOUBLE_EQ(r.named_shrinkage(), 0.2);
@@ -165,12 +165,54 @@ TEST(VerdictMarkdown, MisalignmentFromTheHemCentreSaysSoAndKeepsTheRefitsVerdict
   // Within the floors at the gate: no refit ran.
   DiagnosisResult gate;
   gate.verdict = "misalignment";
-  gate.off_centre = DiagnosisResult::OffCentreMisalignment{2.7, 2.5, "none"};
+  gate.off_centre = DiagnosisResult::OffCentreMisalignment{.ratio = 2.7, .floor = 2.5, .refits_verdict = "none"};
   EXPECT_DOUBLE_EQ(gate.named_shrinkage(), 0.0);
   EXPECT_EQ(gate.named_refit(), nullptr);
   const std::string within = verdict_markdown(gate);
   EXPECT_TRUE(contains(within, "no misalignment refit ran")) << within;
   EXPECT_TRUE(contains(within, "**The refits' verdict: the gap is within the floors**")) << within;
+}
+
+TEST(VerdictMarkdown, MisalignmentFromTheHemCentreOffsetSaysSoOverNoEffectOrTheRefitsYield) {
+  // Rule D: the refits named no effect; the hem's centre lies 7.21 mm off the fitted drape's (its ratio 1.9, under
+  // rule E's 2.5): misalignment by the offset, in mm.
+  DiagnosisResult r;
+  r.verdict = "misalignment";
+  r.off_centre = DiagnosisResult::OffCentreMisalignment{.ratio = 1.9,
+                                                        .floor = 2.5,
+                                                        .offset_mm = 7.21,
+                                                        .offset_floor_mm = 6.5,
+                                                        .by_offset = true,
+                                                        .refits_verdict = "unexplained"};
+  add_candidate(r, Effect::kMisalignment, 0.3);
+  EXPECT_EQ(r.refits_verdict(), "unexplained");
+  const std::string md = verdict_markdown(r);
+  EXPECT_TRUE(contains(md, "**Verdict: misalignment, from the hem's centre**: the hem's centre lies 7.2 mm off the "
+                           "fitted drape's (the order-1 harmonic of the hem's radius and height; at least 6.5 mm, "
+                           "whatever its floor)"))
+      << md;
+  EXPECT_TRUE(contains(md, "the misalignment refit shrinks the excess by 30%). The refits alone named no effect:"))
+      << md;
+  EXPECT_FALSE(contains(md, "times its floor")) << md;
+
+  // Rule D2: over the refits' yield, which the turn-over (rule U at 0.02) does not name.
+  DiagnosisResult over;
+  over.verdict = "misalignment";
+  over.budgets.turn_over_yield = 0.02;
+  over.off_centre = DiagnosisResult::OffCentreMisalignment{.offset_mm = 8.6,
+                                                           .offset_floor_mm = 6.5,
+                                                           .by_offset = true,
+                                                           .refits_verdict = "yield"};
+  add_candidate(over, Effect::kYield, 0.5);
+  EXPECT_EQ(over.refits_verdict(), "yield");
+  EXPECT_EQ(over.named_refit(), nullptr);  // no misalignment refit ran
+  const std::string yielded = verdict_markdown(over);
+  EXPECT_TRUE(contains(yielded, "the hem's centre lies 8.6 mm off")) << yielded;
+  EXPECT_TRUE(contains(yielded, "no misalignment refit ran). The refits named yield, which the turn-over does not "
+                                "name (no turned second capture drapes 0.02 or more stiffer than the capture; "
+                                "`--turn-over-yield`): a yield refit can stand in for an off-centre drape"))
+      << yielded;
+  EXPECT_TRUE(contains(yielded, "**The refits' verdict: yield**")) << yielded;
 }
 
 TEST(VerdictMarkdown, TheAlternationNamesOrWithdrawsYieldAndSaysSo) {
@@ -218,7 +260,8 @@ TEST(VerdictMarkdown, TheAlternationNamesOrWithdrawsYieldAndSaysSo) {
 
   // The hem's centre then named misalignment: its paragraph, with the withdrawal as the refits' verdict.
   withdrawn.verdict = "misalignment";
-  withdrawn.off_centre = DiagnosisResult::OffCentreMisalignment{3.0, 2.5, "unexplained"};
+  withdrawn.off_centre =
+      DiagnosisResult::OffCentreMisalignment{.ratio = 3.0, .floor = 2.5, .refits_verdict = "unexplained"};
   EXPECT_EQ(withdrawn.refits_verdict(), "yield");
   EXPECT_EQ(withdrawn.named_refit(), nullptr);  // no misalignment refit ran
   const std::string centred = verdict_markdown(withdrawn);

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""The turn-over rules of scripts/diagnosis_rules.py (rules U, U15, U2, K and A) and rules E, D and D2 on hand-written reports:
-they decide what is adopted (docs/preregistrations/), so a slip here would mislead a registered test."""
+"""The turn-over rules of scripts/diagnosis_rules.py (rules U, U15, U2, K and A) and rules E, D and D2 on hand-written
+reports: they decide what is adopted (docs/preregistrations/), so a slip here would mislead a registered test."""
 import importlib.util
 import os
 import unittest
