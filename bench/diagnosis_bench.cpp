@@ -515,9 +515,9 @@ int main(int argc, char** argv) {
     }
     const std::string verdict = d.value("verdict", "?");
     // The refits' own verdict where a signature set the verdict (drapegen diagnose --turn-over-yield: "turn_over";
-    // --turn-over-alternation: "alternation"; --off-centre-misalignment: "off_centre", in the order diagnose() lays
-    // them): the first one's refits_verdict; whether the gap was found above the floors is theirs. The label is the
-    // last one's, which set the verdict.
+    // --turn-over-alternation: "alternation"; --off-centre-misalignment, --off-centre-mm: "off_centre", in the order
+    // diagnose() lays them): the first one's refits_verdict; whether the gap was found above the floors is theirs.
+    // The label is the last one's, which set the verdict.
     std::string signature, refits_verdict = verdict;
     for (const auto& [key, label] : {std::pair{"turn_over", "turn-over"}, std::pair{"alternation", "alternation"},
                                      std::pair{"off_centre", "hem centre"}}) {

@@ -156,9 +156,7 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (o.off_centre_misalignment && !(*o.off_centre_misalignment >= 0.0)) {
     return fail("--off-centre-misalignment must be 0 (off) or more (a ratio to the off-centre floor)");
   }
-  if (o.off_centre_mm && !(*o.off_centre_mm >= 0.0 && *o.off_centre_mm <= 150.0)) {
-    return fail("--off-centre-mm must be 0 (off) .. 150 (the specimen's half width)");
-  }
+  if (o.off_centre_mm && !(*o.off_centre_mm >= 0.0)) return fail("--off-centre-mm must be 0 (off) or more (mm)");
   const double off_centre_mm =
       o.off_centre_mm.value_or(o.fine ? diagnosis::DiagnosisSettings::kFineOffCentreMm : 0.0);
   if (o.off_centre_mm_over_yield.value_or(false) && !(off_centre_mm > 0.0)) {
@@ -215,6 +213,11 @@ int run_diagnose(const DiagnoseOptions& o) {
   coordinator::logger()->set_level(level);  // the fleet's
   auto capture = diagnosis::read_capture(o.capture);
   if (!capture) return fail(capture.error().message);
+  if (const double half_mm = 500.0 * std::min(capture->specimen.size_x, capture->specimen.size_y);
+      o.off_centre_mm && *o.off_centre_mm > half_mm) {
+    return fail(fmt::format("--off-centre-mm {:g}: more than half the specimen's side ({:g} mm)", *o.off_centre_mm,
+                            half_mm));
+  }
   std::optional<diagnosis::Capture> held_out, second;
   for (auto [path, into, role] : {std::tuple{&o.held_out, &held_out, "held-out capture"},
                                   std::tuple{&o.second, &second, "second capture"}}) {
@@ -499,7 +502,9 @@ Runner add_diagnose_command(CLI::App& app) {
       "--off-centre-mm-over-yield,!--no-off-centre-mm-over-yield",
       [o](std::int64_t count) { o->off_centre_mm_over_yield = count > 0; },
       "With --off-centre-mm: also where the refits named yield and the turn-over does not (--turn-over-yield): a "
-      "yield refit can stand in for an off-centre drape (default off; --fine on; --no-off-centre-mm-over-yield: off)");
+      "yield refit can stand in for an off-centre drape (default off; --fine on; --no-off-centre-mm-over-yield: off; "
+      "the last one given counts)")
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
   app.add_option("--states", o->states, "Initial states per evaluation (default 3; quick and fine 2)");
   app.add_option("--evaluations", o->evaluations,
                  "Baseline fit evaluations per simplex (default 40; quick and fine 20; a second one with --starts)");

@@ -85,8 +85,8 @@ score. Hypotheses for the next evaluation, not the diagnosis's rule (docs/DIAGNO
   the run's signatures, "misalignment" where the verdict names no effect and the hem's centre lies OFF_CENTRE_MM
   (6.5 mm) or more off the fitted drape's, whatever its floor;
 - off_centre_mm_over_yield (rule D2, an addendum to session 85's registration; +0 -0 on seeds 115-116, +1 -0 on
-  fresh seeds 117-118: adopted, its C++ to come): rule D, and "misalignment" too where the verdict is the refits'
-  yield, the run's rule U names nothing and the hem's centre lies OFF_CENTRE_MM or more off;
+  fresh seeds 117-118: adopted in session 85, in the --fine preset since): rule D, and "misalignment" too where the
+  verdict is the refits' yield, the run's rule U names nothing and the hem's centre lies OFF_CENTRE_MM or more off;
 - lifted_top_friction (rule F, registered in session 84 for fresh seeds 117-118: docs/preregistrations/session86.md;
   +0 -0 there, not adopted): after the run's signatures, "friction" where the verdict is none, unexplained or yield
   and the rigid surfaces read the platform top lifted by LIFTED_TOP_MM (0.5 mm) or more;
@@ -663,6 +663,10 @@ AFTER_SIGNATURES = {"later_yield": later_yield, "alternation_veto": alternation_
                     "lifted_top_friction": lifted_top_friction}
 
 
+# The columns that name yield from the placements' drape coefficients (signatures of their own, as rules U and A).
+TURN_OVER_RULES = ("rise_yield", "rise_yield_015", "rise_later_yield", "alternation_yield")
+
+
 # The rules read off the verdict as run and one more field of the report, with or without candidates.
 REPORT_RULES = {"views_sensor": views_sensor, "views_camera": views_camera, "tie_region": tie_region,
                 "wide_tolerance": wide_tolerance, "rise_yield": rise_yield, "rise_yield_015": rise_yield_015,
@@ -796,7 +800,10 @@ def signatures_applied(j, v):
     if mm_floor > 0.0 and mm is not None and mm >= mm_floor:
         v = named_where_none(v, "misalignment")
         if settings.get("off_centre_mm_over_yield", False) and not turned:
-            v = {r: "misalignment" if x == "yield" and own[r] == "yield" else x for r, x in v.items()}
+            # Over a refits' yield only, as diagnose(): a turn-over rule's column names yield from the placements,
+            # which rule D2 leaves (it would have set report.json turn_over or alternation), unless the refits named it.
+            v = {r: "misalignment" if x == "yield" and own[r] == "yield"
+                 and (r not in TURN_OVER_RULES or j["verdict"] == "yield") else x for r, x in v.items()}
     return v
 
 

@@ -1751,7 +1751,8 @@ if(NOT centred_verdict STREQUAL "misalignment" OR NOT centred_refits MATCHES "^(
                       "shrinkage ${centred_shrinkage} (the yield refit's ${centred_yield_shrinkage})")
 endif()
 file(READ ${WORK}/report_centred/report.md centred_md)
-if(NOT centred_md MATCHES "Verdict: misalignment, from the hem's centre\\*\\*: the hem's centre lies [0-9.]+ times"
+set(says_centred "Verdict: misalignment, from the hem's centre\\*\\*: the hem's order-1 harmonic .* by [0-9.]+ times")
+if(NOT centred_md MATCHES "${says_centred}"
    OR NOT centred_md MATCHES "no misalignment refit ran" OR NOT centred_md MATCHES "The refits' verdict: ")
   message(FATAL_ERROR "--off-centre-misalignment: report.md does not say where the verdict comes from:\n${centred_md}")
 endif()
@@ -1847,7 +1848,8 @@ function(check_off_centre_mm three plain rise_n)
     string(JSON over_setting GET "${over}" settings off_centre_mm_over_yield)
     file(READ ${WORK}/report_over/report.md over_md)
     file(REMOVE_RECURSE ${WORK}/report_over)
-    set(says_over "Verdict: misalignment, from the hem's centre\\*\\*: the hem's centre lies [0-9.]+ mm off")
+    string(CONCAT says_over "Verdict: misalignment, from the hem's centre\\*\\*: the hem's order-1 harmonic .* by "
+                            "[0-9.]+ mm \\(at least")
     if(NOT alone_verdict STREQUAL "yield" OR NOT over_verdict STREQUAL "misalignment"
        OR NOT over_refits STREQUAL "yield" OR NOT over_by STREQUAL "offset" OR NOT over_setting STREQUAL "ON"
        OR NOT over_md MATCHES "${says_over}"
@@ -1857,6 +1859,25 @@ function(check_off_centre_mm three plain rise_n)
                           "${over_refits}), setting ${over_setting}; report.md:\n${over_md}")
     endif()
     math(EXPR offset_over_yield "${offset_over_yield} + 1")
+    # Rule U on (as in --fine) with its floor above the rise: the turn-over names nothing, so rule D2 acts.
+    math(EXPR quiet_n "${rise_n} + 1000")
+    if(quiet_n LESS 1000)
+      set(quiet_n 1000)
+    endif()
+    nano_decimal(quiet "${quiet_n}")
+    run_ok(quiet_run diagnose ${three} ${rise_args} --off-centre-mm ${under} --off-centre-mm-over-yield
+           --turn-over-yield ${quiet} --report ${WORK}/report_quiet)
+    string(JSON quiet_verdict GET "${quiet_run}" verdict)
+    string(JSON quiet_refits GET "${quiet_run}" off_centre refits_verdict)
+    string(JSON quiet_turn ERROR_VARIABLE no_quiet_turn GET "${quiet_run}" turn_over)
+    file(READ ${WORK}/report_quiet/report.md quiet_md)
+    file(REMOVE_RECURSE ${WORK}/report_quiet)
+    if(NOT quiet_verdict STREQUAL "misalignment" OR NOT quiet_refits STREQUAL "yield" OR NOT no_quiet_turn
+       OR NOT quiet_md MATCHES "The refits named yield, which the turn-over does not name")
+      message(FATAL_ERROR "--off-centre-mm-over-yield --turn-over-yield ${quiet} on ${three} (the rise ${rise_n} "
+                          "nano): verdict ${quiet_verdict} (the refits' ${quiet_refits}), turn_over '${quiet_turn}'; "
+                          "report.md:\n${quiet_md}")
+    endif()
     if(rise_n GREATER 2000)
       math(EXPR turned_n "${rise_n} - 1000")
       nano_decimal(turned "${turned_n}")
@@ -1980,7 +2001,18 @@ if(offset_named EQUAL 0 OR offset_over_yield EQUAL 0 OR offset_turned EQUAL 0)
                       "${offset_over_yield} over the refits' yield, ${offset_turned} left a yield rule U names: a "
                       "case untested (take other placements)")
 endif()
-expect_failure(1 "--off-centre-mm must be 0 (off) .. 150" diagnose --capture ${WORK}/rise --off-centre-mm 151)
+run_ok(screened_mm diagnose --capture ${WORK}/rise --quick --resolution 6 --states 1 --evaluations 2 --json --gap-only
+       --off-centre-mm 0.000001 --off-centre-mm-over-yield)
+string(JSON screened_mm_record ERROR_VARIABLE no_screened_mm_record GET "${screened_mm}" off_centre)
+json_number(screened_mm_setting "${screened_mm}" settings off_centre_mm)
+string(JSON screened_mm_over GET "${screened_mm}" settings off_centre_mm_over_yield)
+if(NOT no_screened_mm_record OR NOT screened_mm_setting EQUAL 0 OR NOT screened_mm_over STREQUAL "OFF")
+  message(FATAL_ERROR "--gap-only --off-centre-mm: off_centre '${screened_mm_record}', settings ${screened_mm_setting} "
+                      "mm, over the refits' yield ${screened_mm_over}")
+endif()
+expect_failure(1 "--off-centre-mm must be 0 (off) or more" diagnose --capture ${WORK}/rise --off-centre-mm -1)
+expect_failure(1 "--off-centre-mm 151: more than half the specimen's side (150 mm)" diagnose --capture ${WORK}/rise
+               --off-centre-mm 151)
 expect_failure(1 "give --off-centre-mm above 0" diagnose --capture ${WORK}/rise --off-centre-mm-over-yield)
 # Not with the third placement on the turned face (no alternation); not in a screening run; not in the --fine preset
 # (it left it in session 83), where the hem's centre is at 2.5 (and 6.5 mm, over the refits' yield too).

@@ -766,12 +766,12 @@ void name_misalignment_from_off_centre(DiagnosisResult& r, const Capture& captur
   if (!fires) return;
   const bool by_offset = !(ratio_reaches && names_no_effect(r));
   if (by_offset) {
-    sim::logger()->info("diagnosis: verdict {} but the hem's centre lies {:.2f} mm off the fitted drape's (at least "
-                        "{:g}): misalignment, from the hem's centre",
+    sim::logger()->info("diagnosis: verdict {} but the hem's order-1 harmonic differs from the fitted drape's by "
+                        "{:.2f} mm (at least {:g} mm): misalignment, from the hem's centre",
                         r.verdict, offset_mm, b.off_centre_mm);
   } else {
-    sim::logger()->info("diagnosis: verdict {} but the hem's centre lies {:.2f} times its floor off the fitted "
-                        "drape's (at least {:g}): misalignment, from the hem's centre",
+    sim::logger()->info("diagnosis: verdict {} but the hem's order-1 harmonic differs from the fitted drape's by "
+                        "{:.2f} times its floor (at least {:g}): misalignment, from the hem's centre",
                         r.verdict, ratio, b.off_centre_misalignment);
   }
   r.off_centre = DiagnosisResult::OffCentreMisalignment{ratio,          b.off_centre_misalignment, offset_mm,

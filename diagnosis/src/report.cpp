@@ -261,21 +261,19 @@ std::string verdict_markdown(const DiagnosisResult& r) {
         "drape stiffer turned over and an elastic specimen does not (`--turn-over-yield`",
         t->rise, t->floor);
     md += signature("yield", reading);
-  } else if (const auto& o = r.off_centre; o && o->by_offset) {
-    const std::string reading = fmt::format(
-        "**Verdict: misalignment, from the hem's centre**: the hem's centre lies {:.1f} mm off the fitted drape's "
-        "(the order-1 harmonic of the hem's radius and height; at least {:g} mm, whatever its floor), as a specimen "
-        "laid off centre hangs longer on one side and an elastic fabric's drape on a centred specimen does not "
-        "(`--off-centre-mm`",
-        o->offset_mm, o->offset_floor_mm);
-    md += signature("misalignment", reading);
   } else if (const auto& o = r.off_centre) {
-    const std::string reading = fmt::format(
-        "**Verdict: misalignment, from the hem's centre**: the hem's centre lies {:.2f} times its floor off the fitted "
-        "drape's (the order-1 harmonic of the hem's radius and height; at least {:g}), as a specimen laid off centre "
-        "hangs longer on one side and an elastic fabric's drape on a centred specimen does not "
-        "(`--off-centre-misalignment`",
-        o->ratio, o->floor);
+    // By the difference in mm (rules D and D2) or by the difference over its floor (rule E): the off-centre feature
+    // group's RMS difference of the order-1 harmonics' amplitudes of the hem's radius and height, which grow with the
+    // specimen's offset from the cylinder's axis (their phase, the offset's direction, is not compared).
+    const std::string differs =
+        o->by_offset ? fmt::format("{:.1f} mm (at least {:g} mm, whatever its floor)", o->offset_mm, o->offset_floor_mm)
+                     : fmt::format("{:.2f} times its floor (at least {:g})", o->ratio, o->floor);
+    const std::string reading =
+        fmt::format("**Verdict: misalignment, from the hem's centre**: the hem's order-1 harmonic (its radius and "
+                    "height: how far its centre lies off) differs from the fitted drape's by {}, as a specimen laid "
+                    "off centre hangs longer on one side and an elastic fabric's drape on a centred specimen does not "
+                    "(`{}`",
+                    differs, o->by_offset ? "--off-centre-mm" : "--off-centre-misalignment");
     md += signature("misalignment", reading);
   } else if (const auto& a = r.alternation; a && !a->withdrew()) {
     const std::string reading = fmt::format(

@@ -154,9 +154,9 @@ TEST(VerdictMarkdown, MisalignmentFromTheHemCentreSaysSoAndKeepsTheRefitsVerdict
   ASSERT_NE(r.named_refit(), nullptr);
   EXPECT_EQ(r.named_refit()->effect, Effect::kMisalignment);
   const std::string md = verdict_markdown(r);
-  EXPECT_TRUE(contains(md, "**Verdict: misalignment, from the hem's centre**: the hem's centre lies 3.49 times its "
-                           "floor off the fitted drape's (the order-1 harmonic of the hem's radius and height; at "
-                           "least 2.5)"))
+  EXPECT_TRUE(contains(md, "**Verdict: misalignment, from the hem's centre**: the hem's order-1 harmonic (its radius "
+                           "and height: how far its centre lies off) differs from the fitted drape's by 3.49 times its "
+                           "floor (at least 2.5)"))
       << md;
   EXPECT_TRUE(contains(md, "the misalignment refit shrinks the excess by 20%")) << md;
   EXPECT_TRUE(contains(md, "**The refits' verdict: ")) << md;
@@ -187,9 +187,9 @@ TEST(VerdictMarkdown, MisalignmentFromTheHemCentreOffsetSaysSoOverNoEffectOrTheR
   add_candidate(r, Effect::kMisalignment, 0.3);
   EXPECT_EQ(r.refits_verdict(), "unexplained");
   const std::string md = verdict_markdown(r);
-  EXPECT_TRUE(contains(md, "**Verdict: misalignment, from the hem's centre**: the hem's centre lies 7.2 mm off the "
-                           "fitted drape's (the order-1 harmonic of the hem's radius and height; at least 6.5 mm, "
-                           "whatever its floor)"))
+  EXPECT_TRUE(contains(md, "**Verdict: misalignment, from the hem's centre**: the hem's order-1 harmonic (its radius "
+                           "and height: how far its centre lies off) differs from the fitted drape's by 7.2 mm (at "
+                           "least 6.5 mm, whatever its floor)"))
       << md;
   EXPECT_TRUE(contains(md, "the misalignment refit shrinks the excess by 30%). The refits alone named no effect:"))
       << md;
@@ -207,7 +207,7 @@ TEST(VerdictMarkdown, MisalignmentFromTheHemCentreOffsetSaysSoOverNoEffectOrTheR
   EXPECT_EQ(over.refits_verdict(), "yield");
   EXPECT_EQ(over.named_refit(), nullptr);  // no misalignment refit ran
   const std::string yielded = verdict_markdown(over);
-  EXPECT_TRUE(contains(yielded, "the hem's centre lies 8.6 mm off")) << yielded;
+  EXPECT_TRUE(contains(yielded, "differs from the fitted drape's by 8.6 mm")) << yielded;
   EXPECT_TRUE(contains(yielded, "no misalignment refit ran). The refits named yield, which the turn-over does not "
                                 "name (no turned second capture drapes 0.02 or more stiffer than the capture; "
                                 "`--turn-over-yield`): a yield refit can stand in for an off-centre drape"))

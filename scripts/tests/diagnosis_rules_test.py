@@ -130,6 +130,21 @@ class TurnOverRules(unittest.TestCase):
         j["settings"].update(off_centre_mm_over_yield=True, turn_over_yield=0.005)
         self.assertEqual(rules.verdicts(rules.refits_report(j))["current"], "yield")
 
+    def test_rule_d2_leaves_a_yield_a_turn_over_column_names(self):
+        # A --fine run (rules U at 0.02, E and D2) named misalignment by the offset where the refits named none; the
+        # turned placement rose 0.017: rule U15's column names yield from the turn-over, which diagnose() would have
+        # recorded as turn_over before rule D2, so the offset leaves it; the default's column is the run's verdict.
+        j = report("misalignment", 0.20, 0.217, c2=0.20)
+        j["settings"].update(turn_over_yield=0.02, off_centre_misalignment=2.5, off_centre_mm=6.5,
+                             off_centre_mm_over_yield=True)
+        j["localisation"] = {"feature_groups": {"off_centre": {"ratio": 2.0, "difference_mm": 7.0}}}
+        j["off_centre"] = {"ratio": 2.0, "floor": 2.5, "offset_mm": 7.0, "offset_floor_mm": 6.5, "by": "offset",
+                           "refits_verdict": "none"}
+        v = rules.verdicts(rules.refits_report(j))
+        self.assertEqual(v["current"], "misalignment")
+        self.assertEqual(v["rise_yield_015"], "yield")
+        self.assertEqual(v["rise_yield"], "misalignment")  # 0.017 is under its 0.02: nothing of its own
+
     def test_a_run_with_rule_a_is_read_as_its_refits_then_the_alternation(self):
         # drapegen diagnose --turn-over-alternation 0.015 named yield where the refits named none (alternation 0.016):
         # every rule starts from the refits' verdict and gets the alternation laid on it.
