@@ -45,6 +45,11 @@
 - skirt_dense (rule S, registered in session 74, adopted in session 75: place_gap's since then): lifted_top's
   region, but a gap placed at the hem (not by the views) goes to the skirt where the skirt's pixel enrichment is at
   least --skirt-dense (1.3) times the hem's.
+- hem_offset (rule O, an addendum to session 87's registration, written in session 85 from seeds 101-118: +10 -0
+  there, in sample): as run, but a gap a feature group placed at the skirt (not the views, not the rigid surfaces)
+  goes to the hem where the hem's centre lies --hem-offset-mm (6.5, rule D2's floor) or more off the fitted drape's
+  (localisation.feature_groups.off_centre.difference_mm): a specimen laid off centre makes the skirt's residual denser
+  too (rule S's reading), but only a shifted placement moves the hem's centre.
 
 Per rule: the effect captures whose region is one of the effect's regions (the truth file's `regions`), per family.
 
@@ -75,7 +80,7 @@ from diagnosis_rules import (EFFECT_REGIONS, THRESHOLD, confirmation_rule,  # no
 OUTLINE = {"harmonics", "off_centre", "sorted_radii", "hem_height"}
 RULES = ["as_run", "largest", "place_gap_24", "place_gap", "place_gap_27", "place_gap_27b", "pixel_region",
          "floor_region", "split_enrichment", "split_floor_ratio", "skirt_floor_ratio", "fold_depth", "closure_groups",
-         "closure_regions", "multipath_floor", "lifted_top", "skirt_dense"]
+         "closure_regions", "multipath_floor", "lifted_top", "skirt_dense", "hem_offset"]
 
 
 def leading(loc):
@@ -230,6 +235,16 @@ def skirt_dense(loc, region, factor):
     return "skirt" if enrichment.get("skirt", 0.0) >= factor * enrichment.get("hem", 0.0) else region
 
 
+def hem_offset(loc, offset_mm):
+    """Rule O: the region as run, but a gap a feature group placed at the skirt (not the views, not the stable term or
+    the camera) is the hem's where the hem's centre lies offset_mm or more off the fitted drape's."""
+    lead = loc.get("dominant_feature")
+    if loc["region"] != "skirt" or loc.get("placed_by_views") or lead not in loc["feature_groups"]:
+        return loc["region"]
+    mm = loc["feature_groups"].get("off_centre", {}).get("difference_mm")
+    return "hem" if mm is not None and mm >= offset_mm else loc["region"]
+
+
 def place_gap_27(loc, sensor_scale, skirt_denser, lifted_scale):
     """place_gap with the rigid surfaces placing the gap whatever leads (pre-registered in session 27 for seed 19):
     a platform top above its own floor and seen farther than the fitted cloth (no cloth lies inside the platform),
@@ -315,6 +330,8 @@ def main():
                     help="lifted_top: how far (mm) the top must be lifted for a lifted top to lead (rule T)")
     ap.add_argument("--skirt-dense", type=float, default=1.3,
                     help="skirt_dense: the skirt/hem enrichment ratio from which a hem gap is the skirt's (rule S)")
+    ap.add_argument("--hem-offset-mm", type=float, default=6.5,
+                    help="hem_offset: the hem centre's offset (mm) from which a skirt gap is the hem's (rule O)")
     ap.add_argument("--ranking", action="store_true", help="the region-aware attribution's verdicts instead")
     ap.add_argument("--closure-only", action="store_true",
                     help="count only the reports whose named candidate carries its refit localisation")
@@ -357,6 +374,7 @@ def main():
                       "closure_regions": closure_regions(loc, named), "multipath_floor": multipath_floor(report),
                       "lifted_top": lifted_top(loc, args.lifted_mm, args.fold_depth)}
             region["skirt_dense"] = skirt_dense(loc, region["lifted_top"], args.skirt_dense)
+            region["hem_offset"] = hem_offset(loc, args.hem_offset_mm)
             totals[family] += 1
             if multipath_fired(report):
                 fired["effect captures"] += 1
