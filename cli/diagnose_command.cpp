@@ -46,7 +46,7 @@ struct DiagnoseOptions {
   std::optional<double> turn_over_alternation;
   std::optional<double> off_centre_misalignment;
   std::optional<double> off_centre_mm;
-  std::optional<bool> off_centre_mm_over_yield;  // unset: the preset's
+  std::optional<bool> off_centre_mm_over_yield;  // unset: the settings' (off)
   std::optional<int> states;
   std::optional<int> evaluations;
   std::optional<int> refit_evaluations;
@@ -157,9 +157,7 @@ int run_diagnose(const DiagnoseOptions& o) {
     return fail("--off-centre-misalignment must be 0 (off) or more (a ratio to the off-centre floor)");
   }
   if (o.off_centre_mm && !(*o.off_centre_mm >= 0.0)) return fail("--off-centre-mm must be 0 (off) or more (mm)");
-  const double off_centre_mm =
-      o.off_centre_mm.value_or(o.fine ? diagnosis::DiagnosisSettings::kFineOffCentreMm : 0.0);
-  if (o.off_centre_mm_over_yield.value_or(false) && !(off_centre_mm > 0.0)) {
+  if (o.off_centre_mm_over_yield.value_or(false) && !(o.off_centre_mm.value_or(0.0) > 0.0)) {
     return fail("--off-centre-mm-over-yield weighs the refits' yield by the hem's centre: give --off-centre-mm "
                 "above 0");
   }
@@ -447,12 +445,10 @@ Runner add_diagnose_command(CLI::App& app) {
   auto* quick = app.add_flag("--quick", o->quick, "Small budgets (16x16 mesh, 2 initial states, fewer evaluations)");
   app.add_flag("--fine", o->fine,
                fmt::format("--quick's budgets on a {0}x{0} fitting mesh, with the shape floor calibrated for it, "
-                           "--turn-over-yield {1:g}, --off-centre-misalignment {2:g}, --off-centre-mm {3:g} and "
-                           "--off-centre-mm-over-yield",
+                           "--turn-over-yield {1:g} and --off-centre-misalignment {2:g}",
                            diagnosis::DiagnosisSettings::kFineResolution,
                            diagnosis::DiagnosisSettings::kFineTurnOverYield,
-                           diagnosis::DiagnosisSettings::kFineOffCentreMisalignment,
-                           diagnosis::DiagnosisSettings::kFineOffCentreMm))
+                           diagnosis::DiagnosisSettings::kFineOffCentreMisalignment))
       ->excludes(quick);
   app.add_option("--resolution", o->resolution,
                  "Fitting mesh vertices per side (default 20; quick 16; fine " +
@@ -494,14 +490,14 @@ Runner add_diagnose_command(CLI::App& app) {
                  "Where the verdict names no effect (after --off-centre-misalignment) and the hem's centre lies at "
                  "least this many mm off the fitted drape's, whatever its floor (localisation.feature_groups."
                  "off_centre.difference_mm), name misalignment, from the hem's centre (report.json \"off_centre\", "
-                 "\"by\": \"offset\"; within the floors too; not with --gap-only; default 0: off; --fine " +
-                     fmt::format("{:g}", diagnosis::DiagnosisSettings::kFineOffCentreMm) + ")");
+                 "\"by\": \"offset\"; within the floors too; not with --gap-only; default 0: off, --fine too: it "
+                 "left that preset in session 85)");
   app.add_flag_function(
       "--off-centre-mm-over-yield,!--no-off-centre-mm-over-yield",
       [o](std::int64_t count) { o->off_centre_mm_over_yield = count > 0; },
       "With --off-centre-mm: also where the refits named yield and the turn-over does not (--turn-over-yield): a "
-      "yield refit can stand in for an off-centre drape (default off; --fine on; --no-off-centre-mm-over-yield: off; "
-      "the last one given counts)")
+      "yield refit can stand in for an off-centre drape (default off; --no-off-centre-mm-over-yield: off; the last "
+      "one given counts)")
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
   app.add_option("--states", o->states, "Initial states per evaluation (default 3; quick and fine 2)");
   app.add_option("--evaluations", o->evaluations,

@@ -2015,7 +2015,7 @@ expect_failure(1 "--off-centre-mm 151: more than half the specimen's side (150 m
                --off-centre-mm 151)
 expect_failure(1 "give --off-centre-mm above 0" diagnose --capture ${WORK}/rise --off-centre-mm-over-yield)
 # Not with the third placement on the turned face (no alternation); not in a screening run; not in the --fine preset
-# (it left it in session 83), where the hem's centre is at 2.5 (and 6.5 mm, over the refits' yield too).
+# (it left it in session 83), where the hem's centre is at 2.5 (rules D and D2 off: they left it in session 85).
 run_ok(other_face diagnose --capture ${WORK}/rise --second-capture ${WORK}/rise.p1 --held-out-capture
        ${WORK}/rise.p3 ${rise_args} --turn-over-alternation 0.000001)
 string(JSON other_face_record ERROR_VARIABLE no_other_face_record GET "${other_face}" alternation)
@@ -2049,16 +2049,18 @@ json_number(fine_centre_setting "${fine_alt}" settings off_centre_misalignment)
 json_number(fine_mm_setting "${fine_alt}" settings off_centre_mm)
 string(JSON fine_over_setting GET "${fine_alt}" settings off_centre_mm_over_yield)
 if(NOT no_other_face_record OR NOT no_screened_alt_record OR NOT screened_alt_setting EQUAL 0
-   OR NOT fine_alt_setting EQUAL 0 OR NOT fine_centre_setting EQUAL 2.5 OR NOT fine_mm_setting EQUAL 6.5
-   OR NOT fine_over_setting STREQUAL "ON")
+   OR NOT fine_alt_setting EQUAL 0 OR NOT fine_centre_setting EQUAL 2.5 OR NOT fine_mm_setting EQUAL 0
+   OR NOT fine_over_setting STREQUAL "OFF")
   message(FATAL_ERROR "--turn-over-alternation: third placement turned: alternation '${other_face_record}'; "
                       "--gap-only: '${screened_alt_record}', setting ${screened_alt_setting}; --fine: settings "
                       "${fine_alt_setting}, off-centre ${fine_centre_setting}, ${fine_mm_setting} mm, over the "
                       "refits' yield ${fine_over_setting}")
 endif()
-# Rule D2 (--off-centre-mm 6.5 with --off-centre-mm-over-yield) is in the --fine preset: --no-off-centre-mm-over-yield
-# leaves rule D alone, --off-centre-mm 0 both; the flag is taken with the preset's offset.
-foreach(case "--no-off-centre-mm-over-yield;6.5;OFF" "--off-centre-mm;0;0;OFF" "--off-centre-mm-over-yield;6.5;ON")
+# Rule D2 (--off-centre-mm 6.5 with --off-centre-mm-over-yield) left the --fine preset in session 85; given there, the
+# last of --off-centre-mm-over-yield and --no-off-centre-mm-over-yield counts.
+foreach(case "--off-centre-mm;6.5;6.5;OFF"
+             "--off-centre-mm;6.5;--off-centre-mm-over-yield;--no-off-centre-mm-over-yield;6.5;OFF"
+             "--off-centre-mm;6.5;--no-off-centre-mm-over-yield;--off-centre-mm-over-yield;6.5;ON")
   list(POP_BACK case want_over)
   list(POP_BACK case want_mm)
   run_ok(fine_d2 diagnose --capture ${WORK}/rise --fine --resolution 6 --states 1 --evaluations 2
@@ -2070,8 +2072,7 @@ foreach(case "--no-off-centre-mm-over-yield;6.5;OFF" "--off-centre-mm;0;0;OFF" "
                         "(expected ${want_mm}, ${want_over})")
   endif()
 endforeach()
-expect_failure(1 "give --off-centre-mm above 0" diagnose --capture ${WORK}/rise --fine --off-centre-mm 0
-               --off-centre-mm-over-yield)
+expect_failure(1 "give --off-centre-mm above 0" diagnose --capture ${WORK}/rise --fine --off-centre-mm-over-yield)
 expect_failure(1 "--turn-over-alternation must be 0 (off) .. 1" diagnose --capture ${WORK}/rise --second-capture
                ${WORK}/rise.p1 --held-out-capture ${WORK}/rise.p2 --turn-over-alternation -0.1)
 expect_failure(1 "give --second-capture and --held-out-capture" diagnose --capture ${WORK}/rise --second-capture

@@ -277,8 +277,6 @@ DiagnosisSettings DiagnosisSettings::fine() {
   s.held_out_shape_threshold = kFineHeldOutShapeFloor;
   s.turn_over_yield = kFineTurnOverYield;
   s.off_centre_misalignment = kFineOffCentreMisalignment;
-  s.off_centre_mm = kFineOffCentreMm;
-  s.off_centre_mm_over_yield = true;
   return s;
 }
 
