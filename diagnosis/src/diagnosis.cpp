@@ -960,6 +960,7 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                        {"dominant_feature", L.dominant_feature.empty() ? nlohmann::json(nullptr)
                                                                        : nlohmann::json(L.dominant_feature)},
                        {"moved_to_hem", L.moved_to_hem},
+                       {"moved_by_offset", L.moved_by_offset},
                        {"placed_by_views", L.placed_by_views},
                        {"feature_groups", groups},
                        {"stable_ratio", L.stable_ratio},

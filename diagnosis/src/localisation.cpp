@@ -99,6 +99,7 @@ Region stable_region(const Localisation& L) {
 
 void place_gap(Localisation& L) {
   L.moved_to_hem = false;
+  L.moved_by_offset = false;
   L.placed_by_views = false;
   if (L.camera_moved >= kCameraMovedAtPlatform) {  // the rigid surfaces show the camera elsewhere than recorded
     L.dominant_feature = "camera";
@@ -147,12 +148,18 @@ void place_gap(Localisation& L) {
   if (L.moved_to_hem || (g == FeatureGroup::kOffCentre && skirt_far_denser)) {
     L.dominant = L.moved_to_hem ? Region::kHem : Region::kSkirt;
   }
+  // Rule O: a skirt gap is the hem's where the hem's centre lies kHemOffCentreMm or more off the fitted drape's.
+  constexpr auto kOffCentre = static_cast<std::size_t>(FeatureGroup::kOffCentre);
+  L.moved_by_offset = L.dominant == Region::kSkirt && kOffCentre < L.group_difference.size() &&
+                      L.group_difference[kOffCentre] * 1e3 >= kHemOffCentreMm;
+  if (L.moved_by_offset) L.dominant = Region::kHem;
 }
 
 void place_sensor_gap(Localisation& L) {
   if (L.floor_region == Region::kGlobal || L.dominant_feature == "camera") return;
   L.placed_by_views = true;
   L.moved_to_hem = false;
+  L.moved_by_offset = false;
   L.dominant = L.floor_region;
 }
 

@@ -86,6 +86,12 @@ std::string leading_feature_text(const Localisation& L) {
                               : "led by the stable term, the platform top lifted at a camera error's scale";
     }
   }
+  if (L.moved_by_offset) {
+    constexpr auto kOffCentre = static_cast<std::size_t>(FeatureGroup::kOffCentre);
+    return fmt::format("led by {}, placed on the skirt; but the hem's order-1 harmonic differs from the fitted "
+                       "drape's by {:.1f} mm (at least {:g}), as a specimen laid off centre makes it, so the hem",
+                       led, L.group_difference.at(kOffCentre) * 1e3, kHemOffCentreMm);
+  }
   if (L.moved_to_hem) {
     return fmt::format("led by {}, a change of the skirt; the folds' depth stands more than {} times further above "
                        "its floor than the skirt's mean height, so the folds deepen at the hem",

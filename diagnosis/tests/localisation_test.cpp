@@ -293,6 +293,40 @@ TEST(PlaceGap, ASkirtFarDenserThanTheHemKeepsItsGap) {
   EXPECT_EQ(L.dominant, Region::kHem);
 }
 
+TEST(PlaceGap, ASkirtGapWhoseHemCentreLiesFarOffIsTheHems) {
+  // Rule O: the hem's centre 6.6 mm off the fitted drape's (at least kHemOffCentreMm) moves a skirt gap to the hem;
+  // 6.4 mm leaves it.
+  constexpr auto kOff = static_cast<std::size_t>(FeatureGroup::kOffCentre);
+  const auto off_by = [](Localisation L, double mm) {
+    L.group_difference.assign(std::size(kFeatureGroups), 1e-3);
+    L.group_difference[kOff] = mm * 1e-3;
+    place_gap(L);
+    return L;
+  };
+  Localisation L = off_by(excess(FeatureGroup::kSkirtHeight, 2.0, 0.9, 1.5, 1.0), kHemOffCentreMm + 0.1);
+  EXPECT_EQ(L.dominant, Region::kHem);
+  EXPECT_TRUE(L.moved_by_offset);
+  EXPECT_EQ(L.dominant_feature, "skirt_height");
+  L = off_by(excess(FeatureGroup::kSkirtHeight, 2.0, 0.9, 1.5, 1.0), kHemOffCentreMm - 0.1);
+  EXPECT_EQ(L.dominant, Region::kSkirt);
+  EXPECT_FALSE(L.moved_by_offset);
+  // Rule S kept a gap the centre's offset leads on the far denser skirt: the offset in mm takes it to the hem.
+  L = off_by(excess(FeatureGroup::kOffCentre, 2.0, 0.9, 1.2 * kSkirtDenseAtHem, 1.2), kHemOffCentreMm + 0.1);
+  EXPECT_EQ(L.dominant, Region::kHem);
+  EXPECT_TRUE(L.moved_by_offset);
+  // Placed on the hem already, or by the stable term, or nowhere: as before.
+  L = off_by(excess(FeatureGroup::kHemHeight, 2.0, 0.9, 1.0, 1.2), kHemOffCentreMm + 0.1);
+  EXPECT_EQ(L.dominant, Region::kHem);
+  EXPECT_FALSE(L.moved_by_offset);
+  L = off_by(with_top(excess(FeatureGroup::kSkirtSpread, 0.95, 1.6, 1.0, 1.0, 0.1), -0.2e-3, 0.95),
+             kHemOffCentreMm + 0.1);
+  EXPECT_EQ(L.dominant, Region::kCylinder);
+  EXPECT_FALSE(L.moved_by_offset);
+  L = off_by(excess(FeatureGroup::kSkirtHeight, 0.95, 0.97, 1.5, 1.0), kHemOffCentreMm + 0.1);
+  EXPECT_EQ(L.dominant, Region::kGlobal);
+  EXPECT_FALSE(L.moved_by_offset);
+}
+
 TEST(PlaceGap, GlobalWithNoFeatureNamedWhenNothingExceedsItsFloor) {
   Localisation L = excess(FeatureGroup::kHemHeight, 0.95, 0.97, 1.6, 1.2);
   L.dominant_feature = "left over";

@@ -57,6 +57,8 @@ struct Localisation {
   std::string dominant_feature;
   /// place_gap moved the gap from the skirt to the hem: the folds deepen at the hem (folds_deepen_at_hem).
   bool moved_to_hem = false;
+  /// place_gap moved the gap from the skirt to the hem by the hem's centre (rule O, kHemOffCentreMm).
+  bool moved_by_offset = false;
   /// place_sensor_gap placed the gap where the pixels stand furthest above their floor (the views disagree).
   bool placed_by_views = false;
   /// m: how far the camera error read off the rigid surfaces moves the platform's centre (rigid_pose.hpp,
@@ -157,8 +159,16 @@ void localise_features(Localisation& localisation, const ScoredDrape& drape, con
 /// than the hem's (the outline carries a change of the skirt above it), else kHem. Nothing above 1: kGlobal. Last, a
 /// gap so placed on the skirt moves to the hem where folds_deepen_at_hem. Rule S: where the skirt's pixel residual is
 /// at least kSkirtDenseAtHem times as dense as the hem's (enrichment), neither the centre offset nor the folds' depth
-/// puts the gap at the hem; it stays on the skirt.
+/// puts the gap at the hem; it stays on the skirt. Rule O, after it: a gap a feature group placed on the skirt is the
+/// hem's where the hem's centre lies kHemOffCentreMm or more off the fitted drape's (group_difference of the
+/// off-centre group; moved_by_offset).
 void place_gap(Localisation& localisation);
+
+/// Rule O's offset, mm (rule D2's floor, DiagnosisSettings::kFineOffCentreMm, not fitted on regions): a specimen laid
+/// off centre makes the skirt's residual denser too (rule S's reading sends its gap to the skirt), but only a shifted
+/// placement moves the hem's centre. Registered in session 85 as an addendum to session 87's test (+10 -0 in sample on
+/// seeds 101-118): docs/preregistrations/session87.md.
+inline constexpr double kHemOffCentreMm = 6.5;
 
 /// Rule S's factor: a skirt whose pixel residual is this much denser than the hem's changed as a whole (its shear,
 /// its yielding folds), and the outline's centre and the folds' depth at the hem follow it. Registered in session 74
