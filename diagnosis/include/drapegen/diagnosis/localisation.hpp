@@ -164,10 +164,11 @@ void localise_features(Localisation& localisation, const ScoredDrape& drape, con
 /// off-centre group; moved_by_offset).
 void place_gap(Localisation& localisation);
 
-/// Rule O's offset, mm (rule D2's floor, DiagnosisSettings::kFineOffCentreMm, not fitted on regions): a specimen laid
+/// Rule O's offset, mm (rule D's floor, docs/preregistrations/session85.md, not fitted on regions): a specimen laid
 /// off centre makes the skirt's residual denser too (rule S's reading sends its gap to the skirt), but only a shifted
 /// placement moves the hem's centre. Registered in session 85 as an addendum to session 87's test (+10 -0 in sample on
-/// seeds 101-118): docs/preregistrations/session87.md.
+/// seeds 101-118; +3 -0 on fresh seeds 119-120, three misalignments: adopted in session 85),
+/// docs/DIAGNOSIS_RESULTS.md, "Session 87".
 inline constexpr double kHemOffCentreMm = 6.5;
 
 /// Rule S's factor: a skirt whose pixel residual is this much denser than the hem's changed as a whole (its shear,
