@@ -85,8 +85,9 @@ score. Hypotheses for the next evaluation, not the diagnosis's rule (docs/DIAGNO
   the run's signatures, "misalignment" where the verdict names no effect and the hem's centre lies OFF_CENTRE_MM
   (6.5 mm) or more off the fitted drape's, whatever its floor;
 - off_centre_mm_over_yield (rule D2, an addendum to session 85's registration; +0 -0 on seeds 115-116, +1 -0 on
-  fresh seeds 117-118: adopted in session 85, in the --fine preset since): rule D, and "misalignment" too where the
-  verdict is the refits' yield, the run's rule U names nothing and the hem's centre lies OFF_CENTRE_MM or more off;
+  fresh seeds 117-118: adopted in session 85; its one verdict on seeds 119-120 wrong, a shear within the floors, so it
+  left the --fine preset in the same session): rule D, and "misalignment" too where the verdict is the refits' yield,
+  the run's rule U names nothing and the hem's centre lies OFF_CENTRE_MM or more off;
 - lifted_top_friction (rule F, registered in session 84 for fresh seeds 117-118: docs/preregistrations/session86.md;
   +0 -0 there, not adopted): after the run's signatures, "friction" where the verdict is none, unexplained or yield
   and the rigid surfaces read the platform top lifted by LIFTED_TOP_MM (0.5 mm) or more;
@@ -756,9 +757,8 @@ def refits_report(j):
     """The report with the refits' verdict as its verdict where a signature set the verdict (`drapegen diagnose
     --turn-over-yield`, rule U, report.json turn_over; `--turn-over-alternation`, rule A, alternation;
     `--off-centre-misalignment` and `--off-centre-mm`, rules E, D and D2, off_centre: the first one's
-    refits_verdict), the reported one kept as
-    verdict_reported: the rules recompute the refits' verdict, and verdicts() lays the signatures on every rule's as
-    the run did."""
+    refits_verdict), the reported one kept as verdict_reported: the rules recompute the refits' verdict, and
+    verdicts() lays the signatures on every rule's as the run did."""
     for key in SIGNATURES:
         if j.get(key):
             return dict(j, verdict=j[key]["refits_verdict"], verdict_reported=j["verdict"])
