@@ -89,7 +89,7 @@ std::string leading_feature_text(const Localisation& L) {
   if (L.moved_by_offset) {
     constexpr auto kOffCentre = static_cast<std::size_t>(FeatureGroup::kOffCentre);
     return fmt::format("led by {}, placed on the skirt; but the hem's order-1 harmonic differs from the fitted "
-                       "drape's by {:.1f} mm (at least {:g}), as a specimen laid off centre makes it, so the hem",
+                       "drape's by {:.1f} mm (at least {:g} mm), as a specimen laid off centre makes it, so the hem",
                        led, L.group_difference.at(kOffCentre) * 1e3, kHemOffCentreMm);
   }
   if (L.moved_to_hem) {
