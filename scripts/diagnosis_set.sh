@@ -18,7 +18,9 @@
 #                                                            # these diagnose options added (kept in ARM/arm.args;
 #                                                            # none: scripts/first_mesh.py's default arm); then
 #                                                            # `diagnose ARM` and `scripts/compare_arms.py`
-#   scripts/diagnosis_set.sh score OUT...                    # each set's summary, then the verdict and region tables
+#   scripts/diagnosis_set.sh score OUT...                    # each set's summary, the verdict and region tables,
+#                                                            # the camera reading, then scripts/score_test.py's
+#                                                            # per-capture table and summary
 #
 # BENCH-OPTIONS choose the captures (drapegen_diagnosis_bench --help): e.g.
 #   scripts/diagnosis_set.sh generate out/p72/s80 --families sensor --per-family 6 --controls 3 --seed 80 \
@@ -104,6 +106,8 @@ case $step in
     done
     python3 scripts/diagnosis_rules.py --matrix current --pooled "${runs[@]}"
     python3 scripts/region_rules.py "${runs[@]}"
+    python3 scripts/view_rms.py "${runs[@]}"
+    python3 scripts/score_test.py "${runs[@]}"
     ;;
   *) usage ;;
 esac
