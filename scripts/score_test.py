@@ -18,6 +18,7 @@ import argparse
 import glob
 import json
 import os
+import re
 import statistics
 import sys
 
@@ -33,7 +34,7 @@ def capture(run, path):
     """One capture's row (a dict) from its report and truth; None for a placement's own report or a missing truth."""
     name = os.path.basename(path)[:-len(".json")]
     truth_path = os.path.join(run, "truth", name + ".json")
-    if ".p" in name or not os.path.exists(truth_path):
+    if re.search(r"\.p\d+$", name) or not os.path.exists(truth_path):
         return None
     with open(path) as f:
         j = json.load(f)
@@ -44,14 +45,17 @@ def capture(run, path):
     if not effects:
         family = "none"
     kind = effects[0]["name"] if effects and family == "sensor" else ""
-    signature = next((key for key in SIGNATURES if j.get(key)), None)
+    # Where two signatures are recorded (rule A withdrew the refits' yield, then rule E or D named misalignment), the
+    # last one set the verdict and the first one's record holds the refits' own.
+    recorded = [key for key in SIGNATURES if j.get(key)]
+    signature = recorded[-1] if recorded else None
     loc = j.get("localisation") or {}
     rms = placement_rms(j)
     return {
         "set": os.path.basename(os.path.normpath(run)), "name": name, "family": family, "kind": kind,
         "strength": effects[0].get("strength", 0.0) if effects else 0.0,
         "verdict": j["verdict"], "signature": signature,
-        "refits": j[signature]["refits_verdict"] if signature else j["verdict"],
+        "refits": j[recorded[0]]["refits_verdict"] if recorded else j["verdict"],
         "within": bool(j.get("within_floors")), "bend": bool(j.get("within_floors_after_bending_refit")),
         "region": loc.get("region"), "regions": sorted(truth.get("regions") or []),
         "moved": bool(loc.get("moved_by_offset")),
@@ -63,12 +67,17 @@ def capture(run, path):
 
 
 def rows(runs):
+    names = [os.path.basename(os.path.normpath(run)) for run in runs]
+    if len(set(names)) != len(names):
+        sys.exit("score_test: two sets share a name (" + " ".join(runs) + "): the per-set lines would merge them")
     out = []
     for run in runs:
         for path in sorted(glob.glob(os.path.join(run, "diagnoses", "*.json"))):
             row = capture(run, path)
             if row:
                 out.append(row)
+            elif not re.search(r"\.p\d+\.json$", path):
+                print(f"score_test: {path} has no truth file: not scored", file=sys.stderr)
     return out
 
 

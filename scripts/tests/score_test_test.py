@@ -51,7 +51,8 @@ class ScoreTest(unittest.TestCase):
                          truth("yield", regions=["skirt"])),
             # A misalignment rule O moved to the hem: named right, region right.
             "misalignment_00": (report("misalignment", 0.30, 0.30, 0.30, region="hem", moved=True, offset_mm=9.0,
-                                       ratio=3.0, cpu=300.0), truth("misalign", regions=["hem"])),
+                                       ratio=3.0, cpu=300.0),
+                                truth("misalignment", effect="misalign", regions=["hem"])),
             # A shear named none above the floors, moved to the hem wrongly.
             "shear_00": (report("none", 0.30, 0.30, 0.30, region="hem", moved=True, offset_mm=7.0, cpu=400.0),
                          truth("shear", regions=["skirt"])),
@@ -77,7 +78,7 @@ class ScoreTest(unittest.TestCase):
     def test_rows_read_the_reports_and_truths(self):
         self.assertEqual(len(self.rows), 6)
         by = {r["name"]: r for r in self.rows}
-        self.assertEqual(by["misalignment_00"]["family"], "misalignment")  # truth "misalign"
+        self.assertEqual(by["misalignment_00"]["family"], "misalignment")
         self.assertEqual(by["sensor_00"]["kind"], "pose")
         self.assertEqual(by["yield_00"]["signature"], "turn_over")
         self.assertEqual(by["yield_00"]["refits"], "none")
@@ -87,6 +88,21 @@ class ScoreTest(unittest.TestCase):
         self.assertEqual(by["sensor_00"]["view_rms"], 4.5)
         self.assertTrue(score.right(by["yield_00"]))
         self.assertFalse(score.right(by["shear_00"]))
+
+    def test_the_last_signature_set_the_verdict_and_the_first_holds_the_refits(self):
+        j = report("misalignment", 0.30, 0.31, 0.30, turn_over=None)
+        j["alternation"] = {"alternation": 0.01, "floor": 0.015, "refits_verdict": "yield"}
+        j["off_centre"] = {"ratio": 2.7, "floor": 2.5, "refits_verdict": "unexplained"}
+        run = os.path.join(self.dir.name, "s2")
+        os.makedirs(os.path.join(run, "diagnoses"))
+        os.makedirs(os.path.join(run, "truth"))
+        with open(os.path.join(run, "diagnoses", "misalignment_00.json"), "w") as f:
+            json.dump(j, f)
+        with open(os.path.join(run, "truth", "misalignment_00.json"), "w") as f:
+            json.dump(truth("misalignment", effect="misalign", regions=["hem"]), f)
+        (row,) = score.rows([run])
+        self.assertEqual(row["signature"], "off_centre")
+        self.assertEqual(row["refits"], "yield")
 
     def test_summary_counts(self):
         out = io.StringIO()
