@@ -51,6 +51,10 @@
   goes to the hem where the hem's centre lies --hem-offset-mm (6.5, rule D2's floor) or more off the fitted drape's
   (localisation.feature_groups.off_centre.difference_mm): a specimen laid off centre makes the skirt's residual denser
   too (rule S's reading), but only a shifted placement moves the hem's centre.
+- nearest_group (rule N, an addendum to session 88's registration, written in session 86 before any report of its
+  sets existed): as run, but a gap nothing places (region "global", no feature group, stable term or camera above
+  its floor, not the views) is placed by the feature group nearest its floor, as place_gap places a gap that group
+  leads.
 
 Per rule: the effect captures whose region is one of the effect's regions (the truth file's `regions`), per family.
 
@@ -81,7 +85,7 @@ from diagnosis_rules import (EFFECT_REGIONS, THRESHOLD, confirmation_rule,  # no
 OUTLINE = {"harmonics", "off_centre", "sorted_radii", "hem_height"}
 RULES = ["as_run", "largest", "place_gap_24", "place_gap", "place_gap_27", "place_gap_27b", "pixel_region",
          "floor_region", "split_enrichment", "split_floor_ratio", "skirt_floor_ratio", "fold_depth", "closure_groups",
-         "closure_regions", "multipath_floor", "lifted_top", "skirt_dense", "hem_offset"]
+         "closure_regions", "multipath_floor", "lifted_top", "skirt_dense", "hem_offset", "nearest_group"]
 
 
 def leading(loc):
@@ -246,6 +250,20 @@ def hem_offset(loc, offset_mm):
     return "hem" if mm is not None and mm >= offset_mm else loc["region"]
 
 
+def nearest_group(loc):
+    """Rule N (registered in session 86 for session 88's sets): the region as run, but a gap nothing places (the
+    region "global" with no feature group, stable term or camera above its floor, and not the views) is placed by the
+    feature group nearest its floor, as place_gap places a gap that group leads (group_region: an outline group
+    follows the skirt where the skirt's residual is the denser, the centre's offset is the hem's, the others the
+    skirt's). The report says no more than where the residual comes closest to standing out."""
+    if loc["region"] != "global" or loc.get("dominant_feature") or loc.get("placed_by_views"):
+        return loc["region"]
+    groups = {name: g["ratio"] for name, g in loc["feature_groups"].items() if g.get("ratio") is not None}
+    if not groups:
+        return loc["region"]
+    return group_region(loc, max(groups, key=groups.get))
+
+
 def place_gap_27(loc, sensor_scale, skirt_denser, lifted_scale):
     """place_gap with the rigid surfaces placing the gap whatever leads (pre-registered in session 27 for seed 19):
     a platform top above its own floor and seen farther than the fitted cloth (no cloth lies inside the platform),
@@ -376,6 +394,7 @@ def main():
                       "lifted_top": lifted_top(loc, args.lifted_mm, args.fold_depth)}
             region["skirt_dense"] = skirt_dense(loc, region["lifted_top"], args.skirt_dense)
             region["hem_offset"] = hem_offset(loc, args.hem_offset_mm)
+            region["nearest_group"] = nearest_group(loc)
             totals[family] += 1
             if multipath_fired(report):
                 fired["effect captures"] += 1

@@ -37,5 +37,30 @@ class HemOffset(unittest.TestCase):
         self.assertEqual(regions.hem_offset(localisation("skirt", None, 9.0, placed_by_views=True), 6.5), "skirt")
 
 
+class NearestGroup(unittest.TestCase):
+    def with_ratios(self, region, lead, ratios, skirt_enrichment=1.0, hem_enrichment=1.2, placed_by_views=False):
+        loc = localisation(region, lead, 1.0, placed_by_views)
+        for name, ratio in ratios.items():
+            loc["feature_groups"][name]["ratio"] = ratio
+        loc["regions"] = [{"region": "skirt", "enrichment": skirt_enrichment},
+                          {"region": "hem", "enrichment": hem_enrichment}]
+        return loc
+
+    def test_a_gap_nothing_places_goes_where_a_group_comes_nearest_its_floor(self):
+        self.assertEqual(regions.nearest_group(self.with_ratios("global", None, {"skirt_spread": 0.9})), "skirt")
+        self.assertEqual(regions.nearest_group(self.with_ratios("global", "", {"off_centre": 0.95})), "hem")
+        # An outline group: the hem unless the skirt's residual is the denser.
+        self.assertEqual(regions.nearest_group(self.with_ratios("global", None, {"hem_height": 0.9})), "hem")
+        self.assertEqual(regions.nearest_group(self.with_ratios("global", None, {"hem_height": 0.9},
+                                                                skirt_enrichment=1.5)), "skirt")
+
+    def test_a_placed_gap_stays_as_run(self):
+        self.assertEqual(regions.nearest_group(self.with_ratios("global", "stable", {"skirt_spread": 0.9})), "global")
+        self.assertEqual(regions.nearest_group(self.with_ratios("global", "camera", {"skirt_spread": 0.9})), "global")
+        self.assertEqual(regions.nearest_group(self.with_ratios("hem", "hem_height", {"skirt_spread": 0.9})), "hem")
+        self.assertEqual(regions.nearest_group(self.with_ratios("global", None, {"skirt_spread": 0.9},
+                                                                placed_by_views=True)), "global")
+
+
 if __name__ == "__main__":
     unittest.main()
