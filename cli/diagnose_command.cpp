@@ -390,10 +390,8 @@ int run_diagnose(const DiagnoseOptions& o) {
       named_by("yield", fmt::format("from the turn-over: the turned placement drapes {:.4f} stiffer (at least {:g})",
                                     t->rise, t->floor));
     } else if (const auto& c = r.off_centre) {
-      const std::string by = c->by_offset
-                                 ? fmt::format("{:.2f} mm (at least {:g} mm)", c->offset_mm, c->offset_floor_mm)
-                                 : fmt::format("{:.2f} times its floor (at least {:g})", c->ratio, c->floor);
-      named_by("misalignment", "from the hem's centre: its order-1 harmonic differs from the fitted drape's by " + by);
+      named_by("misalignment",
+               "from the hem's centre: its order-1 harmonic differs from the fitted drape's by " + c->difference());
     } else if (const auto& a = r.alternation; a && !a->withdrew()) {
       named_by("yield", fmt::format("from the turn-over's alternation: the turned placement drapes {:.4f} stiffer than "
                                     "the mean of the others (at least {:g})",

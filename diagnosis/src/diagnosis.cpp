@@ -763,17 +763,11 @@ void name_misalignment_from_off_centre(DiagnosisResult& r, const Capture& captur
                                         : offset_reaches && b.off_centre_mm_over_yield && refits_yield;
   if (!fires) return;
   const bool by_offset = !(ratio_reaches && names_no_effect(r));
-  if (by_offset) {
-    sim::logger()->info("diagnosis: verdict {} but the hem's order-1 harmonic differs from the fitted drape's by "
-                        "{:.2f} mm (at least {:g} mm): misalignment, from the hem's centre",
-                        r.verdict, offset_mm, b.off_centre_mm);
-  } else {
-    sim::logger()->info("diagnosis: verdict {} but the hem's order-1 harmonic differs from the fitted drape's by "
-                        "{:.2f} times its floor (at least {:g}): misalignment, from the hem's centre",
-                        r.verdict, ratio, b.off_centre_misalignment);
-  }
   r.off_centre = DiagnosisResult::OffCentreMisalignment{ratio,          b.off_centre_misalignment, offset_mm,
                                                         b.off_centre_mm, by_offset,                 r.verdict};
+  sim::logger()->info("diagnosis: verdict {} but the hem's order-1 harmonic differs from the fitted drape's by {}: "
+                      "misalignment, from the hem's centre",
+                      r.verdict, r.off_centre->difference());
   r.verdict = "misalignment";
   r.runner_up.clear();  // the refits ranked no misalignment first: nothing stands second to the hem's centre
 }
@@ -800,6 +794,11 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
 const CandidateResult* DiagnosisResult::refit(Effect effect) const {
   const auto found = std::ranges::find(attribution.candidates, effect, &CandidateResult::effect);
   return found == attribution.candidates.end() ? nullptr : &*found;
+}
+
+std::string DiagnosisResult::OffCentreMisalignment::difference() const {
+  return by_offset ? fmt::format("{:.2f} mm (at least {:g} mm)", offset_mm, offset_floor_mm)
+                   : fmt::format("{:.2f} times its floor (at least {:g})", ratio, floor);
 }
 
 const std::string& DiagnosisResult::refits_verdict() const {

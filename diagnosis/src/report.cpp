@@ -89,7 +89,7 @@ std::string leading_feature_text(const Localisation& L) {
   if (L.moved_by_offset) {
     constexpr auto kOffCentre = static_cast<std::size_t>(FeatureGroup::kOffCentre);
     return fmt::format("led by {}, placed on the skirt; but the hem's order-1 harmonic differs from the fitted "
-                       "drape's by {:.1f} mm (at least {:g} mm), as a specimen laid off centre makes it, so the hem",
+                       "drape's by {:.2f} mm (at least {:g} mm), as a specimen laid off centre makes it, so the hem",
                        led, L.group_difference.at(kOffCentre) * 1e3, kHemOffCentreMm);
   }
   if (L.moved_to_hem) {
@@ -139,6 +139,10 @@ std::string confirmations_markdown(const DiagnosisResult& r) {
 }
 
 }  // namespace
+
+std::string dominant_region_markdown(const Localisation& L) {
+  return fmt::format("Dominant region: **{}** ({}).", region_name(L.dominant), leading_feature_text(L));
+}
 
 std::string runtime_markdown(const DiagnosisResult& r) {
   std::string md = fmt::format("Runtime {:.0f} s (fit {:.0f} s, floors {:.0f} s, attribution {:.0f} s); CPU {:.0f} s; "
@@ -271,9 +275,7 @@ std::string verdict_markdown(const DiagnosisResult& r) {
     // By the difference in mm (rules D and D2) or by the difference over its floor (rule E): the off-centre feature
     // group's RMS difference of the order-1 harmonics' amplitudes of the hem's radius and height, which grow with the
     // specimen's offset from the cylinder's axis (their phase, the offset's direction, is not compared).
-    const std::string differs =
-        o->by_offset ? fmt::format("{:.1f} mm (at least {:g} mm, whatever its floor)", o->offset_mm, o->offset_floor_mm)
-                     : fmt::format("{:.2f} times its floor (at least {:g})", o->ratio, o->floor);
+    const std::string differs = o->difference() + (o->by_offset ? ", whatever its floor" : "");
     const std::string reading =
         fmt::format("**Verdict: misalignment, from the hem's centre**: the hem's order-1 harmonic (its radius and "
                     "height: how far its centre lies off) differs from the fitted drape's by {}, as a specimen laid "
@@ -442,8 +444,7 @@ sim::Status write_report(const std::string& directory, const DiagnosisResult& r,
     md += fmt::format("| {} | {:.2f} | {:.2f} | {:.2f} | {:.1f} | {:+.1f} | {:.2f} |\n", region_name(s.region),
                       s.energy_share, s.pixel_share, s.enrichment, s.rms * 1e3, s.mean * 1e3, s.floor_ratio);
   }
-  md += fmt::format("\nDominant region: **{}** ({}). Per-view share of the residual energy:",
-                    region_name(r.localisation.dominant), leading_feature_text(r.localisation));
+  md += "\n" + dominant_region_markdown(r.localisation) + " Per-view share of the residual energy:";
   for (double s : r.localisation.view_share) md += fmt::format(" {:.2f}", s);
   md += fmt::format(".\nFolds: capture {}, model {}; drape coefficient: capture {:.3f}, model {:.3f}.\n",
                     r.localisation.capture_folds, r.localisation.model_folds,

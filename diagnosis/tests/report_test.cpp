@@ -188,8 +188,8 @@ TEST(VerdictMarkdown, MisalignmentFromTheHemCentreOffsetSaysSoOverNoEffectOrTheR
   EXPECT_EQ(r.refits_verdict(), "unexplained");
   const std::string md = verdict_markdown(r);
   EXPECT_TRUE(contains(md, "**Verdict: misalignment, from the hem's centre**: the hem's order-1 harmonic (its radius "
-                           "and height: how far its centre lies off) differs from the fitted drape's by 7.2 mm (at "
-                           "least 6.5 mm, whatever its floor)"))
+                           "and height: how far its centre lies off) differs from the fitted drape's by 7.21 mm (at "
+                           "least 6.5 mm), whatever its floor, as a specimen laid off centre"))
       << md;
   EXPECT_TRUE(contains(md, "the misalignment refit shrinks the excess by 30%). The refits alone named no effect:"))
       << md;
@@ -207,7 +207,7 @@ TEST(VerdictMarkdown, MisalignmentFromTheHemCentreOffsetSaysSoOverNoEffectOrTheR
   EXPECT_EQ(over.refits_verdict(), "yield");
   EXPECT_EQ(over.named_refit(), nullptr);  // no misalignment refit ran
   const std::string yielded = verdict_markdown(over);
-  EXPECT_TRUE(contains(yielded, "differs from the fitted drape's by 8.6 mm")) << yielded;
+  EXPECT_TRUE(contains(yielded, "differs from the fitted drape's by 8.60 mm (at least 6.5 mm)")) << yielded;
   EXPECT_TRUE(contains(yielded, "no misalignment refit ran). The refits named yield, which the turn-over does not "
                                 "name (no turned second capture drapes 0.02 or more stiffer than the capture; "
                                 "`--turn-over-yield`): a yield refit can stand in for an off-centre drape"))
@@ -270,6 +270,39 @@ TEST(VerdictMarkdown, TheAlternationNamesOrWithdrawsYieldAndSaysSo) {
                                 "capture drapes 0.0042"))
       << centred;
   EXPECT_TRUE(contains(centred, "**The refits' verdict: yield**")) << centred;
+}
+
+TEST(DominantRegionMarkdown, SaysWhatPlacedTheGapAndTheRuleThatMovedIt) {
+  Localisation L;
+  L.dominant = Region::kGlobal;
+  EXPECT_EQ(dominant_region_markdown(L), "Dominant region: **global** (nothing exceeds its floor).");
+
+  // Rule O: a skirt group led, the hem's centre lies 7.3 mm off: the hem, and the sentence gives the offset in mm.
+  L.dominant = Region::kHem;
+  L.dominant_feature = "skirt_height";
+  L.group_difference.assign(std::size(kFeatureGroups), 1e-3);
+  L.group_difference[static_cast<std::size_t>(FeatureGroup::kOffCentre)] = 7.3e-3;
+  L.moved_by_offset = true;
+  const std::string moved = dominant_region_markdown(L);
+  EXPECT_TRUE(contains(moved, "Dominant region: **hem** (led by skirt_height, placed on the skirt; but the hem's "
+                              "order-1 harmonic differs from the fitted drape's by 7.30 mm (at least 6.5 mm)"))
+      << moved;
+
+  // The folds deepen at the hem (moved_to_hem): the folds' reason, not the offset's.
+  L.moved_by_offset = false;
+  L.moved_to_hem = true;
+  const std::string folds = dominant_region_markdown(L);
+  EXPECT_TRUE(contains(folds, "**hem** (led by skirt_height, a change of the skirt; the folds' depth stands more "
+                              "than 1.5 times further above its floor than the skirt's mean height"))
+      << folds;
+  EXPECT_FALSE(contains(folds, "order-1 harmonic")) << folds;
+
+  // The multipath test placed it: the views' reason first.
+  L.moved_to_hem = false;
+  L.placed_by_views = true;
+  L.dominant = Region::kSkirt;
+  EXPECT_TRUE(contains(dominant_region_markdown(L), "**skirt** (the four views disagree as a sensor error makes "
+                                                    "them (the multipath test fired)"));
 }
 
 TEST(RuntimeMarkdown, CountsEveryDiagnosisTheRuntimeHolds) {

@@ -284,6 +284,9 @@ struct DiagnosisResult {
     double offset_floor_mm = 0.0;  // DiagnosisSettings::off_centre_mm (0: off)
     bool by_offset = false;      // the offset named it (rules D and D2), else the ratio (rule E)
     std::string refits_verdict;  // the verdict before it: "none" or "unexplained" ("yield": rule D2)
+    /// What it read, for the log, the console and report.md: "7.21 mm (at least 6.5 mm)" by the offset, else
+    /// "3.49 times its floor (at least 2.5)".
+    [[nodiscard]] std::string difference() const;
   };
   std::optional<OffCentreMisalignment> off_centre;
   /// The refits' own verdict: the verdict before the first signature that changed it (turn_over, alternation,

@@ -25,6 +25,10 @@ struct ResidualImage {
 /// under a verdict within the floors ("none") what it does not rule out.
 [[nodiscard]] std::string verdict_markdown(const DiagnosisResult& result);
 
+/// report.md's "Dominant region" sentence: the region place_gap chose and what placed it there (the leading feature
+/// group or term, and the rule that moved it: the folds' depth, the hem's centre offset, the views' disagreement).
+[[nodiscard]] std::string dominant_region_markdown(const Localisation& localisation);
+
 /// report.md's runtime: wall and CPU seconds, and where the result confirmed other diagnoses of the same captures
 /// (--confirm-resolution, --confirm-placement-rise; up to four with both) that these are all of theirs together.
 [[nodiscard]] std::string runtime_markdown(const DiagnosisResult& result);
