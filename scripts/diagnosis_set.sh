@@ -22,6 +22,8 @@
 #                                                            # the camera reading, then scripts/score_test.py's
 #                                                            # per-capture table and summary
 #
+# DRAPEGEN_BIN (default build/bin) is where generate takes the programs from.
+#
 # BENCH-OPTIONS choose the captures (drapegen_diagnosis_bench --help): e.g.
 #   scripts/diagnosis_set.sh generate out/p72/s80 --families sensor --per-family 6 --controls 3 --seed 80 \
 #       --sensor-kinds pose bias
@@ -46,15 +48,16 @@ bench() {  # bench SET MORE-OPTIONS...: the set's own bench on the set, under th
 case $step in
   generate)
     [ $# -gt 0 ] || usage
+    build=${DRAPEGEN_BIN:-build/bin}  # the programs a set is made with (tests point it at stand-ins)
     for p in drapegen drapegen_diagnosis_bench; do
-      [ -x "build/bin/$p" ] || { echo "diagnosis_set: build/bin/$p is missing (scripts/build.sh)" >&2; exit 1; }
+      [ -x "$build/$p" ] || { echo "diagnosis_set: $build/$p is missing (scripts/build.sh)" >&2; exit 1; }
     done
     mkdir -p "$out/bin"
     if [ -f "$out/set.args" ]; then  # a resumed generation keeps its build and options
       set_args "$out"
       [ "${args[*]}" = "$*" ] || { echo "diagnosis_set: $out was generated with: ${args[*]}" >&2; exit 1; }
     else
-      cp build/bin/drapegen build/bin/drapegen_diagnosis_bench "$out/bin/"
+      cp "$build/drapegen" "$build/drapegen_diagnosis_bench" "$out/bin/"
       { git rev-parse HEAD; git status --porcelain --untracked-files=no | sed 's/^/dirty: /'; } > "$out/bin/COMMIT"
       printf '%s\n' "$@" > "$out/set.args"
       set_args "$out"
