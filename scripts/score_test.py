@@ -28,13 +28,14 @@ from diagnosis_rules import (ALTERNATION, CAMERA_RMS_MM, FAMILY, LATER, OFF_CENT
                              turn_over_alternation, turn_over_rise)
 
 NO_EFFECT = ("none", "unexplained")
+PLACEMENT = re.compile(r"\.p\d+\.json$")  # a later placement's own report (the bench names it CASE.pK.json)
 
 
 def capture(run, path):
-    """One capture's row (a dict) from its report and truth; None for a placement's own report or a missing truth."""
+    """One capture's row (a dict) from its report and truth; None where the truth file is missing."""
     name = os.path.basename(path)[:-len(".json")]
     truth_path = os.path.join(run, "truth", name + ".json")
-    if re.search(r"\.p\d+$", name) or not os.path.exists(truth_path):
+    if not os.path.exists(truth_path):
         return None
     with open(path) as f:
         j = json.load(f)
@@ -73,10 +74,12 @@ def rows(runs):
     out = []
     for run in runs:
         for path in sorted(glob.glob(os.path.join(run, "diagnoses", "*.json"))):
+            if PLACEMENT.search(path):
+                continue
             row = capture(run, path)
             if row:
                 out.append(row)
-            elif not re.search(r"\.p\d+\.json$", path):
+            else:
                 print(f"score_test: {path} has no truth file: not scored", file=sys.stderr)
     return out
 

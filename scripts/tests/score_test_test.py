@@ -67,9 +67,11 @@ class ScoreTest(unittest.TestCase):
                 json.dump(j, f)
             with open(os.path.join(run, "truth", name + ".json"), "w") as f:
                 json.dump(t, f)
-        # A placement's own report is not a capture.
+        # A placement's own report is not a capture, though the bench writes a truth file for each placement too.
         with open(os.path.join(run, "diagnoses", "none_00.p2.json"), "w") as f:
             json.dump(report("none", 0.3, 0.3, 0.3), f)
+        with open(os.path.join(run, "truth", "none_00.p2.json"), "w") as f:
+            json.dump(truth("none"), f)
         self.rows = score.rows([run])
 
     def tearDown(self):
