@@ -47,10 +47,10 @@
   least --skirt-dense (1.3) times the hem's.
 - hem_offset (rule O, an addendum to session 87's registration, written in session 85 from seeds 101-118: +10 -0
   there, in sample; +3 -0 on fresh seeds 119-120: adopted in session 85, localisation.cpp's place_gap since, so on
-  reports of later builds "as run" already applies it): as run, but a gap a feature group placed at the skirt (not the views, not the rigid surfaces)
-  goes to the hem where the hem's centre lies --hem-offset-mm (6.5, rule D2's floor) or more off the fitted drape's
-  (localisation.feature_groups.off_centre.difference_mm): a specimen laid off centre makes the skirt's residual denser
-  too (rule S's reading), but only a shifted placement moves the hem's centre.
+  reports of later builds "as run" already applies it): as run, but a gap a feature group placed at the skirt (not the
+  views, not the rigid surfaces) goes to the hem where the hem's centre lies --hem-offset-mm (6.5, rule D2's floor) or
+  more off the fitted drape's (localisation.feature_groups.off_centre.difference_mm): a specimen laid off centre makes
+  the skirt's residual denser too (rule S's reading), but only a shifted placement moves the hem's centre.
 - nearest_group (rule N, an addendum to session 88's registration, written in session 86 before any report of its
   sets existed): as run, but a gap nothing places (region "global", no feature group, stable term or camera above
   its floor, not the views) is placed by the feature group nearest its floor, as place_gap places a gap that group
