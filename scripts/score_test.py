@@ -12,7 +12,8 @@ one set it: turn_over = rule U, alternation = rule A, off_centre = rules E, D, D
 the gap lay within the floors at the gate (`within`) or once the bending was refitted (`bend`), the region as run
 against the truth's regions (`moved` where rule O moved it to the hem), the first and third placements' rises of the
 drape coefficient and the alternation, the hem centre's ratio to its floor and its offset in mm, the smallest view
-RMS over the placements (the camera reading) and the diagnosis's CPU seconds.
+RMS over the placements (the camera reading) and the diagnosis's CPU seconds. The summary has the confusion matrix
+as run (docs/DIAGNOSIS.md's, pooled).
 """
 import argparse
 import glob
@@ -24,8 +25,8 @@ import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from diagnosis_rules import (ALTERNATION, CAMERA_RMS_MM, FAMILY, LATER, OFF_CENTRE, OFF_CENTRE_MM,  # noqa: E402
-                             RISE, SIGNATURES, off_centre_mm, off_centre_ratio, placement_rms, third_rise,
-                             turn_over_alternation, turn_over_rise)
+                             RISE, SIGNATURES, off_centre_mm, off_centre_ratio, placement_rms, print_matrix,
+                             third_rise, turn_over_alternation, turn_over_rise)
 
 NO_EFFECT = ("none", "unexplained")
 PLACEMENT = re.compile(r"\.p\d+\.json$")  # a later placement's own report (the bench names it CASE.pK.json)
@@ -152,6 +153,9 @@ def summary(rs):
     families = sorted({r["family"] for r in effects})
     by_family = {f: [r for r in effects if r["family"] == f] for f in families}
     print("families: " + ", ".join(f"{f} {count(rs_f, right)}/{len(rs_f)}" for f, rs_f in by_family.items()))
+    print("\nthe confusion matrix, as run (rows the truth):")
+    print_matrix([(r["family"], r["verdict"]) for r in rs], top1=True)
+    print()
     sensors = [r for r in effects if r["family"] == "sensor"]
     if sensors:
         print("sensor kinds: " + ", ".join(f"{r['set']} {r['name']} {r['kind']} -> {r['verdict']}" for r in sensors))
