@@ -6,6 +6,8 @@ the truth files are read only to score. What docs/preregistrations/ score as "th
 
     scripts/score_test.py out/p90/s121 out/p90/s122            # the table, then the summary
     scripts/score_test.py --summary-only out/p90/s121 out/p90/s122
+    scripts/score_test.py --misses 88 out/p90/s121 out/p90/s122 >> docs/results/misses_80_124.csv
+    scripts/score_test.py --named-controls 88 out/p90/s121 out/p90/s122 >> docs/results/controls_80_124.csv
 
 Columns: the truth (the sensor error's kind; the effect's strength), the verdict as run (a signature's name where
 one set it: turn_over = rule U, alternation = rule A, off_centre = rules E, D, D2) and the refits' verdict, whether
@@ -13,7 +15,8 @@ the gap lay within the floors at the gate (`within`) or once the bending was ref
 against the truth's regions (`moved` where rule O moved it to the hem), the first and third placements' rises of the
 drape coefficient and the alternation, the hem centre's ratio to its floor and its offset in mm, the smallest view
 RMS over the placements (the camera reading) and the diagnosis's CPU seconds. The summary has the confusion matrix
-as run (docs/DIAGNOSIS.md's, pooled).
+as run (docs/DIAGNOSIS.md's, pooled). --misses SESSION and --named-controls SESSION print instead the rows the pooled
+matrix's CSV files take (docs/results/README.md): each effect capture not named right, each control not named none.
 """
 import argparse
 import glob
@@ -68,18 +71,29 @@ def capture(run, path):
     }
 
 
+def seed_of(run):
+    """The set's seed from its bench options (set.args, one word a line); None where it does not say."""
+    try:
+        with open(os.path.join(run, "set.args")) as f:
+            words = f.read().split()
+    except OSError:
+        return None
+    return words[words.index("--seed") + 1] if "--seed" in words[:-1] else None
+
+
 def rows(runs):
     names = [os.path.basename(os.path.normpath(run)) for run in runs]
     if len(set(names)) != len(names):
         sys.exit("score_test: two sets share a name (" + " ".join(runs) + "): the per-set lines would merge them")
     out = []
     for run in runs:
+        seed = seed_of(run)
         for path in sorted(glob.glob(os.path.join(run, "diagnoses", "*.json"))):
             if PLACEMENT.search(path):
                 continue
             row = capture(run, path)
             if row:
-                out.append(row)
+                out.append(dict(row, seed=seed))
             else:
                 print(f"score_test: {path} has no truth file: not scored", file=sys.stderr)
     return out
@@ -188,14 +202,39 @@ def summary(rs):
     print(f"smallest view RMS >= {CAMERA_RMS_MM} mm: " + record(camera, "view_rms", CAMERA_RMS_MM))
 
 
+def floors(row):
+    return "within" if row["within"] else ("above (within once refitted)" if row["bend"] else "above")
+
+
+def misses(rs, session):
+    """docs/results/misses_*.csv rows: session, seed, capture, truth, verdict, floors, where it is recorded."""
+    return [f"{session},{r['seed']},{r['name']},{r['family']},{r['verdict']},{floors(r)},session{session}.tar.xz"
+            for r in rs if r["family"] != "none" and not right(r)]
+
+
+def named_controls(rs, session):
+    """docs/results/controls_*.csv rows: session, seed, capture, verdict, where it is recorded."""
+    return [f"{session},{r['seed']},{r['name']},{r['verdict']},session{session}.tar.xz"
+            for r in rs if r["family"] == "none" and r["verdict"] != "none"]
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("runs", nargs="+", help="diagnosis sets (diagnoses/, truth/)")
     ap.add_argument("--summary-only", action="store_true", help="the summary without the per-capture table")
+    ap.add_argument("--misses", metavar="SESSION", help="only the misses' CSV rows (docs/results/misses_*.csv)")
+    ap.add_argument("--named-controls", metavar="SESSION",
+                    help="only the CSV rows of the controls not named none (docs/results/controls_*.csv)")
     args = ap.parse_args()
     rs = rows(args.runs)
     if not rs:
         sys.exit("score_test: no diagnosed capture with a truth file in " + " ".join(args.runs))
+    if args.misses or args.named_controls:
+        if any(r["seed"] is None for r in rs):
+            sys.exit("score_test: a set has no --seed in its set.args: its rows would have no seed")
+        for line in misses(rs, args.misses) if args.misses else named_controls(rs, args.named_controls):
+            print(line)
+        return
     if not args.summary_only:
         table(rs)
     summary(rs)

@@ -73,6 +73,7 @@ class ScoreTest(unittest.TestCase):
         with open(os.path.join(run, "truth", "none_00.p2.json"), "w") as f:
             json.dump(truth("none"), f)
         self.rows = score.rows([run])
+        self.run = run
 
     def tearDown(self):
         self.dir.cleanup()
@@ -127,6 +128,14 @@ class ScoreTest(unittest.TestCase):
                       "sensor 0/1 (max below 0), shear 0/1 (max below 0), yield 1/1", text)
         self.assertIn("smallest view RMS >= 4.0 mm: misalignment 0/1 (max below 2), none 0/2 (max below 2), "
                       "pose 1/1", text)
+
+    def test_csv_rows_of_the_misses_and_the_named_controls(self):
+        self.assertIsNone(self.rows[0]["seed"])  # no set.args: no seed, and the CSV rows are refused in main()
+        with open(os.path.join(self.run, "set.args"), "w") as f:
+            f.write("--families\nshear\n--seed\n7\n")
+        rs = score.rows([self.run])
+        self.assertEqual(score.misses(rs, 90), ["90,7,shear_00,shear,none,above,session90.tar.xz"])
+        self.assertEqual(score.named_controls(rs, 90), ["90,7,none_01,friction,session90.tar.xz"])
 
     def test_table_marks_the_wrong_verdicts_and_moved_regions(self):
         out = io.StringIO()
