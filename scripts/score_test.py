@@ -222,9 +222,10 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("runs", nargs="+", help="diagnosis sets (diagnoses/, truth/)")
     ap.add_argument("--summary-only", action="store_true", help="the summary without the per-capture table")
-    ap.add_argument("--misses", metavar="SESSION", help="only the misses' CSV rows (docs/results/misses_*.csv)")
-    ap.add_argument("--named-controls", metavar="SESSION",
-                    help="only the CSV rows of the controls not named none (docs/results/controls_*.csv)")
+    rows_only = ap.add_mutually_exclusive_group()
+    rows_only.add_argument("--misses", metavar="SESSION", help="only the misses' CSV rows (docs/results/misses_*.csv)")
+    rows_only.add_argument("--named-controls", metavar="SESSION",
+                           help="only the CSV rows of the controls not named none (docs/results/controls_*.csv)")
     args = ap.parse_args()
     rs = rows(args.runs)
     if not rs:
