@@ -8,6 +8,7 @@ the truth files are read only to score. What docs/preregistrations/ score as "th
     scripts/score_test.py --summary-only out/p90/s121 out/p90/s122
     scripts/score_test.py --misses 88 out/p90/s121 out/p90/s122 >> docs/results/misses_80_124.csv
     scripts/score_test.py --named-controls 88 out/p90/s121 out/p90/s122 >> docs/results/controls_80_124.csv
+    scripts/score_test.py --set-counts 88 out/p90/s121 out/p90/s122 >> docs/results/sets_80_124.csv
 
 Columns: the truth (the sensor error's kind; the effect's strength), the verdict as run (a signature's name where
 one set it: turn_over = rule U, alternation = rule A, off_centre = rules E, D, D2) and the refits' verdict, whether
@@ -16,7 +17,9 @@ against the truth's regions (`moved` where rule O moved it to the hem), the firs
 drape coefficient and the alternation, the hem centre's ratio to its floor and its offset in mm, the smallest view
 RMS over the placements (the camera reading) and the diagnosis's CPU seconds. The summary has the confusion matrix
 as run (docs/DIAGNOSIS.md's, pooled). --misses SESSION and --named-controls SESSION print instead the rows the pooled
-matrix's CSV files take (docs/results/README.md): each effect capture not named right, each control not named none.
+matrix's CSV files take (docs/results/README.md): each effect capture not named right, each control not named none;
+--set-counts SESSION the rows of the sets' ledger: how many captures of each family each set held (scripts/pooled.py
+sums the three files into the pooled family table and confusion matrix).
 """
 import argparse
 import glob
@@ -218,6 +221,19 @@ def named_controls(rs, session):
             for r in rs if r["family"] == "none" and r["verdict"] != "none"]
 
 
+ORDER = ["yield", "shear", "curl", "friction", "misalignment", "sensor", "none"]
+
+
+def set_counts(rs, session):
+    """docs/results/sets_*.csv rows: session, seed, family, captures, where they are recorded (ORDER within a set)."""
+    counts = {}
+    for r in rs:
+        counts[(r["seed"], r["family"])] = counts.get((r["seed"], r["family"]), 0) + 1
+    seeds = sorted({seed for seed, _ in counts}, key=int)
+    return [f"{session},{seed},{fam},{counts[(seed, fam)]},session{session}.tar.xz"
+            for seed in seeds for fam in ORDER if (seed, fam) in counts]
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("runs", nargs="+", help="diagnosis sets (diagnoses/, truth/)")
@@ -226,14 +242,22 @@ def main():
     rows_only.add_argument("--misses", metavar="SESSION", help="only the misses' CSV rows (docs/results/misses_*.csv)")
     rows_only.add_argument("--named-controls", metavar="SESSION",
                            help="only the CSV rows of the controls not named none (docs/results/controls_*.csv)")
+    rows_only.add_argument("--set-counts", metavar="SESSION",
+                           help="only the sets' ledger rows, captures per family (docs/results/sets_*.csv)")
     args = ap.parse_args()
     rs = rows(args.runs)
     if not rs:
         sys.exit("score_test: no diagnosed capture with a truth file in " + " ".join(args.runs))
-    if args.misses or args.named_controls:
+    if args.misses or args.named_controls or args.set_counts:
         if any(r["seed"] is None for r in rs):
             sys.exit("score_test: a set has no --seed in its set.args: its rows would have no seed")
-        for line in misses(rs, args.misses) if args.misses else named_controls(rs, args.named_controls):
+        if args.misses:
+            lines = misses(rs, args.misses)
+        elif args.named_controls:
+            lines = named_controls(rs, args.named_controls)
+        else:
+            lines = set_counts(rs, args.set_counts)
+        for line in lines:
             print(line)
         return
     if not args.summary_only:

@@ -136,6 +136,9 @@ class ScoreTest(unittest.TestCase):
         rs = score.rows([self.run])
         self.assertEqual(score.misses(rs, 90), ["90,7,shear_00,shear,none,above,session90.tar.xz"])
         self.assertEqual(score.named_controls(rs, 90), ["90,7,none_01,friction,session90.tar.xz"])
+        self.assertEqual(score.set_counts(rs, 90), ["90,7,yield,1,session90.tar.xz", "90,7,shear,1,session90.tar.xz",
+                                                    "90,7,misalignment,1,session90.tar.xz",
+                                                    "90,7,sensor,1,session90.tar.xz", "90,7,none,2,session90.tar.xz"])
 
     def test_table_marks_the_wrong_verdicts_and_moved_regions(self):
         out = io.StringIO()
