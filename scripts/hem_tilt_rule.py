@@ -1,0 +1,102 @@
+#!/usr/bin/env python3
+"""Rule H, the hem's tilt (docs/DIAGNOSIS_RESULTS.md, "Session 90"): misalignment wherever the hem's height has a first
+harmonic of at least --floor mm (8) on every placement of the specimen (the capture, the second, the held-out), laid on
+the reports of diagnosis sets as a record. The tilts come from bench/hem_tilt_probe.cpp, which reads the captures only:
+
+    build/bin/drapegen_hem_tilt_probe out/p92/s125 out/p92/s126 > out/p92/hem_tilt.csv
+    scripts/hem_tilt_rule.py --tilt out/p92/hem_tilt.csv out/p92/s125 out/p92/s126
+
+A specimen laid off the axis hangs more cloth, and its hem lower, on one side each time it is laid, whichever way it
+was turned; a centred elastic one tilts only as far as its folds do, and an effect that tilts one placement (a curled
+edge, a camera error) need not tilt the others. Prints each verdict the rule changes (right or wrong against the
+truth files, read only to score), its tally, and per family the smallest placement's tilt (its range, and how many
+reach the floor).
+"""
+import argparse
+import csv
+import json
+import os
+import re
+import sys
+
+PLACEMENT = re.compile(r"\.p\d+\.json$")  # a later placement's own report (the bench names it CASE.pK.json)
+FAMILY = {"pose": "sensor", "bias": "sensor", "multipath": "sensor", "misalign": "misalignment"}
+
+
+def tilts(path):
+    """{(set, capture): [tilt of placement 0, 1, 2]} from the probe's CSV; the set is the set directory's name."""
+    out = {}
+    with open(path, newline="") as f:
+        reader = csv.DictReader(f)
+        if reader.fieldnames != ["set", "capture", "placement", "hem_tilt_mm", "outline_offset_mm"]:
+            raise ValueError(f"{path}: not drapegen_hem_tilt_probe's CSV (header {reader.fieldnames})")
+        for r in reader:
+            out.setdefault((r["set"], r["capture"]), {})[int(r["placement"])] = float(r["hem_tilt_mm"])
+    return {k: [v[p] for p in sorted(v)] for k, v in out.items()}
+
+
+def rows(sets, tilt):
+    """Per capture with a report, a truth file and the probe's tilts: set, name, family, verdict, smallest tilt."""
+    out = []
+    for run in sets:
+        name_of_set = os.path.basename(os.path.normpath(run))
+        diagnoses = os.path.join(run, "diagnoses")
+        for file in sorted(os.listdir(diagnoses)):
+            if not file.endswith(".json") or PLACEMENT.search(file):
+                continue
+            name = file[:-len(".json")]
+            truth_file = os.path.join(run, "truth", file)
+            if not os.path.exists(truth_file):
+                continue
+            with open(os.path.join(diagnoses, file)) as f:
+                report = json.load(f)
+            with open(truth_file) as f:
+                truth = json.load(f)
+            family = FAMILY.get(truth.get("family"), truth.get("family")) or "none"
+            placements = tilt.get((name_of_set, name))
+            if placements is None:
+                raise ValueError(f"{run}: {name} has a report but no tilt in the probe's CSV")
+            out.append({"set": name_of_set, "name": name, "family": family, "verdict": report.get("verdict"),
+                        "placements": len(placements), "tilt": min(placements)})
+    return out
+
+
+def rule(row, floor):
+    """Rule H's verdict: misalignment where every placement's hem tilts by `floor` mm or more (all three seen)."""
+    return "misalignment" if row["placements"] >= 3 and row["tilt"] >= floor else row["verdict"]
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("sets", nargs="+", help="diagnosis sets (diagnoses/, truth/)")
+    ap.add_argument("--tilt", required=True, help="drapegen_hem_tilt_probe's CSV over these sets")
+    ap.add_argument("--floor", type=float, default=8.0, help="the smallest placement's tilt that names misalignment "
+                    "(mm; default 8)")
+    args = ap.parse_args()
+    try:
+        rs = rows(args.sets, tilts(args.tilt))
+    except (OSError, ValueError) as e:
+        sys.exit(f"hem_tilt_rule: {e}")
+    if not rs:
+        sys.exit("hem_tilt_rule: no diagnosed capture with a truth file in " + " ".join(args.sets))
+    gained, lost = [], []
+    for r in rs:
+        v = rule(r, args.floor)
+        if v == r["verdict"]:
+            continue
+        line = f"{r['set']} {r['name']} ({r['family']}): {r['verdict']} -> {v}, smallest tilt {r['tilt']:.2f} mm"
+        (gained if v == r["family"] else lost).append(line)
+    for line in gained:
+        print("right: " + line)
+    for line in lost:
+        print("wrong: " + line)
+    print(f"rule H (tilt >= {args.floor:g} mm on every placement): +{len(gained)} -{len(lost)} "
+          f"over {len(rs)} captures")
+    for fam in sorted({r["family"] for r in rs}):
+        t = sorted(r["tilt"] for r in rs if r["family"] == fam)
+        reach = sum(x >= args.floor for x in t)
+        print(f"{fam}: smallest placement's tilt {t[0]:.2f}-{t[-1]:.2f} mm, {reach} of {len(t)} reach {args.floor:g}")
+
+
+if __name__ == "__main__":
+    main()
