@@ -47,6 +47,7 @@ struct DiagnoseOptions {
   std::optional<double> off_centre_misalignment;
   std::optional<double> off_centre_mm;
   std::optional<bool> off_centre_mm_over_yield;  // unset: the settings' (off)
+  std::optional<double> hem_tilt_misalignment;
   std::optional<int> states;
   std::optional<int> evaluations;
   std::optional<int> refit_evaluations;
@@ -161,6 +162,13 @@ int run_diagnose(const DiagnoseOptions& o) {
     return fail("--off-centre-mm-over-yield weighs the refits' yield by the hem's centre: give --off-centre-mm "
                 "above 0");
   }
+  if (o.hem_tilt_misalignment && !(*o.hem_tilt_misalignment >= 0.0)) {
+    return fail("--hem-tilt-misalignment must be 0 (off) or more (mm)");
+  }
+  if (o.hem_tilt_misalignment.value_or(0.0) > 0.0 && (o.second.empty() || o.held_out.empty())) {
+    return fail("--hem-tilt-misalignment reads the hem's tilt on three placements: give --second-capture and "
+                "--held-out-capture");
+  }
   if (!(o.held_out_tolerance >= 0.0 && o.held_out_tolerance <= 1.0)) return fail("--held-out-tolerance must be 0 .. 1");
   if (outside(o.starts, 0, 100)) return fail("--starts must be 0 (the guess alone) .. 100");
   if (bad_scan(o.refit_scan, 100)) return fail("--refit-scan must be 0 (off) or 2 .. 100");
@@ -245,6 +253,7 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (o.off_centre_misalignment) settings.off_centre_misalignment = *o.off_centre_misalignment;
   if (o.off_centre_mm) settings.off_centre_mm = *o.off_centre_mm;
   if (o.off_centre_mm_over_yield) settings.off_centre_mm_over_yield = *o.off_centre_mm_over_yield;
+  if (o.hem_tilt_misalignment) settings.hem_tilt_misalignment = *o.hem_tilt_misalignment;
   if (o.states) settings.fit.initial_states = *o.states;
   if (o.evaluations) settings.baseline_optimiser.max_evaluations = *o.evaluations;
   if (o.refit_evaluations) settings.attribution.optimiser.max_evaluations = *o.refit_evaluations;
@@ -379,14 +388,19 @@ int run_diagnose(const DiagnoseOptions& o) {
                                "here\n",
                                p->other->verdict, p->rise, p->floor);
     }
-    // A signature of its own set the verdict (rules U, A, E and D): what it read, the refits' verdict, the named refit.
+    // A signature of its own set the verdict (rules U, A, E, D and H): what it read, the refits' verdict, the named
+    // refit.
     const auto named_by = [&r](std::string_view effect, const std::string& reading) {
       const diagnosis::CandidateResult* refit = r.named_refit();
       std::cout << fmt::format("  verdict: {}, {}; the refits' verdict {}; {}\n", effect, reading, r.refits_verdict(),
                                refit ? fmt::format("the {} refit's shrinkage {:.0f}%", effect, 100 * refit->shrinkage)
                                      : fmt::format("no {} refit ran", effect));
     };
-    if (const auto& t = r.turn_over) {
+    if (const auto& h = r.hem_tilt) {
+      named_by("misalignment", fmt::format("from the hem's tilt: it hangs lower on one side by {:.2f} mm or more on "
+                                           "each of the three placements (at least {:g} mm)",
+                                           h->smallest_mm, h->floor_mm));
+    } else if (const auto& t = r.turn_over) {
       named_by("yield", fmt::format("from the turn-over: the turned placement drapes {:.4f} stiffer (at least {:g})",
                                     t->rise, t->floor));
     } else if (const auto& c = r.off_centre) {
@@ -497,6 +511,12 @@ Runner add_diagnose_command(CLI::App& app) {
       "yield refit can stand in for an off-centre drape (default off; --no-off-centre-mm-over-yield: off; the last "
       "one given counts)")
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
+  app.add_option("--hem-tilt-misalignment", o->hem_tilt_misalignment,
+                 "After the other signatures, where the hem's height has a first harmonic of at least this many mm on "
+                 "each of the three placements (the capture, --second-capture, --held-out-capture; report.json "
+                 "\"placement_hem_tilt_mm\"), name misalignment, from the hem's tilt, whatever the verdict: a "
+                 "specimen laid off the axis hangs lower on one side however it is turned (report.json \"hem_tilt\"; "
+                 "within the floors too; not with --gap-only; default 0: off, --fine too)");
   app.add_option("--states", o->states, "Initial states per evaluation (default 3; quick and fine 2)");
   app.add_option("--evaluations", o->evaluations,
                  "Baseline fit evaluations per simplex (default 40; quick and fine 20; a second one with --starts)");

@@ -748,17 +748,17 @@ def verdicts(j):
 COLUMNS = ["none", "unexplained", "not attributed", "yield", "shear", "curl", "friction", "misalignment", "sensor"]
 
 
-# report.json's records of rules U, A and E (D and D2 too: off_centre) where they set the verdict, in the order
-# diagnose() lays them.
-SIGNATURES = ("turn_over", "alternation", "off_centre")
+# report.json's records of rules U, A and E (D and D2 too: off_centre) and H (hem_tilt) where they set the verdict,
+# in the order diagnose() lays them.
+SIGNATURES = ("turn_over", "alternation", "off_centre", "hem_tilt")
 
 
 def refits_report(j):
     """The report with the refits' verdict as its verdict where a signature set the verdict (`drapegen diagnose
     --turn-over-yield`, rule U, report.json turn_over; `--turn-over-alternation`, rule A, alternation;
-    `--off-centre-misalignment` and `--off-centre-mm`, rules E, D and D2, off_centre: the first one's
-    refits_verdict), the reported one kept as verdict_reported: the rules recompute the refits' verdict, and
-    verdicts() lays the signatures on every rule's as the run did."""
+    `--off-centre-misalignment` and `--off-centre-mm`, rules E, D and D2, off_centre; `--hem-tilt-misalignment`,
+    rule H, hem_tilt: the first one's refits_verdict), the reported one kept as verdict_reported: the rules
+    recompute the refits' verdict, and verdicts() lays the signatures on every rule's as the run did."""
     for key in SIGNATURES:
         if j.get(key):
             return dict(j, verdict=j[key]["refits_verdict"], verdict_reported=j["verdict"])
@@ -778,7 +778,9 @@ def signatures_applied(j, v):
     alternation is below it and the turn-over named nothing; then the hem's centre's (settings.off_centre_misalignment
     > 0), misalignment where the rule still names no effect and the hem's centre offset reaches the run's ratio, or
     (settings.off_centre_mm > 0) the run's offset in mm; with settings.off_centre_mm_over_yield also where the rule's
-    own yield stands (the turn-over named nothing, the alternation withdrew nothing) and the offset reaches it."""
+    own yield stands (the turn-over named nothing, the alternation withdrew nothing) and the offset reaches it; last
+    the hem's tilt (settings.hem_tilt_misalignment > 0), misalignment whatever the rule names where each of the three
+    placements' tilts (placement_hem_tilt_mm) reaches the run's floor."""
     settings = j.get("settings") or {}
     own = dict(v)
     turned = run_turn_over_names(j)
@@ -804,6 +806,10 @@ def signatures_applied(j, v):
             # which rule D2 leaves (it would have set report.json turn_over or alternation), unless the refits named it.
             v = {r: "misalignment" if x == "yield" and own[r] == "yield"
                  and (r not in TURN_OVER_RULES or j["verdict"] == "yield") else x for r, x in v.items()}
+    tilt_floor = settings.get("hem_tilt_misalignment", 0.0)
+    tilts = j.get("placement_hem_tilt_mm") or []
+    if tilt_floor > 0.0 and len(tilts) == 3 and min(tilts) >= tilt_floor:
+        v = {r: "misalignment" for r in v}
     return v
 
 

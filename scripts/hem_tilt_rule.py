@@ -1,10 +1,12 @@
 #!/usr/bin/env python3
 """Rule H, the hem's tilt (docs/DIAGNOSIS_RESULTS.md, "Session 90"): misalignment wherever the hem's height has a first
 harmonic of at least --floor mm (8) on every placement of the specimen (the capture, the second, the held-out), laid on
-the reports of diagnosis sets as a record. The tilts come from bench/hem_tilt_probe.cpp, which reads the captures only:
+the reports of diagnosis sets as a record. The tilts come from the reports (placement_hem_tilt_mm, builds since
+session 88) or, for sets diagnosed before, from bench/hem_tilt_probe.cpp, which reads the captures only:
 
     build/bin/drapegen_hem_tilt_probe out/p92/s125 out/p92/s126 > out/p92/hem_tilt.csv
     scripts/hem_tilt_rule.py --tilt out/p92/hem_tilt.csv out/p92/s125 out/p92/s126
+    scripts/hem_tilt_rule.py out/p93/s127 out/p93/s128      # the reports' own tilts
 
 A specimen laid off the axis hangs more cloth, and its hem lower, on one side each time it is laid, whichever way it
 was turned; a centred elastic one tilts only as far as its folds do, and an effect that tilts one placement (a curled
@@ -53,9 +55,15 @@ def rows(sets, tilt):
             with open(truth_file) as f:
                 truth = json.load(f)
             family = FAMILY.get(truth.get("family"), truth.get("family")) or "none"
-            placements = tilt.get((name_of_set, name))
-            if placements is None:
-                raise ValueError(f"{run}: {name} has a report but no tilt in the probe's CSV")
+            if tilt is None:
+                placements = report.get("placement_hem_tilt_mm")
+                if placements is None:
+                    raise ValueError(f"{run}: {name}'s report has no placement_hem_tilt_mm (an older build's): "
+                                     "give --tilt with drapegen_hem_tilt_probe's CSV")
+            else:
+                placements = tilt.get((name_of_set, name))
+                if placements is None:
+                    raise ValueError(f"{run}: {name} has a report but no tilt in the probe's CSV")
             out.append({"set": name_of_set, "name": name, "family": family, "verdict": report.get("verdict"),
                         "placements": len(placements), "tilt": min(placements)})
     return out
@@ -69,12 +77,13 @@ def rule(row, floor):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("sets", nargs="+", help="diagnosis sets (diagnoses/, truth/)")
-    ap.add_argument("--tilt", required=True, help="drapegen_hem_tilt_probe's CSV over these sets")
+    ap.add_argument("--tilt", help="drapegen_hem_tilt_probe's CSV over these sets (default: the reports' "
+                    "placement_hem_tilt_mm)")
     ap.add_argument("--floor", type=float, default=8.0, help="the smallest placement's tilt that names misalignment "
                     "(mm; default 8)")
     args = ap.parse_args()
     try:
-        rs = rows(args.sets, tilts(args.tilt))
+        rs = rows(args.sets, tilts(args.tilt) if args.tilt else None)
     except (OSError, ValueError) as e:
         sys.exit(f"hem_tilt_rule: {e}")
     if not rs:

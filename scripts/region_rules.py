@@ -166,11 +166,11 @@ def folds_deeper_than_mean(loc, factor):
 def named_localisation(report):
     """The named candidate's refit localisation (None: nothing named, or a report without refit localisations); the
     refit of the effect a signature named where one set the verdict (report.json turn_over or alternation: yield;
-    off_centre: misalignment)."""
+    off_centre or hem_tilt: misalignment)."""
     a = report.get("attribution") or {}
     if report["verdict"] in ("none", "unexplained", "not attributed") or not a.get("candidates"):
         return None
-    if any(report.get(key) for key in ("turn_over", "alternation", "off_centre")):
+    if any(report.get(key) for key in ("turn_over", "alternation", "off_centre", "hem_tilt")):
         named = [c for c in a["candidates"] if c["effect"] == report["verdict"]]
         return named[0].get("localisation") if named else None
     return a["candidates"][0].get("localisation")

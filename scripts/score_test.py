@@ -11,12 +11,12 @@ the truth files are read only to score. What docs/preregistrations/ score as "th
     scripts/score_test.py --set-counts 88 out/p90/s121 out/p90/s122 >> docs/results/sets_80_124.csv
 
 Columns: the truth (the sensor error's kind; the effect's strength), the verdict as run (a signature's name where
-one set it: turn_over = rule U, alternation = rule A, off_centre = rules E, D, D2) and the refits' verdict, whether
-the gap lay within the floors at the gate (`within`) or once the bending was refitted (`bend`), the region as run
-against the truth's regions (`moved` where rule O moved it to the hem), the first and third placements' rises of the
-drape coefficient and the alternation, the hem centre's ratio to its floor and its offset in mm, the smallest view
-RMS over the placements (the camera reading) and the diagnosis's CPU seconds. The summary has the confusion matrix
-as run (docs/DIAGNOSIS.md's, pooled). --misses SESSION and --named-controls SESSION print instead the rows the pooled
+one set it: turn_over = rule U, alternation = rule A, off_centre = rules E, D, D2, hem_tilt = rule H) and the refits'
+verdict, whether the gap lay within the floors at the gate (`within`) or once the bending was refitted (`bend`), the
+region as run against the truth's regions (`moved` where rule O moved it to the hem), the first and third placements'
+rises of the drape coefficient and the alternation, the hem centre's ratio to its floor and its offset in mm, the
+smallest view RMS over the placements (the camera reading) and the diagnosis's CPU seconds. The summary has the
+confusion matrix as run (docs/DIAGNOSIS.md's, pooled). --misses SESSION and --named-controls SESSION print instead the rows the pooled
 matrix's CSV files take (docs/results/README.md): each effect capture not named right, each control not named none;
 --set-counts SESSION the rows of the sets' ledger: how many captures of each family each set held (scripts/pooled.py
 sums the three files into the pooled family table and confusion matrix).

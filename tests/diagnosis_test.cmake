@@ -1896,6 +1896,73 @@ function(check_off_centre_mm three plain rise_n)
   set(offset_over_yield ${offset_over_yield} PARENT_SCOPE)
   set(offset_turned ${offset_turned} PARENT_SCOPE)
 endfunction()
+# --hem-tilt-misalignment T (rule H; after the other signatures): misalignment, whatever the verdict, where the hem's
+# tilt (report.json placement_hem_tilt_mm, in every report) reaches T mm on each of the three placements. Checked on
+# the first order of placements below with T just under and just over the least tilted placement's tilt.
+set(hem_tilt_checked 0)
+function(check_hem_tilt three plain)
+  if(hem_tilt_checked)
+    return()
+  endif()
+  string(JSON verdict GET "${plain}" verdict)
+  string(JSON count LENGTH "${plain}" placement_hem_tilt_mm)
+  if(NOT count EQUAL 3)
+    message(FATAL_ERROR "${three}: placement_hem_tilt_mm has ${count} entries, not one per placement")
+  endif()
+  set(least_n -1)
+  foreach(i 0 1 2)
+    json_number(tilt "${plain}" placement_hem_tilt_mm ${i})
+    json_nano(tilt_n "${tilt}")
+    if(least_n LESS 0 OR tilt_n LESS least_n)
+      set(least_n ${tilt_n})
+    endif()
+  endforeach()
+  if(least_n LESS 2000)
+    message(FATAL_ERROR "the least tilted placement of ${three} tilts by ${least_n} nano-mm: no tilt to test on")
+  endif()
+  math(EXPR under_n "${least_n} - 1000")
+  math(EXPR over_n "${least_n} + 1000")
+  nano_decimal(under "${under_n}")
+  nano_decimal(over "${over_n}")
+  run_ok(tilted diagnose ${three} ${rise_args} --hem-tilt-misalignment ${under} --report ${WORK}/report_tilt)
+  run_ok(level diagnose ${three} ${rise_args} --hem-tilt-misalignment ${over})
+  string(JSON tilted_verdict GET "${tilted}" verdict)
+  string(JSON level_verdict GET "${level}" verdict)
+  string(JSON level_record ERROR_VARIABLE no_level_record GET "${level}" hem_tilt)
+  json_number(level_setting "${level}" settings hem_tilt_misalignment)
+  file(READ ${WORK}/report_tilt/report.md tilt_md)
+  file(REMOVE_RECURSE ${WORK}/report_tilt)
+  if(NOT level_verdict STREQUAL verdict OR NOT no_level_record OR NOT level_setting GREATER 0)
+    message(FATAL_ERROR "--hem-tilt-misalignment ${over} on ${three}: verdict ${level_verdict} (without it "
+                        "${verdict}), hem_tilt '${level_record}', setting ${level_setting}")
+  endif()
+  if(verdict STREQUAL "misalignment")
+    string(JSON tilted_record ERROR_VARIABLE no_tilted_record GET "${tilted}" hem_tilt)
+    if(NOT tilted_verdict STREQUAL "misalignment" OR NOT no_tilted_record)
+      message(FATAL_ERROR "--hem-tilt-misalignment ${under} on ${three}: the refits named misalignment already, yet "
+                          "hem_tilt '${tilted_record}'")
+    endif()
+  else()
+    string(JSON tilted_refits GET "${tilted}" hem_tilt refits_verdict)
+    string(JSON tilted_confidence TYPE "${tilted}" confidence)
+    json_number(tilted_least "${tilted}" hem_tilt smallest_mm)
+    json_nano(tilted_least_n "${tilted_least}")
+    math(EXPR least_off "${tilted_least_n} - ${least_n}")
+    if(NOT tilted_verdict STREQUAL "misalignment" OR NOT tilted_refits STREQUAL verdict
+       OR NOT tilted_confidence STREQUAL "NULL" OR least_off GREATER 2 OR least_off LESS -2
+       OR NOT tilt_md MATCHES "Verdict: misalignment, from the hem's tilt\\*\\*: on each of the three placements"
+       OR NOT tilt_md MATCHES "The refits")
+      message(FATAL_ERROR "--hem-tilt-misalignment ${under} on ${three}: verdict ${tilted_verdict} (without it "
+                          "${verdict}; hem_tilt.refits_verdict ${tilted_refits}), confidence ${tilted_confidence}, "
+                          "smallest ${tilted_least} mm (the reports' ${least_n} nano-mm); report.md:\n${tilt_md}")
+    endif()
+  endif()
+  set(hem_tilt_checked 1 PARENT_SCOPE)
+endfunction()
+expect_failure(1 "--hem-tilt-misalignment must be 0 (off) or more" diagnose --capture ${WORK}/rise
+               --hem-tilt-misalignment -1)
+expect_failure(1 "--hem-tilt-misalignment reads the hem's tilt on three placements" diagnose --capture ${WORK}/rise
+               --second-capture ${WORK}/rise.p1 --hem-tilt-misalignment 8)
 set(alternation_named 0)
 set(alternation_withdrawn 0)
 set(alternation_kept 0)  # floors on the other side of the alternation, where nothing changes
@@ -1917,6 +1984,7 @@ foreach(order "rise.p2;rise.p3;rise" "rise.p2;rise.p1;rise" "rise;rise.p1;rise.p
   math(EXPR alt_n "${c1_n} - (${c0_n} + ${c2_n}) / 2")
   math(EXPR rise_n "${c1_n} - ${c0_n}")
   check_off_centre_mm("${three}" "${plain}" ${rise_n})
+  check_hem_tilt("${three}" "${plain}")
   if(plain_verdict STREQUAL "yield")
     set(expected unexplained)
     math(EXPR change_n "${alt_n} + 1000")
@@ -1995,6 +2063,9 @@ if(alternation_named EQUAL 0 OR alternation_withdrawn EQUAL 0 OR alternation_kep
                       "${alternation_withdrawn} withdrew the refits' yield, ${alternation_kept} kept the verdict "
                       "on the other side, ${alternation_rised} kept a yield rule U names: a case untested (take "
                       "other placements)")
+endif()
+if(NOT hem_tilt_checked)
+  message(FATAL_ERROR "--hem-tilt-misalignment: no order of placements was checked")
 endif()
 if(offset_named EQUAL 0 OR offset_over_yield EQUAL 0 OR offset_turned EQUAL 0)
   message(FATAL_ERROR "--off-centre-mm: ${offset_named} orders named misalignment where no effect was named, "

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <optional>
 #include <nlohmann/json.hpp>
 
@@ -13,6 +14,7 @@
 
 #include "drapegen/diagnosis/bending_json.hpp"
 #include "drapegen/diagnosis/hem_profile.hpp"
+#include "drapegen/diagnosis/shape_features.hpp"
 #include "drapegen/sim/logging.hpp"
 
 namespace drapegen::diagnosis {
@@ -772,6 +774,45 @@ void name_misalignment_from_off_centre(DiagnosisResult& r, const Capture& captur
   r.runner_up.clear();  // the refits ranked no misalignment first: nothing stands second to the hem's centre
 }
 
+/// The hem's tilt of one placement (mm): the first harmonic of its height against the angle about the axis, from all
+/// its views; nothing where it saw too little of the skirt.
+std::optional<double> hem_tilt_mm(const Capture& placement) {
+  std::vector<int> views(placement.views.size());
+  std::iota(views.begin(), views.end(), 0);
+  const ShapeFeatures f = shape_features(placement, views);
+  if (!f.valid || f.off_centre.size() < 2) return std::nullopt;
+  return f.off_centre[1] * 1e3;
+}
+
+/// The hem's tilt on the capture, the second and the held-out capture, as many as were given and read; empty if any
+/// given one saw too little of the skirt (the rule needs every placement).
+std::vector<double> placement_hem_tilts(const Capture& capture, const OtherPlacements& others) {
+  std::vector<double> tilts;
+  for (const Capture* placement : {&capture, others.second, others.held_out}) {
+    if (!placement) continue;
+    const std::optional<double> tilt = hem_tilt_mm(*placement);
+    if (!tilt) return {};
+    tilts.push_back(*tilt);
+  }
+  return tilts;
+}
+
+/// DiagnosisSettings::hem_tilt_misalignment (rule H), after the other signatures: misalignment, whatever the verdict,
+/// where the capture, the second and the held-out capture each tilt by at least budgets.hem_tilt_misalignment.
+void name_misalignment_from_hem_tilt(DiagnosisResult& r, const OtherPlacements& others) {
+  const double floor = r.budgets.hem_tilt_misalignment;
+  const auto& tilts = r.placement_hem_tilt_mm;
+  if (floor <= 0.0 || r.verdict == "misalignment" || !others.second || !others.held_out || tilts.size() != 3) return;
+  const double smallest = *std::ranges::min_element(tilts);
+  if (!(smallest >= floor)) return;
+  sim::logger()->info("diagnosis: verdict {} but the hem tilts by {:.2f} mm or more on each of the three placements "
+                      "(at least {:g} mm): misalignment, from the hem's tilt",
+                      r.verdict, smallest, floor);
+  r.hem_tilt = DiagnosisResult::HemTiltMisalignment{smallest, floor, r.verdict};
+  r.verdict = "misalignment";
+  r.runner_up.clear();  // whatever stood first, the tilt of every placement names the effect
+}
+
 }  // namespace
 
 sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisSettings& settings,
@@ -788,6 +829,9 @@ sim::Expected<DiagnosisResult> diagnose(const Capture& capture, const DiagnosisS
   name_yield_from_turn_over(*result, capture, others);
   weigh_yield_by_alternation(*result, capture, others);
   name_misalignment_from_off_centre(*result, capture, others);
+  result->budgets.hem_tilt_misalignment = settings.attribute ? settings.hem_tilt_misalignment : 0.0;
+  result->placement_hem_tilt_mm = placement_hem_tilts(capture, others);
+  name_misalignment_from_hem_tilt(*result, others);
   return result;
 }
 
@@ -805,6 +849,7 @@ const std::string& DiagnosisResult::refits_verdict() const {
   if (turn_over) return turn_over->refits_verdict;
   if (alternation) return alternation->refits_verdict;
   if (off_centre) return off_centre->refits_verdict;
+  if (hem_tilt) return hem_tilt->refits_verdict;
   return verdict;
 }
 
@@ -1053,7 +1098,8 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                    {"turn_over_alternation", r.budgets.turn_over_alternation},
                    {"off_centre_misalignment", r.budgets.off_centre_misalignment},
                    {"off_centre_mm", r.budgets.off_centre_mm},
-                   {"off_centre_mm_over_yield", r.budgets.off_centre_mm_over_yield}};
+                   {"off_centre_mm_over_yield", r.budgets.off_centre_mm_over_yield},
+                   {"hem_tilt_misalignment", r.budgets.hem_tilt_misalignment}};
   if (const auto& m = r.mesh_confirmation) {
     j["mesh_confirmation"] = {{"resolution", m->resolution},
                               {"gap_found", m->gap_found},
@@ -1078,6 +1124,10 @@ nlohmann::json to_json(const DiagnosisResult& r, const Capture& capture) {
                        {"offset_floor_mm", o->offset_floor_mm},
                        {"by", o->by_offset ? "offset" : "ratio"},
                        {"refits_verdict", o->refits_verdict}};
+  }
+  j["placement_hem_tilt_mm"] = r.placement_hem_tilt_mm;
+  if (const auto& h = r.hem_tilt) {
+    j["hem_tilt"] = {{"smallest_mm", h->smallest_mm}, {"floor_mm", h->floor_mm}, {"refits_verdict", h->refits_verdict}};
   }
   j["runtime"] = {{"seconds", r.seconds},
                   {"cpu_seconds", r.cpu_seconds},

@@ -231,9 +231,9 @@ std::string refits_markdown(const DiagnosisResult& r, std::string_view verdict, 
 
 std::string verdict_markdown(const DiagnosisResult& r) {
   std::string md;
-  // A signature of its own set the verdict (rules U, A, E and D): what it read (an open parenthesis at its end, naming
-  // the option), the named effect's refit, then the refits' verdict (with the alternation's withdrawal where the hem's
-  // centre named misalignment after it).
+  // A signature of its own set the verdict (rules U, A, E, D and H): what it read (an open parenthesis at its end,
+  // naming the option), the named effect's refit, then the refits' verdict (with the alternation's withdrawal where the
+  // hem's centre named misalignment after it).
   const std::string& refits_verdict = r.refits_verdict();
   const auto withdrawal = [&r] {
     const auto& a = *r.alternation;
@@ -251,6 +251,10 @@ std::string verdict_markdown(const DiagnosisResult& r) {
     std::string refits = "The refits alone named no effect:";
     if (refits_verdict == "yield" && r.alternation) {
       refits = "The refits named yield, withdrawn: " + withdrawal() + ".";
+    } else if (r.hem_tilt && refits_verdict != "none" && refits_verdict != "unexplained") {  // rule H
+      refits = fmt::format("The refits named {}: a refit can stand in for an off-centre drape, which the hem's tilt on "
+                           "every placement names over it (`--hem-tilt-misalignment`).",
+                           refits_verdict);
     } else if (refits_verdict == "yield") {  // rule D2
       const std::string turn_over =
           r.budgets.turn_over_yield > 0.0
@@ -264,7 +268,14 @@ std::string verdict_markdown(const DiagnosisResult& r) {
     return fmt::format("{}; {}). {}\n\n", reading, shrinks, refits) +
            refits_markdown(r, refits_verdict, "The refits' verdict");
   };
-  if (const auto& t = r.turn_over) {
+  if (const auto& h = r.hem_tilt) {
+    const std::string reading = fmt::format(
+        "**Verdict: misalignment, from the hem's tilt**: on each of the three placements the hem hangs lower on one "
+        "side, its height's first harmonic at least {:.2f} mm (at least {:g} mm), as a specimen laid off the axis "
+        "does however it is turned and a centred elastic specimen does not (`--hem-tilt-misalignment`",
+        h->smallest_mm, h->floor_mm);
+    md += signature("misalignment", reading);
+  } else if (const auto& t = r.turn_over) {
     const std::string reading = fmt::format(
         "**Verdict: yield, from the turn-over**: the second capture, laid on the specimen's other face, drapes {:.4f} "
         "stiffer than the capture (drape coefficient; at least {:g}), as the plastic set of a drape makes a specimen "

@@ -173,6 +173,42 @@ TEST(VerdictMarkdown, MisalignmentFromTheHemCentreSaysSoAndKeepsTheRefitsVerdict
   EXPECT_TRUE(contains(within, "**The refits' verdict: the gap is within the floors**")) << within;
 }
 
+TEST(VerdictMarkdown, MisalignmentFromTheHemTiltSaysSoOverAnyVerdict) {
+  // Rule H over the refits' friction: every placement's hem tilts by 10.34 mm or more.
+  DiagnosisResult r;
+  r.verdict = "misalignment";
+  r.placement_hem_tilt_mm = {15.1, 10.34, 17.7};
+  r.hem_tilt =
+      DiagnosisResult::HemTiltMisalignment{.smallest_mm = 10.34, .floor_mm = 8.0, .refits_verdict = "friction"};
+  add_candidate(r, Effect::kFriction, 0.9);
+  add_candidate(r, Effect::kMisalignment, 0.1);
+  EXPECT_TRUE(r.signature_set());
+  EXPECT_EQ(r.refits_verdict(), "friction");
+  ASSERT_NE(r.named_refit(), nullptr);
+  EXPECT_EQ(r.named_refit()->effect, Effect::kMisalignment);
+  EXPECT_DOUBLE_EQ(r.named_shrinkage(), 0.1);
+  const std::string md = verdict_markdown(r);
+  EXPECT_TRUE(contains(md, "**Verdict: misalignment, from the hem's tilt**: on each of the three placements the hem "
+                           "hangs lower on one side, its height's first harmonic at least 10.34 mm (at least 8 mm)"))
+      << md;
+  EXPECT_TRUE(contains(md, "the misalignment refit shrinks the excess by 10%). The refits named friction: a refit can "
+                           "stand in for an off-centre drape, which the hem's tilt on every placement names over it"))
+      << md;
+  EXPECT_TRUE(contains(md, "**The refits' verdict: friction**")) << md;
+
+  // Over the turn-over's yield: the refits' own verdict (none) is the turn-over's record's.
+  DiagnosisResult turned;
+  turned.verdict = "misalignment";
+  turned.turn_over = DiagnosisResult::TurnOverYield{0.03, 0.02, "none"};
+  turned.hem_tilt =
+      DiagnosisResult::HemTiltMisalignment{.smallest_mm = 9.0, .floor_mm = 8.0, .refits_verdict = "yield"};
+  EXPECT_EQ(turned.refits_verdict(), "none");
+  const std::string over = verdict_markdown(turned);
+  EXPECT_TRUE(contains(over, "**Verdict: misalignment, from the hem's tilt**")) << over;
+  EXPECT_TRUE(contains(over, "no misalignment refit ran). The refits alone named no effect:")) << over;
+  EXPECT_FALSE(contains(over, "from the turn-over**")) << over;
+}
+
 TEST(VerdictMarkdown, MisalignmentFromTheHemCentreOffsetSaysSoOverNoEffectOrTheRefitsYield) {
   // Rule D: the refits named no effect; the hem's centre lies 7.21 mm off the fitted drape's (its ratio 1.9, under
   // rule E's 2.5): misalignment by the offset, in mm.

@@ -19,24 +19,27 @@ CASES = {  # name: (truth family, verdict as run, the three placements' tilts in
 }
 
 
+def write_set(run, cases):
+    """A set directory with each case's report and truth file: cases {name: (report, truth family)}."""
+    os.makedirs(os.path.join(run, "diagnoses"))
+    os.makedirs(os.path.join(run, "truth"))
+    for name, (report, family) in cases.items():
+        with open(os.path.join(run, "diagnoses", name + ".json"), "w") as f:
+            json.dump(report, f)
+        with open(os.path.join(run, "truth", name + ".json"), "w") as f:
+            json.dump({"family": family}, f)
+
+
 class HemTiltRuleTest(unittest.TestCase):
     def run_rule(self, *extra):
         with tempfile.TemporaryDirectory() as d:
             run = os.path.join(d, "s7")
-            os.makedirs(os.path.join(run, "diagnoses"))
-            os.makedirs(os.path.join(run, "truth"))
-            lines = ["set,capture,placement,hem_tilt_mm,outline_offset_mm"]
-            for name, (family, verdict, tilt) in CASES.items():
-                with open(os.path.join(run, "diagnoses", name + ".json"), "w") as f:
-                    json.dump({"verdict": verdict}, f)
-                with open(os.path.join(run, "truth", name + ".json"), "w") as f:
-                    json.dump({"family": family}, f)
-                lines += [f"s7,{name},{p},{t},1.0" for p, t in enumerate(tilt)]
             # A later placement's own report and truth file are not captures.
-            with open(os.path.join(run, "diagnoses", "none_00.p2.json"), "w") as f:
-                json.dump({"verdict": "misalignment"}, f)
-            with open(os.path.join(run, "truth", "none_00.p2.json"), "w") as f:
-                json.dump({"family": "none"}, f)
+            write_set(run, {**{name: ({"verdict": verdict}, family) for name, (family, verdict, _) in CASES.items()},
+                            "none_00.p2": ({"verdict": "misalignment"}, "none")})
+            lines = ["set,capture,placement,hem_tilt_mm,outline_offset_mm"]
+            for name, (_, _, tilt) in CASES.items():
+                lines += [f"s7,{name},{p},{t},1.0" for p, t in enumerate(tilt)]
             tilt_csv = os.path.join(d, "tilt.csv")
             with open(tilt_csv, "w") as f:
                 f.write("\n".join(lines) + "\n")
@@ -61,14 +64,26 @@ class HemTiltRuleTest(unittest.TestCase):
                       out.stdout)
         self.assertIn("+2 -1 over 5 captures", out.stdout)
 
+    def test_reads_the_reports_own_tilts_without_the_probe(self):
+        with tempfile.TemporaryDirectory() as d:
+            run = os.path.join(d, "s9")
+            write_set(run, {"misalignment_00": ({"verdict": "friction", "placement_hem_tilt_mm": [9.0, 11.0, 12.0]},
+                                                "misalign"),
+                            "none_00": ({"verdict": "none", "placement_hem_tilt_mm": [2.0, 9.0, 3.0]}, "none")})
+            out = subprocess.run([sys.executable, SCRIPT, run], capture_output=True, text=True)
+            self.assertEqual(out.returncode, 0, out.stderr)
+            self.assertIn("right: s9 misalignment_00 (misalignment): friction -> misalignment", out.stdout)
+            self.assertIn("+1 -0 over 2 captures", out.stdout)
+            with open(os.path.join(run, "diagnoses", "none_00.json"), "w") as f:
+                json.dump({"verdict": "none"}, f)  # an older build's report
+            out = subprocess.run([sys.executable, SCRIPT, run], capture_output=True, text=True)
+            self.assertNotEqual(out.returncode, 0)
+            self.assertIn("has no placement_hem_tilt_mm", out.stderr)
+
     def test_refuses_a_capture_without_tilts(self):
         with tempfile.TemporaryDirectory() as d:
             run = os.path.join(d, "s8")
-            os.makedirs(os.path.join(run, "diagnoses"))
-            os.makedirs(os.path.join(run, "truth"))
-            for sub, j in (("diagnoses", {"verdict": "none"}), ("truth", {"family": "none"})):
-                with open(os.path.join(run, sub, "none_00.json"), "w") as f:
-                    json.dump(j, f)
+            write_set(run, {"none_00": ({"verdict": "none"}, "none")})
             tilt_csv = os.path.join(d, "tilt.csv")
             with open(tilt_csv, "w") as f:
                 f.write("set,capture,placement,hem_tilt_mm,outline_offset_mm\n")

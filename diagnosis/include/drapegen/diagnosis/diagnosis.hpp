@@ -122,6 +122,17 @@ struct DiagnosisSettings {
   /// capture, or its rise under turn_over_yield): a yield refit can stand in for an off-centre drape (rule D2,
   /// docs/preregistrations/session85.md).
   bool off_centre_mm_over_yield = false;
+  /// mm. Where the hem's height has a first harmonic (its amplitude against the angle about the axis,
+  /// ShapeFeatures::off_centre's second entry, from all of a capture's views) of at least this on each of the three
+  /// placements (the capture, the second and the held-out capture), name misalignment whatever the verdict
+  /// (DiagnosisResult::hem_tilt): a specimen laid off the axis hangs more cloth, and its hem lower, on one side each
+  /// time it is laid, however it was turned; a centred elastic specimen tilts only as far as its folds do, and an
+  /// effect that tilts one placement (a curled edge, a camera error) need not tilt the others (rule H, an addendum to
+  /// docs/preregistrations/session90.md: on seeds 121-124 the smallest placement's tilt read 10.3-19.0 mm on all 12
+  /// misalignments and at most 5.85 mm on the 66 other captures). Reads the captures alone, no fit; after the other
+  /// signatures; not with attribute false. The refits stand as they ran. 0: off. Every report records the placements'
+  /// tilts (DiagnosisResult::placement_hem_tilt_mm) either way.
+  double hem_tilt_misalignment = 0.0;
 
   /// Small budgets for tests and the --quick benchmark.
   [[nodiscard]] static DiagnosisSettings quick();
@@ -158,6 +169,7 @@ struct DiagnosisResult {
     double off_centre_misalignment = 0.0;  // DiagnosisSettings::off_centre_misalignment where it could (0: off)
     double off_centre_mm = 0.0;            // DiagnosisSettings::off_centre_mm where it could (0: off)
     bool off_centre_mm_over_yield = false;  // DiagnosisSettings::off_centre_mm_over_yield where it could
+    double hem_tilt_misalignment = 0.0;     // DiagnosisSettings::hem_tilt_misalignment where it could (0: off)
   } budgets;
   /// Each capture it read (report.json "placements"): its directory and the face the specimen lay on (a turned
   /// specimen's rest shape, a curl or a yield's creases, bends the other way face down).
@@ -223,7 +235,7 @@ struct DiagnosisResult {
   /// The verdict: the named effect ("none" within the floors, "unexplained" if no candidate shrinks it enough,
   /// "not attributed" above the floors when DiagnosisSettings::attribute is false; "yield" from the turn-over where
   /// turn_over is set, "yield" or "unexplained" from its alternation where alternation is set, "misalignment" from the
-  /// hem's centre where off_centre is set, whatever the refits named).
+  /// hem's centre where off_centre or hem_tilt is set, whatever the refits named).
   std::string verdict;
   /// Second to the named effect (with "unexplained", the best candidate: the withdrawn yield where the alternation
   /// withdrew it); empty where the turn-over, its alternation or the hem's centre named the effect.
@@ -289,13 +301,26 @@ struct DiagnosisResult {
     [[nodiscard]] std::string difference() const;
   };
   std::optional<OffCentreMisalignment> off_centre;
+  /// The hem's tilt on each placement read (the capture, the second, the held-out capture, as many as were given),
+  /// mm: the first harmonic of the hem's height against the angle about the axis
+  /// (DiagnosisSettings::hem_tilt_misalignment); empty where a placement saw too little of the skirt to read it.
+  std::vector<double> placement_hem_tilt_mm;
+  /// With DiagnosisSettings::hem_tilt_misalignment where it fired: the verdict is "misalignment" from the hem's tilt
+  /// on every placement, not from the refits or an earlier signature, whose verdict was `refits_verdict` (the
+  /// attribution above stands as it ran).
+  struct HemTiltMisalignment {
+    double smallest_mm = 0.0;    // the least tilted placement's tilt
+    double floor_mm = 0.0;       // DiagnosisSettings::hem_tilt_misalignment
+    std::string refits_verdict;  // the verdict before it (any but "misalignment")
+  };
+  std::optional<HemTiltMisalignment> hem_tilt;
   /// The refits' own verdict: the verdict before the first signature that changed it (turn_over, alternation,
-  /// off_centre, in the order diagnose() lays them), else the verdict.
+  /// off_centre, hem_tilt, in the order diagnose() lays them), else the verdict.
   [[nodiscard]] const std::string& refits_verdict() const;
   /// The candidate refit of `effect` (attribution.candidates), null where none ran.
   [[nodiscard]] const CandidateResult* refit(Effect effect) const;
-  /// Whether a signature (turn_over, alternation, off_centre) set the verdict rather than the refits.
-  [[nodiscard]] bool signature_set() const { return turn_over || alternation || off_centre; }
+  /// Whether a signature (turn_over, alternation, off_centre, hem_tilt) set the verdict rather than the refits.
+  [[nodiscard]] bool signature_set() const { return turn_over || alternation || off_centre || hem_tilt; }
   /// The named effect's refit: the first candidate where the attribution named it; where a signature set the verdict,
   /// the refit of the effect it named (the yield refit where the turn-over or its alternation named yield, the
   /// misalignment refit where the hem's centre named misalignment); null where no effect is named (the alternation's
