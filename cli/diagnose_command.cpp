@@ -457,10 +457,9 @@ Runner add_diagnose_command(CLI::App& app) {
   auto* quick = app.add_flag("--quick", o->quick, "Small budgets (16x16 mesh, 2 initial states, fewer evaluations)");
   app.add_flag("--fine", o->fine,
                fmt::format("--quick's budgets on a {0}x{0} fitting mesh, with the shape floor calibrated for it, "
-                           "--turn-over-yield {1:g} and --off-centre-misalignment {2:g}",
+                           "and --turn-over-yield {1:g}",
                            diagnosis::DiagnosisSettings::kFineResolution,
-                           diagnosis::DiagnosisSettings::kFineTurnOverYield,
-                           diagnosis::DiagnosisSettings::kFineOffCentreMisalignment))
+                           diagnosis::DiagnosisSettings::kFineTurnOverYield))
       ->excludes(quick);
   app.add_option("--resolution", o->resolution,
                  "Fitting mesh vertices per side (default 20; quick 16; fine " +
@@ -496,8 +495,8 @@ Runner add_diagnose_command(CLI::App& app) {
                  "hem's centre lies at least this many times its floor off the fitted drape's (localisation."
                  "feature_groups.off_centre.ratio), name misalignment, from the hem's centre: a specimen laid off "
                  "centre hangs longer on one side (report.json \"off_centre\"; within the floors too; not with "
-                 "--gap-only; default 0: off; --fine " +
-                     fmt::format("{:g}", diagnosis::DiagnosisSettings::kFineOffCentreMisalignment) + ")");
+                 "--gap-only; default 0: off, --fine too: it left that preset in session 88, at 2.5 there since "
+                 "session 82)");
   app.add_option("--off-centre-mm", o->off_centre_mm,
                  "Where the verdict names no effect (after --off-centre-misalignment) and the hem's centre lies at "
                  "least this many mm off the fitted drape's, whatever its floor (localisation.feature_groups."

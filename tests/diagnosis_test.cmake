@@ -2120,7 +2120,7 @@ json_number(fine_centre_setting "${fine_alt}" settings off_centre_misalignment)
 json_number(fine_mm_setting "${fine_alt}" settings off_centre_mm)
 string(JSON fine_over_setting GET "${fine_alt}" settings off_centre_mm_over_yield)
 if(NOT no_other_face_record OR NOT no_screened_alt_record OR NOT screened_alt_setting EQUAL 0
-   OR NOT fine_alt_setting EQUAL 0 OR NOT fine_centre_setting EQUAL 2.5 OR NOT fine_mm_setting EQUAL 0
+   OR NOT fine_alt_setting EQUAL 0 OR NOT fine_centre_setting EQUAL 0 OR NOT fine_mm_setting EQUAL 0
    OR NOT fine_over_setting STREQUAL "OFF")
   message(FATAL_ERROR "--turn-over-alternation: third placement turned: alternation '${other_face_record}'; "
                       "--gap-only: '${screened_alt_record}', setting ${screened_alt_setting}; --fine: settings "

@@ -278,7 +278,6 @@ DiagnosisSettings DiagnosisSettings::fine() {
   s.floors.shape_threshold = kFineShapeFloor;
   s.held_out_shape_threshold = kFineHeldOutShapeFloor;
   s.turn_over_yield = kFineTurnOverYield;
-  s.off_centre_misalignment = kFineOffCentreMisalignment;
   return s;
 }
 
