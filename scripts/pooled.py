@@ -6,7 +6,7 @@ matrix), summed from the three ledgers in docs/results/ rather than by hand:
 - misses_*.csv: session, seed, capture, truth, verdict, floors, source: each effect capture not named right;
 - controls_*.csv: session, seed, capture, verdict, source: each control (family "none") not named none.
 
-    scripts/pooled.py docs/results/sets_80_124.csv docs/results/misses_80_124.csv docs/results/controls_80_124.csv
+    scripts/pooled.py docs/results/sets_80_126.csv docs/results/misses_80_126.csv docs/results/controls_80_126.csv
 
 A family's right verdicts are its captures less its misses; the matrix's diagonal is those, its other cells the
 misses (and the named controls) by verdict. The ledgers are checked against each other first: a miss or a named

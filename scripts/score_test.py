@@ -6,9 +6,9 @@ the truth files are read only to score. What docs/preregistrations/ score as "th
 
     scripts/score_test.py out/p90/s121 out/p90/s122            # the table, then the summary
     scripts/score_test.py --summary-only out/p90/s121 out/p90/s122
-    scripts/score_test.py --misses 88 out/p90/s121 out/p90/s122 >> docs/results/misses_80_124.csv
-    scripts/score_test.py --named-controls 88 out/p90/s121 out/p90/s122 >> docs/results/controls_80_124.csv
-    scripts/score_test.py --set-counts 88 out/p90/s121 out/p90/s122 >> docs/results/sets_80_124.csv
+    scripts/score_test.py --misses 88 out/p90/s121 out/p90/s122 >> docs/results/misses_80_126.csv
+    scripts/score_test.py --named-controls 88 out/p90/s121 out/p90/s122 >> docs/results/controls_80_126.csv
+    scripts/score_test.py --set-counts 88 out/p90/s121 out/p90/s122 >> docs/results/sets_80_126.csv
 
 Columns: the truth (the sensor error's kind; the effect's strength), the verdict as run (a signature's name where
 one set it: turn_over = rule U, alternation = rule A, off_centre = rules E, D, D2, hem_tilt = rule H) and the refits'
