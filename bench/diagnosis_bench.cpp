@@ -515,12 +515,12 @@ int main(int argc, char** argv) {
     }
     const std::string verdict = d.value("verdict", "?");
     // The refits' own verdict where a signature set the verdict (drapegen diagnose --turn-over-yield: "turn_over";
-    // --turn-over-alternation: "alternation"; --off-centre-misalignment, --off-centre-mm: "off_centre", in the order
-    // diagnose() lays them): the first one's refits_verdict; whether the gap was found above the floors is theirs.
-    // The label is the last one's, which set the verdict.
+    // --turn-over-alternation: "alternation"; --off-centre-misalignment, --off-centre-mm: "off_centre";
+    // --hem-tilt-misalignment: "hem_tilt", in the order diagnose() lays them): the first one's refits_verdict; whether
+    // the gap was found above the floors is theirs. The label is the last one's, which set the verdict.
     std::string signature, refits_verdict = verdict;
     for (const auto& [key, label] : {std::pair{"turn_over", "turn-over"}, std::pair{"alternation", "alternation"},
-                                     std::pair{"off_centre", "hem centre"}}) {
+                                     std::pair{"off_centre", "hem centre"}, std::pair{"hem_tilt", "hem tilt"}}) {
       if (!d.contains(key) || !d[key].is_object()) continue;
       if (signature.empty()) refits_verdict = d[key].value("refits_verdict", "?");
       signature = label;
