@@ -16,13 +16,11 @@ reach the floor).
 """
 import argparse
 import csv
-import json
 import os
-import re
 import sys
 
-PLACEMENT = re.compile(r"\.p\d+\.json$")  # a later placement's own report (the bench names it CASE.pK.json)
-FAMILY = {"pose": "sensor", "bias": "sensor", "multipath": "sensor", "misalign": "misalignment"}
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import score_test  # noqa: E402
 
 
 def tilts(path):
@@ -38,34 +36,20 @@ def tilts(path):
 
 
 def rows(sets, tilt):
-    """Per capture with a report, a truth file and the probe's tilts: set, name, family, verdict, smallest tilt."""
+    """scripts/score_test.py's rows (a report and a truth file each) with the placements' tilts: the probe's where
+    `tilt` is given, else the report's own; their count and the smallest."""
     out = []
-    for run in sets:
-        name_of_set = os.path.basename(os.path.normpath(run))
-        diagnoses = os.path.join(run, "diagnoses")
-        for file in sorted(os.listdir(diagnoses)):
-            if not file.endswith(".json") or PLACEMENT.search(file):
-                continue
-            name = file[:-len(".json")]
-            truth_file = os.path.join(run, "truth", file)
-            if not os.path.exists(truth_file):
-                continue
-            with open(os.path.join(diagnoses, file)) as f:
-                report = json.load(f)
-            with open(truth_file) as f:
-                truth = json.load(f)
-            family = FAMILY.get(truth.get("family"), truth.get("family")) or "none"
-            if tilt is None:
-                placements = report.get("placement_hem_tilt_mm")
-                if placements is None:
-                    raise ValueError(f"{run}: {name}'s report has no placement_hem_tilt_mm (an older build's): "
-                                     "give --tilt with drapegen_hem_tilt_probe's CSV")
-            else:
-                placements = tilt.get((name_of_set, name))
-                if placements is None:
-                    raise ValueError(f"{run}: {name} has a report but no tilt in the probe's CSV")
-            out.append({"set": name_of_set, "name": name, "family": family, "verdict": report.get("verdict"),
-                        "placements": len(placements), "tilt": min(placements)})
+    for r in score_test.rows(sets):
+        if tilt is None:
+            placements = r["hem_tilts"]
+            if placements is None:
+                raise ValueError(f"{r['set']}: {r['name']}'s report has no placement_hem_tilt_mm (an older build's): "
+                                 "give --tilt with drapegen_hem_tilt_probe's CSV")
+        else:
+            placements = tilt.get((r["set"], r["name"]))
+            if placements is None:
+                raise ValueError(f"{r['set']}: {r['name']} has a report but no tilt in the probe's CSV")
+        out.append(dict(r, placements=len(placements), tilt=min(placements)))
     return out
 
 

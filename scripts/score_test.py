@@ -16,10 +16,10 @@ verdict, whether the gap lay within the floors at the gate (`within`) or once th
 region as run against the truth's regions (`moved` where rule O moved it to the hem), the first and third placements'
 rises of the drape coefficient and the alternation, the hem centre's ratio to its floor and its offset in mm, the
 smallest view RMS over the placements (the camera reading) and the diagnosis's CPU seconds. The summary has the
-confusion matrix as run (docs/DIAGNOSIS.md's, pooled). --misses SESSION and --named-controls SESSION print instead the rows the pooled
-matrix's CSV files take (docs/results/README.md): each effect capture not named right, each control not named none;
---set-counts SESSION the rows of the sets' ledger: how many captures of each family each set held (scripts/pooled.py
-sums the three files into the pooled family table and confusion matrix).
+confusion matrix as run (docs/DIAGNOSIS.md's, pooled). --misses SESSION and --named-controls SESSION print instead
+the rows the pooled matrix's CSV files take (docs/results/README.md): each effect capture not named right, each
+control not named none; --set-counts SESSION the rows of the sets' ledger: how many captures of each family each set
+held (scripts/pooled.py sums the three files into the pooled family table and confusion matrix).
 """
 import argparse
 import glob
@@ -33,6 +33,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from diagnosis_rules import (ALTERNATION, CAMERA_RMS_MM, FAMILY, LATER, OFF_CENTRE, OFF_CENTRE_MM,  # noqa: E402
                              RISE, SIGNATURES, off_centre_mm, off_centre_ratio, placement_rms, print_matrix,
                              third_rise, turn_over_alternation, turn_over_rise)
+from pooled import FAMILIES  # noqa: E402
 
 NO_EFFECT = ("none", "unexplained")
 PLACEMENT = re.compile(r"\.p\d+\.json$")  # a later placement's own report (the bench names it CASE.pK.json)
@@ -71,6 +72,7 @@ def capture(run, path):
         "ratio": off_centre_ratio(j), "offset_mm": off_centre_mm(j),
         "view_rms": min(rms) if rms else None,
         "cpu_s": ((j.get("runtime") or {}).get("cpu_seconds")),
+        "hem_tilts": j.get("placement_hem_tilt_mm"),
     }
 
 
@@ -221,7 +223,7 @@ def named_controls(rs, session):
             for r in rs if r["family"] == "none" and r["verdict"] != "none"]
 
 
-ORDER = ["yield", "shear", "curl", "friction", "misalignment", "sensor", "none"]
+ORDER = FAMILIES + ["none"]  # the ledger's order within a set, as scripts/pooled.py prints its tables
 
 
 def set_counts(rs, session):

@@ -27,7 +27,9 @@ def write_set(run, cases):
         with open(os.path.join(run, "diagnoses", name + ".json"), "w") as f:
             json.dump(report, f)
         with open(os.path.join(run, "truth", name + ".json"), "w") as f:
-            json.dump({"family": family}, f)
+            # As the bench writes it: an effect capture's effect, none for a control.
+            effects = [] if family == "none" else [{"name": family, "strength": 20.0}]
+            json.dump({"family": family, "effects": effects}, f)
 
 
 class HemTiltRuleTest(unittest.TestCase):
